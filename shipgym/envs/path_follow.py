@@ -1,0 +1,394 @@
+"""ShipPathFollow: one ship follows a path while its dynamics change (SPEC §5).
+
+Data flow through one ``step`` (one control period Ts):
+
+    action → rudder command δc → plant RK4 substeps at h (true parameters from the event
+    schedule, disturbances) → sensor model → measurements → path tracker / guidance →
+    observation, reward, info → episode log → metrics at the end.
+
+Observation (float32, 9 entries, each within its documented bound):
+
+    0  e / e_max                       cross-track error over the corridor half-width, [-1, 1]
+    1  sin ψ̃, 2  cos ψ̃                 heading error to the path angle (measured heading)
+    3  r / (2 u0 / L)                  yaw rate, clipped to [-1, 1]
+    4  δ / δmax                        rudder angle
+    5  δc_prev / δmax                  last rudder command
+    6  U / U0                          speed over ground over nominal speed, clipped [0, 2]
+    7  Δψ_next / π                     path-angle change to the next leg
+    8  d_next / (d_next + 10 L)        distance to the next waypoint, squashed to [0, 1)
+
+Reward per step (SPEC §5), from the *true* state (the score, the same for everyone):
+
+    r = −( |e|/L + w_ψ·|ψ̃| + w_δ·(δc/δmax)² + w_Δ·(Δδc/δmax)² )
+
+plus ``goal_bonus`` when the last waypoint is reached (terminated), and, when the ship
+leaves the corridor |e| > max_cross_track (terminated), a penalty equal to the cost of
+staying at the corridor edge for the rest of the time limit, (e_max/L)·(steps left), so
+that leaving is never cheaper than staying.  The time limit truncates.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from shipgym.autopilot import HeadingPID, PIDGains
+from shipgym.disturbances import SensorModel, current_velocity
+from shipgym.envs.context import ControllerContext
+from shipgym.guidance import lookahead_los_heading, los_radius, los_relative_heading
+from shipgym.metrics import EpisodeLog, MetricSettings, compute_metrics
+from shipgym.models.integrator import PeriodIntegrator
+from shipgym.paths import wrap_angle
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.tracking import PathTracker
+
+OBS_NAMES = (
+    "cross_track",
+    "sin_heading_error",
+    "cos_heading_error",
+    "yaw_rate",
+    "rudder_angle",
+    "last_rudder_command",
+    "speed",
+    "next_angle_change",
+    "next_distance",
+)
+_OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
+_OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
+
+#: guidance action: a0 → R_LOS multiplier n = 3·2^a0 ∈ [1.5, 6] (look-ahead Δ = nL for
+#: look-ahead LOS); a1 → course offset a1·30°.
+GUIDANCE_OFFSET_MAX = math.radians(30.0)
+
+
+class ShipPathFollowEnv(gym.Env):
+    """Path following of one ship under scheduled parameter changes (see module doc)."""
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+
+    def __init__(
+        self,
+        scenario: Any = "rudder_aging",
+        action_mode: str = "rudder",
+        render_mode: str | None = None,
+        jit: bool = False,
+    ) -> None:
+        if action_mode not in ("rudder", "guidance"):
+            raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        self.scenario: Scenario = load_scenario(scenario)
+        self.action_mode = action_mode
+        self.render_mode = render_mode
+        sc = self.scenario
+        self.model = sc.model
+        self._L = sc.ship_length
+        self._u0 = self.model.nominal_speed
+        self._dmax = self.model.rudder_limit
+        self._Ts = sc.control_period
+        self._h = sc.fine_step
+        self._n = sc.substeps
+        self._e_max = sc.max_cross_track
+        self._max_steps = int(math.ceil(sc.config.time_limit / self._Ts - 1e-9))
+        self._integrator = PeriodIntegrator(self.model, self._h, self._n, jit=jit)
+        self._sensor = SensorModel(sc.config.sensors)
+        self._tracker = PathTracker(sc.path, sc.acceptance_radius, sc.config.path.switching)
+        self._ix = self.model.state_index("x")
+        self._iy = self.model.state_index("y")
+        self._ipsi = self.model.state_index("psi")
+        self._ir = self.model.state_index("r")
+        self._idelta = self.model.state_index("delta")
+        # per-substep disturbance and parameter blocks (rows = substeps)
+        self._w_block = np.zeros((self._n, self.model.n_disturbances))
+        cx, cy = current_velocity(sc.config.disturbances.current)
+        names = self.model.disturbance_names
+        if "current_x" in names:
+            self._w_block[:, names.index("current_x")] = cx
+            self._w_block[:, names.index("current_y")] = cy
+        self._p_block = np.zeros((self._n, self.model.n_params))
+        self._sample_offsets = self._h * np.arange(1, self._n + 1)
+        weights = sc.config.reward
+        self._w_psi = weights.heading_weight
+        self._w_delta = weights.rudder_weight
+        self._w_rate = weights.rudder_rate_weight
+        self._goal_bonus = weights.goal_bonus
+        self._metric_settings = MetricSettings(convergence_threshold=sc.config.convergence_threshold)
+        if action_mode == "rudder":
+            self.action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+        else:
+            self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+            K, T = self.model.first_order_nomoto(sc.nominal_params)
+            self._autopilot = HeadingPID(PIDGains.from_nomoto(K, T), self._dmax)
+        self.observation_space = spaces.Box(_OBS_LOW, _OBS_HIGH, dtype=np.float32)
+        self._fig = None
+        self._state: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ public helpers
+    @property
+    def controller_context(self) -> ControllerContext:
+        """What a controller may know (nominal model, path, timing); never the truth."""
+        sc = self.scenario
+        return ControllerContext(
+            ship=self.model.name,
+            nominal_model=type(self.model)(sc.nominal_params),
+            waypoints=np.array(sc.path.waypoints),
+            path_type=sc.config.path.type,
+            ship_length=self._L,
+            nominal_speed=self._u0,
+            rudder_limit=self._dmax,
+            control_period=self._Ts,
+            fine_step=self._h,
+            acceptance_radius=sc.acceptance_radius,
+            los_radius_L=sc.config.guidance.los_radius_L,
+            action_mode=self.action_mode,
+            scenario_name=sc.name,
+        )
+
+    # ------------------------------------------------------------------ gym API
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        sc = self.scenario
+        self._state = sc.initial_state()
+        self._step_count = 0
+        self._t = 0.0
+        self._delta_c = 0.0
+        self._p_block[:] = sc.schedule.vector_at(0.0)
+        self._p_block_dirty = False
+        self._sensor.reset()
+        if self.action_mode == "guidance":
+            self._autopilot.reset()
+        x = self._state
+        psi_m, r_m = self._sensor.measure(
+            x[self._ipsi : self._ipsi + 1], x[self._ir : self._ir + 1], self.np_random
+        )
+        self._psi_m, self._r_m = float(psi_m[0]), float(r_m[0])
+        frame = self._tracker.reset(float(x[self._ix]), float(x[self._iy]))
+        self._speed = self._u0
+        self._track = [(float(x[self._ix]), float(x[self._iy]))]
+        self._records: list[dict[str, float]] = []
+        self._reached_goal = False
+        e = frame.cross_track
+        samples = {
+            "t": np.zeros(1),
+            "psi": psi_m,
+            "r": r_m,
+            "delta": x[self._idelta : self._idelta + 1].copy(),
+            "delta_c": np.zeros(1),
+            "e": np.array([e]),
+        }
+        info = self._info(frame, samples)
+        self._last_return_time = time.perf_counter()
+        return self._observation(frame), info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        if self._state is None:
+            raise RuntimeError("call reset() before step()")
+        called = time.perf_counter()
+        compute_time = called - self._last_return_time
+        a = self._check_action(action)
+        frame = self._tracker.frame
+        sc = self.scenario
+        # --- action -> rudder command (rad)
+        if self.action_mode == "rudder":
+            delta_c = float(a[0]) * self._dmax
+        else:
+            delta_c = self._autopilot_command(a, frame)
+        prev_delta_c = self._delta_c
+        # --- true parameters for the substeps of this period
+        t0 = self._t
+        t1 = t0 + self._Ts
+        if not sc.schedule.is_constant_on(t0, t1):
+            sc.schedule.fill_matrix(t0, self._h, self._p_block)
+            self._p_block_dirty = True
+        elif self._p_block_dirty:
+            self._p_block[:] = sc.schedule.vector_at(t1)
+            self._p_block_dirty = False
+        # --- plant
+        states = self._integrator(self._state, delta_c, self._w_block, self._p_block)
+        self._step_count += 1
+        self._t = self._step_count * self._Ts
+        self._delta_c = delta_c
+        if not np.all(np.isfinite(states)):
+            return self._non_finite_step(frame, delta_c)
+        xs, ys = states[:, self._ix], states[:, self._iy]
+        e_samples = self._tracker.cross_track_of(xs, ys)
+        self._state = states[-1]
+        x = self._state
+        px, py = float(x[self._ix]), float(x[self._iy])
+        self._track.append((px, py))
+        psi, r, delta = float(x[self._ipsi]), float(x[self._ir]), float(x[self._idelta])
+        # --- sensors
+        psi_m, r_m = self._sensor.measure(states[:, self._ipsi], states[:, self._ir], self.np_random)
+        self._psi_m, self._r_m = float(psi_m[-1]), float(r_m[-1])
+        self._speed = math.hypot(xs[-1] - xs[-2], ys[-1] - ys[-2]) / self._h if self._n > 1 else self._u0
+        # --- path
+        frame = self._tracker.update(px, py)
+        e = frame.cross_track
+        heading_error_true = float(wrap_angle(psi - frame.path_angle))
+        # --- reward (true state)
+        dd = (delta_c - prev_delta_c) / self._dmax
+        reward = -(
+            abs(e) / self._L
+            + self._w_psi * abs(heading_error_true)
+            + self._w_delta * (delta_c / self._dmax) ** 2
+            + self._w_rate * dd * dd
+        )
+        terminated = False
+        reason = None
+        if frame.at_goal:
+            terminated, reason = True, "goal"
+            self._reached_goal = True
+            reward += self._goal_bonus
+        elif abs(e) > self._e_max:
+            terminated, reason = True, "corridor"
+            reward -= (self._e_max / self._L) * (self._max_steps - self._step_count)
+        truncated = not terminated and self._step_count >= self._max_steps
+        if truncated:
+            reason = "time_limit"
+        self._records.append(
+            {
+                "t": self._t,
+                "cross_track_error": e,
+                "heading_error": heading_error_true,
+                "rudder_angle": delta,
+                "rudder_command": delta_c,
+                "reward": reward,
+                "compute_time": compute_time,
+            }
+        )
+        samples = {
+            "t": t0 + self._sample_offsets,
+            "psi": psi_m,
+            "r": r_m,
+            "delta": states[:, self._idelta].copy(),
+            "delta_c": np.full(self._n, delta_c),
+            "e": e_samples,
+        }
+        info = self._info(frame, samples)
+        if terminated or truncated:
+            info["termination_reason"] = reason
+            info["episode_metrics"] = self.episode_metrics()
+        if self.render_mode == "human":
+            self.render()
+        self._last_return_time = time.perf_counter()
+        return self._observation(frame), float(reward), terminated, truncated, info
+
+    # ------------------------------------------------------------------ pieces
+    def _check_action(self, action: Any) -> np.ndarray:
+        try:
+            a = np.asarray(action, dtype=np.float64).reshape(self.action_space.shape)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(
+                f"action must be an array of shape {self.action_space.shape}, got {action!r}"
+            ) from exc
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
+        return np.clip(a, -1.0, 1.0)
+
+    def _autopilot_command(self, a: np.ndarray, frame: Any) -> float:
+        """Guidance mode: heading reference from the guidance law, PID to δc (module doc)."""
+        gcfg = self.scenario.config.guidance
+        n = 3.0 * 2.0 ** float(a[0])
+        if gcfg.law == "los":
+            radius = los_radius(frame.cross_track, self._L, n)
+            desired = frame.path_angle + los_relative_heading(frame.cross_track, radius)
+        else:
+            desired = lookahead_los_heading(frame.cross_track, frame.path_angle, n * self._L)
+        desired += float(a[1]) * GUIDANCE_OFFSET_MAX
+        return self._autopilot.command(desired, self._psi_m, self._r_m, self._Ts)
+
+    def _observation(self, frame: Any) -> np.ndarray:
+        x = self._state
+        err = self._psi_m - frame.path_angle
+        r_scale = 2.0 * self._u0 / self._L
+        d = frame.distance_to_next
+        obs = np.array(
+            [
+                frame.cross_track / self._e_max,
+                math.sin(err),
+                math.cos(err),
+                self._r_m / r_scale,
+                float(x[self._idelta]) / self._dmax,
+                self._delta_c / self._dmax,
+                self._speed / self._u0,
+                frame.angle_change_next / math.pi,
+                d / (d + 10.0 * self._L),
+            ],
+            dtype=np.float32,
+        )
+        return np.clip(obs, _OBS_LOW, _OBS_HIGH)
+
+    def _info(self, frame: Any, samples: dict[str, np.ndarray]) -> dict[str, Any]:
+        x = self._state
+        return {
+            "t": self._t,
+            "cross_track_error": frame.cross_track,
+            "heading_error": float(wrap_angle(self._psi_m - frame.path_angle)),
+            "heading": self._psi_m,
+            "yaw_rate": self._r_m,
+            "rudder_angle": float(x[self._idelta]),
+            "rudder_command": self._delta_c,
+            "position": (float(x[self._ix]), float(x[self._iy])),
+            "waypoint_index": frame.leg,
+            "samples": samples,
+        }
+
+    def _non_finite_step(self, frame: Any, delta_c: float):  # noqa: ANN202
+        """The plant produced NaN/inf: keep the last finite state and terminate with a reason."""
+        reward = -(self._e_max / self._L) * (self._max_steps - self._step_count + 1)
+        info = self._info(frame, {k: np.zeros(0) for k in ("t", "psi", "r", "delta", "delta_c", "e")})
+        info["termination_reason"] = "non_finite_state"
+        if self._records:
+            info["episode_metrics"] = self.episode_metrics()
+        self._last_return_time = time.perf_counter()
+        return self._observation(frame), float(reward), True, False, info
+
+    def episode_log(self) -> EpisodeLog:
+        """The control-step log of the current episode (true errors, for the metrics)."""
+        return EpisodeLog.from_records(
+            self._records,
+            change_time=self.scenario.change_time,
+            ship_length=self._L,
+            reached_goal=self._reached_goal,
+            dt=self._Ts,
+        )
+
+    def episode_metrics(self) -> dict[str, Any]:
+        return compute_metrics(self.episode_log(), self._metric_settings)
+
+    @property
+    def track(self) -> np.ndarray:
+        """Positions (x, y) [m] at the control steps so far, shape (k+1, 2)."""
+        return np.array(self._track)
+
+    # ------------------------------------------------------------------ rendering
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode to make()")
+            return None
+        from shipgym.rendering import render_frame
+
+        self._fig, image = render_frame(self, self._fig, self.render_mode)
+        return image
+
+    def close(self) -> None:
+        if self._fig is not None:
+            import matplotlib.pyplot as plt
+
+            plt.close(self._fig)
+            self._fig = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_fig"] = None
+        return state

@@ -1,0 +1,28 @@
+"""Ship models: one right-hand side each, evaluated by numpy and CasADi."""
+
+from shipgym.models.base import (
+    CASADI,
+    NUMPY,
+    ParameterError,
+    ParameterRecord,
+    ShipModel,
+    rk4_step,
+)
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params, UnitReading, params_from_paper
+
+#: model id -> class; the scenario loader and the env look models up here.
+MODELS: dict[str, type[ShipModel]] = {"nomoto2": Nomoto2}
+
+__all__ = [
+    "CASADI",
+    "MODELS",
+    "NUMPY",
+    "Nomoto2",
+    "Nomoto2Params",
+    "ParameterError",
+    "ParameterRecord",
+    "ShipModel",
+    "UnitReading",
+    "params_from_paper",
+    "rk4_step",
+]

@@ -1,0 +1,269 @@
+"""The ship-model protocol: one right-hand side, evaluated by numpy and by CasADi.
+
+Every ship model writes its dynamics once, in :meth:`ShipModel.rhs`, against a small
+math *backend* (``NUMPY`` or ``CASADI``).  The same expression then
+
+* runs in numpy on one ship (state shape ``(n_x,)``) or a batch (``(n_x, N)``),
+* builds CasADi SX graphs for NMPC and linearisation, and
+* compiles into the CasADi period integrator that the single env uses for speed.
+
+Pattern after pc-gym's models (a dataclass whose call works on numpy and CasADi alike)
+and PythonVehicleSimulator's actuator-in-the-plant habit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
+from functools import cached_property
+from types import SimpleNamespace
+from typing import Any, ClassVar
+
+import casadi as ca
+import numpy as np
+
+
+class ParameterError(ValueError):
+    """A model parameter is non-physical (e.g. a time constant ≤ 0)."""
+
+
+def _np_stack(rows: Sequence[Any]) -> np.ndarray:
+    return np.stack(np.broadcast_arrays(*rows))
+
+
+#: numpy backend: works on floats, 1-D states and batched ``(n_x, N)`` states.
+NUMPY = SimpleNamespace(
+    name="numpy",
+    sin=np.sin,
+    cos=np.cos,
+    tanh=np.tanh,
+    sqrt=np.sqrt,
+    abs=np.abs,
+    atan2=np.arctan2,
+    fmin=np.minimum,
+    fmax=np.maximum,
+    clip=np.clip,
+    stack=_np_stack,
+)
+
+#: CasADi backend: SX/MX symbols.
+CASADI = SimpleNamespace(
+    name="casadi",
+    sin=ca.sin,
+    cos=ca.cos,
+    tanh=ca.tanh,
+    sqrt=ca.sqrt,
+    abs=ca.fabs,
+    atan2=ca.atan2,
+    fmin=ca.fmin,
+    fmax=ca.fmax,
+    clip=lambda a, lo, hi: ca.fmin(ca.fmax(a, lo), hi),
+    stack=lambda rows: ca.vertcat(*rows),
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterRecord:
+    """Base of the typed, validated parameter records (SI units, radians).
+
+    Subclasses list their fields with units in comments and name the fields that must be
+    strictly positive in ``positive``.  Records convert to and from a flat vector (field
+    order) so that a CasADi solver can take them as parameters.
+    """
+
+    positive: ClassVar[tuple[str, ...]] = ()
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise ParameterError(
+                    f"{type(self).__name__}.{f.name} must be a number, got {value!r}"
+                )
+            if not math.isfinite(value):
+                raise ParameterError(f"{type(self).__name__}.{f.name} must be finite, got {value}")
+        for name in self.positive:
+            value = getattr(self, name)
+            if value <= 0:
+                raise ParameterError(
+                    f"{type(self).__name__}.{name} must be > 0 (physical), got {value}"
+                )
+
+    @classmethod
+    def names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(cls))
+
+    def to_vector(self) -> np.ndarray:
+        return np.array([float(getattr(self, n)) for n in self.names()])
+
+    @classmethod
+    def from_vector(cls, vector: Sequence[float]) -> ParameterRecord:
+        names = cls.names()
+        if len(vector) != len(names):
+            raise ParameterError(f"{cls.__name__} needs {len(names)} values, got {len(vector)}")
+        return cls(**{n: float(v) for n, v in zip(names, vector, strict=True)})
+
+    def replace(self, **changes: float) -> ParameterRecord:
+        unknown = set(changes) - set(self.names())
+        if unknown:
+            raise ParameterError(
+                f"{type(self).__name__} has no parameter(s) {sorted(unknown)}; "
+                f"valid: {list(self.names())}"
+            )
+        return dataclasses.replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        return {n: float(getattr(self, n)) for n in self.names()}
+
+
+def parameter_view(names: Sequence[str], vector: Any) -> SimpleNamespace:
+    """Attribute access ``p.K`` into a parameter vector (numpy rows or CasADi SX entries)."""
+    return SimpleNamespace(**{n: vector[i] for i, n in enumerate(names)})
+
+
+def rk4_step(
+    f: Callable[[Any, Any, Any, Any], Any], x: Any, u: Any, w: Any, p: Any, h: float
+) -> Any:
+    """One classical Runge–Kutta-4 step of ``ẋ = f(x, u, w, p)`` with u, w, p held; h in s.
+
+    Shared by every model and by both backends (numpy arrays or CasADi SX).
+    """
+    k1 = f(x, u, w, p)
+    k2 = f(x + (0.5 * h) * k1, u, w, p)
+    k3 = f(x + (0.5 * h) * k2, u, w, p)
+    k4 = f(x + h * k3, u, w, p)
+    return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+class ShipModel(ABC):
+    """A ship model: states, input, disturbance inputs, parameters and one rhs.
+
+    Subclasses set the class attributes and implement :meth:`rhs`.  States are SI / rad.
+    ``disturbance_names`` are exogenous inputs the environment drives (currents, wave
+    loads); they are zero for a calm sea.
+    """
+
+    name: ClassVar[str]
+    state_names: ClassVar[tuple[str, ...]]
+    input_names: ClassVar[tuple[str, ...]] = ("rudder_command",)
+    disturbance_names: ClassVar[tuple[str, ...]]
+    params_type: ClassVar[type[ParameterRecord]]
+    #: rudder angle limit [rad] and rate limit [rad/s] (inf when the servo has none)
+    rudder_limit: float
+    rudder_rate_limit: float = math.inf
+    #: default control period Ts and fine integration step h [s]
+    control_period: ClassVar[float]
+    fine_step: ClassVar[float]
+    #: unit readings the model accepts for config/paper numbers (first = default)
+    unit_readings: ClassVar[tuple[str, ...]] = ("si",)
+
+    def __init__(self, params: ParameterRecord | None = None) -> None:
+        self.params = params if params is not None else self.params_type()
+        if not isinstance(self.params, self.params_type):
+            raise TypeError(f"{self.name} needs {self.params_type.__name__}, got {params!r}")
+
+    @classmethod
+    def config_to_si(cls, values: dict[str, float], unit_reading: str | None) -> dict[str, float]:
+        """Convert parameter values as written in configs (paper units) to SI."""
+        reading = unit_reading or cls.unit_readings[0]
+        if reading not in cls.unit_readings:
+            raise ParameterError(
+                f"{cls.name}: unknown unit_reading {reading!r}; valid: {list(cls.unit_readings)}"
+            )
+        unknown = set(values) - set(cls.params_type.names())
+        if unknown:
+            raise ParameterError(
+                f"{cls.name} has no parameter(s) {sorted(unknown)}; "
+                f"valid: {list(cls.params_type.names())}"
+            )
+        return dict(values)
+
+    @classmethod
+    def from_config(cls, values: dict[str, float], unit_reading: str | None = None) -> ShipModel:
+        """The model with its default parameters overridden by ``values`` (config units)."""
+        return cls(cls.params_type().replace(**cls.config_to_si(values, unit_reading)))
+
+    # -- the one definition -------------------------------------------------------------
+    @abstractmethod
+    def rhs(self, x: Any, u: Any, w: Any, p: Any, ops: SimpleNamespace) -> Any:
+        """ẋ = f(x, u, w, p).  x, u, w index like sequences, p has attribute access."""
+
+    # -- declared figures ---------------------------------------------------------------
+    @property
+    @abstractmethod
+    def length(self) -> float:
+        """Ship length L [m]."""
+
+    @property
+    @abstractmethod
+    def nominal_speed(self) -> float:
+        """Nominal (service) speed [m/s]."""
+
+    @property
+    def n_states(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def n_disturbances(self) -> int:
+        return len(self.disturbance_names)
+
+    @property
+    def n_params(self) -> int:
+        return len(self.params_type.names())
+
+    def state_index(self, name: str) -> int:
+        return self.state_names.index(name)
+
+    def initial_state(self, **values: float) -> np.ndarray:
+        """State vector with the named entries set (others zero); names as ``state_names``."""
+        x = np.zeros(self.n_states)
+        for key, value in values.items():
+            if key not in self.state_names:
+                raise KeyError(f"{self.name} has no state {key!r}; states: {self.state_names}")
+            x[self.state_names.index(key)] = value
+        return x
+
+    def first_order_nomoto(self, params: ParameterRecord | None = None) -> tuple[float, float]:
+        """First-order Nomoto (K [1/s], T [s]) of the model, for autopilot design.
+
+        Models without a closed form get theirs from a zig-zag identification.
+        """
+        raise NotImplementedError(f"{self.name} has no closed-form first-order Nomoto model")
+
+    def __getstate__(self) -> dict[str, Any]:
+        # CasADi functions are rebuilt on demand after unpickling
+        return {k: v for k, v in self.__dict__.items() if k != "casadi_rhs"}
+
+    # -- numpy evaluation ---------------------------------------------------------------
+    def f_numpy(self, x: np.ndarray, u: Any, w: Any, p_vector: np.ndarray) -> np.ndarray:
+        """rhs with numpy; x (n_x,) or (n_x, N); p_vector (n_p,) or (n_p, N)."""
+        return self.rhs(x, u, w, parameter_view(self.params_type.names(), p_vector), NUMPY)
+
+    def step_numpy(
+        self, x: np.ndarray, u: Any, w: Any, p_vector: np.ndarray, h: float
+    ) -> np.ndarray:
+        """One RK4 step of length h [s] in numpy (single or batched)."""
+        return rk4_step(self.f_numpy, x, u, w, p_vector, h)
+
+    # -- CasADi evaluation --------------------------------------------------------------
+    @cached_property
+    def casadi_rhs(self) -> ca.Function:
+        """``f(x, u, w, p) -> ẋ`` as a CasADi SX Function (p: parameter vector)."""
+        x = ca.SX.sym("x", self.n_states)
+        u = ca.SX.sym("u", len(self.input_names))
+        w = ca.SX.sym("w", self.n_disturbances)
+        p = ca.SX.sym("p", self.n_params)
+        xdot = self.rhs(x, u, w, parameter_view(self.params_type.names(), p), CASADI)
+        return ca.Function(f"{self.name}_rhs", [x, u, w, p], [xdot], ["x", "u", "w", "p"], ["xdot"])
+
+    def casadi_step(self, h: float) -> ca.Function:
+        """One RK4 step of length h [s] as a CasADi Function ``(x, u, w, p) -> x⁺``."""
+        f = self.casadi_rhs
+        x = ca.SX.sym("x", self.n_states)
+        u = ca.SX.sym("u", len(self.input_names))
+        w = ca.SX.sym("w", self.n_disturbances)
+        p = ca.SX.sym("p", self.n_params)
+        x_next = rk4_step(lambda *a: f(*a), x, u, w, p, h)
+        return ca.Function(f"{self.name}_rk4", [x, u, w, p], [x_next], ["x", "u", "w", "p"], ["xf"])

@@ -1,0 +1,522 @@
+"""Reference paths for ship path following (SPEC §3).
+
+Conventions (fixed for the whole package): SI units and radians, plane coordinates (x, y),
+heading ψ with ẋ = u cos ψ, ẏ = u sin ψ.  For a leg from P_n to P_{n+1}:
+
+* path angle        ψp  = atan2(y_{n+1} − y_n, x_{n+1} − x_n),
+* along-track       x_r = (x − x_n) cos ψp + (y − y_n) sin ψp,
+* cross-track error e   = −(x − x_n) sin ψp + (y − y_n) cos ψp,
+
+which is Borkowski (2018) eq. (25).  e > 0 on the side a positive heading rotation points to
+(left of the path in an x-right / y-up plot), so that ė = u sin(ψ − ψp), Liu et al. (2019)
+eq. (7).  Angles are wrapped to [−π, π).
+
+Two path types are provided:
+
+* :class:`WaypointPath` — the straight-leg polyline of Liu et al. (2019) §2.2 / Borkowski
+  (2018) §3, with a fast per-leg frame for the environment step;
+* :class:`PchipPath` — a smooth, shape-preserving piecewise cubic Hermite path through the same
+  waypoints (Xu & Guedes Soares 2020 §2, eqs. (2)–(5)), parametrised by arc length.
+
+Waypoint switching rules are pure functions: the acceptance circle of Liu et al. (2019)
+eq. (13) and the along-track rule of Borkowski (2018) eq. (27).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal, overload
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import PchipInterpolator
+from scipy.optimize import minimize_scalar
+
+__all__ = [
+    "LegFrame",
+    "PchipPath",
+    "WaypointPath",
+    "acceptance_circle_reached",
+    "advance_leg",
+    "along_track_reached",
+    "segment_frame",
+    "wrap_angle",
+]
+
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+
+
+# --------------------------------------------------------------------------------------------
+# Angles
+# --------------------------------------------------------------------------------------------
+@overload
+def wrap_angle(a: float) -> float: ...
+@overload
+def wrap_angle(a: NDArray[np.floating]) -> NDArray[np.float64]: ...
+
+
+def wrap_angle(a):
+    """Wrap an angle [rad] (float or numpy array) to the half-open interval [−π, π)."""
+    if isinstance(a, (float, int)):  # also catches numpy float64 (a float subclass)
+        w = (a + _PI) % _TWO_PI - _PI
+        # Float modulo can round up to exactly 2π for tiny negative inputs (e.g. −1e-20).
+        return float(w - _TWO_PI) if w >= _PI else float(w)
+    arr = np.asarray(a, dtype=float)
+    w = np.mod(arr + _PI, _TWO_PI) - _PI
+    w = np.where(w >= _PI, w - _TWO_PI, w)
+    if w.ndim == 0:
+        return float(w)
+    return w
+
+
+# --------------------------------------------------------------------------------------------
+# Leg frame
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True, slots=True)
+class LegFrame:
+    """Ship position in the frame of one straight leg (Borkowski 2018 eq. (25)).
+
+    Attributes:
+        along_track: x_r [m], distance along the leg from its start point.
+        cross_track: e [m], signed; positive left of the leg (x-right / y-up plot).
+        path_angle: ψp [rad], direction of the leg, in [−π, π).
+        leg_length: |P_n P_{n+1}| [m].
+    """
+
+    along_track: float
+    cross_track: float
+    path_angle: float
+    leg_length: float
+
+
+def segment_frame(
+    x: float, y: float, p_start: tuple[float, float], p_end: tuple[float, float]
+) -> LegFrame:
+    """Leg frame of the point (x, y) [m] for the leg p_start → p_end [m] (pure float math).
+
+    Raises ValueError if p_start and p_end coincide.
+    """
+    x0 = float(p_start[0])
+    y0 = float(p_start[1])
+    dx = float(p_end[0]) - x0
+    dy = float(p_end[1]) - y0
+    length = math.hypot(dx, dy)
+    if not length > 0.0:
+        raise ValueError("segment_frame: p_start and p_end coincide (zero-length leg)")
+    c = dx / length
+    s = dy / length
+    rx = x - x0
+    ry = y - y0
+    # Borkowski (2018) eq. (25); the path angle is eq. (26) written as atan2.
+    return LegFrame(rx * c + ry * s, -rx * s + ry * c, math.atan2(dy, dx), length)
+
+
+def _validate_waypoints(waypoints: ArrayLike) -> NDArray[np.float64]:
+    """Return waypoints as a fresh float (M, 2) array, or raise ValueError naming the problem."""
+    try:
+        arr = np.array(waypoints, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"waypoints must be a numeric (M, 2) array: {exc}") from exc
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise ValueError(f"waypoints must have shape (M, 2), got shape {arr.shape}")
+    if arr.shape[0] < 2:
+        raise ValueError(f"at least 2 waypoints are required, got {arr.shape[0]}")
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(arr), axis=1))[0])
+        raise ValueError(f"waypoints contain non-finite values (first at index {bad})")
+    steps = np.diff(arr, axis=0)
+    same = np.flatnonzero(np.all(steps == 0.0, axis=1))
+    if same.size:
+        i = int(same[0])
+        raise ValueError(
+            f"consecutive waypoints {i} and {i + 1} are identical ({arr[i].tolist()}): "
+            "zero-length leg"
+        )
+    arr.setflags(write=False)
+    return arr
+
+
+def _readonly(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    a.setflags(write=False)
+    return a
+
+
+# --------------------------------------------------------------------------------------------
+# Straight-leg path
+# --------------------------------------------------------------------------------------------
+class WaypointPath:
+    """Polyline of straight legs through M ≥ 2 waypoints [m] (Liu et al. 2019 §2.2, Fig. 3).
+
+    Leg i runs from waypoint i to waypoint i + 1 (i = 0 … n_legs − 1).  Arc length s [m] is
+    measured from waypoint 0 along the legs.
+    """
+
+    def __init__(self, waypoints: ArrayLike) -> None:
+        wp = _validate_waypoints(waypoints)
+        self.waypoints: NDArray[np.float64] = wp
+        steps = np.diff(wp, axis=0)
+        self.n_legs: int = wp.shape[0] - 1
+        self.leg_lengths: NDArray[np.float64] = _readonly(np.hypot(steps[:, 0], steps[:, 1]))
+        self.cumulative_length: NDArray[np.float64] = _readonly(
+            np.concatenate(([0.0], np.cumsum(self.leg_lengths)))
+        )
+        self.length: float = float(self.cumulative_length[-1])
+        angles = np.arctan2(steps[:, 1], steps[:, 0])
+        self._angles_arr = _readonly(wrap_angle(angles))
+        self._unit = _readonly(steps / self.leg_lengths[:, None])
+        # Plain Python floats for the per-step leg_frame (no numpy scalar overhead).
+        self._x0: list[float] = wp[:-1, 0].tolist()
+        self._y0: list[float] = wp[:-1, 1].tolist()
+        self._cos: list[float] = self._unit[:, 0].tolist()
+        self._sin: list[float] = self._unit[:, 1].tolist()
+        self._angle: list[float] = self._angles_arr.tolist()
+        self._len: list[float] = self.leg_lengths.tolist()
+
+    def __repr__(self) -> str:
+        return f"WaypointPath(n_legs={self.n_legs}, length={self.length:.6g})"
+
+    # -- per-leg frame --------------------------------------------------------------------
+    def leg_frame(self, x: float, y: float, leg: int) -> LegFrame:
+        """Frame of the point (x, y) [m] relative to leg `leg` (Borkowski 2018 eq. (25))."""
+        if not 0 <= leg < self.n_legs:
+            raise IndexError(f"leg {leg} out of range [0, {self.n_legs - 1}]")
+        c = self._cos[leg]
+        s = self._sin[leg]
+        rx = x - self._x0[leg]
+        ry = y - self._y0[leg]
+        return LegFrame(rx * c + ry * s, -rx * s + ry * c, self._angle[leg], self._len[leg])
+
+    def leg_angle(self, leg: int) -> float:
+        """Path angle ψp [rad] of leg `leg`."""
+        return self._angle[leg]
+
+    def next_leg_angle_change(self, leg: int) -> float:
+        """Wrapped course change [rad] from leg `leg` to leg `leg + 1` (0 for the last leg)."""
+        if not 0 <= leg < self.n_legs:
+            raise IndexError(f"leg {leg} out of range [0, {self.n_legs - 1}]")
+        if leg == self.n_legs - 1:
+            return 0.0
+        return wrap_angle(self._angle[leg + 1] - self._angle[leg])
+
+    # -- arc-length parametrisation -------------------------------------------------------
+    def _leg_of(self, s: NDArray[np.float64]) -> NDArray[np.intp]:
+        # At a shared waypoint the outgoing (later) leg is used.
+        idx = np.searchsorted(self.cumulative_length, s, side="right") - 1
+        return np.clip(idx, 0, self.n_legs - 1)
+
+    def leg_index(self, s: float) -> int:
+        """Index of the leg containing arc length s [m] (the later leg at a waypoint)."""
+        return int(self._leg_of(np.asarray(float(s)))[()])
+
+    def point(self, s: ArrayLike) -> NDArray[np.float64]:
+        """Point [m] at arc length s [m], clamped to [0, length]; shape (2,) or (N, 2)."""
+        s_arr = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        leg = self._leg_of(s_arr)
+        ds = s_arr - self.cumulative_length[leg]
+        return self.waypoints[leg] + ds[..., None] * self._unit[leg]
+
+    def angle(self, s: ArrayLike) -> float | NDArray[np.float64]:
+        """Path angle ψp [rad] at arc length s [m] (the outgoing leg at a waypoint)."""
+        s_arr = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        out = self._angles_arr[self._leg_of(s_arr)]
+        return float(out) if out.ndim == 0 else out
+
+    def curvature(self, s: ArrayLike) -> float | NDArray[np.float64]:
+        """Curvature [1/m] at arc length s [m]: 0 on straight legs."""
+        s_arr = np.asarray(s, dtype=float)
+        return 0.0 if s_arr.ndim == 0 else np.zeros_like(s_arr)
+
+    # -- closest point --------------------------------------------------------------------
+    def project(self, x: float, y: float) -> tuple[float, float, float, NDArray[np.float64]]:
+        """Global closest point of the polyline to (x, y) [m].
+
+        Returns (s, cross_track, path_angle, closest_point): arc length s [m] of the closest
+        point, signed cross-track error [m] relative to the line of the leg holding that
+        point (same convention as :meth:`leg_frame`), that leg's angle [rad], and the point
+        itself [m] as a (2,) array.  On exact ties the earliest leg wins, except that a closest
+        point at a shared waypoint is attributed to the outgoing leg (consistent with
+        :meth:`angle`).
+        """
+        p0 = self.waypoints[:-1]
+        rx = x - p0[:, 0]
+        ry = y - p0[:, 1]
+        along = rx * self._unit[:, 0] + ry * self._unit[:, 1]
+        cross = -rx * self._unit[:, 1] + ry * self._unit[:, 0]
+        t = np.clip(along, 0.0, self.leg_lengths)
+        d2 = (along - t) ** 2 + cross**2
+        k = int(np.argmin(d2))
+        if k + 1 < self.n_legs and t[k] >= self.leg_lengths[k] and along[k + 1] <= 0.0:
+            # Closest point is waypoint k+1, shared by legs k and k+1: use the outgoing leg.
+            k += 1
+        tk = float(t[k])
+        if tk <= 0.0:
+            closest = self.waypoints[k].copy()
+        elif tk >= self.leg_lengths[k]:
+            closest = self.waypoints[k + 1].copy()
+        else:
+            closest = self.waypoints[k] + tk * self._unit[k]
+        s = float(self.cumulative_length[k]) + tk
+        return s, float(cross[k]), self._angle[k], closest
+
+
+# --------------------------------------------------------------------------------------------
+# Smooth PCHIP path
+# --------------------------------------------------------------------------------------------
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+class PchipPath:
+    """Smooth path through the waypoints by piecewise cubic Hermite interpolation.
+
+    Xu & Guedes Soares (2020) §2 build P(x) with the shape-preserving slopes of eqs. (4)–(5)
+    (Moler 2004), which needs monotone x.  Here x(t) and y(t) are each interpolated with
+    ``scipy.interpolate.PchipInterpolator`` (the same Fritsch–Carlson-type slopes) over the
+    cumulative chord length t, so any waypoint order works (U-turns, loops), and the curve is
+    then re-parametrised by arc length s ∈ [0, length] [m]: |P'(t)| is integrated with
+    Gauss–Legendre quadrature on a fine grid and s → t is inverted by safeguarded Newton
+    iterations started from linear interpolation of that grid.
+
+    Caveat of component-wise PCHIP: at a waypoint where *both* x and y have a local extremum
+    or a flat neighbouring step (e.g. an axis-aligned right-angle turn), both slopes are set
+    to zero, so dP/dt = 0 there and the curve has a corner (the tangent jumps, curvature is
+    unbounded nearby).  ``angle`` returns the outgoing tangent at such a point and
+    ``curvature`` returns 0 exactly at it.
+
+    Args:
+        waypoints: (M, 2) waypoints [m], M ≥ 2, no two consecutive identical.
+        samples_per_segment: grid subintervals per waypoint interval used for arc length and
+            the coarse closest-point search.
+    """
+
+    def __init__(self, waypoints: ArrayLike, samples_per_segment: int = 64) -> None:
+        if samples_per_segment < 2:
+            raise ValueError(f"samples_per_segment must be >= 2, got {samples_per_segment}")
+        wp = _validate_waypoints(waypoints)
+        self.waypoints: NDArray[np.float64] = wp
+        chords = np.hypot(*np.diff(wp, axis=0).T)
+        knots = np.concatenate(([0.0], np.cumsum(chords)))
+        self._knots = _readonly(knots)
+        # Vector-valued PCHIP: x(t) and y(t) together (axis 0 is the parameter).
+        self._p = PchipInterpolator(knots, wp, axis=0)
+        self._dp = self._p.derivative(1)
+        self._ddp = self._p.derivative(2)
+
+        # Parameter grid, containing every knot exactly.
+        n = int(samples_per_segment)
+        frac = np.linspace(0.0, 1.0, n + 1)[:-1]
+        tg = (knots[:-1, None] + chords[:, None] * frac[None, :]).ravel()
+        tg = np.concatenate((tg, knots[-1:]))
+        knot_idx = np.arange(wp.shape[0]) * n
+        tg[knot_idx] = knots
+        self._tg = _readonly(tg)
+        a, b = tg[:-1], tg[1:]
+        seg = self._quad_speed(a, b)
+        sg = np.concatenate(([0.0], np.cumsum(seg)))
+        self._sg = _readonly(sg)
+        self._pg = _readonly(self._p(tg))
+        self.length: float = float(sg[-1])
+        self.waypoint_arc_lengths: NDArray[np.float64] = _readonly(sg[knot_idx].copy())
+        self._tol_s = 1e-13 * max(1.0, self.length)
+        self._tiny_speed = 1e-12
+
+    def __repr__(self) -> str:
+        return f"PchipPath(n_waypoints={self.waypoints.shape[0]}, length={self.length:.6g})"
+
+    # -- internals ------------------------------------------------------------------------
+    def _speed(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
+        d = self._dp(t)
+        return np.hypot(d[..., 0], d[..., 1])
+
+    def _quad_speed(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+        """∫_a^b |P'(t)| dt by 8-point Gauss–Legendre (a, b 1-D arrays of the same shape)."""
+        half = 0.5 * (b - a)
+        mid = 0.5 * (b + a)
+        nodes = mid[:, None] + half[:, None] * _GL_NODES[None, :]
+        return half * (self._speed(nodes) @ _GL_WEIGHTS)
+
+    def _s_of_t(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
+        t = np.clip(t, self._tg[0], self._tg[-1])
+        j = np.clip(np.searchsorted(self._tg, t, side="right") - 1, 0, self._tg.size - 2)
+        return self._sg[j] + self._quad_speed(self._tg[j], t)
+
+    def _t_of_s(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Invert the arc length: solve S(t) = s on the bracketing grid cell (1-D arrays)."""
+        s = np.clip(s, 0.0, self.length)
+        tg, sg = self._tg, self._sg
+        j = np.clip(np.searchsorted(sg, s, side="right") - 1, 0, tg.size - 2)
+        lo = tg[j].copy()
+        hi = tg[j + 1].copy()
+        s_lo = sg[j]
+        t = lo + (hi - lo) * (s - s_lo) / (sg[j + 1] - s_lo)
+        for _ in range(30):
+            f = s_lo + self._quad_speed(tg[j], t) - s
+            if np.all(np.abs(f) <= self._tol_s):
+                break
+            hi = np.where(f > 0.0, t, hi)
+            lo = np.where(f < 0.0, t, lo)
+            sp = self._speed(t)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t_new = t - f / sp
+            bad = ~((t_new > lo) & (t_new < hi)) | (sp <= self._tiny_speed)
+            t = np.where(bad, 0.5 * (lo + hi), t_new)
+        return t
+
+    def _tangent_angle(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
+        d = self._dp(t)
+        stalled = np.hypot(d[..., 0], d[..., 1]) <= self._tiny_speed
+        if np.any(stalled):
+            # Zero parametric speed (corner): use the outgoing direction, or the incoming one
+            # at the path end.
+            eps = 1e-7 * max(1.0, float(self._tg[-1]))
+            t_st = t[stalled]
+            t_st = np.where(t_st + eps <= self._tg[-1], t_st + eps, t_st - eps)
+            d = d.copy()
+            d[stalled] = self._dp(t_st)
+        return wrap_angle(np.arctan2(d[..., 1], d[..., 0]))
+
+    def _curvature_t(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
+        d = self._dp(t)
+        dd = self._ddp(t)
+        sp = np.hypot(d[..., 0], d[..., 1])
+        num = d[..., 0] * dd[..., 1] - d[..., 1] * dd[..., 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = num / sp**3
+        return np.where(sp > self._tiny_speed, k, 0.0)
+
+    # -- arc-length parametrisation -------------------------------------------------------
+    def point(self, s: ArrayLike) -> NDArray[np.float64]:
+        """Point [m] at arc length s [m], clamped to [0, length]; shape (2,) or (N, 2)."""
+        s_arr = np.asarray(s, dtype=float)
+        p = self._p(self._t_of_s(np.atleast_1d(s_arr).ravel()))
+        return p[0] if s_arr.ndim == 0 else p.reshape((*s_arr.shape, 2))
+
+    def angle(self, s: ArrayLike) -> float | NDArray[np.float64]:
+        """Tangent angle [rad] at arc length s [m], in [−π, π)."""
+        s_arr = np.asarray(s, dtype=float)
+        a = self._tangent_angle(self._t_of_s(np.atleast_1d(s_arr).ravel()))
+        return float(a[0]) if s_arr.ndim == 0 else a.reshape(s_arr.shape)
+
+    def curvature(self, s: ArrayLike) -> float | NDArray[np.float64]:
+        """Signed curvature [1/m] at arc length s [m] (positive turning left, i.e. ψ increasing).
+
+        PCHIP is C¹ only, so curvature jumps at waypoints; there the outgoing piece is used.
+        """
+        s_arr = np.asarray(s, dtype=float)
+        k = self._curvature_t(self._t_of_s(np.atleast_1d(s_arr).ravel()))
+        return float(k[0]) if s_arr.ndim == 0 else k.reshape(s_arr.shape)
+
+    def segment_index(self, s: float) -> int:
+        """Index i of the waypoint interval [waypoint i, waypoint i+1] containing s [m]."""
+        idx = np.searchsorted(self.waypoint_arc_lengths, float(s), side="right") - 1
+        return int(np.clip(idx, 0, self.waypoints.shape[0] - 2))
+
+    # -- closest point --------------------------------------------------------------------
+    def project(
+        self, x: float, y: float, s_hint: float | None = None, window: float | None = None
+    ) -> tuple[float, float, float, NDArray[np.float64]]:
+        """Closest point of the curve to (x, y) [m].
+
+        The search is global unless both `s_hint` and `window` [m] are given, in which case it
+        is restricted to arc lengths [s_hint − window, s_hint + window] ∩ [0, length] (use it
+        to follow the ship along self-approaching routes).  A coarse search over the arc-length
+        grid is refined with a bounded scalar minimisation of the squared distance.
+
+        Returns (s, cross_track, path_angle, closest_point) as :meth:`WaypointPath.project`,
+        with the signed cross-track e = −(x − x_c) sin ψ_c + (y − y_c) cos ψ_c relative to the
+        tangent angle ψ_c at the closest point (x_c, y_c) — positive left of the path.
+        """
+        tg, pg = self._tg, self._pg
+        if s_hint is not None and window is not None:
+            if window < 0.0:
+                raise ValueError(f"window must be >= 0, got {window}")
+            s_lo = max(0.0, float(s_hint) - window)
+            s_hi = min(self.length, float(s_hint) + window)
+            if s_lo > s_hi:  # hint outside the path: search at the nearest end
+                s_lo = s_hi = min(max(float(s_hint), 0.0), self.length)
+            t_lo, t_hi = self._t_of_s(np.array([s_lo, s_hi]))
+            inside = (tg > t_lo) & (tg < t_hi)
+            cand_t = np.concatenate(([t_lo], tg[inside], [t_hi]))
+            cand_p = np.vstack((self._p(np.array([t_lo])), pg[inside], self._p(np.array([t_hi]))))
+        else:
+            cand_t, cand_p = tg, pg
+        d2 = (cand_p[:, 0] - x) ** 2 + (cand_p[:, 1] - y) ** 2
+        k = int(np.argmin(d2))
+        t_best = float(cand_t[k])
+        d2_best = float(d2[k])
+        a = float(cand_t[max(k - 1, 0)])
+        b = float(cand_t[min(k + 1, cand_t.size - 1)])
+        if b > a:
+            p = self._p
+
+            def dist2(t: float) -> float:
+                q = p(t)
+                return (float(q[0]) - x) ** 2 + (float(q[1]) - y) ** 2
+
+            res = minimize_scalar(
+                dist2, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * (b - a)}
+            )
+            if res.fun < d2_best:
+                t_best = float(res.x)
+        t_arr = np.array([t_best])
+        s = float(self._s_of_t(t_arr)[0])
+        closest = self._p(t_arr)[0]
+        psi = float(self._tangent_angle(t_arr)[0])
+        rx = x - float(closest[0])
+        ry = y - float(closest[1])
+        cross = -rx * math.sin(psi) + ry * math.cos(psi)
+        return s, cross, psi, closest
+
+
+# --------------------------------------------------------------------------------------------
+# Waypoint switching
+# --------------------------------------------------------------------------------------------
+def acceptance_circle_reached(
+    x: float, y: float, waypoint: tuple[float, float], radius: float
+) -> bool:
+    """Liu et al. (2019) eq. (13): (x − x_{n+1})² + (y − y_{n+1})² ≤ R0² (all in m).
+
+    The caller chooses R0; the paper uses R0 = 2L and requires R_LOS ≥ R0.
+    """
+    dx = x - float(waypoint[0])
+    dy = y - float(waypoint[1])
+    return dx * dx + dy * dy <= radius * radius
+
+
+def along_track_reached(frame: LegFrame, radius: float) -> bool:
+    """Borkowski (2018) eq. (27): |P_i P_{i+1}| − x_r < R [m] (remaining along-track distance)."""
+    return frame.leg_length - frame.along_track < radius
+
+
+def advance_leg(
+    path: WaypointPath,
+    x: float,
+    y: float,
+    leg: int,
+    radius: float,
+    rule: Literal["circle", "along_track"] = "circle",
+) -> int:
+    """Active leg index after applying the waypoint switching rule at ship position (x, y) [m].
+
+    Leg i ends at waypoint i + 1; while that waypoint counts as reached (``"circle"``: Liu et al.
+    2019 eq. (13) with R0 = `radius`; ``"along_track"``: Borkowski 2018 eq. (27) with R =
+    `radius`) the next leg becomes active, so several legs can be skipped in one call.  The
+    last leg is never left.
+    """
+    if rule not in ("circle", "along_track"):
+        raise ValueError(f"unknown switching rule {rule!r}; use 'circle' or 'along_track'")
+    last = path.n_legs - 1
+    if not 0 <= leg <= last:
+        raise IndexError(f"leg {leg} out of range [0, {last}]")
+    wp = path.waypoints
+    while leg < last:
+        if rule == "circle":
+            nxt = wp[leg + 1]
+            reached = acceptance_circle_reached(x, y, (float(nxt[0]), float(nxt[1])), radius)
+        else:
+            reached = along_track_reached(path.leg_frame(x, y, leg), radius)
+        if not reached:
+            break
+        leg += 1
+    return leg

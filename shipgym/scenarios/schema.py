@@ -1,0 +1,126 @@
+"""Scenario schema: ship, initial state, path, disturbances, sensors, events, reward.
+
+Validated once, at the boundary (pydantic, unknown keys rejected), so that a bad file fails
+with an error naming the file and the key.  Values are in the units of the config files:
+metres, seconds, degrees where a key says ``_deg``; ship parameters in the units of the
+model's source paper (for nomoto2: Liu et al. 2019, d0 in °/s), converted to SI by the
+model under the scenario's ``unit_reading``.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ShipConfig(_Strict):
+    """Which model, its parameters (paper units) and the unit reading of those numbers."""
+
+    model: str = "nomoto2"
+    unit_reading: str | None = Field(
+        default=None, description="how the paper's units map to SI (nomoto2: si|degrees|…)"
+    )
+    params: dict[str, float] = Field(default_factory=dict)
+
+
+class InitialState(_Strict):
+    x: float = 0.0  # m
+    y: float = 0.0  # m
+    heading_deg: float = 0.0  # deg
+    states: dict[str, float] = Field(default_factory=dict)  # other states, SI
+
+
+class PathConfig(_Strict):
+    type: Literal["waypoints", "pchip"] = "waypoints"
+    waypoints: list[tuple[float, float]]
+    switching: Literal["circle", "along_track"] = "circle"
+    acceptance_radius_L: float = Field(2.0, gt=0)  # R0 = 2L, Liu et al. (2019) eq. (13)
+
+    @field_validator("waypoints")
+    @classmethod
+    def _at_least_two(cls, v: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        if len(v) < 2:
+            raise ValueError("a path needs at least 2 waypoints")
+        return v
+
+
+class GuidanceConfig(_Strict):
+    """Guidance law the env uses for its heading reference (observation, guidance mode)."""
+
+    law: Literal["los", "lookahead_los"] = "los"
+    los_radius_L: float = Field(3.0, gt=0)  # R_LOS = 3L, Liu et al. (2019) eq. (12)
+    lookahead_L: float = Field(2.0, gt=0)  # Δ for look-ahead LOS
+
+
+class CurrentConfig(_Strict):
+    speed: float = Field(0.0, ge=0)  # m/s
+    direction_deg: float = 0.0  # direction the current flows to
+
+
+class DisturbanceConfig(_Strict):
+    current: CurrentConfig = CurrentConfig()
+
+
+class SensorConfig(_Strict):
+    heading_noise_deg: float = Field(0.0, ge=0)  # std of Gaussian heading noise
+    yaw_rate_noise_deg_s: float = Field(0.0, ge=0)
+    outlier_probability: float = Field(0.0, ge=0, le=1)  # per fine sample
+    outlier_magnitude_deg: tuple[float, float] = (5.0, 15.0)  # |spike| range on heading
+    dropout_probability: float = Field(0.0, ge=0, le=1)  # per fine sample: hold last value
+
+
+class EventConfig(_Strict):
+    """At ``time`` the true plant parameters change (step, or linear ramp over ``duration``)."""
+
+    time: float = Field(ge=0)
+    params: dict[str, float]
+    kind: Literal["step", "ramp"] = "step"
+    duration: float = Field(0.0, ge=0)
+
+    @model_validator(mode="after")
+    def _ramp_needs_duration(self) -> EventConfig:
+        if self.kind == "ramp" and self.duration <= 0:
+            raise ValueError("a ramp event needs duration > 0")
+        if not self.params:
+            raise ValueError("an event must change at least one parameter")
+        return self
+
+
+class RewardConfig(_Strict):
+    """r = −(|e|/L + w_ψ|ψ̃| + w_δ(δc/δmax)² + w_Δ(Δδc/δmax)²), SPEC §5."""
+
+    heading_weight: float = Field(0.1, ge=0)
+    rudder_weight: float = Field(0.01, ge=0)
+    rudder_rate_weight: float = Field(0.05, ge=0)
+    goal_bonus: float = Field(10.0, ge=0)
+    max_cross_track_L: float = Field(10.0, gt=0)  # corridor half-width in ship lengths
+
+
+class ScenarioConfig(_Strict):
+    name: str
+    description: str = ""
+    source: str = ""
+    ship: ShipConfig = ShipConfig()
+    initial_state: InitialState = InitialState()
+    path: PathConfig
+    guidance: GuidanceConfig = GuidanceConfig()
+    disturbances: DisturbanceConfig = DisturbanceConfig()
+    sensors: SensorConfig = SensorConfig()
+    events: list[EventConfig] = Field(default_factory=list)
+    time_limit: float = Field(gt=0)  # s
+    control_period: float | None = Field(None, gt=0)  # s; None: the ship's default
+    fine_step: float | None = Field(None, gt=0)  # s; None: the ship's default
+    reward: RewardConfig = RewardConfig()
+    convergence_threshold: float | None = Field(None, gt=0)  # m; None: 0.05·L/0.95
+
+    @model_validator(mode="after")
+    def _events_sorted(self) -> ScenarioConfig:
+        times = [e.time for e in self.events]
+        if times != sorted(times):
+            raise ValueError("events must be listed in time order")
+        return self
