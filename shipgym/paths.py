@@ -350,17 +350,20 @@ class PchipPath:
         hi = tg[j + 1].copy()
         s_lo = sg[j]
         t = lo + (hi - lo) * (s - s_lo) / (sg[j + 1] - s_lo)
-        for _ in range(30):
+        for _ in range(60):
             f = s_lo + self._quad_speed(tg[j], t) - s
-            if np.all(np.abs(f) <= self._tol_s):
+            active = np.abs(f) > self._tol_s
+            if not np.any(active):
                 break
             hi = np.where(f > 0.0, t, hi)
             lo = np.where(f < 0.0, t, lo)
             sp = self._speed(t)
             with np.errstate(divide="ignore", invalid="ignore"):
                 t_new = t - f / sp
-            bad = ~((t_new > lo) & (t_new < hi)) | (sp <= self._tiny_speed)
-            t = np.where(bad, 0.5 * (lo + hi), t_new)
+            # Safeguard: bisect the bracket when Newton leaves it or the speed vanishes.
+            bad = ~((t_new >= lo) & (t_new <= hi)) | (sp <= self._tiny_speed)
+            t_new = np.where(bad, 0.5 * (lo + hi), t_new)
+            t = np.where(active, t_new, t)  # converged entries stay put
         return t
 
     def _tangent_angle(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -458,7 +461,19 @@ class PchipPath:
                 dist2, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * (b - a)}
             )
             if res.fun < d2_best:
-                t_best = float(res.x)
+                t_best, d2_best = float(res.x), float(res.fun)
+            # One Newton polish of g(t) = (P − q)·P' = 0, kept only if it stays in the bracket
+            # and does not increase the distance (Brent's tolerance is ~1e-8 relative in t).
+            q = p(t_best)
+            d1 = self._dp(t_best)
+            g = (float(q[0]) - x) * float(d1[0]) + (float(q[1]) - y) * float(d1[1])
+            d2v = self._ddp(t_best)
+            dg = float(d1[0]) ** 2 + float(d1[1]) ** 2
+            dg += (float(q[0]) - x) * float(d2v[0]) + (float(q[1]) - y) * float(d2v[1])
+            if dg > 0.0:
+                t_new = t_best - g / dg
+                if a <= t_new <= b and dist2(t_new) <= d2_best:
+                    t_best = t_new
         t_arr = np.array([t_best])
         s = float(self._s_of_t(t_arr)[0])
         closest = self._p(t_arr)[0]
@@ -466,7 +481,7 @@ class PchipPath:
         rx = x - float(closest[0])
         ry = y - float(closest[1])
         cross = -rx * math.sin(psi) + ry * math.cos(psi)
-        return s, cross, psi, closest
+        return s, float(cross), psi, closest
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,7 +1,8 @@
-"""Tests for shipgym.guidance: LOS (Liu et al. 2019) and look-ahead LOS (Xu & Guedes Soares 2020)."""
+"""Tests for shipgym.guidance: LOS (Liu et al. 2019), look-ahead LOS (Xu & Guedes Soares 2020)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -96,7 +97,7 @@ def test_los_point_bearing_equals_closed_form_property() -> None:
 
         psi_d, radius, e_out = los_heading(x, y, p0, p1, ship_length)
         assert e_out == pytest.approx(e, abs=1e-9)
-        assert radius == los_radius(e, ship_length)
+        assert radius == pytest.approx(los_radius(e, ship_length), rel=1e-12)
         closed_form = wrap_angle(chi + los_relative_heading(e_out, radius))
         assert psi_d == pytest.approx(closed_form, abs=1e-12)
 
@@ -110,7 +111,7 @@ def test_los_point_bearing_equals_closed_form_property() -> None:
 def test_los_heading_accepts_numpy_points_and_returns_floats() -> None:
     out = los_heading(1.0, -2.0, np.array([0.0, 0.0]), np.array([0.0, 10.0]), 1.0)
     assert all(type(v) is float for v in out)
-    psi_d, radius, e = out
+    psi_d, _, e = out
     assert e == pytest.approx(-1.0)  # right of an upward leg
     assert psi_d == pytest.approx(math.pi / 2 + math.asin(1.0 / 3.0))  # steer left, back to it
 
@@ -125,7 +126,7 @@ def test_los_guidance_converges_on_kinematic_ship() -> None:
         es.append(abs(e))
         x += u * math.cos(psi) * dt
         y += u * math.sin(psi) * dt
-    assert all(b <= a + 1e-12 for a, b in zip(es, es[1:], strict=False))
+    assert all(b <= a + 1e-12 for a, b in itertools.pairwise(es))
     assert es[-1] < 1e-3
 
 

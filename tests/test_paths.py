@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import astuple
 
 import numpy as np
 import pytest
@@ -28,7 +29,10 @@ def test_wrap_angle_float_range_and_values() -> None:
     assert wrap_angle(math.pi) == -math.pi  # half-open interval [−π, π)
     assert wrap_angle(-math.pi) == -math.pi
     assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
-    assert wrap_angle(-1e-20) == -1e-20  # float modulo rounds to 2π here; still in range
+    # Edge cases where float modulo rounds (a + π) mod 2π up to exactly 2π.
+    for a in (np.nextafter(-math.pi, -4.0), np.nextafter(math.pi, 4.0), -1e-17, 3 * math.pi):
+        assert -math.pi <= wrap_angle(float(a)) < math.pi
+        assert -math.pi <= wrap_angle(np.array([a]))[0] < math.pi
     assert isinstance(wrap_angle(1.0), float)
 
 
@@ -58,21 +62,19 @@ def test_cross_track_positive_left_of_path() -> None:
 def test_cross_track_rate_matches_liu_eq7() -> None:
     """ė = u sin(ψ − ψp) along a straight-line motion (finite difference)."""
     rng = np.random.default_rng(1)
+    dt = 1e-3
     for _ in range(50):
         p0 = rng.uniform(-100, 100, 2)
-        p1 = p0 + rng.uniform(5, 50) * np.array(
-            [math.cos(a := rng.uniform(-math.pi, math.pi)), math.sin(a)]
+        chi = rng.uniform(-math.pi, math.pi)
+        path = WaypointPath(
+            [p0, p0 + rng.uniform(5, 50) * np.array([math.cos(chi), math.sin(chi)])]
         )
-        path = WaypointPath([p0, p1])
-        psi, u, dt = rng.uniform(-math.pi, math.pi), rng.uniform(0.5, 10.0), 1e-3
+        psi, u = rng.uniform(-math.pi, math.pi), rng.uniform(0.5, 10.0)
         x0, y0 = rng.uniform(-100, 100, 2)
-
-        def e_at(t: float, x0: float = x0, y0: float = y0, psi: float = psi, u: float = u):
-            x = x0 + u * math.cos(psi) * t
-            y = y0 + u * math.sin(psi) * t
-            return path.leg_frame(x, y, 0).cross_track
-
-        e_dot = (e_at(dt) - e_at(-dt)) / (2 * dt)
+        vx, vy = u * math.cos(psi), u * math.sin(psi)
+        e_plus = path.leg_frame(x0 + vx * dt, y0 + vy * dt, 0).cross_track
+        e_minus = path.leg_frame(x0 - vx * dt, y0 - vy * dt, 0).cross_track
+        e_dot = (e_plus - e_minus) / (2 * dt)
         assert e_dot == pytest.approx(u * math.sin(psi - path.leg_angle(0)), abs=1e-6)
 
 
@@ -122,7 +124,7 @@ def test_leg_frame_matches_segment_frame() -> None:
     for leg in range(path.n_legs):
         a = path.leg_frame(0.3, -0.7, leg)
         b = segment_frame(0.3, -0.7, path.waypoints[leg], path.waypoints[leg + 1])
-        assert a == pytest.approx(b)
+        assert astuple(a) == pytest.approx(astuple(b), rel=1e-12, abs=1e-12)
 
 
 def test_point_and_angle_by_arc_length() -> None:
@@ -158,8 +160,8 @@ def test_project_picks_nearest_leg() -> None:
     assert e == pytest.approx(1.0)
     assert psi == pytest.approx(math.pi / 2)
     assert np.allclose(c, [10, 6])
-    s, e, psi, c = path.project(4.0, 8.5)  # 1.5 m right of leg 2 (heading −x)
-    assert s == pytest.approx(26.0) and e == pytest.approx(-1.5)
+    s, e, psi, c = path.project(4.0, 8.5)  # 1.5 m left of leg 2 (heading −x: left is −y)
+    assert s == pytest.approx(26.0) and e == pytest.approx(1.5)
     assert psi == pytest.approx(-math.pi) and np.allclose(c, [4, 10])
     # Outside the outer corner at (10, 0): closest point is the waypoint, outgoing leg 1.
     s, e, psi, c = path.project(12.0, -1.0)
@@ -253,6 +255,19 @@ def test_pchip_straight_line_arc_length() -> None:
     assert two.length == pytest.approx(5.0, abs=1e-6)
 
 
+def test_pchip_axis_aligned_corner_degenerates_to_polyline() -> None:
+    """Documented caveat: both PCHIP slopes vanish at an axis-aligned right-angle waypoint."""
+    path = PchipPath([(0, 0), (10, 0), (10, 10)])
+    assert path.length == pytest.approx(20.0, abs=1e-6)
+    assert np.allclose(path.point(np.linspace(0, 10, 11))[:, 1], 0.0, atol=1e-12)
+    assert path.angle(9.99) == pytest.approx(0.0, abs=1e-12)
+    assert path.angle(10.0) == pytest.approx(math.pi / 2)  # outgoing tangent at the corner
+    assert path.curvature(10.0) == 0.0
+    s, e, psi, c = path.project(11.0, -1.0)
+    assert s == pytest.approx(10.0, abs=1e-9) and np.allclose(c, [10, 0], atol=1e-9)
+    assert psi == pytest.approx(math.pi / 2) and e == pytest.approx(-1.0, abs=1e-9)
+
+
 def test_pchip_u_turn_works() -> None:
     path = PchipPath(ROUTES["u_turn"])
     s = np.linspace(0, path.length, 2001)
@@ -318,7 +333,7 @@ def test_pchip_project_sign_matches_straight_leg_convention() -> None:
 def test_pchip_project_window_restricts_search() -> None:
     # The loop passes near its start at the end; a hint keeps the projection local.
     path = PchipPath([(0, 0), (100, 0), (100, 100), (0, 100), (0, 2)])
-    s_glob, _, _, c_glob = path.project(1.0, 1.0)
+    s_glob, *_ = path.project(1.0, 1.0)
     assert s_glob == pytest.approx(0.0, abs=1.5)
     s_loc, _, _, c_loc = path.project(1.0, 1.0, s_hint=path.length - 5.0, window=10.0)
     assert s_loc > path.length - 15.0

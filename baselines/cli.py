@@ -1,0 +1,102 @@
+"""The ``shipgym`` console script (SPEC §9b).
+
+``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+
+def _emit(args: argparse.Namespace, document: Any, text: str) -> None:
+    if args.json:
+        sys.stdout.write(json.dumps(document) + "\n")
+    else:
+        sys.stdout.write(text + "\n")
+
+
+def cmd_scenarios(args: argparse.Namespace) -> int:
+    from shipgym.scenarios import list_scenarios, load_scenario
+
+    names = list_scenarios()
+    lines = []
+    for name in names:
+        sc = load_scenario(name)
+        lines.append(f"{name:28s} {sc.model.name:10s} {sc.config.description.strip()}")
+    _emit(args, names, "\n".join(lines))
+    return 0
+
+
+def cmd_leaderboard(args: argparse.Namespace) -> int:
+    from baselines.leaderboard import markdown_table, run_leaderboard
+
+    rows = run_leaderboard(
+        suite=args.suite,
+        seeds=args.seeds,
+        out_dir=args.out,
+        backend=args.backend,
+        workers=args.workers,
+        show_progress=not args.no_progress,
+    )
+    if args.json:
+        _emit(args, rows, "")
+    else:
+        sys.stdout.write(markdown_table(rows))
+        sys.stderr.write(f"wrote {args.out}/leaderboard.md, .csv, .json and plots\n")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from baselines.benchmarks import bench_env
+
+    if args.target != "env":
+        sys.stderr.write(f"shipgym bench: unknown target {args.target!r}; available: env\n")
+        return 2
+    figures = bench_env(repeats=args.repeats)
+    text = "\n".join(f"{k:34s} {v:,.3f}" if isinstance(v, float) else f"{k:34s} {v}"
+                     for k, v in figures.items())
+    _emit(args, figures, text)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="shipgym", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("leaderboard", help="run every controller on a suite (SPEC §9)")
+    p.add_argument("--suite", default="default", help="suite name in configs/suites or a YAML path")
+    p.add_argument("--seeds", type=int, default=None, help="seeds per scenario (default: suite's)")
+    p.add_argument("--out", default="results/leaderboard", help="output directory")
+    p.add_argument("--backend", choices=["local", "ray"], default="local")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
+    p.set_defaults(func=cmd_leaderboard)
+
+    p = sub.add_parser("scenarios", help="list the scenario catalogue")
+    p.add_argument("--json", action="store_true", help="print the names as a JSON list")
+    p.set_defaults(func=cmd_scenarios)
+
+    p = sub.add_parser("bench", help="benchmarks of SPEC §10")
+    p.add_argument("target", choices=["env"], help="what to benchmark")
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--json", action="store_true", help="print the figures as a JSON object")
+    p.set_defaults(func=cmd_bench)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, KeyError, RuntimeError) as exc:
+        sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,111 @@
+"""The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9)."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+import shipgym  # noqa: F401  (registers the envs)
+from baselines.policy import Policy
+from baselines.registry import make_controller
+
+ENV_ID = "ShipPathFollow-v0"
+#: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
+EVAL_SEED_OFFSET = 10_000
+
+
+@dataclasses.dataclass
+class EpisodeResult:
+    """Metrics and trajectory of one (controller, scenario, seed) episode."""
+
+    controller: str
+    kind: str
+    scenario: str
+    seed: int
+    metrics: dict[str, Any]
+    trajectory: dict[str, np.ndarray]
+
+    def row(self) -> dict[str, Any]:
+        return {
+            "scenario": self.scenario,
+            "controller": self.controller,
+            "kind": self.kind,
+            "seed": self.seed,
+            **self.metrics,
+        }
+
+
+def run_episode(
+    policy: Policy,
+    scenario: Any,
+    seed: int,
+    action_mode: str = "rudder",
+    env_id: str = ENV_ID,
+) -> EpisodeResult:
+    """Run one episode; the policy sees only obs, info and the controller context."""
+    env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+    try:
+        obs, info = env.reset(seed=seed)
+        base = env.unwrapped
+        policy.reset(base.controller_context, seed=seed)
+        act_times: list[float] = []
+        rows: list[tuple[float, ...]] = [_traj_row(info)]
+        while True:
+            start = time.perf_counter()
+            action = policy.act(obs, info)
+            act_times.append(time.perf_counter() - start)
+            obs, _reward, terminated, truncated, info = env.step(action)
+            rows.append(_traj_row(info))
+            if terminated or truncated:
+                break
+        metrics = dict(info["episode_metrics"])
+        metrics["termination_reason"] = info.get("termination_reason")
+        # controller compute time = time spent in act(), measured here
+        metrics["compute_ms"] = 1e3 * float(np.mean(act_times))
+        metrics["compute_ms_max"] = 1e3 * float(np.max(act_times))
+        traj = np.array(rows)
+        trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
+        return EpisodeResult(
+            controller=policy.name,
+            kind=policy.kind,
+            scenario=base.scenario.name,
+            seed=seed,
+            metrics=metrics,
+            trajectory=trajectory,
+        )
+    finally:
+        env.close()
+
+
+_TRAJ_KEYS = ("t", "x", "y", "cross_track_error", "heading", "rudder_angle", "rudder_command")
+
+
+def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:
+    x, y = info["position"]
+    return (
+        info["t"],
+        x,
+        y,
+        info["cross_track_error"],
+        info["heading"],
+        info["rudder_angle"],
+        info["rudder_command"],
+    )
+
+
+def evaluate(
+    controller: str | Policy, scenario: Any, seeds: list[int], **settings: Any
+) -> list[EpisodeResult]:
+    """Evaluate a controller (registry name or Policy instance) on a scenario over seeds."""
+    results = []
+    for seed in seeds:
+        if isinstance(controller, str):
+            policy, mode = make_controller(controller, **settings)
+        else:
+            policy, mode = controller, settings.get("action_mode", "rudder")
+        results.append(run_episode(policy, scenario, seed, mode))
+    return results

@@ -1,0 +1,229 @@
+"""The leaderboard: every controller on every suite scenario × seeds, one table (SPEC §9).
+
+Jobs are independent (controller, scenario, seed) tasks.  ``local`` runs them in a process
+pool; ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import sys
+from collections.abc import Callable, Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from tqdm import tqdm
+
+from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
+from shipgym.metrics import aggregate
+
+REPO = Path(__file__).resolve().parents[1]
+SUITE_DIR = REPO / "configs" / "suites"
+
+#: metric columns aggregated over seeds (mean and *_std)
+COLUMNS = (
+    "ace",
+    "ace_L",
+    "t_c",
+    "return",
+    "rudder_travel",
+    "J",
+    "success",
+    "compute_ms",
+    "mean_abs_cross_track",
+    "max_abs_cross_track",
+)
+
+
+def list_suites() -> list[str]:
+    return sorted(p.stem for p in SUITE_DIR.glob("*.yaml"))
+
+
+def load_suite(name_or_path: str) -> dict[str, Any]:
+    path = Path(name_or_path)
+    if not path.suffix:
+        path = SUITE_DIR / f"{name_or_path}.yaml"
+        if not path.is_file():
+            raise ValueError(f"unknown suite {name_or_path!r}; valid: {', '.join(list_suites())}")
+    if not path.is_file():
+        raise ValueError(f"suite file not found: {path}")
+    suite = yaml.safe_load(path.read_text())
+    for key in ("scenarios", "controllers"):
+        if not isinstance(suite, dict) or not isinstance(suite.get(key), list):
+            raise ValueError(f"{path}: key '{key}' must be a list")
+    return suite
+
+
+def run_job(job: tuple[str, str, int]) -> EpisodeResult:
+    """One (controller, scenario, seed) episode; top-level so process pools can pickle it."""
+    controller, scenario, seed = job
+    return evaluate(controller, scenario, [seed])[0]
+
+
+def _run_local(jobs: list, workers: int, progress: Callable[[], None]) -> list[EpisodeResult]:
+    if workers <= 1:
+        out = []
+        for job in jobs:
+            out.append(run_job(job))
+            progress()
+        return out
+    out = []
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        for fut in as_completed([pool.submit(run_job, j) for j in jobs]):
+            out.append(fut.result())
+            progress()
+    return out
+
+
+def _run_ray(jobs: list, progress: Callable[[], None]) -> list[EpisodeResult]:
+    try:
+        import ray
+    except ImportError as exc:
+        raise RuntimeError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
+    if not ray.is_initialized():
+        ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
+    remote = ray.remote(run_job)
+    pending = [remote.remote(j) for j in jobs]
+    out = []
+    while pending:
+        done, pending = ray.wait(pending)
+        out.extend(ray.get(done))
+        for _ in done:
+            progress()
+    return out
+
+
+def run_leaderboard(
+    suite: str = "default",
+    seeds: int | None = None,
+    out_dir: str | os.PathLike = "results/leaderboard",
+    backend: str = "local",
+    workers: int | None = None,
+    controllers: Iterable[str] | None = None,
+    show_progress: bool = True,
+) -> list[dict[str, Any]]:
+    """Run the suite, write leaderboard.{md,csv,json} and plots; return the aggregate rows."""
+    spec = load_suite(suite)
+    n_seeds = int(seeds if seeds is not None else spec.get("seeds", 5))
+    if n_seeds < 1:
+        raise ValueError(f"--seeds must be ≥ 1, got {n_seeds}")
+    names = list(controllers) if controllers else list(spec["controllers"])
+    seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
+    jobs = [(c, s, seed) for s in spec["scenarios"] for c in names for seed in seed_list]
+    bar = tqdm(total=len(jobs), desc="leaderboard", file=sys.stderr, disable=not show_progress)
+    if backend == "local":
+        results = _run_local(jobs, workers or os.cpu_count() or 1, lambda: bar.update(1))
+    elif backend == "ray":
+        results = _run_ray(jobs, lambda: bar.update(1))
+    else:
+        raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
+    bar.close()
+    rows = aggregate_results(results, spec["scenarios"], names)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_tables(rows, out)
+    plot_results(results, out)
+    return rows
+
+
+def aggregate_results(
+    results: list[EpisodeResult], scenarios: list[str], controllers: list[str]
+) -> list[dict[str, Any]]:
+    rows = []
+    for scenario in scenarios:
+        for controller in controllers:
+            group = [r for r in results if r.scenario == scenario and r.controller == controller]
+            if not group:
+                continue
+            agg = aggregate([r.metrics for r in group], COLUMNS)
+            rows.append(
+                {
+                    "scenario": scenario,
+                    "controller": controller,
+                    "kind": group[0].kind,
+                    "seeds": len(group),
+                    **{k: v for k, v in agg.items() if k != "n"},
+                }
+            )
+    return rows
+
+
+def _fmt(value: Any, std: Any = None) -> str:
+    if isinstance(value, float):
+        if math.isinf(value):
+            return "never" if value > 0 else "-inf"
+        if math.isnan(value):
+            return "–"
+        text = f"{value:.3f}"
+        if isinstance(std, float) and math.isfinite(std):
+            text += f" ± {std:.3f}"
+        return text
+    return str(value)
+
+
+def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
+    (out / "leaderboard.json").write_text(json.dumps(rows, indent=2))
+    keys = list(rows[0].keys()) if rows else []
+    with open(out / "leaderboard.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=keys)
+        writer.writeheader()
+        writer.writerows(rows)
+    (out / "leaderboard.md").write_text(markdown_table(rows))
+
+
+def markdown_table(rows: list[dict[str, Any]]) -> str:
+    head = ["scenario", "controller", "kind", "ACE [m]", "ACE/L", "t_c [s]", "return",
+            "rudder travel [rad]", "J", "success", "compute [ms]"]
+    keys = ["ace", "ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        cells = [r["scenario"], r["controller"], r["kind"]]
+        cells += [_fmt(r[k], r.get(f"{k}_std")) for k in keys]
+        lines.append("| " + " | ".join(cells) + " |")
+    note = (
+        "\nMean ± std over seeds. t_c: moment (s of simulation time) from which |e| stays "
+        "below the threshold after the first parameter change; 'never' when it does not.\n"
+    )
+    return "\n".join(lines) + "\n" + note
+
+
+def plot_results(results: list[EpisodeResult], out: Path) -> None:
+    """Per scenario: tracks over the path, e(t) and δ(t) of the first seed of each controller."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from shipgym.scenarios import load_scenario
+
+    for scenario in sorted({r.scenario for r in results}):
+        sc = load_scenario(scenario)
+        first: dict[str, EpisodeResult] = {}
+        for r in sorted(results, key=lambda r: r.seed):
+            if r.scenario == scenario:
+                first.setdefault(r.controller, r)
+        fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+        pts = sc.path.point(np.linspace(0, sc.path.length, 300))
+        axes[0].plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="path")
+        for name, r in first.items():
+            tr = r.trajectory
+            axes[0].plot(tr["x"], tr["y"], lw=1, label=name)
+            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=name)
+            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=name)
+        if sc.change_time is not None:
+            for ax in axes[1:]:
+                ax.axvline(sc.change_time, color="gray", ls=":", lw=1)
+        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=f"{scenario}: tracks")
+        axes[0].set_aspect("equal", adjustable="datalim")
+        axes[1].set(xlabel="t [s]", ylabel="e [m]", title="cross-track error")
+        axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
+        axes[0].legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / f"{scenario}.png", dpi=90)
+        plt.close(fig)

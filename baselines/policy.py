@@ -1,0 +1,25 @@
+"""The one policy interface every controller and agent implements (SPEC §8)."""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from shipgym.envs.context import ControllerContext
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """A controller: ``reset`` once per episode with what it may know, ``act`` every step.
+
+    ``act`` receives the observation and the env's ``info`` (measurements, samples); it
+    never sees the true plant parameters or the event schedule.
+    """
+
+    name: str
+    kind: str  # "classical" | "learned" | "reference"
+
+    def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray: ...
