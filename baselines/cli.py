@@ -56,8 +56,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
         sys.stderr.write(f"shipgym bench: unknown target {args.target!r}; available: env\n")
         return 2
     figures = bench_env(repeats=args.repeats)
-    text = "\n".join(f"{k:34s} {v:,.3f}" if isinstance(v, float) else f"{k:34s} {v}"
-                     for k, v in figures.items())
+    text = "\n".join(
+        f"{k:34s} {v:,.3f}" if isinstance(v, float) else f"{k:34s} {v}" for k, v in figures.items()
+    )
     _emit(args, figures, text)
     return 0
 

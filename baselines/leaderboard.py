@@ -178,8 +178,19 @@ def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
 
 
 def markdown_table(rows: list[dict[str, Any]]) -> str:
-    head = ["scenario", "controller", "kind", "ACE [m]", "ACE/L", "t_c [s]", "return",
-            "rudder travel [rad]", "J", "success", "compute [ms]"]
+    head = [
+        "scenario",
+        "controller",
+        "kind",
+        "ACE [m]",
+        "ACE/L",
+        "t_c [s]",
+        "return",
+        "rudder travel [rad]",
+        "J",
+        "success",
+        "compute [ms]",
+    ]
     keys = ["ace", "ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:

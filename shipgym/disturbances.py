@@ -34,9 +34,17 @@ class SensorModel:
         self.sigma_psi = config.heading_noise_deg * DEG
         self.sigma_r = config.yaw_rate_noise_deg_s * DEG
         self.p_outlier = config.outlier_probability
-        self.outlier_range = (config.outlier_magnitude_deg[0] * DEG, config.outlier_magnitude_deg[1] * DEG)
+        self.outlier_range = (
+            config.outlier_magnitude_deg[0] * DEG,
+            config.outlier_magnitude_deg[1] * DEG,
+        )
         self.p_dropout = config.dropout_probability
-        self.ideal = self.sigma_psi == 0 and self.sigma_r == 0 and self.p_outlier == 0 and self.p_dropout == 0
+        self.ideal = (
+            self.sigma_psi == 0
+            and self.sigma_r == 0
+            and self.p_outlier == 0
+            and self.p_dropout == 0
+        )
         self._last: tuple[float, float] | None = None
 
     def reset(self) -> None:

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -69,7 +69,7 @@ GUIDANCE_OFFSET_MAX = math.radians(30.0)
 class ShipPathFollowEnv(gym.Env):
     """Path following of one ship under scheduled parameter changes (see module doc)."""
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
 
     def __init__(
         self,
@@ -97,7 +97,7 @@ class ShipPathFollowEnv(gym.Env):
         self._h = sc.fine_step
         self._n = sc.substeps
         self._e_max = sc.max_cross_track
-        self._max_steps = int(math.ceil(sc.config.time_limit / self._Ts - 1e-9))
+        self._max_steps = math.ceil(sc.config.time_limit / self._Ts - 1e-9)
         self._integrator = PeriodIntegrator(self.model, self._h, self._n, jit=jit)
         self._sensor = SensorModel(sc.config.sensors)
         self._tracker = PathTracker(sc.path, sc.acceptance_radius, sc.config.path.switching)
@@ -120,7 +120,9 @@ class ShipPathFollowEnv(gym.Env):
         self._w_delta = weights.rudder_weight
         self._w_rate = weights.rudder_rate_weight
         self._goal_bonus = weights.goal_bonus
-        self._metric_settings = MetricSettings(convergence_threshold=sc.config.convergence_threshold)
+        self._metric_settings = MetricSettings(
+            convergence_threshold=sc.config.convergence_threshold
+        )
         if action_mode == "rudder":
             self.action_space = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
         else:
@@ -226,11 +228,15 @@ class ShipPathFollowEnv(gym.Env):
         x = self._state
         px, py = float(x[self._ix]), float(x[self._iy])
         self._track.append((px, py))
-        psi, r, delta = float(x[self._ipsi]), float(x[self._ir]), float(x[self._idelta])
+        psi, delta = float(x[self._ipsi]), float(x[self._idelta])
         # --- sensors
-        psi_m, r_m = self._sensor.measure(states[:, self._ipsi], states[:, self._ir], self.np_random)
+        psi_m, r_m = self._sensor.measure(
+            states[:, self._ipsi], states[:, self._ir], self.np_random
+        )
         self._psi_m, self._r_m = float(psi_m[-1]), float(r_m[-1])
-        self._speed = math.hypot(xs[-1] - xs[-2], ys[-1] - ys[-2]) / self._h if self._n > 1 else self._u0
+        self._speed = (
+            math.hypot(xs[-1] - xs[-2], ys[-1] - ys[-2]) / self._h if self._n > 1 else self._u0
+        )
         # --- path
         frame = self._tracker.update(px, py)
         e = frame.cross_track
@@ -343,10 +349,12 @@ class ShipPathFollowEnv(gym.Env):
             "samples": samples,
         }
 
-    def _non_finite_step(self, frame: Any, delta_c: float):  # noqa: ANN202
+    def _non_finite_step(self, frame: Any, delta_c: float):
         """The plant produced NaN/inf: keep the last finite state and terminate with a reason."""
         reward = -(self._e_max / self._L) * (self._max_steps - self._step_count + 1)
-        info = self._info(frame, {k: np.zeros(0) for k in ("t", "psi", "r", "delta", "delta_c", "e")})
+        info = self._info(
+            frame, {k: np.zeros(0) for k in ("t", "psi", "r", "delta", "delta_c", "e")}
+        )
         info["termination_reason"] = "non_finite_state"
         if self._records:
             info["episode_metrics"] = self.episode_metrics()

@@ -55,7 +55,7 @@ class Scenario:
         return self.config.name
 
     @property
-    def nominal_params(self):  # noqa: ANN201 - the model's ParameterRecord type
+    def nominal_params(self):
         return self.schedule.nominal
 
     @property
@@ -87,7 +87,7 @@ class Scenario:
     def change_time(self) -> float | None:
         return self.schedule.first_change_time
 
-    def initial_state(self):  # noqa: ANN201
+    def initial_state(self):
         cfg = self.config.initial_state
         values = {"x": cfg.x, "y": cfg.y, "psi": cfg.heading_deg * DEG, **cfg.states}
         return self.model.initial_state(**values)
@@ -142,7 +142,9 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
 
 def scenario_from_dict(data: Any, origin: str = "<dict>") -> Scenario:
     if not isinstance(data, dict):
-        raise ScenarioError(f"{origin}: expected a mapping at the top level, got {type(data).__name__}")
+        raise ScenarioError(
+            f"{origin}: expected a mapping at the top level, got {type(data).__name__}"
+        )
     try:
         config = ScenarioConfig.model_validate(data)
     except ValidationError as exc:
