@@ -24,9 +24,11 @@ def render_frame(env: Any, fig: Any, mode: str) -> tuple[Any, np.ndarray | None]
     import matplotlib
 
     if mode == "rgb_array" and fig is None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
         fig = Figure(figsize=(6, 4.5), dpi=80)
+        FigureCanvasAgg(fig)
     elif fig is None:
         import matplotlib.pyplot as plt
 

@@ -1,0 +1,102 @@
+"""Baselines, the evaluation loop, the leaderboard and the CLI contract (SPEC §8, §9, §9b)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from baselines.cli import main
+from baselines.classical.pid import PIDLOS
+from baselines.evaluation import evaluate, run_episode
+from baselines.leaderboard import run_leaderboard
+from baselines.registry import make_controller
+from shipgym.autopilot import HeadingPID, PIDGains
+
+
+def test_pid_gains_place_closed_loop_poles() -> None:
+    """Pole placement on T·ṙ + r = Kδ: the closed loop has a double pole at −ωn (ζ = 1)."""
+    K, T, wn = 0.5, 1.5, 0.8
+    g = PIDGains.from_nomoto(K, T, natural_frequency=wn, damping=1.0)
+    # characteristic polynomial of T s² + (1 + K kd) s + K kp
+    poles = np.roots([T, 1 + K * g.kd, K * g.kp])
+    np.testing.assert_allclose(poles, [-wn, -wn], atol=1e-6)
+
+
+def test_heading_pid_saturates_and_does_not_wind_up() -> None:
+    pid = HeadingPID(PIDGains(kp=2.0, ki=1.0, kd=0.0), rudder_limit=0.5)
+    for _ in range(100):
+        assert pid.command(1.0, 0.0, 0.0, 0.5) == pytest.approx(0.5)
+    assert pid.integral == 0.0  # conditional integration: no windup while saturated
+
+
+def test_pid_los_follows_nominal_path_to_the_goal() -> None:
+    (result,) = evaluate("pid_los", "nominal", seeds=[0])
+    m = result.metrics
+    assert m["success"] is True
+    assert m["termination_reason"] == "goal"
+    # the path is 37 m long at 0.8 m/s: the goal is reached in well under the time limit
+    assert m["duration"] < 70.0
+    # far better than doing nothing
+    (zero,) = evaluate("zero_rudder", "nominal", seeds=[0])
+    assert m["ace"] < 0.5 * zero.metrics["ace"]
+
+
+def test_pid_los_sees_no_truth() -> None:
+    """The controller context carries the nominal model only, not the post-event parameters."""
+    policy = PIDLOS()
+    result = run_episode(policy, "rudder_aging", seed=0)
+    assert policy.ctx.nominal_params.Tc == pytest.approx(0.1)
+    assert not hasattr(policy.ctx, "schedule")
+    assert result.metrics["steps"] > 0
+
+
+def test_unknown_controller_lists_valid_names() -> None:
+    with pytest.raises(KeyError, match="pid_los"):
+        make_controller("nope")
+
+
+def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
+    rows = run_leaderboard("default", seeds=2, out_dir=tmp_path, workers=2, show_progress=False)
+    for name in ("leaderboard.md", "leaderboard.csv", "leaderboard.json"):
+        assert (tmp_path / name).is_file()
+    on_disk = json.loads((tmp_path / "leaderboard.json").read_text())
+    assert len(on_disk) == len(rows) == 4 * 3
+    required = {"scenario", "controller", "kind", "ace", "ace_L", "t_c", "return", "success",
+                "compute_ms", "ace_std", "t_c_std", "return_std", "compute_ms_std"}
+    for row in on_disk:
+        assert required <= set(row)
+        assert row["kind"] in ("classical", "learned", "reference")
+    pid = {r["scenario"]: r for r in on_disk if r["controller"] == "pid_los"}
+    zero = {r["scenario"]: r for r in on_disk if r["controller"] == "zero_rudder"}
+    for scenario in pid:
+        assert pid[scenario]["ace"] < zero[scenario]["ace"]
+    assert (tmp_path / "rudder_aging.png").is_file()
+
+
+def test_cli_scenarios_json(capsys) -> None:
+    assert main(["scenarios", "--json"]) == 0
+    names = json.loads(capsys.readouterr().out)
+    assert {"nominal", "rudder_aging", "current_shift", "maneuverability_change"} <= set(names)
+
+
+def test_cli_leaderboard_json_is_one_document(tmp_path, capsys) -> None:
+    code = main(["leaderboard", "--seeds", "1", "--out", str(tmp_path), "--json", "--no-progress"])
+    assert code == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert isinstance(rows, list) and rows
+    assert all(isinstance(r["ace"], float) and math.isfinite(r["ace"]) for r in rows)
+
+
+def test_cli_bench_env_json(capsys) -> None:
+    assert main(["bench", "env", "--repeats", "1", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["single_env_steps_per_s"] > 0
+    assert figures["batched_env_steps_per_s"] > 0
+
+
+def test_cli_bad_suite_is_a_clear_error(capsys) -> None:
+    assert main(["leaderboard", "--suite", "nope", "--no-progress"]) == 2
+    assert "valid: default" in capsys.readouterr().err
