@@ -64,8 +64,21 @@ def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
         assert (tmp_path / name).is_file()
     on_disk = json.loads((tmp_path / "leaderboard.json").read_text())
     assert len(on_disk) == len(rows) == 4 * 3
-    required = {"scenario", "controller", "kind", "ace", "ace_L", "t_c", "return", "success",
-                "compute_ms", "ace_std", "t_c_std", "return_std", "compute_ms_std"}
+    required = {
+        "scenario",
+        "controller",
+        "kind",
+        "ace",
+        "ace_L",
+        "t_c",
+        "return",
+        "success",
+        "compute_ms",
+        "ace_std",
+        "t_c_std",
+        "return_std",
+        "compute_ms_std",
+    }
     for row in on_disk:
         assert required <= set(row)
         assert row["kind"] in ("classical", "learned", "reference")
@@ -100,3 +113,21 @@ def test_cli_bench_env_json(capsys) -> None:
 def test_cli_bad_suite_is_a_clear_error(capsys) -> None:
     assert main(["leaderboard", "--suite", "nope", "--no-progress"]) == 2
     assert "valid: default" in capsys.readouterr().err
+
+
+def test_guidance_mode_with_zero_action_is_pid_los() -> None:
+    """The env's internal autopilot (guidance mode, a = 0) is the pid_los baseline, step for step."""
+    import gymnasium as gym
+
+    pid = run_episode(PIDLOS(), "rudder_aging", seed=3)
+    env = gym.make("ShipPathFollow-v0", scenario="rudder_aging", action_mode="guidance")
+    env.reset(seed=3)
+    commands = []
+    while True:
+        _, _, terminated, truncated, info = env.step(np.zeros(2, dtype=np.float32))
+        commands.append(info["rudder_command"])
+        if terminated or truncated:
+            break
+    # pid_los passes δc/δmax through a float32 action: equal to float32 resolution
+    assert len(commands) == len(pid.trajectory["rudder_command"]) - 1
+    np.testing.assert_allclose(commands, pid.trajectory["rudder_command"][1:], atol=1e-6)
