@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from baselines.cli import main
 from baselines.classical.pid import PIDLOS
+from baselines.cli import main
 from baselines.evaluation import evaluate, run_episode
 from baselines.leaderboard import run_leaderboard
 from baselines.registry import make_controller
@@ -116,7 +116,7 @@ def test_cli_bad_suite_is_a_clear_error(capsys) -> None:
 
 
 def test_guidance_mode_with_zero_action_is_pid_los() -> None:
-    """The env's internal autopilot (guidance mode, a = 0) is the pid_los baseline, step for step."""
+    """The env's autopilot (guidance mode, a = 0) is the pid_los baseline, step for step."""
     import gymnasium as gym
 
     pid = run_episode(PIDLOS(), "rudder_aging", seed=3)
