@@ -29,7 +29,7 @@ class PeriodIntegrator:
     def __init__(self, model: ShipModel, h: float, n_sub: int, jit: bool = False) -> None:
         if h <= 0 or n_sub < 1:
             raise ValueError(f"need h > 0 and n_sub ≥ 1, got h={h}, n_sub={n_sub}")
-        self.model, self.h, self.n_sub = model, float(h), int(n_sub)
+        self.model, self.h, self.n_sub, self.jit = model, float(h), int(n_sub), jit
         step = model.casadi_step(h)
         nx, nw, npar = model.n_states, model.n_disturbances, model.n_params
         x0 = ca.SX.sym("x0", nx)
@@ -68,7 +68,7 @@ class PeriodIntegrator:
         return self._out.copy()
 
     def __getstate__(self) -> dict:
-        return {"model": self.model, "h": self.h, "n_sub": self.n_sub}
+        return {"model": self.model, "h": self.h, "n_sub": self.n_sub, "jit": self.jit}
 
     def __setstate__(self, state: dict) -> None:
-        self.__init__(state["model"], state["h"], state["n_sub"])
+        self.__init__(state["model"], state["h"], state["n_sub"], state["jit"])
