@@ -120,13 +120,13 @@ def test_step_numpy_matches_solve_ivp_reference(which: str) -> None:
     model = Nomoto2(params)
     p_vec = params.to_vector()
     s0 = np.array([0.0, 0.0, 0.3, 0.0, 0.0, 0.0])
-    n_steps = int(round(20.0 / H))
+    n_steps = round(20.0 / H)
     times = H * np.arange(1, n_steps + 1)
     ref = reference_solution(si_dict(params), s0, times)
     x = s0.copy()
     states = np.empty((n_steps, 6))
     w = np.zeros(3)
-    steps_per_segment = int(round(SEGMENT / H))
+    steps_per_segment = round(SEGMENT / H)
     for i in range(n_steps):
         dc = COMMANDS_DEG[i // steps_per_segment] * DEG
         x = model.step_numpy(x, np.array([dc]), w, p_vec, H)
@@ -145,12 +145,12 @@ def test_period_integrator_matches_solve_ivp_reference(which: str) -> None:
     model = Nomoto2(params)
     integ = PeriodIntegrator(model, H, N_SUB)
     s0 = np.array([1.0, -2.0, -0.2, 0.01, 0.0, 5 * DEG])
-    n_periods = int(round(20.0 / (H * N_SUB)))
+    n_periods = round(20.0 / (H * N_SUB))
     times = H * np.arange(1, n_periods * N_SUB + 1)
     ref = reference_solution(si_dict(params), s0, times)
     w_block = np.zeros((N_SUB, 3))
     p_block = np.tile(params.to_vector(), (N_SUB, 1))
-    periods_per_segment = int(round(SEGMENT / (H * N_SUB)))
+    periods_per_segment = round(SEGMENT / (H * N_SUB))
     x = s0.copy()
     out = []
     for k in range(n_periods):
@@ -354,7 +354,7 @@ def simulate_steady_rates(params: Nomoto2Params, rudders: np.ndarray, seconds: f
     u = rudders.reshape(1, n)
     w = np.zeros((3, n))
     p = np.tile(params.to_vector()[:, None], (1, n))
-    for _ in range(int(round(seconds / H))):
+    for _ in range(round(seconds / H)):
         x = model.step_numpy(x, u, w, p, H)
     return x[3]
 

@@ -221,7 +221,7 @@ class ShipPathFollowEnv(gym.Env):
         self._t = self._step_count * self._Ts
         self._delta_c = delta_c
         if not np.all(np.isfinite(states)):
-            return self._non_finite_step(frame, delta_c)
+            return self._non_finite_step(frame, delta_c, compute_time)
         xs, ys = states[:, self._ix], states[:, self._iy]
         e_samples = self._tracker.cross_track_of(xs, ys)
         self._state = states[-1]
@@ -349,15 +349,30 @@ class ShipPathFollowEnv(gym.Env):
             "samples": samples,
         }
 
-    def _non_finite_step(self, frame: Any, delta_c: float):
-        """The plant produced NaN/inf: keep the last finite state and terminate with a reason."""
+    def _non_finite_step(self, frame: Any, delta_c: float, compute_time: float):
+        """The plant produced NaN/inf: keep the last finite state and terminate with a reason.
+
+        The penalty is that of leaving the corridor; the step is logged like any other, so
+        ``episode_metrics`` count it.  ``info["samples"]`` is empty (no valid samples).
+        """
         reward = -(self._e_max / self._L) * (self._max_steps - self._step_count + 1)
+        x = self._state
+        self._records.append(
+            {
+                "t": self._t,
+                "cross_track_error": frame.cross_track,
+                "heading_error": float(wrap_angle(float(x[self._ipsi]) - frame.path_angle)),
+                "rudder_angle": float(x[self._idelta]),
+                "rudder_command": delta_c,
+                "reward": reward,
+                "compute_time": compute_time,
+            }
+        )
         info = self._info(
             frame, {k: np.zeros(0) for k in ("t", "psi", "r", "delta", "delta_c", "e")}
         )
         info["termination_reason"] = "non_finite_state"
-        if self._records:
-            info["episode_metrics"] = self.episode_metrics()
+        info["episode_metrics"] = self.episode_metrics()
         self._last_return_time = time.perf_counter()
         return self._observation(frame), float(reward), True, False, info
 
