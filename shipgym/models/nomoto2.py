@@ -128,7 +128,7 @@ class Nomoto2(ShipModel):
             + w[2]
             - (p.T1 + p.T2) * r_dot
             - r
-            - p.beta * r**3
+            - p.beta * r * r * r
         ) / (p.T1 * p.T2)
         return ops.stack(
             [
