@@ -1,0 +1,180 @@
+"""Nomoto regressors and parameter extraction (Liu et al. 2019 §3.1.2, eq. (31)–(42)).
+
+Forward differences of order n at spacing h (eq. (32)) turn the 2nd-order nonlinear Nomoto
+model (1) and the rudder servo (2) into two linear regressions y = θᵀx:
+
+* eq. (35)–(36):  y1 = Δ³ψ,  x1 = [−hΔ²ψ, h³δ, h³, −h²Δψ, −(Δψ)³, h²Δδ],
+                  θ1 = [T1+T2, K, d0, 1, β, K·T3] / (T1·T2);
+* eq. (37):       y2 = (δc − δ)·h,  x2 = Δδ,  θ2 = Tc;
+
+and the parameters follow from θ1 by the algebra after eq. (42) (T1 > T2 root).
+
+Forward-difference bias (h = 0.01 s).  Δⁿf(t)/hⁿ = f⁽ⁿ⁾(t + nh/2) + O(h²): the terms of
+(33) are evaluated at t + 1.5h, t + h, t + h/2 and t, so the regression is consistent only
+to O(h).  For the servo, with δc held over a fine step the exact update is
+Δδ = (δc − δ)(1 − e^{−h/Tc}), so eq. (34) estimates θ2 = h/(1 − e^{−h/Tc}) ≈ Tc + h/2:
++5.1 % at Tc = 0.1 s, +0.5 % at Tc = 1 s.  ``servo_model="exact"`` inverts that relation,
+Tc = −h / ln(1 − h/θ2), and is exact for a piecewise-constant command; ``"forward"`` is the
+paper's eq. (34) as written.  All angles in rad, rates in rad/s, SI parameters.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from shipgym.identification.lssvm import LSSVMSolution, lssvm_primal, weighted_lssvm
+from shipgym.models.nomoto2 import Nomoto2Params
+
+#: γ of Liu et al. (2019) §4
+GAMMA = 1e15
+
+
+class IdentificationError(ValueError):
+    """The data cannot identify the model (degenerate, too short, non-physical result)."""
+
+
+def forward_difference(f: np.ndarray, order: int) -> np.ndarray:
+    """Δⁿ_h[f](t_k) = Σ_i (−1)^i C(n, i) f(t_k + (n − i)h), eq. (32); length len(f) − n."""
+    f = np.asarray(f, dtype=float)
+    if order == 0:
+        return f.copy()
+    n = f.shape[0] - order
+    out = np.zeros(n)
+    for i in range(order + 1):
+        out += (-1) ** i * math.comb(order, i) * f[order - i : order - i + n]
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class NomotoRegression:
+    """Regression data of eq. (35)–(37), one row per time t_k with ψ(t_k … t_k+3h) known."""
+
+    y1: np.ndarray  # (n,) Δ³ψ
+    x1: np.ndarray  # (n, 6)
+    y2: np.ndarray  # (n,) (δc − δ)·h
+    x2: np.ndarray  # (n, 1) Δδ
+
+
+def nomoto_regressors(
+    psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray, h: float
+) -> NomotoRegression:
+    """Build eq. (35)–(37) from heading ψ [rad], rudder δ and command δc [rad] at spacing h [s]."""
+    psi = np.asarray(psi, dtype=float)
+    delta = np.asarray(delta, dtype=float)
+    delta_c = np.asarray(delta_c, dtype=float)
+    if not (psi.shape == delta.shape == delta_c.shape) or psi.ndim != 1:
+        raise IdentificationError("psi, delta and delta_c must be 1-D arrays of equal length")
+    if psi.shape[0] < 4:
+        raise IdentificationError(f"need at least 4 samples for Δ³ψ, got {psi.shape[0]}")
+    n = psi.shape[0] - 3
+    d1 = forward_difference(psi, 1)[:n]
+    d2 = forward_difference(psi, 2)[:n]
+    d3 = forward_difference(psi, 3)
+    dd = forward_difference(delta, 1)[:n]
+    x1 = np.column_stack(
+        [-h * d2, h**3 * delta[:n], np.full(n, h**3), -(h**2) * d1, -(d1**3), h**2 * dd]
+    )
+    y2 = (delta_c[:n] - delta[:n]) * h
+    return NomotoRegression(d3, x1, y2, dd[:, None])
+
+
+def theta1_from_params(p: Nomoto2Params) -> np.ndarray:
+    """θ1 of eq. (36) from parameters."""
+    return np.array([p.T1 + p.T2, p.K, p.d0, 1.0, p.beta, p.K * p.T3]) / (p.T1 * p.T2)
+
+
+def params_from_theta1(theta1: np.ndarray) -> dict[str, float]:
+    """K, T1, T2, T3, d0, β from θ1 (Liu et al. 2019, after eq. (42), T1 > T2).
+
+    Raises IdentificationError for a non-physical θ1 (θ1(4) ≤ 0, complex T1/T2, K = 0).
+    """
+    t = np.asarray(theta1, dtype=float)
+    if not np.all(np.isfinite(t)):
+        raise IdentificationError("θ1 is not finite")
+    if t[3] <= 0:
+        raise IdentificationError(f"θ1(4) = 1/(T1·T2) = {t[3]:.3g} ≤ 0")
+    disc = t[0] ** 2 - 4.0 * t[3]
+    if disc < 0:
+        raise IdentificationError(f"T1, T2 complex: θ1(1)² − 4θ1(4) = {disc:.3g} < 0")
+    if t[1] == 0:
+        raise IdentificationError("K = 0: the rudder has no effect in the data")
+    root = math.sqrt(disc)
+    return {
+        "K": t[1] / t[3],
+        "T1": (t[0] + root) / (2.0 * t[3]),
+        "T2": (t[0] - root) / (2.0 * t[3]),
+        "T3": t[5] / t[1],
+        "d0": t[2] / t[3],
+        "beta": t[4] / t[3],
+    }
+
+
+def tc_from_theta2(theta2: float, h: float, servo_model: str = "forward") -> float:
+    """Tc from θ2 of eq. (37): as estimated (``forward``) or ZOH-corrected (``exact``)."""
+    if not theta2 > 0:
+        raise IdentificationError(f"θ2 = Tc = {theta2:.3g} ≤ 0")
+    if servo_model == "forward":
+        return float(theta2)
+    if servo_model == "exact":
+        if theta2 <= h:
+            raise IdentificationError(f"θ2 = {theta2:.3g} ≤ h: no exact servo time constant")
+        return -h / math.log(1.0 - h / theta2)
+    raise ValueError(f"servo_model must be 'forward' or 'exact', got {servo_model!r}")
+
+
+def solve_theta(
+    x: np.ndarray,
+    y: np.ndarray,
+    gamma: float = GAMMA,
+    weighted: bool = True,
+    bias_penalty: bool = True,
+    prior_weights: np.ndarray | None = None,
+) -> tuple[LSSVMSolution, np.ndarray]:
+    """θ̂ of one sub-model by (weighted) bias-penalised LS-SVM, primal solve (eq. (39)–(42))."""
+    if weighted:
+        return weighted_lssvm(x, y, gamma, bias_penalty, prior_weights=prior_weights)
+    sol = lssvm_primal(x, y, gamma, prior_weights, bias_penalty)
+    return sol, np.ones_like(y) if prior_weights is None else np.asarray(prior_weights)
+
+
+def _check_excitation(reg: NomotoRegression) -> None:
+    if np.ptp(reg.x1[:, 1]) == 0.0:
+        raise IdentificationError(
+            "the rudder angle is constant over the data: no persistent excitation (eq. (45))"
+        )
+    if not np.any(reg.x2[:, 0] != 0.0):
+        raise IdentificationError("the rudder never moves: Tc is not identifiable")
+
+
+def fit_nomoto2(
+    psi: np.ndarray,
+    delta: np.ndarray,
+    delta_c: np.ndarray,
+    h: float,
+    *,
+    gamma: float = GAMMA,
+    weighted: bool = True,
+    bias_penalty: bool = True,
+    servo_model: str = "forward",
+    base: Nomoto2Params | None = None,
+) -> Nomoto2Params:
+    """Batch fit of the nomoto2 parameters from sampled ψ, δ, δc [rad] at spacing h [s].
+
+    Liu et al. (2019) eq. (31)–(42): weighted (robust) bias-penalised LS-SVM with a linear
+    kernel, solved in its primal form.  Returns a :class:`Nomoto2Params` in SI units (u0, L,
+    Kc from ``base``).  Raises IdentificationError (naming the reason) on degenerate data.
+    """
+    reg = nomoto_regressors(psi, delta, delta_c, h)
+    _check_excitation(reg)
+    sol1, _ = solve_theta(reg.x1, reg.y1, gamma, weighted, bias_penalty)
+    sol2, _ = solve_theta(reg.x2, reg.y2, gamma, weighted, bias_penalty)
+    values = params_from_theta1(sol1.theta)
+    values["Tc"] = tc_from_theta2(float(sol2.theta[0]), h, servo_model)
+    base = base if base is not None else Nomoto2Params()
+    try:
+        return base.replace(**values)
+    except ValueError as exc:
+        raise IdentificationError(f"identified parameters are not physical: {exc}") from exc
