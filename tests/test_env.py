@@ -345,22 +345,26 @@ def test_info_keys_and_types(case: tuple) -> None:
     assert info["t"] == 0.0
     assert "episode_metrics" not in info
     actions = seeded_actions(env.action_space, 40, seed=3)
-    prev_leg = info["waypoint_index"]
+    assert all(len(v) == 0 for v in info["samples"].values())  # no period integrated yet
+    prev = info
     for k, a in enumerate(actions, start=1):
         _, _, terminated, truncated, info = env.step(a)
         check_info_types(info)
         s = info["samples"]
         assert len(s["t"]) == n_sub
         assert info["t"] == pytest.approx(k * inner.scenario.control_period, abs=1e-12)
-        assert s["t"][-1] == pytest.approx(info["t"], abs=1e-12)
+        # samples at the substep starts: t0, t0 + h, ..., t0 + Ts - h
+        assert s["t"][0] == pytest.approx(prev["t"], abs=1e-12)
+        assert s["t"][-1] == pytest.approx(info["t"] - h, abs=1e-12)
         np.testing.assert_allclose(np.diff(s["t"]), h, rtol=0, atol=1e-12)
         np.testing.assert_array_equal(s["delta_c"], info["rudder_command"])
-        assert s["psi"][-1] == info["heading"]
-        assert s["r"][-1] == info["yaw_rate"]
-        assert s["delta"][-1] == info["rudder_angle"]
-        if info["waypoint_index"] == prev_leg:
-            assert s["e"][-1] == pytest.approx(info["cross_track_error"], abs=1e-9)
-        prev_leg = info["waypoint_index"]
+        # the first sample is the previous step's measurement (measured once per instant)
+        assert s["psi"][0] == prev["heading"]
+        assert s["r"][0] == prev["yaw_rate"]
+        assert s["delta"][0] == prev["rudder_angle"]
+        if info["waypoint_index"] == prev["waypoint_index"]:
+            assert s["e"][0] == pytest.approx(prev["cross_track_error"], abs=1e-9)
+        prev = info
         if case[1] == "rudder":
             assert info["rudder_command"] == pytest.approx(
                 float(a[0]) * inner.model.rudder_limit, rel=1e-7

@@ -277,12 +277,14 @@ def test_event_scenario_equals_its_eventless_twin_until_the_event(name: str) -> 
         assert a[1:4] == b[1:4], k
         assert identical(a[4], b[4]), k
     assert with_event[n_before][4]["t"] == pytest.approx(event_time)
-    # the very first fine sample after the event already differs, and the plant stays changed
+    # samples sit at substep starts: the one at the event instant is still equal, the very
+    # next one (event_time + h) already differs, and the plant stays changed
     first_after = with_event[n_before + 1][4]["samples"]
-    assert first_after["t"][0] == pytest.approx(event_time + sc.fine_step)
-    assert np.any(
-        plant_samples(with_event[n_before + 1])[:, 0] != plant_samples(plain[n_before + 1])[:, 0]
-    )
+    assert first_after["t"][0] == pytest.approx(event_time)
+    assert first_after["t"][1] == pytest.approx(event_time + sc.fine_step)
+    changed, unchanged = plant_samples(with_event[n_before + 1]), plant_samples(plain[n_before + 1])
+    assert np.array_equal(changed[:, 0], unchanged[:, 0])
+    assert np.any(changed[:, 1] != unchanged[:, 1])
     for k in range(n_before + 1, n_steps + 1):
         assert np.any(plant_samples(with_event[k]) != plant_samples(plain[k])), k
 
@@ -297,9 +299,9 @@ def test_off_grid_event_acts_at_its_substep() -> None:
     for k in range(25):
         assert identical(a[k][4], b[k][4])
     sa, sb = a[25][4]["samples"], b[25][4]["samples"]
-    assert sa["t"][24] == pytest.approx(12.25)
-    np.testing.assert_array_equal(sa["delta"][:25], sb["delta"][:25])
-    assert np.all(sa["delta"][25:] != sb["delta"][25:])
+    assert sa["t"][25] == pytest.approx(12.25)
+    np.testing.assert_array_equal(sa["delta"][:26], sb["delta"][:26])
+    assert np.all(sa["delta"][26:] != sb["delta"][26:])
 
 
 def test_ramp_event_through_the_env_matches_an_independent_simulation() -> None:
@@ -319,15 +321,15 @@ def test_ramp_event_through_the_env_matches_an_independent_simulation() -> None:
         info = env.step(a)[4]
         t0, ref = k * ts, []
         for i in range(n_sub):
+            ref.append(x)  # samples are the states at the substep starts
             p = sc.schedule.vector_at(t0 + i * h)
             x = model.step_numpy(x, np.array([float(a[0]) * dmax]), np.zeros(3), p, h)
-            ref.append(x)
         ref = np.array(ref)
         s = info["samples"]
         np.testing.assert_allclose(s["delta"], ref[:, 5], rtol=0, atol=1e-10)
         np.testing.assert_allclose(s["r"], ref[:, 3], rtol=0, atol=1e-10)
         np.testing.assert_allclose(s["psi"], ref[:, 2], rtol=0, atol=1e-10)
-        np.testing.assert_allclose(info["position"], ref[-1, :2], rtol=0, atol=1e-10)
+        np.testing.assert_allclose(info["position"], x[:2], rtol=0, atol=1e-10)
     assert info["t"] == pytest.approx(8.0)  # past the end of the ramp (5.2 s)
 
 

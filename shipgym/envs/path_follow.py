@@ -25,6 +25,14 @@ plus ``goal_bonus`` when the last waypoint is reached (terminated), and, when th
 leaves the corridor |e| > max_cross_track (terminated), a penalty equal to the cost of
 staying at the corridor edge for the rest of the time limit, (e_max/L)·(steps left), so
 that leaving is never cheaper than staying.  The time limit truncates.
+
+``info["samples"]`` (for online identifiers at the fine step h): the period's samples at
+the substep starts t0, t0 + h, …, t0 + Ts − h, i.e. each sample's ``delta_c`` is exactly the
+command acting on [t, t + h).  Concatenated over an episode they form one uniform grid
+0, h, 2h, … without repeats; the state at t0 + Ts opens the next step's samples.  Measured
+values (ψ, r with sensor noise) are measured once per instant, so the first sample of a
+step equals the previous step's ``info["heading"]`` / ``info["yaw_rate"]``.  At reset (no
+period yet) and on a non-finite step the arrays are empty.
 """
 
 from __future__ import annotations
@@ -60,6 +68,9 @@ OBS_NAMES = (
 )
 _OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
 _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
+
+#: keys of ``info["samples"]``
+SAMPLE_KEYS = ("t", "psi", "r", "delta", "delta_c", "e")
 
 #: guidance action: a0 → R_LOS multiplier n = 3·2^a0 ∈ [1.5, 6] (look-ahead Δ = nL for
 #: look-ahead LOS); a1 → course offset a1·30°.
@@ -114,7 +125,7 @@ class ShipPathFollowEnv(gym.Env):
             self._w_block[:, names.index("current_x")] = cx
             self._w_block[:, names.index("current_y")] = cy
         self._p_block = np.zeros((self._n, self.model.n_params))
-        self._sample_offsets = self._h * np.arange(1, self._n + 1)
+        self._sample_offsets = self._h * np.arange(self._n)
         weights = sc.config.reward
         self._w_psi = weights.heading_weight
         self._w_delta = weights.rudder_weight
@@ -179,15 +190,7 @@ class ShipPathFollowEnv(gym.Env):
         self._track = [(float(x[self._ix]), float(x[self._iy]))]
         self._records: list[dict[str, float]] = []
         self._reached_goal = False
-        e = frame.cross_track
-        samples = {
-            "t": np.zeros(1),
-            "psi": psi_m,
-            "r": r_m,
-            "delta": x[self._idelta : self._idelta + 1].copy(),
-            "delta_c": np.zeros(1),
-            "e": np.array([e]),
-        }
+        samples = {k: np.zeros(0) for k in SAMPLE_KEYS}  # no period integrated yet
         info = self._info(frame, samples)
         self._last_return_time = time.perf_counter()
         return self._observation(frame), info
@@ -223,7 +226,10 @@ class ShipPathFollowEnv(gym.Env):
         if not np.all(np.isfinite(states)):
             return self._non_finite_step(frame, delta_c, compute_time)
         xs, ys = states[:, self._ix], states[:, self._iy]
-        e_samples = self._tracker.cross_track_of(xs, ys)
+        # fine samples at the substep *starts* t0, t0+h, …, t0+Ts−h (module doc)
+        start = np.vstack([self._state[None, :], states[:-1]])
+        e_samples = self._tracker.cross_track_of(start[:, self._ix], start[:, self._iy])
+        psi_m0, r_m0 = self._psi_m, self._r_m
         self._state = states[-1]
         x = self._state
         px, py = float(x[self._ix]), float(x[self._iy])
@@ -274,9 +280,9 @@ class ShipPathFollowEnv(gym.Env):
         )
         samples = {
             "t": t0 + self._sample_offsets,
-            "psi": psi_m,
-            "r": r_m,
-            "delta": states[:, self._idelta].copy(),
+            "psi": np.concatenate(([psi_m0], psi_m[:-1])),
+            "r": np.concatenate(([r_m0], r_m[:-1])),
+            "delta": start[:, self._idelta].copy(),
             "delta_c": np.full(self._n, delta_c),
             "e": e_samples,
         }
@@ -368,9 +374,7 @@ class ShipPathFollowEnv(gym.Env):
                 "compute_time": compute_time,
             }
         )
-        info = self._info(
-            frame, {k: np.zeros(0) for k in ("t", "psi", "r", "delta", "delta_c", "e")}
-        )
+        info = self._info(frame, {k: np.zeros(0) for k in SAMPLE_KEYS})
         info["termination_reason"] = "non_finite_state"
         info["episode_metrics"] = self.episode_metrics()
         self._last_return_time = time.perf_counter()

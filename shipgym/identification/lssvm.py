@@ -61,7 +61,9 @@ def robust_weights(errors: np.ndarray, c1: float = C1, c2: float = C2) -> np.nda
     return np.where(z >= c2, V_MIN, v)
 
 
-def _check(x: np.ndarray, y: np.ndarray, v: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _check(
+    x: np.ndarray, y: np.ndarray, v: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     x = np.atleast_2d(np.asarray(x, dtype=float))
     y = np.asarray(y, dtype=float).ravel()
     if x.shape[0] != y.shape[0]:

@@ -1,0 +1,276 @@
+"""Online identification of the nomoto2 model: sliding window, weighted and λ-LS-SVM.
+
+Liu et al. (2019) §3.2:
+
+* sliding data window (§3.2.1): regression rows accumulate; the first model is identified
+  when the window holds N_w rows, then every time it holds N_w + N_u rows the oldest N_u
+  are dropped and the model is re-identified (N_w = 1200, N_u = 50 at h = 0.01 s, i.e. one
+  update per 0.5 s control period);
+* :class:`WeightedLSSVMOnline`: weighted LS-SVM on each window, nothing else;
+* :class:`LambdaLSSVM` (Algorithm 2): the change index λ_k (eq. (43)) of each sub-model,
+  computed with the previous model on the newest N_u rows; when λ_k exceeds λ_c the rows of
+  the older half of the window are re-weighted by c3 and the newer half by c4 (eq. (44));
+  a θ1 giving K < 0 or T1 < 0 (or no real T1, T2) is rejected and the previous one kept;
+* :class:`PersistentExcitation`: u_per = u_ori + N(0, σ²) (eq. (45)).
+
+Units of λ_c.  The paper's thresholds λ_c¹ = 1e-5 and λ_c² = 1e-2 only make sense with
+angles in degrees: with radians y2 = (δc − δ)·h never exceeds 0.52·0.01 = 5e-3, so λ_k²
+could never pass 1e-2.  λ_k is therefore evaluated on errors converted to degrees
+(``index_unit="deg"``, default; ``"rad"`` available).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from shipgym.identification.lssvm import LSSVMSolution
+from shipgym.identification.nomoto import (
+    GAMMA,
+    IdentificationError,
+    nomoto_regressors,
+    params_from_theta1,
+    solve_theta,
+    tc_from_theta2,
+    theta1_from_params,
+)
+from shipgym.models.nomoto2 import Nomoto2Params
+
+DEG = 180.0 / math.pi
+
+
+class PersistentExcitation:
+    """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad]."""
+
+    def __init__(self, sigma: float, rng: np.random.Generator | None = None) -> None:
+        if sigma < 0:
+            raise ValueError(f"sigma must be ≥ 0, got {sigma}")
+        self.sigma = sigma
+        self.rng = rng if rng is not None else np.random.default_rng()
+
+    def __call__(self, u: float) -> float:
+        return u + self.sigma * float(self.rng.standard_normal()) if self.sigma else u
+
+
+@dataclasses.dataclass
+class _SubModel:
+    """θ̂ and bias of one regression (θ1: Nomoto, θ2: servo)."""
+
+    theta: np.ndarray
+    bias: float = 0.0
+
+
+class _SlidingWindowNomoto:
+    """Streaming regression rows of eq. (35)–(37) in a sliding window (§3.2.1)."""
+
+    def __init__(
+        self,
+        h: float,
+        initial: Nomoto2Params | None = None,
+        window: int = 1200,
+        update_every: int = 50,
+        gamma: float = GAMMA,
+        servo_model: str = "forward",
+        bias_penalty: bool = True,
+    ) -> None:
+        if h <= 0 or window < 10 or update_every < 1:
+            raise ValueError(
+                f"need h > 0, window ≥ 10, update_every ≥ 1; got {h}, {window}, {update_every}"
+            )
+        self.h = h
+        self.window = window
+        self.update_every = update_every
+        self.gamma = gamma
+        self.servo_model = servo_model
+        self.bias_penalty = bias_penalty
+        self.params = initial if initial is not None else Nomoto2Params()
+        self._base = self.params
+        self.sub1 = _SubModel(theta1_from_params(self.params))
+        self.sub2 = _SubModel(np.array([self._theta2_of(self.params.Tc)]))
+        self._tail = np.zeros((0, 3))  # last raw samples (ψ, δ, δc) not yet usable
+        self._rows1 = np.zeros((0, 6))
+        self._y1 = np.zeros(0)
+        self._rows2 = np.zeros((0, 1))
+        self._y2 = np.zeros(0)
+        self.identified = False
+        self.updates = 0
+        self.last_reason: str | None = None
+        self.history: list[dict[str, Any]] = []
+        self.t = 0.0
+
+    def _theta2_of(self, tc: float) -> float:
+        if self.servo_model == "exact":
+            return self.h / (1.0 - math.exp(-self.h / tc))
+        return tc
+
+    # -- feeding ----------------------------------------------------------------------
+    def update(self, samples: Mapping[str, np.ndarray]) -> bool:
+        """Feed ``info["samples"]`` (keys psi, delta, delta_c; t optional); True if re-identified."""
+        if "t" in samples and len(samples["t"]):
+            self.t = float(np.asarray(samples["t"])[-1])
+        return self.update_arrays(samples["psi"], samples["delta"], samples["delta_c"])
+
+    def update_arrays(self, psi: Any, delta: Any, delta_c: Any) -> bool:
+        new = np.column_stack(
+            [
+                np.asarray(psi, float).ravel(),
+                np.asarray(delta, float).ravel(),
+                np.asarray(delta_c, float).ravel(),
+            ]
+        )
+        if new.shape[0] == 0:
+            return False
+        if not np.all(np.isfinite(new)):
+            self.last_reason = "non-finite samples ignored"
+            new = new[np.all(np.isfinite(new), axis=1)]
+        raw = np.vstack([self._tail, new])
+        if self._tail.shape[0]:  # keep heading continuous across calls
+            raw[:, 0] = np.unwrap(raw[:, 0])
+        if raw.shape[0] < 4:
+            self._tail = raw
+            return False
+        reg = nomoto_regressors(raw[:, 0], raw[:, 1], raw[:, 2], self.h)
+        self._tail = raw[-3:]
+        self._rows1 = np.vstack([self._rows1, reg.x1])
+        self._y1 = np.concatenate([self._y1, reg.y1])
+        self._rows2 = np.vstack([self._rows2, reg.x2])
+        self._y2 = np.concatenate([self._y2, reg.y2])
+        updated = False
+        while True:
+            n = self._y1.shape[0]
+            if not self.identified and n >= self.window:
+                self._trim(n - self.window)
+            elif self.identified and n >= self.window + self.update_every:
+                self._trim(self.update_every)
+            else:
+                break
+            self._identify()
+            self.identified = True
+            updated = True
+        return updated
+
+    def _trim(self, k: int) -> None:
+        self._rows1, self._y1 = self._rows1[k:], self._y1[k:]
+        self._rows2, self._y2 = self._rows2[k:], self._y2[k:]
+
+    # -- identification ---------------------------------------------------------------
+    def _identify(self) -> None:
+        raise NotImplementedError
+
+    def _solve(self, x: np.ndarray, y: np.ndarray, prior: np.ndarray | None) -> LSSVMSolution:
+        sol, _ = solve_theta(x, y, self.gamma, True, self.bias_penalty, prior_weights=prior)
+        return sol
+
+    def _accept(
+        self,
+        theta1: np.ndarray,
+        bias1: float,
+        theta2: np.ndarray,
+        bias2: float,
+        reject_negative: bool,
+    ) -> dict[str, Any]:
+        """Turn θ̂ into parameters; keep the previous sub-model when it is not usable."""
+        flags: dict[str, Any] = {"rejected1": False, "rejected2": False}
+        try:
+            values = params_from_theta1(theta1)
+            if reject_negative and (values["K"] < 0 or values["T1"] < 0):
+                raise IdentificationError(f"K = {values['K']:.3g} or T1 = {values['T1']:.3g} < 0")
+            candidate = self.params.replace(**values)
+            self.sub1 = _SubModel(np.asarray(theta1), bias1)
+        except (IdentificationError, ValueError) as exc:
+            flags["rejected1"] = True
+            self.last_reason = f"θ1 kept: {exc}"
+            candidate = self.params
+        try:
+            tc = tc_from_theta2(float(theta2[0]), self.h, self.servo_model)
+            candidate = candidate.replace(Tc=tc)
+            self.sub2 = _SubModel(np.asarray(theta2), bias2)
+        except (IdentificationError, ValueError) as exc:
+            flags["rejected2"] = True
+            self.last_reason = f"θ2 kept: {exc}"
+        self.params = candidate
+        self.updates += 1
+        return flags
+
+    def _record(self, **extra: Any) -> None:
+        self.history.append({"t": self.t, **self.params.as_dict(), **extra})
+
+
+class WeightedLSSVMOnline(_SlidingWindowNomoto):
+    """Weighted LS-SVM on each sliding window (Liu et al. 2019's comparison method).
+
+    No change index, no re-weighting; a θ̂ without real T1, T2 cannot be turned into
+    parameters and keeps the previous model (negative K or T1 are accepted, as in the paper's
+    Figure 7 where this method "generated some abnormal values").
+    """
+
+    def _identify(self) -> None:
+        s1 = self._solve(self._rows1, self._y1, None)
+        s2 = self._solve(self._rows2, self._y2, None)
+        flags = self._accept(s1.theta, s1.bias, s2.theta, s2.bias, reject_negative=False)
+        self._record(**flags)
+
+
+class LambdaLSSVM(_SlidingWindowNomoto):
+    """λ-LS-SVM online identifier, Liu et al. (2019) Algorithm 2.
+
+    ``update(info["samples"])`` after every env step; ``params`` is the current
+    :class:`Nomoto2Params` (SI).  ``history`` holds, per identification, the parameters,
+    λ_k¹, λ_k² and which sub-models were re-weighted or rejected.
+    """
+
+    def __init__(
+        self,
+        h: float,
+        initial: Nomoto2Params | None = None,
+        window: int = 1200,
+        update_every: int = 50,
+        gamma: float = GAMMA,
+        lambda_c1: float = 1e-5,
+        lambda_c2: float = 1e-2,
+        c3: float = 0.01,
+        c4: float = 0.99,
+        index_unit: str = "deg",
+        servo_model: str = "forward",
+        bias_penalty: bool = True,
+    ) -> None:
+        super().__init__(h, initial, window, update_every, gamma, servo_model, bias_penalty)
+        if index_unit not in ("deg", "rad"):
+            raise ValueError(f"index_unit must be 'deg' or 'rad', got {index_unit!r}")
+        self.lambda_c = (lambda_c1, lambda_c2)
+        self.c3, self.c4 = c3, c4
+        self._index_scale = DEG if index_unit == "deg" else 1.0
+        self.lambdas: tuple[float, float] = (0.0, 0.0)
+
+    def change_index(self, x: np.ndarray, y: np.ndarray, sub: _SubModel) -> float:
+        """λ_k of eq. (43): |mean error| of the newest N_u rows under the previous model."""
+        nu = self.update_every
+        e = y[-nu:] - x[-nu:] @ sub.theta - sub.bias
+        return abs(float(np.sum(e))) / nu * self._index_scale
+
+    def _reweighting(self, n: int) -> np.ndarray:
+        """Eq. (44): c3 for the older half of the window, c4 for the newer half."""
+        w = np.full(n, self.c4)
+        w[: n // 2] = self.c3
+        return w
+
+    def _identify(self) -> None:
+        x1, y1, x2, y2 = self._rows1, self._y1, self._rows2, self._y2
+        if self.identified:
+            lam1 = self.change_index(x1, y1, self.sub1)
+            lam2 = self.change_index(x2, y2, self.sub2)
+        else:  # no previous identified model yet: the index is undefined
+            lam1 = lam2 = 0.0
+        self.lambdas = (lam1, lam2)
+        changed1 = lam1 > self.lambda_c[0]
+        changed2 = lam2 > self.lambda_c[1]
+        s1 = self._solve(x1, y1, self._reweighting(y1.shape[0]) if changed1 else None)
+        s2 = self._solve(x2, y2, self._reweighting(y2.shape[0]) if changed2 else None)
+        flags = self._accept(s1.theta, s1.bias, s2.theta, s2.bias, reject_negative=True)
+        self._record(
+            lambda1=lam1, lambda2=lam2, reweighted1=changed1, reweighted2=changed2, **flags
+        )
