@@ -109,9 +109,9 @@ class _SlidingWindowNomoto:
 
     # -- feeding ----------------------------------------------------------------------
     def update(self, samples: Mapping[str, np.ndarray]) -> bool:
-        """Feed ``info["samples"]`` (keys psi, delta, delta_c; t optional); True if re-identified."""
+        """Feed ``info["samples"]`` (psi, delta, delta_c; t optional); True if re-identified."""
         if "t" in samples and len(samples["t"]):
-            self.t = float(np.asarray(samples["t"])[-1])
+            self.t = float(np.asarray(samples["t"])[-1]) + self.h  # end of the period
         return self.update_arrays(samples["psi"], samples["delta"], samples["delta_c"])
 
     def update_arrays(self, psi: Any, delta: Any, delta_c: Any) -> bool:
@@ -148,10 +148,23 @@ class _SlidingWindowNomoto:
                 self._trim(self.update_every)
             else:
                 break
+            reason = self._degenerate_window()
+            if reason is not None:  # keep the previous model and say why
+                self.last_reason = reason
+                self._record(skipped=reason)
+                break
             self._identify()
             self.identified = True
             updated = True
         return updated
+
+    def _degenerate_window(self) -> str | None:
+        """Why the window cannot identify the model (None when it can)."""
+        if np.ptp(self._rows1[:, 1]) == 0.0:
+            return "rudder angle constant over the window: no excitation (eq. (45)); model kept"
+        if not np.any(self._rows2[:, 0] != 0.0):
+            return "rudder never moves in the window: Tc not identifiable; model kept"
+        return None
 
     def _trim(self, k: int) -> None:
         self._rows1, self._y1 = self._rows1[k:], self._y1[k:]

@@ -1,0 +1,47 @@
+"""Identification toolkit (SPEC §7): LS-SVM, λ-LS-SVM online, continuous LS, zig-zag fits.
+
+Public entry points: :func:`fit_nomoto2` (batch, Liu et al. 2019) and :class:`LambdaLSSVM`
+(online, Algorithm 2), fed with ``info["samples"]`` of the env.
+"""
+
+from shipgym.identification.continuous_ls import ContinuousLeastSquares
+from shipgym.identification.lssvm import (
+    LSSVMSolution,
+    lssvm_dual,
+    lssvm_primal,
+    robust_scale,
+    robust_weights,
+    weighted_lssvm,
+)
+from shipgym.identification.nomoto import (
+    IdentificationError,
+    fit_nomoto2,
+    forward_difference,
+    nomoto_regressors,
+    params_from_theta1,
+    theta1_from_params,
+)
+from shipgym.identification.online import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
+from shipgym.identification.zigzag import NomotoFit, fit_nomoto_zigzag, zigzag_nomoto
+
+__all__ = [
+    "ContinuousLeastSquares",
+    "IdentificationError",
+    "LSSVMSolution",
+    "LambdaLSSVM",
+    "NomotoFit",
+    "PersistentExcitation",
+    "WeightedLSSVMOnline",
+    "fit_nomoto2",
+    "fit_nomoto_zigzag",
+    "forward_difference",
+    "lssvm_dual",
+    "lssvm_primal",
+    "nomoto_regressors",
+    "params_from_theta1",
+    "robust_scale",
+    "robust_weights",
+    "theta1_from_params",
+    "weighted_lssvm",
+    "zigzag_nomoto",
+]
