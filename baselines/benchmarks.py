@@ -58,3 +58,134 @@ def bench_env(
         "substeps_per_step": n_sub,
         "repeats": repeats,
     }
+
+
+#: the three jump cases of Liu et al. (2019) and the parameters each changes; Case 3 also
+#: without its heading noise and outliers, to separate the sensor model from the algorithm
+JUMP_CASES = {
+    "rudder_aging": ("Tc",),
+    "current_shift": ("d0",),
+    "maneuverability_change": ("K", "T1", "T2", "T3", "d0", "beta", "Tc"),
+    "maneuverability_change_noise_free": ("K", "T1", "T2", "T3", "d0", "beta", "Tc"),
+}
+
+
+def _jump_case(name: str) -> Any:
+    """A catalogue scenario, or ``<name>_noise_free``: the same without its sensor model."""
+    from shipgym.scenarios import catalogue_dir, scenario_from_dict
+
+    base = name.removesuffix("_noise_free")
+    import yaml
+
+    data = yaml.safe_load((catalogue_dir() / f"{base}.yaml").read_text())
+    if name != base:
+        data.pop("sensors", None)
+        data["name"] = name
+    return scenario_from_dict(data, name)
+
+
+def identification_log(
+    scenario: str, seed: int = 0, excitation_deg: float = 1.0
+) -> tuple[list[dict[str, np.ndarray]], Any]:
+    """Per-step ``info["samples"]`` of ``pid_los`` + persistent excitation (eq. (45)) on a case.
+
+    Returns the samples and the scenario (whose schedule is the truth to score against).
+    """
+    import math
+
+    import gymnasium as gym
+
+    import shipgym  # noqa: F401
+    from baselines.classical.pid import PIDLOS
+    from shipgym.identification import PersistentExcitation
+
+    env = gym.make(
+        "ShipPathFollow-v0",
+        scenario=_jump_case(scenario) if isinstance(scenario, str) else scenario,
+    )
+    obs, info = env.reset(seed=seed)
+    ctx = env.unwrapped.controller_context
+    pid = PIDLOS()
+    pid.reset(ctx, seed)
+    excite = PersistentExcitation(math.radians(excitation_deg), np.random.default_rng(seed))
+    log = []
+    while True:
+        delta_c = excite(float(pid.act(obs, info)[0]) * ctx.rudder_limit)
+        obs, _, terminated, truncated, info = env.step([np.clip(delta_c / ctx.rudder_limit, -1, 1)])
+        log.append(info["samples"])
+        if terminated or truncated:
+            return log, env.unwrapped.scenario
+
+
+def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str, Any]:
+    """Parameter error and time per update of each online identifier on the three cases.
+
+    For every case: relative error of each changed parameter at the end of the episode,
+    the first time after the change from which the changed parameters stay within 10 %
+    (``inf`` if never), and the median / p99 µs per window update.  Batch ``fit_nomoto2``
+    on the post-change data is reported beside them.
+    """
+    import math
+
+    from shipgym.identification import (
+        IdentificationError,
+        LambdaLSSVM,
+        WeightedLSSVMOnline,
+        fit_nomoto2,
+    )
+
+    out: dict[str, Any] = {}
+    for case, changed in JUMP_CASES.items():
+        log, sc = identification_log(case, seed, excitation_deg)
+        truth = sc.schedule.final
+        h = sc.fine_step
+        change = sc.change_time
+        row: dict[str, Any] = {}
+        for name, cls in (("lambda_lssvm", LambdaLSSVM), ("weighted_lssvm", WeightedLSSVMOnline)):
+            ident = cls(h, sc.nominal_params)
+            times = []
+            for samples in log:
+                start = time.perf_counter()
+                if ident.update(samples):
+                    times.append(time.perf_counter() - start)
+            errors = {
+                k: abs(getattr(ident.params, k) - getattr(truth, k)) / abs(getattr(truth, k))
+                for k in changed
+            }
+            within = math.inf
+            for entry in ident.history:
+                ok = entry["t"] > change and all(
+                    abs(entry[k] - getattr(truth, k)) <= 0.1 * abs(getattr(truth, k))
+                    for k in changed
+                )
+                if ok and within == math.inf:
+                    within = entry["t"]
+                elif not ok and entry["t"] > change:
+                    within = math.inf
+            row[name] = {
+                "final_relative_error": errors,
+                "t_within_10pct": within,
+                "update_us_median": 1e6 * statistics.median(times) if times else math.nan,
+                "update_us_p99": 1e6 * float(np.percentile(times, 99)) if times else math.nan,
+                "updates": len(times),
+            }
+        samples = {k: np.concatenate([s[k] for s in log]) for k in ("t", "psi", "delta", "delta_c")}
+        after = samples["t"] >= change
+        try:
+            fit = fit_nomoto2(
+                samples["psi"][after],
+                samples["delta"][after],
+                samples["delta_c"][after],
+                h,
+                base=sc.nominal_params,
+            )
+            row["batch_fit_nomoto2"] = {
+                "final_relative_error": {
+                    k: abs(getattr(fit, k) - getattr(truth, k)) / abs(getattr(truth, k))
+                    for k in changed
+                }
+            }
+        except IdentificationError as exc:
+            row["batch_fit_nomoto2"] = {"error": str(exc)}
+        out[case] = row
+    return out

@@ -50,17 +50,27 @@ def cmd_leaderboard(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from baselines.benchmarks import bench_env
+    from baselines.benchmarks import bench_env, bench_identification
 
-    if args.target != "env":
-        sys.stderr.write(f"shipgym bench: unknown target {args.target!r}; available: env\n")
-        return 2
-    figures = bench_env(repeats=args.repeats)
-    text = "\n".join(
-        f"{k:34s} {v:,.3f}" if isinstance(v, float) else f"{k:34s} {v}" for k, v in figures.items()
-    )
-    _emit(args, figures, text)
+    if args.target == "env":
+        figures = bench_env(repeats=args.repeats)
+    else:
+        figures = bench_identification()
+    _emit(args, figures, "\n".join(_flatten_lines(figures)))
     return 0
+
+
+def _flatten_lines(figures: dict[str, Any], prefix: str = "") -> list[str]:
+    lines = []
+    for key, value in figures.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            lines.extend(_flatten_lines(value, name + "."))
+        elif isinstance(value, float):
+            lines.append(f"{name:60s} {value:,.4g}")
+        else:
+            lines.append(f"{name:60s} {value}")
+    return lines
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -82,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_scenarios)
 
     p = sub.add_parser("bench", help="benchmarks of SPEC §10")
-    p.add_argument("target", choices=["env"], help="what to benchmark")
+    p.add_argument("target", choices=["env", "identification"], help="what to benchmark")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--json", action="store_true", help="print the figures as a JSON object")
     p.set_defaults(func=cmd_bench)

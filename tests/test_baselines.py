@@ -131,3 +131,15 @@ def test_guidance_mode_with_zero_action_is_pid_los() -> None:
     # pid_los passes δc/δmax through a float32 action: equal to float32 resolution
     assert len(commands) == len(pid.trajectory["rudder_command"]) - 1
     np.testing.assert_allclose(commands, pid.trajectory["rudder_command"][1:], atol=1e-6)
+
+
+def test_cli_bench_identification_json(capsys) -> None:
+    """SPEC §9b: one JSON object; per case and identifier, errors, convergence time and µs."""
+    assert main(["bench", "identification", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert {"rudder_aging", "current_shift", "maneuverability_change"} <= set(figures)
+    aging = figures["rudder_aging"]
+    for name in ("lambda_lssvm", "weighted_lssvm"):
+        assert aging[name]["update_us_median"] > 0
+        assert aging[name]["final_relative_error"]["Tc"] < 0.05
+    assert aging["lambda_lssvm"]["t_within_10pct"] <= aging["weighted_lssvm"]["t_within_10pct"]

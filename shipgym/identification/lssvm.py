@@ -134,25 +134,42 @@ def lssvm_primal(
     ridge on w stays ½‖w‖², i.e. I/γ in the γ-scaled normal equations.
     """
     x, y, v = _check(x, y, v)
-    n, d = x.shape
+    return _primal(_augment(x), y, v, gamma, bias_penalty, regularisation)
+
+
+def _augment(x: np.ndarray) -> np.ndarray:
+    """[x, 1]: the regressors with the bias column."""
+    z = np.empty((x.shape[0], x.shape[1] + 1))
+    z[:, :-1] = x
+    z[:, -1] = 1.0
+    return z
+
+
+def _primal(
+    z: np.ndarray,
+    y: np.ndarray,
+    v: np.ndarray,
+    gamma: float,
+    bias_penalty: bool,
+    regularisation: float,
+) -> LSSVMSolution:
+    """Core of :func:`lssvm_primal` on validated data with the bias column appended."""
+    d = z.shape[1] - 1
     if regularisation:
         v = 1.0 / (gamma * (1.0 / (gamma * v) + regularisation))
     # bias "penalty" ½·pb·b² in the Lagrangian; dual (0,0) entry = −pb
     pb = (gamma if bias_penalty else 0.0) - regularisation
     # normal equations of the γ-scaled problem, Jacobi-equilibrated:
     # [XᵀVX + I/γ, XᵀV1; 1ᵀVX, 1ᵀV1 + pb/γ] [w; b] = [XᵀVy; 1ᵀVy]
-    z = np.empty((n, d + 1))
-    z[:, :d] = x
-    z[:, d] = 1.0
     zv = z * v[:, None]
     m = z.T @ zv
-    m[np.arange(d), np.arange(d)] += 1.0 / gamma
-    m[d, d] += pb / gamma
+    m.flat[:: d + 2] += 1.0 / gamma  # ridge on w (the last diagonal entry is undone below)
+    m[d, d] += (pb - 1.0) / gamma
     rhs = zv.T @ y
     scale = 1.0 / np.sqrt(np.abs(np.diag(m)))
     sol = scale * np.linalg.solve(m * np.outer(scale, scale), rhs * scale)
     theta, b = sol[:d], float(sol[d])
-    return LSSVMSolution(theta, b, y - x @ theta - b)
+    return LSSVMSolution(theta, b, y - z @ sol)
 
 
 def weighted_lssvm(
@@ -170,9 +187,12 @@ def weighted_lssvm(
     weights (28) of the stage-1 errors times the prior weights.  Returns the stage-2
     solution and the weights used.
     """
-    solve = lssvm_primal if solver == "primal" else lssvm_dual
-    first = solve(x, y, gamma, prior_weights, bias_penalty, regularisation)
-    v = robust_weights(first.residuals)
-    if prior_weights is not None:
-        v = v * np.asarray(prior_weights, dtype=float)
-    return solve(x, y, gamma, v, bias_penalty, regularisation), v
+    x, y, prior = _check(x, y, prior_weights)
+    if solver == "primal":
+        z = _augment(x)
+        first = _primal(z, y, prior, gamma, bias_penalty, regularisation)
+        v = robust_weights(first.residuals) * prior
+        return _primal(z, y, v, gamma, bias_penalty, regularisation), v
+    first = lssvm_dual(x, y, gamma, prior, bias_penalty, regularisation)
+    v = robust_weights(first.residuals) * prior
+    return lssvm_dual(x, y, gamma, v, bias_penalty, regularisation), v

@@ -50,9 +50,7 @@ class NomotoFit:
         return base.replace(K=self.K, T1=self.T1, T2=self.T2, T3=self.T3, d0=self.d0, beta=beta)
 
 
-def fit_nomoto_zigzag(
-    r: np.ndarray, delta: np.ndarray, h: float, C: float = C_ZIGZAG
-) -> NomotoFit:
+def fit_nomoto_zigzag(r: np.ndarray, delta: np.ndarray, h: float, C: float = C_ZIGZAG) -> NomotoFit:
     """Fit eq. (27) to yaw rate r [rad/s] and rudder angle δ [rad] sampled at h [s]."""
     r = np.asarray(r, dtype=float)
     delta = np.asarray(delta, dtype=float)
