@@ -121,8 +121,9 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
     """Parameter error and time per update of each online identifier on the three cases.
 
     For every case: relative error of each changed parameter at the end of the episode,
-    the first time after the change from which the changed parameters stay within 10 %
-    (``inf`` if never), and the median / p99 µs per window update.  Batch ``fit_nomoto2``
+    the first time after the change from which the changed parameters (β excepted: it is
+    not identifiable at these yaw rates, README) stay within 10 % (``inf`` if never), and
+    the median / p99 µs per window update.  Batch ``fit_nomoto2``
     on the post-change data is reported beside them.
     """
     import math
@@ -157,6 +158,7 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
                 ok = entry["t"] > change and all(
                     abs(entry[k] - getattr(truth, k)) <= 0.1 * abs(getattr(truth, k))
                     for k in changed
+                    if k != "beta"
                 )
                 if ok and within == math.inf:
                     within = entry["t"]
