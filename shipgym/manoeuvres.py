@@ -77,7 +77,7 @@ def zigzag(
                 break
         peak = max(peak, psi) if sign < 0 else min(peak, psi)
         commands[k] = command
-        x = integ(x, command, w, p)[0]
+        x = integ(x, command, w, p)[-1]
         states[k + 1] = x
     states, commands = states[: n + 1], commands[: n + 1]
     commands[n] = command

@@ -136,7 +136,7 @@ def simulate(params: Nomoto2Params, h: float = H, duration: float = 60.0, seed: 
     psi, delta, delta_c = [x[2]], [x[5]], []
     for k in range(round(duration / 0.5)):
         u = math.radians(10.0 * math.sin(0.15 * k) + 5.0 * rng.normal())
-        states = integ(x, u, w, p)
+        states = integ(x, u, w, p)[1:]  # drop the initial-state row
         x = states[-1]
         psi += list(states[:, 2])
         delta += list(states[:, 5])

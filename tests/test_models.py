@@ -155,8 +155,10 @@ def test_period_integrator_matches_solve_ivp_reference(which: str) -> None:
     out = []
     for k in range(n_periods):
         dc = COMMANDS_DEG[k // periods_per_segment] * DEG
-        block = integ(x, dc, w_block, p_block)
-        assert block.shape == (N_SUB, 6)
+        full = integ(x, dc, w_block, p_block)
+        assert full.shape == (N_SUB + 1, 6)
+        np.testing.assert_array_equal(full[0], x)  # row 0 is the initial state
+        block = full[1:]
         out.append(block)
         x = block[-1]
     states = np.concatenate(out)
@@ -286,7 +288,7 @@ def test_period_integrator_equals_repeated_step_numpy() -> None:
         dc = float(rng.uniform(-0.5, 0.5))
         w_block = rng.normal(size=(N_SUB, 3)) * 0.05
         p_block = np.tile(random_params(rng), (N_SUB, 1))
-        got = integ(x0, dc, w_block, p_block)
+        got = integ(x0, dc, w_block, p_block)[1:]
         np.testing.assert_allclose(
             got, repeated_steps(model, x0, dc, w_block, p_block), rtol=1e-12, atol=1e-12
         )
@@ -305,8 +307,8 @@ def test_period_integrator_respects_per_substep_parameter_rows(k: int, name: str
     changed = p_block.copy()
     j = Nomoto2Params.names().index(name)
     changed[k:, j] = {"K": 3.0, "Tc": 1.0, "d0": -4.0 * DEG}[name]
-    a = integ(x0, dc, w_block, p_block)
-    b = integ(x0, dc, w_block, changed)
+    a = integ(x0, dc, w_block, p_block)[1:]
+    b = integ(x0, dc, w_block, changed)[1:]
     # identical before substep k, different at substep k (state at its end) and after
     np.testing.assert_array_equal(a[:k], b[:k])
     assert np.any(a[k] != b[k])

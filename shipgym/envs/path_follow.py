@@ -219,15 +219,17 @@ class ShipPathFollowEnv(gym.Env):
             self._p_block[:] = sc.schedule.vector_at(t1)
             self._p_block_dirty = False
         # --- plant
-        states = self._integrator(self._state, delta_c, self._w_block, self._p_block)
+        trajectory = self._integrator(self._state, delta_c, self._w_block, self._p_block)
         self._step_count += 1
         self._t = self._step_count * self._Ts
         self._delta_c = delta_c
-        if not np.all(np.isfinite(states)):
+        # NaN/inf propagate through RK4: checking the final state suffices
+        if not all(map(math.isfinite, trajectory[-1].tolist())):
             return self._non_finite_step(frame, delta_c, compute_time)
+        states = trajectory[1:]  # ends of the substeps
         xs, ys = states[:, self._ix], states[:, self._iy]
         # fine samples at the substep *starts* t0, t0+h, …, t0+Ts−h (module doc)
-        start = np.vstack([self._state[None, :], states[:-1]])
+        start = trajectory[:-1]
         e_samples = self._tracker.cross_track_of(start[:, self._ix], start[:, self._iy])
         psi_m0, r_m0 = self._psi_m, self._r_m
         self._state = states[-1]
@@ -296,18 +298,19 @@ class ShipPathFollowEnv(gym.Env):
         return self._observation(frame), float(reward), terminated, truncated, info
 
     # ------------------------------------------------------------------ pieces
-    def _check_action(self, action: Any) -> np.ndarray:
+    def _check_action(self, action: Any) -> list[float]:
+        """The action as floats clipped to [-1, 1]; ValueError (state untouched) if malformed."""
         try:
-            a = np.asarray(action, dtype=np.float64).reshape(self.action_space.shape)
+            values = np.asarray(action, dtype=np.float64).reshape(self.action_space.shape).tolist()
         except (TypeError, ValueError) as exc:
             raise ValueError(
                 f"action must be an array of shape {self.action_space.shape}, got {action!r}"
             ) from exc
-        if not np.all(np.isfinite(a)):
+        if not all(map(math.isfinite, values)):
             raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
-        return np.clip(a, -1.0, 1.0)
+        return [min(1.0, max(-1.0, v)) for v in values]
 
-    def _autopilot_command(self, a: np.ndarray, frame: Any) -> float:
+    def _autopilot_command(self, a: list[float], frame: Any) -> float:
         """Guidance mode: heading reference from the guidance law, PID to δc (module doc)."""
         gcfg = self.scenario.config.guidance
         n = 3.0 * 2.0 ** float(a[0])

@@ -22,8 +22,8 @@ class PeriodIntegrator:
     """Integrate ``n_sub`` RK4 steps of length ``h`` [s] with the rudder command held.
 
     Call with the initial state, the command, and (n_sub, n_w) disturbances and
-    (n_sub, n_p) parameters (row i acts on substep i); returns the (n_sub, n_x) states at
-    the end of each substep.  The returned array is a fresh copy.
+    (n_sub, n_p) parameters (row i acts on substep i); returns the (n_sub + 1, n_x) states
+    at t0, t0 + h, …, t0 + n_sub·h (row 0 is the initial state).  A fresh copy.
     """
 
     def __init__(self, model: ShipModel, h: float, n_sub: int, jit: bool = False) -> None:
@@ -51,16 +51,17 @@ class PeriodIntegrator:
         self._u = np.zeros(len(model.input_names))
         self._w = np.zeros((n_sub, nw))
         self._p = np.zeros((n_sub, npar))
-        self._out = np.zeros((n_sub, nx))
+        self._out = np.zeros((n_sub + 1, nx))  # row 0: x0, rows 1..: CasADi writes here
         self._buffer, self._eval = self.function.buffer()
         for i, array in enumerate((self._x0, self._u, self._w, self._p)):
             self._buffer.set_arg(i, memoryview(array))
-        self._buffer.set_res(0, memoryview(self._out))
+        self._buffer.set_res(0, memoryview(self._out[1:]))
 
     def __call__(
         self, x0: np.ndarray, u: float | np.ndarray, w: np.ndarray, p: np.ndarray
     ) -> np.ndarray:
         self._x0[:] = x0
+        self._out[0] = x0
         self._u[:] = u
         self._w[:] = w
         self._p[:] = p
