@@ -72,16 +72,10 @@ JUMP_CASES = {
 
 def _jump_case(name: str) -> Any:
     """A catalogue scenario, or ``<name>_noise_free``: the same without its sensor model."""
-    from shipgym.scenarios import catalogue_dir, scenario_from_dict
+    from baselines.variants import scenario_variant
 
     base = name.removesuffix("_noise_free")
-    import yaml
-
-    data = yaml.safe_load((catalogue_dir() / f"{base}.yaml").read_text())
-    if name != base:
-        data.pop("sensors", None)
-        data["name"] = name
-    return scenario_from_dict(data, name)
+    return scenario_variant(base, noise_free=name != base)
 
 
 def identification_log(

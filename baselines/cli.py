@@ -73,6 +73,26 @@ def _flatten_lines(figures: dict[str, Any], prefix: str = "") -> list[str]:
     return lines
 
 
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from baselines.reproduce import PAPERS
+
+    module = PAPERS[args.paper]
+    bar = tqdm(desc=f"reproduce {args.paper}", file=sys.stderr, disable=args.no_progress)
+    rows = module.run(
+        out_dir=args.out or f"results/reproduce/{args.paper}",
+        seeds=args.seeds,
+        progress=lambda: bar.update(1),
+    )
+    bar.close()
+    if args.json:
+        _emit(args, rows, "")
+    else:
+        sys.stdout.write(module.markdown(rows))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shipgym", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -86,6 +106,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
     p.set_defaults(func=cmd_leaderboard)
+
+    p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
+    p.add_argument("paper", choices=["liu2019"], help="which paper")
+    p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
+    p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
+    p.set_defaults(func=cmd_reproduce)
 
     p = sub.add_parser("scenarios", help="list the scenario catalogue")
     p.add_argument("--json", action="store_true", help="print the names as a JSON list")

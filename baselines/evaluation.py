@@ -67,6 +67,9 @@ def run_episode(
         # controller compute time = time spent in act(), measured here
         metrics["compute_ms"] = 1e3 * float(np.mean(act_times))
         metrics["compute_ms_max"] = 1e3 * float(np.max(act_times))
+        stats = getattr(policy, "episode_stats", None)
+        if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
+            metrics.update(stats())
         traj = np.array(rows)
         trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
         return EpisodeResult(

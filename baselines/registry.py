@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCWeightedLSSVM
 from baselines.classical.pid import PIDLOS
 from baselines.classical.reference import RandomRudder, ZeroRudder
 from baselines.policy import Policy
@@ -12,6 +13,9 @@ from baselines.policy import Policy
 #: name -> (factory, action mode the controller drives)
 CONTROLLERS: dict[str, tuple[Callable[..., Policy], str]] = {
     "pid_los": (PIDLOS, "rudder"),
+    "nmpc": (NMPC, "rudder"),
+    "nmpc_wlssvm": (NMPCWeightedLSSVM, "rudder"),
+    "nmpc_lambda_lssvm": (NMPCLambdaLSSVM, "rudder"),
     "zero_rudder": (ZeroRudder, "rudder"),
     "random": (RandomRudder, "rudder"),
 }

@@ -8,14 +8,11 @@ every catalogue nomoto2 scenario with ``ship.unit_reading`` set to each reading 
 from __future__ import annotations
 
 import argparse
-import copy
 import json
 
-import yaml
-
 from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from baselines.variants import scenario_variant
 from shipgym.models.nomoto2 import UnitReading
-from shipgym.scenarios import catalogue_dir, scenario_from_dict
 
 SCENARIOS = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
 
@@ -23,11 +20,8 @@ SCENARIOS = ("nominal", "rudder_aging", "current_shift", "maneuverability_change
 def sweep(controller: str = "pid_los", seed: int = EVAL_SEED_OFFSET) -> list[dict]:
     rows = []
     for name in SCENARIOS:
-        base = yaml.safe_load((catalogue_dir() / f"{name}.yaml").read_text())
         for reading in UnitReading:
-            data = copy.deepcopy(base)
-            data["ship"]["unit_reading"] = reading.value
-            (result,) = evaluate(controller, scenario_from_dict(data, name), [seed])
+            (result,) = evaluate(controller, scenario_variant(name, reading.value), [seed])
             m = result.metrics
             rows.append(
                 {

@@ -16,8 +16,6 @@ import numpy as np
 from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import los_radius, los_relative_heading
-from shipgym.paths import PchipPath, WaypointPath
-from shipgym.tracking import PathTracker
 
 
 class PIDLOS:
@@ -35,8 +33,7 @@ class PIDLOS:
         K, T = context.nominal_model.first_order_nomoto()
         gains = PIDGains.from_nomoto(K, T, self.natural_frequency, self.damping)
         self.pid = HeadingPID(gains, context.rudder_limit)
-        path_cls = PchipPath if context.path_type == "pchip" else WaypointPath
-        self.tracker = PathTracker(path_cls(context.waypoints), context.acceptance_radius)
+        self.tracker = context.new_tracker()
         self._started = False
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:

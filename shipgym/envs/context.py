@@ -7,6 +7,8 @@ import dataclasses
 import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
+from shipgym.paths import PchipPath, WaypointPath
+from shipgym.tracking import PathTracker
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,6 +29,7 @@ class ControllerContext:
     control_period: float  # Ts [s]
     fine_step: float  # h [s]
     acceptance_radius: float  # R0 [m]
+    switching: str  # waypoint switching rule: "circle" | "along_track"
     los_radius_L: float  # n in R_LOS = nL
     action_mode: str  # "rudder" | "guidance"
     scenario_name: str
@@ -34,3 +37,10 @@ class ControllerContext:
     @property
     def nominal_params(self) -> ParameterRecord:
         return self.nominal_model.params
+
+    def new_tracker(self) -> PathTracker:
+        """A path tracker with the env's path and switching rule (for measured positions)."""
+        path = (
+            PchipPath(self.waypoints) if self.path_type == "pchip" else WaypointPath(self.waypoints)
+        )
+        return PathTracker(path, self.acceptance_radius, self.switching)

@@ -160,6 +160,7 @@ class ShipPathFollowEnv(gym.Env):
             control_period=self._Ts,
             fine_step=self._h,
             acceptance_radius=sc.acceptance_radius,
+            switching=sc.config.path.switching,
             los_radius_L=sc.config.guidance.los_radius_L,
             action_mode=self.action_mode,
             scenario_name=sc.name,

@@ -1,0 +1,357 @@
+"""Nonlinear MPC path following with LOS reference (Liu et al. 2019 §2.2.3, Algorithm 1).
+
+Prediction model: the ship model's own right-hand side and RK4 step (the simulator's), in
+CasADi SX, with the model parameters as solver parameters, so that an online identifier
+can change them without rebuilding the solver.  States [x, y, ψ, r, ṙ, δ] are predicted
+with ``prediction_substeps`` RK4 steps per control period (one step per Ts = 0.5 s is
+unstable for T2 = 0.0247 s); the error states of eq. (14) are outputs of the prediction:
+
+    e = −(x − x_n) sin ψp + (y − y_n) cos ψp,   ψ̃ = wrap(ψ − ψp)
+
+which is eq. (14) exactly (ė = u0 sin ψ̃, ψ̃̇ = r) on the active leg.  Cost eq. (16) with
+x_e = [e, ψ̃ − ψ̃_LOS, r, ṙ, δ], ψ̃_LOS(k+i) = −asin(e(k+i)/R_LOS) (eq. (9), evaluated along
+the prediction, with eq. (12) in the continuous form R_LOS = max(nL, |e| + L) so that the
+reference stays differentiable), Q = diag(1, 1, 0.01, 0.01, 0.001),
+R = 0.01; input held after N_c (eq. (17)); |δc| ≤ 30°.  Solved by CasADi's SQP method with
+the qrqp QP solver and a Gauss–Newton Hessian (the cost is a sum of squares), warm-started
+from the shifted previous plan.  On solver failure the shifted last plan is applied and the
+failure is counted.
+
+Adaptive variants update the model parameters from ``info["samples"]`` each step with the
+weighted LS-SVM or λ-LS-SVM online identifier, with persistent excitation (eq. (45)).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from typing import Any, ClassVar
+
+import casadi as ca
+import numpy as np
+
+from shipgym.codegen import compiled
+from shipgym.envs.context import ControllerContext
+from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
+from shipgym.models.base import ShipModel
+
+
+@dataclasses.dataclass(frozen=True)
+class NMPCSettings:
+    """Liu et al. (2019) §4 defaults, plus the numerical choices (documented in the module)."""
+
+    horizon: int = 10  # N_p
+    control_horizon: int = 8  # N_c
+    Q: tuple[float, float, float, float, float] = (1.0, 1.0, 0.01, 0.01, 0.001)
+    R: float = 0.01
+    prediction_substeps: int = 10  # RK4 steps per control period in the prediction
+    max_iter: int = 3  # Gauss–Newton SQP iterations per control step (warm-started, RTI-style)
+    step_tolerance: float = 1e-5  # rad: stop when the accepted step is smaller
+    compile: bool = True  # compile residual + Jacobian to C (cached); VM otherwise
+
+
+class NMPCSolver:
+    """The NMPC problem for one model class, horizon and control period (built once).
+
+    The cost (16) is a sum of squares ‖ρ(u; p)‖², so each SQP iteration is a Gauss–Newton
+    step: the box-constrained linear least-squares problem min ‖ρ + J·Δ‖² with
+    δmin ≤ u + Δ ≤ δmax (as a QP, CasADi's qrqp), then a backtracking line search on the cost.
+    ρ and J = ∂ρ/∂u come from one CasADi function, compiled to C and cached on disk
+    (``shipgym.codegen``).
+    """
+
+    def __init__(
+        self, model: ShipModel, settings: NMPCSettings, control_period: float, rudder_limit: float
+    ) -> None:
+        s = settings
+        if not 1 <= s.control_horizon <= s.horizon:
+            raise ValueError("need 1 ≤ control_horizon ≤ horizon")
+        self.model, self.settings = model, settings
+        self.rudder_limit = rudder_limit
+        nx, npar = model.n_states, model.n_params
+        h = control_period / s.prediction_substeps
+        step = model.casadi_step(h)
+        ix, iy, ipsi = (model.state_index(k) for k in ("x", "y", "psi"))
+        ir, irdot, idelta = (model.state_index(k) for k in ("r", "r_dot", "delta"))
+        u = ca.SX.sym("u", s.control_horizon)
+        # parameters: x0, leg start (x_n, y_n), path angle ψp, nL, model parameters
+        p = ca.SX.sym("p", nx + 4 + npar)
+        x = p[:nx]
+        xn, yn, psip, radius = p[nx], p[nx + 1], p[nx + 2], p[nx + 3]
+        length = model.length
+        theta = p[nx + 4 :]
+        w = ca.SX.zeros(model.n_disturbances)
+        q = [math.sqrt(v) for v in s.Q]
+        residuals, states = [], []
+        for i in range(s.horizon):
+            ui = u[min(i, s.control_horizon - 1)]  # eq. (17): held after N_c
+            for _ in range(s.prediction_substeps):
+                x = step(x, ui, w, theta)
+            states.append(x)
+            e = -(x[ix] - xn) * ca.sin(psip) + (x[iy] - yn) * ca.cos(psip)
+            rel = ca.atan2(ca.sin(x[ipsi] - psip), ca.cos(x[ipsi] - psip))
+            # eq. (9) along the prediction; eq. (12) made continuous, R = max(nL, |e| + L),
+            # so that |e/R| < 1 and asin stays differentiable
+            r_los = ca.fmax(radius, ca.fabs(e) + length)
+            ref = -ca.asin(e / r_los)
+            residuals += [
+                q[0] * e,
+                q[1] * (rel - ref),
+                q[2] * x[ir],
+                q[3] * x[irdot],
+                q[4] * x[idelta],
+            ]
+        residuals += [math.sqrt(s.R) * u[i] for i in range(s.control_horizon)]
+        rho = ca.vertcat(*residuals)  # cost (16) = ‖ρ‖²
+        self.n_residuals = rho.shape[0]
+        self.predict_function = ca.Function("predict", [u, p], [ca.horzcat(*states)])
+        tag = f"{model.name}_n{s.horizon}_c{s.control_horizon}_s{s.prediction_substeps}"
+        residual = ca.Function(f"nmpc_rho_{tag}", [u, p], [rho])
+        jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.jacobian(rho, u)])
+        if s.compile:
+            residual, jacobian = compiled(residual), compiled(jacobian)
+        self._u = np.zeros(s.control_horizon)
+        self._p = np.zeros(nx + 4 + npar)
+        self._rho = np.zeros(self.n_residuals)
+        self._jac = np.zeros((s.control_horizon, self.n_residuals))  # column-major J
+        self._rho_eval = self._bind(residual, [self._rho])
+        self._jac_eval = self._bind(jacobian, [self._rho, self._jac])
+        self._functions = (residual, jacobian)  # keep the buffers' owners alive
+        self.lb = np.full(s.control_horizon, -rudder_limit)
+        self.ub = np.full(s.control_horizon, rudder_limit)
+        # the Gauss–Newton QP: min ½Δᵀ(JᵀJ)Δ + (Jᵀρ)ᵀΔ, lb − u ≤ Δ ≤ ub − u (CasADi qrqp)
+        n = s.control_horizon
+        qp = ca.conic(
+            "gn_qp",
+            "qrqp",
+            {"h": ca.Sparsity.dense(n, n), "a": ca.Sparsity(0, n)},
+            {
+                "print_iter": False,
+                "print_header": False,
+                "print_info": False,
+                "error_on_fail": False,
+            },
+        )
+        self._qp_in = {
+            name: np.zeros(qp.sparsity_in(i).nnz()) for i, name in enumerate(qp.name_in())
+        }
+        self._qp_out = [np.zeros(qp.sparsity_out(i).nnz()) for i in range(qp.n_out())]
+        buffer, self._qp_eval = qp.buffer()
+        for i, name in enumerate(qp.name_in()):
+            buffer.set_arg(i, memoryview(self._qp_in[name]))
+        for i, out in enumerate(self._qp_out):
+            buffer.set_res(i, memoryview(out))
+        self._qp = (qp, buffer)
+
+    def _gauss_newton_step(self, u: np.ndarray, rho: np.ndarray, jac: np.ndarray) -> np.ndarray:
+        """Box-constrained Gauss–Newton step Δ (the SQP's QP), solved by qrqp."""
+        q = self._qp_in
+        q["h"][:] = (jac.T @ jac).ravel()
+        q["g"][:] = jac.T @ rho
+        q["lbx"][:] = self.lb - u
+        q["ubx"][:] = self.ub - u
+        self._qp_eval()
+        return self._qp_out[0].copy()
+
+    def _bind(self, function: ca.Function, outputs: list[np.ndarray]):
+        buffer, evaluate = function.buffer()
+        buffer.set_arg(0, memoryview(self._u))
+        buffer.set_arg(1, memoryview(self._p))
+        for i, out in enumerate(outputs):
+            buffer.set_res(i, memoryview(out))
+        return buffer, evaluate
+
+    def parameters(
+        self,
+        x0: np.ndarray,
+        leg_start: tuple[float, float],
+        path_angle: float,
+        radius: float,
+        params: np.ndarray,
+    ) -> np.ndarray:
+        return np.concatenate([x0, [leg_start[0], leg_start[1], path_angle, radius], params])
+
+    def cost(self, plan: np.ndarray, p: np.ndarray) -> float:
+        self._u[:], self._p[:] = plan, p
+        self._rho_eval[1]()
+        return float(self._rho @ self._rho)
+
+    def candidate_plans(self, guess: np.ndarray) -> list[np.ndarray]:
+        """Warm start plus coarse alternatives: constant rudder at 0, ±½, ±1 of the limit and
+        'turn hard, then straighten' plans.  The problem is non-convex (slow yaw dynamics, the
+        asin reference, the input held after N_c): started only from the shifted plan, the
+        Gauss–Newton iterations can stay in a local minimum that postpones the turn forever."""
+        n, lim = self.settings.control_horizon, self.rudder_limit
+        plans = [np.clip(guess, self.lb, self.ub)]
+        plans += [np.full(n, c * lim) for c in (-1.0, -0.5, 0.0, 0.5, 1.0)]
+        for k in (2, 4):
+            for sign in (-1.0, 1.0):
+                plan = np.zeros(n)
+                plan[:k] = sign * lim
+                plans.append(plan)
+        return plans
+
+    def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
+        """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""
+        s = self.settings
+        self._p[:] = p
+        costs = [
+            (self.cost(plan, p), i, plan) for i, plan in enumerate(self.candidate_plans(guess))
+        ]
+        finite = [c for c in costs if math.isfinite(c[0])]
+        if not finite:
+            return np.clip(guess, self.lb, self.ub), False, 0
+        cost, _, u = min(finite, key=lambda c: (c[0], c[1]))
+        iterations = 0
+        for iterations in range(1, s.max_iter + 1):
+            self._u[:] = u
+            self._jac_eval[1]()
+            rho, jac = self._rho.copy(), self._jac.T
+            if not (np.all(np.isfinite(rho)) and np.all(np.isfinite(jac))):
+                return u, False, iterations
+            step = self._gauss_newton_step(u, rho, jac)
+            alpha = 1.0
+            while alpha > 1e-3:  # backtracking on the cost
+                trial = np.clip(u + alpha * step, self.lb, self.ub)
+                trial_cost = self.cost(trial, p)
+                if trial_cost <= cost:
+                    break
+                alpha *= 0.5
+            else:
+                break  # no descent: converged as far as Gauss–Newton goes
+            moved = float(np.max(np.abs(trial - u)))
+            u, cost = trial, trial_cost
+            if moved < s.step_tolerance:
+                break
+        return u, bool(np.all(np.isfinite(u)) and math.isfinite(cost)), iterations
+
+    def predict(self, plan: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """Predicted states (N_p, n_x) at the ends of the control periods."""
+        return np.asarray(self.predict_function(plan, p)).T
+
+
+_SOLVERS: dict[tuple, NMPCSolver] = {}
+
+
+def get_solver(model: ShipModel, settings: NMPCSettings, ts: float, limit: float) -> NMPCSolver:
+    """Solvers are built once per process for a model class, settings and timing."""
+    key = (type(model).__name__, settings, ts, limit)
+    if key not in _SOLVERS:
+        _SOLVERS[key] = NMPCSolver(model, settings, ts, limit)
+    return _SOLVERS[key]
+
+
+def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) -> float:
+    """ṙ estimate [rad/s²]: least-squares slope of the last fine yaw-rate samples and r now."""
+    r = np.asarray(samples.get("r", ()), dtype=float)
+    if r.size == 0:
+        return 0.0
+    values = np.append(r[-5:], yaw_rate)
+    t = h * np.arange(values.size)
+    t -= t.mean()
+    return float(t @ (values - values.mean()) / (t @ t))
+
+
+class NMPC:
+    """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019)."""
+
+    name: ClassVar[str] = "nmpc"
+    kind: ClassVar[str] = "classical"
+    identifier_type: ClassVar[type | None] = None
+
+    def __init__(
+        self, settings: NMPCSettings | None = None, excitation_deg: float | None = None
+    ) -> None:
+        self.settings = settings if settings is not None else NMPCSettings()
+        # eq. (45) excitation: only the adaptive variants need it (default 1°)
+        default = 1.0 if self.identifier_type is not None else 0.0
+        self.excitation = math.radians(excitation_deg if excitation_deg is not None else default)
+
+    def reset(self, context: ControllerContext, seed: int | None = None) -> None:
+        if context.action_mode != "rudder":
+            raise ValueError(
+                f"{self.name} drives the rudder; make the env with action_mode='rudder'"
+            )
+        self.ctx = context
+        self.solver = get_solver(
+            context.nominal_model, self.settings, context.control_period, context.rudder_limit
+        )
+        self.params = context.nominal_params
+        self.identifier = (
+            self.identifier_type(context.fine_step, context.nominal_params)
+            if self.identifier_type is not None
+            else None
+        )
+        self.pe = PersistentExcitation(self.excitation, np.random.default_rng(seed))
+        self.tracker = context.new_tracker()
+        self._started = False
+        self.plan = np.zeros(self.settings.control_horizon)
+        self.failures = 0
+        self.solves = 0
+        self.solve_times: list[float] = []
+        self.param_history: list[dict[str, float]] = []
+
+    def _state(self, info: dict[str, Any]) -> np.ndarray:
+        model = self.ctx.nominal_model
+        x0 = np.zeros(model.n_states)
+        x0[model.state_index("x")], x0[model.state_index("y")] = info["position"]
+        x0[model.state_index("psi")] = info["heading"]
+        x0[model.state_index("r")] = info["yaw_rate"]
+        x0[model.state_index("r_dot")] = yaw_acceleration(
+            info["samples"], info["yaw_rate"], self.ctx.fine_step
+        )
+        x0[model.state_index("delta")] = info["rudder_angle"]
+        return x0
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        if self.identifier is not None and len(info["samples"]["t"]):
+            self.identifier.update(info["samples"])
+            self.params = self.identifier.params
+        x, y = info["position"]
+        frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
+        self._started = True
+        leg_start = (
+            tuple(self.tracker.path.point(frame.along_track))  # closest point; tangent line
+            if self.tracker.is_curve
+            else tuple(self.ctx.waypoints[frame.leg])
+        )
+        radius = self.ctx.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
+        p = self.solver.parameters(
+            self._state(info), leg_start, frame.path_angle, radius, self.params.to_vector()
+        )
+        guess = np.append(self.plan[1:], self.plan[-1])  # shifted previous solution
+        start = time.perf_counter()
+        plan, ok, _ = self.solver.solve(p, guess)
+        self.solve_times.append(time.perf_counter() - start)
+        self.solves += 1
+        if ok:
+            self.plan = plan
+        else:  # fall back to the shifted last plan and count it
+            self.failures += 1
+            self.plan = guess
+        self.param_history.append({"t": info["t"], **self.params.as_dict()})
+        delta_c = self.pe(float(self.plan[0]))
+        return np.array([np.clip(delta_c / self.ctx.rudder_limit, -1.0, 1.0)], dtype=np.float32)
+
+    def episode_stats(self) -> dict[str, float]:
+        times = np.array(self.solve_times) if self.solve_times else np.array([math.nan])
+        return {
+            "solver_failures": float(self.failures),
+            "solve_ms_median": 1e3 * float(np.median(times)),
+            "solve_ms_p99": 1e3 * float(np.percentile(times, 99)),
+        }
+
+
+class NMPCWeightedLSSVM(NMPC):
+    """``nmpc_wlssvm``: NMPC with the model updated online by weighted LS-SVM."""
+
+    name = "nmpc_wlssvm"
+    identifier_type = WeightedLSSVMOnline
+
+
+class NMPCLambdaLSSVM(NMPC):
+    """``nmpc_lambda_lssvm``: NMPC with the model updated by λ-LS-SVM (Algorithm 2)."""
+
+    name = "nmpc_lambda_lssvm"
+    identifier_type = LambdaLSSVM

@@ -1,0 +1,8 @@
+"""Re-runs of the source papers' experiments (``shipgym reproduce PAPER``)."""
+
+from baselines.reproduce import liu2019
+
+#: paper id -> module with ``run(out_dir, seeds) -> rows``
+PAPERS = {"liu2019": liu2019}
+
+__all__ = ["PAPERS"]
