@@ -12,10 +12,15 @@ which is eq. (14) exactly (ė = u0 sin ψ̃, ψ̃̇ = r) on the active leg.  Cos
 x_e = [e, ψ̃ − ψ̃_LOS, r, ṙ, δ], ψ̃_LOS(k+i) = −asin(e(k+i)/R_LOS) (eq. (9), evaluated along
 the prediction, with eq. (12) in the continuous form R_LOS = max(nL, |e| + L) so that the
 reference stays differentiable), Q = diag(1, 1, 0.01, 0.01, 0.001),
-R = 0.01; input held after N_c (eq. (17)); |δc| ≤ 30°.  Solved by CasADi's SQP method with
-the qrqp QP solver and a Gauss–Newton Hessian (the cost is a sum of squares), warm-started
-from the shifted previous plan.  On solver failure the shifted last plan is applied and the
-failure is counted.
+R = 0.01; input held after N_c (eq. (17)); |δc| ≤ 30°.
+
+Solver: the cost is a sum of squares ‖ρ(u)‖², so the SQP uses the Gauss–Newton Hessian;
+each QP (a box-constrained linear least-squares problem) is solved by CasADi's qrqp, with a
+backtracking line search, warm-started from the shifted previous plan.  ρ and its (dense)
+Jacobian are one CasADi function compiled to C once per machine (``shipgym.codegen``).  From
+the warm start it typically converges in 1–3 iterations (``max_iter`` = 10 bounds the worst
+case).  On solver failure (non-finite prediction or plan) the shifted last plan is applied
+and the failure is counted.  On a PCHIP path the "leg" is the tangent at the closest point.
 
 Adaptive variants update the model parameters from ``info["samples"]`` each step with the
 weighted LS-SVM or λ-LS-SVM online identifier, with persistent excitation (eq. (45)).
@@ -46,7 +51,7 @@ class NMPCSettings:
     Q: tuple[float, float, float, float, float] = (1.0, 1.0, 0.01, 0.01, 0.001)
     R: float = 0.01
     prediction_substeps: int = 10  # RK4 steps per control period in the prediction
-    max_iter: int = 3  # Gauss–Newton SQP iterations per control step (warm-started, RTI-style)
+    max_iter: int = 10  # Gauss–Newton SQP iterations per control step (warm-started)
     step_tolerance: float = 1e-5  # rad: stop when the accepted step is smaller
     compile: bool = True  # compile residual + Jacobian to C (cached); VM otherwise
 
@@ -108,7 +113,8 @@ class NMPCSolver:
         self.predict_function = ca.Function("predict", [u, p], [ca.horzcat(*states)])
         tag = f"{model.name}_n{s.horizon}_c{s.control_horizon}_s{s.prediction_substeps}"
         residual = ca.Function(f"nmpc_rho_{tag}", [u, p], [rho])
-        jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.jacobian(rho, u)])
+        # dense: the buffer interface writes only the structural nonzeros of an output
+        jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.densify(ca.jacobian(rho, u))])
         if s.compile:
             residual, jacobian = compiled(residual), compiled(jacobian)
         self._u = np.zeros(s.control_horizon)
@@ -177,32 +183,14 @@ class NMPCSolver:
         self._rho_eval[1]()
         return float(self._rho @ self._rho)
 
-    def candidate_plans(self, guess: np.ndarray) -> list[np.ndarray]:
-        """Warm start plus coarse alternatives: constant rudder at 0, ±½, ±1 of the limit and
-        'turn hard, then straighten' plans.  The problem is non-convex (slow yaw dynamics, the
-        asin reference, the input held after N_c): started only from the shifted plan, the
-        Gauss–Newton iterations can stay in a local minimum that postpones the turn forever."""
-        n, lim = self.settings.control_horizon, self.rudder_limit
-        plans = [np.clip(guess, self.lb, self.ub)]
-        plans += [np.full(n, c * lim) for c in (-1.0, -0.5, 0.0, 0.5, 1.0)]
-        for k in (2, 4):
-            for sign in (-1.0, 1.0):
-                plan = np.zeros(n)
-                plan[:k] = sign * lim
-                plans.append(plan)
-        return plans
-
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""
         s = self.settings
+        u = np.clip(guess, self.lb, self.ub)
         self._p[:] = p
-        costs = [
-            (self.cost(plan, p), i, plan) for i, plan in enumerate(self.candidate_plans(guess))
-        ]
-        finite = [c for c in costs if math.isfinite(c[0])]
-        if not finite:
-            return np.clip(guess, self.lb, self.ub), False, 0
-        cost, _, u = min(finite, key=lambda c: (c[0], c[1]))
+        cost = self.cost(u, p)
+        if not math.isfinite(cost):
+            return u, False, 0
         iterations = 0
         for iterations in range(1, s.max_iter + 1):
             self._u[:] = u
@@ -264,8 +252,8 @@ class NMPC:
         self, settings: NMPCSettings | None = None, excitation_deg: float | None = None
     ) -> None:
         self.settings = settings if settings is not None else NMPCSettings()
-        # eq. (45) excitation: only the adaptive variants need it (default 1°)
-        default = 1.0 if self.identifier_type is not None else 0.0
+        # eq. (45) excitation (σ not given by the paper; 0 by default: see the README)
+        default = 0.0
         self.excitation = math.radians(excitation_deg if excitation_deg is not None else default)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
