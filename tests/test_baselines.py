@@ -63,7 +63,7 @@ def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
     for name in ("leaderboard.md", "leaderboard.csv", "leaderboard.json"):
         assert (tmp_path / name).is_file()
     on_disk = json.loads((tmp_path / "leaderboard.json").read_text())
-    assert len(on_disk) == len(rows) == 4 * 3
+    assert len(on_disk) == len(rows) == 10 * 6
     required = {
         "scenario",
         "controller",

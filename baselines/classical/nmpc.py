@@ -179,9 +179,12 @@ class NMPCSolver:
         return np.concatenate([x0, [leg_start[0], leg_start[1], path_angle, radius], params])
 
     def cost(self, plan: np.ndarray, p: np.ndarray) -> float:
+        """Cost (16) of a plan; inf when the prediction diverges (e.g. absurd parameters)."""
         self._u[:], self._p[:] = plan, p
         self._rho_eval[1]()
-        return float(self._rho @ self._rho)
+        with np.errstate(over="ignore", invalid="ignore"):
+            value = float(self._rho @ self._rho)
+        return value if math.isfinite(value) else math.inf
 
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""

@@ -1,0 +1,140 @@
+"""NMPC of Liu et al. (2019) §2.2.3 and its adaptive variants (issue: NMPC + λ-LS-SVM)."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCSettings, NMPCSolver
+from baselines.evaluation import evaluate, run_episode
+from shipgym.models import Nomoto2, Nomoto2Params
+from shipgym.scenarios import scenario_from_dict
+
+DEG = math.pi / 180.0
+
+
+def test_open_loop_prediction_equals_the_simulator() -> None:
+    """Same model, same RK4 at the same step (h = 0.01 s): prediction = env, to 1e-9."""
+    params = Nomoto2Params()
+    settings = NMPCSettings(prediction_substeps=50, compile=False)
+    solver = NMPCSolver(Nomoto2(params), settings, 0.5, 30 * DEG)
+    env = gym.make("ShipPathFollow-v0", scenario="nominal")
+    env.reset(seed=0)
+    inner = env.unwrapped
+    x0 = inner._state.copy()
+    fractions = np.array([0.25, -0.125, 0.75, 0.0, -1.0, 0.5, 0.125, -0.375], dtype=np.float32)
+    plan = fractions.astype(float) * 30 * DEG  # exactly what the float32 action becomes
+    p = solver.parameters(x0, (1.0, 1.0), 0.0, 2.85, params.to_vector())
+    predicted = solver.predict(plan, p)
+    for i in range(settings.horizon):
+        env.step(fractions[min(i, 7)][None])
+        np.testing.assert_allclose(predicted[i], inner._state, rtol=0, atol=1e-9)
+
+
+def test_default_prediction_is_close_to_the_simulator() -> None:
+    """10 RK4 substeps per period (h = 0.05 s): the discretisation error stays small."""
+    params = Nomoto2Params()
+    coarse = NMPCSolver(Nomoto2(params), NMPCSettings(compile=False), 0.5, 30 * DEG)
+    fine = NMPCSolver(
+        Nomoto2(params), NMPCSettings(prediction_substeps=50, compile=False), 0.5, 30 * DEG
+    )
+    x0 = np.array([0.0, 0.0, 0.1, 0.05, 0.0, 0.1])
+    p = coarse.parameters(x0, (0.0, 0.0), 0.0, 2.85, params.to_vector())
+    plan = np.full(8, 20 * DEG)
+    assert np.max(np.abs(coarse.predict(plan, p) - fine.predict(plan, p))) < 1e-4
+
+
+def straight_leg(offset: float = 1.0) -> object:
+    return scenario_from_dict(
+        {
+            "name": "straight_leg",
+            "path": {"waypoints": [[0, 0], [60, 0]]},
+            "initial_state": {"x": 0.0, "y": -offset},
+            "ship": {"model": "nomoto2", "params": {}},
+            "time_limit": 40.0,
+        }
+    )
+
+
+def test_nmpc_with_true_model_converges_on_a_straight_leg() -> None:
+    """From 1 m off the leg, |e| < 0.05 m from t = 10 s on, and |δc| ≤ 30° at every step."""
+    policy = NMPC()
+    result = run_episode(policy, straight_leg(), seed=0)
+    tr = result.trajectory
+    after = tr["t"] >= 10.0
+    assert np.all(np.abs(tr["cross_track_error"][after]) < 0.05)
+    assert np.all(np.abs(tr["rudder_command"]) <= 30 * DEG + 1e-12)
+    assert policy.failures == 0
+
+
+def test_solver_failure_falls_back_to_the_shifted_plan() -> None:
+    """A NaN model parameter makes the prediction NaN: no crash, shifted plan, counted."""
+
+    class BrokenModel(NMPC):
+        name = "nmpc_broken"
+
+        def act(self, obs, info):
+            if info["t"] >= 2.0:  # from then on the "identified" model is garbage
+                self.params = _NaNParams(self.ctx.nominal_params)
+            return super().act(obs, info)
+
+    policy = BrokenModel()
+    env = gym.make("ShipPathFollow-v0", scenario=straight_leg())
+    obs, info = env.reset(seed=0)
+    policy.reset(env.unwrapped.controller_context, 0)
+    commands = []
+    for _ in range(12):
+        before = policy.plan.copy()
+        action = policy.act(obs, info)
+        commands.append(float(action[0]))
+        if info["t"] >= 2.0:
+            np.testing.assert_array_equal(policy.plan, np.append(before[1:], before[-1]))
+        obs, _, _, _, info = env.step(action)
+    assert policy.failures == 12 - 4  # t = 2.0, 2.5, ..., 5.5
+    assert all(math.isfinite(c) and abs(c) <= 1.0 for c in commands)
+    assert policy.episode_stats()["solver_failures"] == 8.0
+
+
+class _NaNParams:
+    """Stands in for a parameter record whose values are NaN."""
+
+    def __init__(self, record: Nomoto2Params) -> None:
+        self._record = record
+
+    def to_vector(self) -> np.ndarray:
+        return np.full(len(self._record.names()), np.nan)
+
+    def as_dict(self) -> dict[str, float]:
+        return dict.fromkeys(self._record.names(), math.nan)
+
+
+def test_lambda_lssvm_beats_plain_nmpc_on_current_shift() -> None:
+    """Case 2 (d0 jump): adapting the model lowers ACE (fixed seed; long-leg variant too)."""
+    for scenario in ("current_shift", "current_shift_long"):
+        plain = evaluate("nmpc", scenario, [0])[0].metrics["ace"]
+        adaptive = evaluate("nmpc_lambda_lssvm", scenario, [0])[0].metrics["ace"]
+        assert adaptive < plain, scenario
+
+
+def test_identifier_tracks_what_the_data_can_identify() -> None:
+    """After the d0 jump the steady-state rudder −d0/K is identified; d0 itself needs
+    persistent excitation (eq. (45)): without it K and d0 drift together on straight legs."""
+    true_ratio = 4.0 / 0.506  # deg: −d0/K after the change
+    plain = NMPCLambdaLSSVM()  # σ = 0
+    run_episode(plain, "current_shift_long", seed=0)
+    ratio = -plain.identifier.params.d0 / plain.identifier.params.K / DEG
+    assert ratio == pytest.approx(true_ratio, rel=0.25)
+    excited = NMPCLambdaLSSVM(excitation_deg=2.0)
+    run_episode(excited, "current_shift_long", seed=0)
+    assert excited.identifier.params.d0 == pytest.approx(-4.0 * DEG, rel=0.05)
+    assert excited.identifier.params.K == pytest.approx(0.506, rel=0.05)
+
+
+def test_nmpc_refuses_guidance_mode() -> None:
+    env = gym.make("ShipPathFollow-v0", action_mode="guidance")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="rudder"):
+        NMPC().reset(env.unwrapped.controller_context, 0)
