@@ -185,3 +185,31 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
             row["batch_fit_nomoto2"] = {"error": str(exc)}
         out[case] = row
     return out
+
+
+def bench_nmpc(scenarios: tuple[str, ...] = ("nominal", "rudder_aging", "current_shift")) -> dict:
+    """NMPC solve time (Np = 10, 5 error states) in closed loop: median, p99, ratio to Ts."""
+    from baselines.classical.nmpc import NMPC
+    from baselines.evaluation import run_episode
+
+    times: list[float] = []
+    solves = failures = 0
+    control_period = None
+    for name in scenarios:
+        policy = NMPC()
+        run_episode(policy, name, seed=0)
+        times += policy.solve_times
+        solves += policy.solves
+        failures += policy.failures
+        control_period = policy.ctx.control_period
+    median = statistics.median(times)
+    p99 = float(np.percentile(times, 99))
+    return {
+        "nmpc_median_ms": 1e3 * median,
+        "nmpc_p99_ms": 1e3 * p99,
+        "nmpc_target_median_ms": 0.5,
+        "nmpc_target_p99_ms": 2.0,
+        "median_ratio_to_control_period": median / control_period,
+        "solves": solves,
+        "failures": failures,
+    }

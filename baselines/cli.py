@@ -50,10 +50,12 @@ def cmd_leaderboard(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from baselines.benchmarks import bench_env, bench_identification
+    from baselines.benchmarks import bench_env, bench_identification, bench_nmpc
 
     if args.target == "env":
         figures = bench_env(repeats=args.repeats)
+    elif args.target == "nmpc":
+        figures = bench_nmpc()
     else:
         figures = bench_identification()
     _emit(args, figures, "\n".join(_flatten_lines(figures)))
@@ -120,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_scenarios)
 
     p = sub.add_parser("bench", help="benchmarks of SPEC §10")
-    p.add_argument("target", choices=["env", "identification"], help="what to benchmark")
+    p.add_argument("target", choices=["env", "nmpc", "identification"], help="what to benchmark")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--json", action="store_true", help="print the figures as a JSON object")
     p.set_defaults(func=cmd_bench)

@@ -143,3 +143,21 @@ def test_cli_bench_identification_json(capsys) -> None:
         assert aging[name]["update_us_median"] > 0
         assert aging[name]["final_relative_error"]["Tc"] < 0.05
     assert aging["lambda_lssvm"]["t_within_10pct"] <= aging["weighted_lssvm"]["t_within_10pct"]
+
+
+def test_cli_bench_nmpc_json(capsys) -> None:
+    assert main(["bench", "nmpc", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert 0 < figures["nmpc_median_ms"] <= figures["nmpc_p99_ms"]
+    assert figures["failures"] == 0 and figures["solves"] > 100
+
+
+def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
+    """SPEC §9b shape: case, controller, metric, ours, paper; all three cases and controllers."""
+    assert main(["reproduce", "liu2019", "--out", str(tmp_path), "--json", "--no-progress"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert {"case", "controller", "metric", "ours", "paper"} <= set(rows[0])
+    assert {r["case"] for r in rows} == {"rudder_aging", "current_shift", "maneuverability_change"}
+    assert {r["controller"] for r in rows} == {"nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"}
+    assert {r["metric"] for r in rows} == {"ace", "t_c"}
+    assert (tmp_path / "liu2019.md").is_file() and (tmp_path / "rudder_aging_si.png").is_file()
