@@ -125,6 +125,13 @@ def los_heading(
 # --------------------------------------------------------------------------------------------
 # Look-ahead LOS — Xu & Guedes Soares (2020) §3
 # --------------------------------------------------------------------------------------------
+def los_desired_heading(
+    cross_track: float, path_angle: float, ship_length: float, n: float = 3.0
+) -> float:
+    """ψ_LOS = ψp + ψ̃_LOS with R_LOS of eq. (12): Liu et al. (2019) eq. (9)–(12) [rad]."""
+    return path_angle + los_relative_heading(cross_track, los_radius(cross_track, ship_length, n))
+
+
 def lookahead_los_heading(
     cross_track: float, path_angle: float, lookahead: float, sideslip: float = 0.0
 ) -> float:

@@ -70,32 +70,60 @@ def test_nmpc_with_true_model_converges_on_a_straight_leg() -> None:
     assert policy.failures == 0
 
 
-def test_solver_failure_falls_back_to_the_shifted_plan() -> None:
-    """A NaN model parameter makes the prediction NaN: no crash, shifted plan, counted."""
+def test_diverging_identified_model_falls_back_to_the_last_good_model() -> None:
+    """NaN "identified" parameters: the solve is redone with the last model that worked."""
 
     class BrokenModel(NMPC):
-        name = "nmpc_broken"
+        name = "nmpc_broken_model"
 
         def act(self, obs, info):
-            if info["t"] >= 2.0:  # from then on the "identified" model is garbage
+            if info["t"] >= 2.0:
                 self.params = _NaNParams(self.ctx.nominal_params)
             return super().act(obs, info)
 
-    policy = BrokenModel()
+    policy, commands = _run_steps(BrokenModel(), 12)
+    assert policy.model_fallbacks == 12 - 4 and policy.failures == 0
+    assert all(math.isfinite(c) and abs(c) <= 1.0 for c in commands)
+
+
+def test_solver_failure_falls_back_to_the_shifted_plan() -> None:
+    """A NaN state makes every solve fail: no crash, shifted last plan, failures counted."""
+
+    class BrokenSensor(NMPC):
+        name = "nmpc_broken_sensor"
+
+        def _state(self, info):
+            x0 = super()._state(info)
+            if info["t"] >= 2.0:
+                x0[:] = np.nan
+            return x0
+
+    shifted = []
+
+    def check(policy, before):
+        if policy.last_t >= 2.0:
+            shifted.append(np.array_equal(policy.plan, np.append(before[1:], before[-1])))
+
+    policy, commands = _run_steps(BrokenSensor(), 12, check)
+    assert policy.failures == 12 - 4 and all(shifted) and len(shifted) == 8
+    assert all(math.isfinite(c) and abs(c) <= 1.0 for c in commands)
+    assert policy.episode_stats()["solver_failures"] == 8.0
+
+
+def _run_steps(policy, n, check=None):
     env = gym.make("ShipPathFollow-v0", scenario=straight_leg())
     obs, info = env.reset(seed=0)
     policy.reset(env.unwrapped.controller_context, 0)
     commands = []
-    for _ in range(12):
+    for _ in range(n):
         before = policy.plan.copy()
+        policy.last_t = info["t"]
         action = policy.act(obs, info)
         commands.append(float(action[0]))
-        if info["t"] >= 2.0:
-            np.testing.assert_array_equal(policy.plan, np.append(before[1:], before[-1]))
+        if check is not None:
+            check(policy, before)
         obs, _, _, _, info = env.step(action)
-    assert policy.failures == 12 - 4  # t = 2.0, 2.5, ..., 5.5
-    assert all(math.isfinite(c) and abs(c) <= 1.0 for c in commands)
-    assert policy.episode_stats()["solver_failures"] == 8.0
+    return policy, commands
 
 
 class _NaNParams:
@@ -112,11 +140,11 @@ class _NaNParams:
 
 
 def test_lambda_lssvm_beats_plain_nmpc_on_current_shift() -> None:
-    """Case 2 (d0 jump): adapting the model lowers ACE (fixed seed; long-leg variant too)."""
-    for scenario in ("current_shift", "current_shift_long"):
-        plain = evaluate("nmpc", scenario, [0])[0].metrics["ace"]
-        adaptive = evaluate("nmpc_lambda_lssvm", scenario, [0])[0].metrics["ace"]
-        assert adaptive < plain, scenario
+    """Case 2 (d0 jump) on the long-leg path, where tracking after the change (not the
+    corner overshoot of the 0.95 m ship, README) decides ACE: adaptation lowers it."""
+    plain = evaluate("nmpc", "current_shift_long", [0])[0].metrics["ace"]
+    adaptive = evaluate("nmpc_lambda_lssvm", "current_shift_long", [0])[0].metrics["ace"]
+    assert adaptive < 0.95 * plain
 
 
 def test_identifier_tracks_what_the_data_can_identify() -> None:

@@ -480,3 +480,9 @@ def re_word(word: str, text: str) -> bool:
     import re
 
     return re.search(rf"\b{re.escape(word)}\b", text) is not None
+
+
+def test_unknown_initial_state_name_is_a_load_error_naming_the_key() -> None:
+    config = minimal_config(initial_state={"x": 0.0, "y": 0.0, "states": {"rdot": 0.1}})
+    with pytest.raises(ScenarioError, match=r"initial_state\.states.*rdot"):
+        scenario_from_dict(config)

@@ -19,8 +19,10 @@ each QP (a box-constrained linear least-squares problem) is solved by CasADi's q
 backtracking line search, warm-started from the shifted previous plan.  ρ and its (dense)
 Jacobian are one CasADi function compiled to C once per machine (``shipgym.codegen``).  From
 the warm start it typically converges in 1–3 iterations (``max_iter`` = 10 bounds the worst
-case).  On solver failure (non-finite prediction or plan) the shifted last plan is applied
-and the failure is counted.  On a PCHIP path the "leg" is the tangent at the closest point.
+case).  If the identified model makes the prediction diverge, the last model for which the
+solve worked is used instead (counted as ``model_fallbacks``); if that fails too (non-finite
+prediction or plan) the shifted last plan is applied and counted as ``solver_failures``.
+On a PCHIP path the "leg" is the tangent at the closest point.
 
 Adaptive variants update the model parameters from ``info["samples"]`` each step with the
 weighted LS-SVM or λ-LS-SVM online identifier, with persistent excitation (eq. (45)).
@@ -227,7 +229,7 @@ _SOLVERS: dict[tuple, NMPCSolver] = {}
 
 def get_solver(model: ShipModel, settings: NMPCSettings, ts: float, limit: float) -> NMPCSolver:
     """Solvers are built once per process for a model class, settings and timing."""
-    key = (type(model).__name__, settings, ts, limit)
+    key = (type(model).__name__, model.length, settings, ts, limit)  # L is in the graph
     if key not in _SOLVERS:
         _SOLVERS[key] = NMPCSolver(model, settings, ts, limit)
     return _SOLVERS[key]
@@ -279,6 +281,8 @@ class NMPC:
         self._started = False
         self.plan = np.zeros(self.settings.control_horizon)
         self.failures = 0
+        self.model_fallbacks = 0
+        self._good_params = context.nominal_params
         self.solves = 0
         self.solve_times: list[float] = []
         self.param_history: list[dict[str, float]] = []
@@ -308,12 +312,26 @@ class NMPC:
             else tuple(self.ctx.waypoints[frame.leg])
         )
         radius = self.ctx.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
-        p = self.solver.parameters(
-            self._state(info), leg_start, frame.path_angle, radius, self.params.to_vector()
-        )
+        x0 = self._state(info)
         guess = np.append(self.plan[1:], self.plan[-1])  # shifted previous solution
         start = time.perf_counter()
-        plan, ok, _ = self.solver.solve(p, guess)
+        plan, ok, _ = self.solver.solve(
+            self.solver.parameters(
+                x0, leg_start, frame.path_angle, radius, self.params.to_vector()
+            ),
+            guess,
+        )
+        if ok:
+            self._good_params = self.params
+        elif self._good_params is not self.params:
+            # the identified model makes the prediction diverge: use the last one that worked
+            self.model_fallbacks += 1
+            plan, ok, _ = self.solver.solve(
+                self.solver.parameters(
+                    x0, leg_start, frame.path_angle, radius, self._good_params.to_vector()
+                ),
+                guess,
+            )
         self.solve_times.append(time.perf_counter() - start)
         self.solves += 1
         if ok:
@@ -329,6 +347,7 @@ class NMPC:
         times = np.array(self.solve_times) if self.solve_times else np.array([math.nan])
         return {
             "solver_failures": float(self.failures),
+            "model_fallbacks": float(self.model_fallbacks),
             "solve_ms_median": 1e3 * float(np.median(times)),
             "solve_ms_p99": 1e3 * float(np.percentile(times, 99)),
         }

@@ -15,7 +15,7 @@ import numpy as np
 
 from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym.envs.context import ControllerContext
-from shipgym.guidance import los_radius, los_relative_heading
+from shipgym.guidance import los_desired_heading
 
 
 class PIDLOS:
@@ -40,9 +40,9 @@ class PIDLOS:
         x, y = info["position"]
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
         self._started = True
-        L = self.ctx.ship_length
-        radius = los_radius(frame.cross_track, L, self.ctx.los_radius_L)
-        desired = frame.path_angle + los_relative_heading(frame.cross_track, radius)
+        desired = los_desired_heading(
+            frame.cross_track, frame.path_angle, self.ctx.ship_length, self.ctx.los_radius_L
+        )
         delta_c = self.pid.command(
             desired, info["heading"], info["yaw_rate"], self.ctx.control_period
         )

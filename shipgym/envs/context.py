@@ -32,7 +32,6 @@ class ControllerContext:
     switching: str  # waypoint switching rule: "circle" | "along_track"
     los_radius_L: float  # n in R_LOS = nL
     action_mode: str  # "rudder" | "guidance"
-    scenario_name: str
 
     @property
     def nominal_params(self) -> ParameterRecord:

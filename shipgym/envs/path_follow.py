@@ -48,8 +48,8 @@ from gymnasium import spaces
 from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym.disturbances import SensorModel, current_velocity
 from shipgym.envs.context import ControllerContext
-from shipgym.guidance import lookahead_los_heading, los_radius, los_relative_heading
-from shipgym.metrics import EpisodeLog, MetricSettings, compute_metrics
+from shipgym.guidance import lookahead_los_heading, los_desired_heading
+from shipgym.metrics import ARRAY_FIELDS, EpisodeLog, MetricSettings, compute_metrics
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.paths import wrap_angle
 from shipgym.scenarios import Scenario, load_scenario
@@ -72,8 +72,8 @@ _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
 #: keys of ``info["samples"]``
 SAMPLE_KEYS = ("t", "psi", "r", "delta", "delta_c", "e")
 
-#: guidance action: a0 → R_LOS multiplier n = 3·2^a0 ∈ [1.5, 6] (look-ahead Δ = nL for
-#: look-ahead LOS); a1 → course offset a1·30°.
+#: guidance action: a0 scales the scenario's R_LOS = nL (or look-ahead Δ) by 2^a0 ∈ [½, 2];
+#: a1 → course offset a1·30°.
 GUIDANCE_OFFSET_MAX = math.radians(30.0)
 
 
@@ -163,7 +163,6 @@ class ShipPathFollowEnv(gym.Env):
             switching=sc.config.path.switching,
             los_radius_L=sc.config.guidance.los_radius_L,
             action_mode=self.action_mode,
-            scenario_name=sc.name,
         )
 
     # ------------------------------------------------------------------ gym API
@@ -189,7 +188,7 @@ class ShipPathFollowEnv(gym.Env):
         frame = self._tracker.reset(float(x[self._ix]), float(x[self._iy]))
         self._speed = self._u0
         self._track = [(float(x[self._ix]), float(x[self._iy]))]
-        self._records: list[dict[str, float]] = []
+        self._log: dict[str, list[float]] = {name: [] for name in ARRAY_FIELDS}
         self._reached_goal = False
         samples = {k: np.zeros(0) for k in SAMPLE_KEYS}  # no period integrated yet
         info = self._info(frame, samples)
@@ -270,22 +269,12 @@ class ShipPathFollowEnv(gym.Env):
         truncated = not terminated and self._step_count >= self._max_steps
         if truncated:
             reason = "time_limit"
-        self._records.append(
-            {
-                "t": self._t,
-                "cross_track_error": e,
-                "heading_error": heading_error_true,
-                "rudder_angle": delta,
-                "rudder_command": delta_c,
-                "reward": reward,
-                "compute_time": compute_time,
-            }
-        )
+        self._record(e, heading_error_true, delta, delta_c, reward, compute_time)
         samples = {
             "t": t0 + self._sample_offsets,
             "psi": np.concatenate(([psi_m0], psi_m[:-1])),
             "r": np.concatenate(([r_m0], r_m[:-1])),
-            "delta": start[:, self._idelta].copy(),
+            "delta": start[:, self._idelta],  # a view into this step's fresh trajectory
             "delta_c": np.full(self._n, delta_c),
             "e": e_samples,
         }
@@ -314,12 +303,15 @@ class ShipPathFollowEnv(gym.Env):
     def _autopilot_command(self, a: list[float], frame: Any) -> float:
         """Guidance mode: heading reference from the guidance law, PID to δc (module doc)."""
         gcfg = self.scenario.config.guidance
-        n = 3.0 * 2.0 ** float(a[0])
+        scale = 2.0 ** float(a[0])
         if gcfg.law == "los":
-            radius = los_radius(frame.cross_track, self._L, n)
-            desired = frame.path_angle + los_relative_heading(frame.cross_track, radius)
+            desired = los_desired_heading(
+                frame.cross_track, frame.path_angle, self._L, gcfg.los_radius_L * scale
+            )
         else:
-            desired = lookahead_los_heading(frame.cross_track, frame.path_angle, n * self._L)
+            desired = lookahead_los_heading(
+                frame.cross_track, frame.path_angle, gcfg.lookahead_L * self._L * scale
+            )
         desired += float(a[1]) * GUIDANCE_OFFSET_MAX
         return self._autopilot.command(desired, self._psi_m, self._r_m, self._Ts)
 
@@ -342,7 +334,7 @@ class ShipPathFollowEnv(gym.Env):
             ],
             dtype=np.float32,
         )
-        return np.clip(obs, _OBS_LOW, _OBS_HIGH)
+        return np.clip(obs, _OBS_LOW, _OBS_HIGH, out=obs)
 
     def _info(self, frame: Any, samples: dict[str, np.ndarray]) -> dict[str, Any]:
         x = self._state
@@ -367,16 +359,9 @@ class ShipPathFollowEnv(gym.Env):
         """
         reward = -(self._e_max / self._L) * (self._max_steps - self._step_count + 1)
         x = self._state
-        self._records.append(
-            {
-                "t": self._t,
-                "cross_track_error": frame.cross_track,
-                "heading_error": float(wrap_angle(float(x[self._ipsi]) - frame.path_angle)),
-                "rudder_angle": float(x[self._idelta]),
-                "rudder_command": delta_c,
-                "reward": reward,
-                "compute_time": compute_time,
-            }
+        heading_error = float(wrap_angle(float(x[self._ipsi]) - frame.path_angle))
+        self._record(
+            frame.cross_track, heading_error, float(x[self._idelta]), delta_c, reward, compute_time
         )
         info = self._info(frame, {k: np.zeros(0) for k in SAMPLE_KEYS})
         info["termination_reason"] = "non_finite_state"
@@ -384,10 +369,27 @@ class ShipPathFollowEnv(gym.Env):
         self._last_return_time = time.perf_counter()
         return self._observation(frame), float(reward), True, False, info
 
+    def _record(
+        self,
+        e: float,
+        heading_error: float,
+        delta: float,
+        delta_c: float,
+        reward: float,
+        compute_time: float,
+    ) -> None:
+        """Append one control step to the episode log (columns in ARRAY_FIELDS order)."""
+        for column, value in zip(
+            self._log.values(),
+            (self._t, e, heading_error, delta, delta_c, reward, compute_time),
+            strict=True,
+        ):
+            column.append(value)
+
     def episode_log(self) -> EpisodeLog:
         """The control-step log of the current episode (true errors, for the metrics)."""
-        return EpisodeLog.from_records(
-            self._records,
+        return EpisodeLog(
+            **{name: np.array(values) for name, values in self._log.items()},
             change_time=self.scenario.change_time,
             ship_length=self._L,
             reached_goal=self._reached_goal,

@@ -86,6 +86,15 @@ def theta1_from_params(p: Nomoto2Params) -> np.ndarray:
     return np.array([p.T1 + p.T2, p.K, p.d0, 1.0, p.beta, p.K * p.T3]) / (p.T1 * p.T2)
 
 
+def time_constants(total: float, product: float) -> tuple[float, float]:
+    """T1 ≥ T2 with T1 + T2 = ``total`` and T1·T2 = ``product`` (roots of s² − S·s + P)."""
+    disc = total * total - 4.0 * product
+    if disc < 0:
+        raise IdentificationError(f"T1, T2 complex: (T1 + T2)² − 4·T1·T2 = {disc:.3g} < 0")
+    root = math.sqrt(disc)
+    return float((total + root) / 2.0), float((total - root) / 2.0)
+
+
 def params_from_theta1(theta1: np.ndarray) -> dict[str, float]:
     """K, T1, T2, T3, d0, β from θ1 (Liu et al. 2019, after eq. (42), T1 > T2).
 
@@ -96,16 +105,14 @@ def params_from_theta1(theta1: np.ndarray) -> dict[str, float]:
         raise IdentificationError("θ1 is not finite")
     if t[3] <= 0:
         raise IdentificationError(f"θ1(4) = 1/(T1·T2) = {t[3]:.3g} ≤ 0")
-    disc = t[0] ** 2 - 4.0 * t[3]
-    if disc < 0:
-        raise IdentificationError(f"T1, T2 complex: θ1(1)² − 4θ1(4) = {disc:.3g} < 0")
     if t[1] == 0:
         raise IdentificationError("K = 0: the rudder has no effect in the data")
-    root = math.sqrt(disc)
+    # θ1(1)/θ1(4) = T1 + T2, 1/θ1(4) = T1·T2
+    t1, t2 = time_constants(t[0] / t[3], 1.0 / t[3])
     return {
         "K": t[1] / t[3],
-        "T1": (t[0] + root) / (2.0 * t[3]),
-        "T2": (t[0] - root) / (2.0 * t[3]),
+        "T1": t1,
+        "T2": t2,
         "T3": t[5] / t[1],
         "d0": t[2] / t[3],
         "beta": t[4] / t[3],
@@ -114,13 +121,13 @@ def params_from_theta1(theta1: np.ndarray) -> dict[str, float]:
 
 def tc_from_theta2(theta2: float, h: float, servo_model: str = "forward") -> float:
     """Tc from θ2 of eq. (37): as estimated (``forward``) or ZOH-corrected (``exact``)."""
-    if not theta2 > 0:
-        raise IdentificationError(f"θ2 = Tc = {theta2:.3g} ≤ 0")
+    # for any Tc > 0 a held command gives θ2 = h/(1 − e^{−h/Tc}) > h (module doc): θ2 ≤ h
+    # is not a servo the data can show, whichever reading of eq. (34) is used
+    if not theta2 > h:
+        raise IdentificationError(f"θ2 = {theta2:.3g} ≤ h = {h}: no physical servo time constant")
     if servo_model == "forward":
         return float(theta2)
     if servo_model == "exact":
-        if theta2 <= h:
-            raise IdentificationError(f"θ2 = {theta2:.3g} ≤ h: no exact servo time constant")
         return -h / math.log(1.0 - h / theta2)
     raise ValueError(f"servo_model must be 'forward' or 'exact', got {servo_model!r}")
 
@@ -140,13 +147,13 @@ def solve_theta(
     return sol, np.ones_like(y) if prior_weights is None else np.asarray(prior_weights)
 
 
-def _check_excitation(reg: NomotoRegression) -> None:
-    if np.ptp(reg.x1[:, 1]) == 0.0:
-        raise IdentificationError(
-            "the rudder angle is constant over the data: no persistent excitation (eq. (45))"
-        )
-    if not np.any(reg.x2[:, 0] != 0.0):
-        raise IdentificationError("the rudder never moves: Tc is not identifiable")
+def excitation_problem(x1: np.ndarray, x2: np.ndarray) -> str | None:
+    """Why regression rows of eq. (36)–(37) cannot identify the model (None if they can)."""
+    if x1.shape[0] == 0 or np.ptp(x1[:, 1]) == 0.0:
+        return "rudder angle constant over the data: no excitation (eq. (45)); model kept"
+    if not np.any(x2[:, 0] != 0.0):
+        return "the rudder never moves: Tc not identifiable; model kept"
+    return None
 
 
 def fit_nomoto2(
@@ -168,7 +175,9 @@ def fit_nomoto2(
     Kc from ``base``).  Raises IdentificationError (naming the reason) on degenerate data.
     """
     reg = nomoto_regressors(psi, delta, delta_c, h)
-    _check_excitation(reg)
+    problem = excitation_problem(reg.x1, reg.x2)
+    if problem is not None:
+        raise IdentificationError(problem)
     sol1, _ = solve_theta(reg.x1, reg.y1, gamma, weighted, bias_penalty)
     sol2, _ = solve_theta(reg.x2, reg.y2, gamma, weighted, bias_penalty)
     values = params_from_theta1(sol1.theta)

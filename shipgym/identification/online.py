@@ -32,6 +32,7 @@ from shipgym.identification.lssvm import LSSVMSolution
 from shipgym.identification.nomoto import (
     GAMMA,
     IdentificationError,
+    excitation_problem,
     nomoto_regressors,
     params_from_theta1,
     solve_theta,
@@ -40,7 +41,7 @@ from shipgym.identification.nomoto import (
 )
 from shipgym.models.nomoto2 import Nomoto2Params
 
-DEG = 180.0 / math.pi
+RAD_TO_DEG = 180.0 / math.pi
 
 
 class PersistentExcitation:
@@ -115,6 +116,12 @@ class _SlidingWindowNomoto:
         return self.update_arrays(samples["psi"], samples["delta"], samples["delta_c"])
 
     def update_arrays(self, psi: Any, delta: Any, delta_c: Any) -> bool:
+        """Feed fine samples (rad); True if the model was re-identified.
+
+        Rows enter the window in the paper's rhythm (N_w, then N_u at a time) however many
+        arrive per call.  A non-finite (dropped) sample breaks the difference chain: rows are
+        only built within unbroken runs of samples.
+        """
         new = np.column_stack(
             [
                 np.asarray(psi, float).ravel(),
@@ -122,11 +129,22 @@ class _SlidingWindowNomoto:
                 np.asarray(delta_c, float).ravel(),
             ]
         )
-        if new.shape[0] == 0:
-            return False
-        if not np.all(np.isfinite(new)):
-            self.last_reason = "non-finite samples ignored"
-            new = new[np.all(np.isfinite(new), axis=1)]
+        finite = np.all(np.isfinite(new), axis=1)
+        updated = False
+        if not np.all(finite):
+            self.last_reason = "non-finite samples: difference chain restarted"
+        # unbroken runs of finite samples
+        breaks = np.flatnonzero(~finite)
+        start = 0
+        for stop in [*breaks.tolist(), new.shape[0]]:
+            if stop > start:
+                updated |= self._feed_run(new[start:stop])
+            if stop < new.shape[0]:
+                self._tail = np.zeros((0, 3))  # a gap: no difference across it
+            start = stop + 1
+        return updated
+
+    def _feed_run(self, new: np.ndarray) -> bool:
         raw = np.vstack([self._tail, new])
         if self._tail.shape[0]:  # keep heading continuous across calls
             raw[:, 0] = np.unwrap(raw[:, 0])
@@ -135,24 +153,31 @@ class _SlidingWindowNomoto:
             return False
         reg = nomoto_regressors(raw[:, 0], raw[:, 1], raw[:, 2], self.h)
         self._tail = raw[-3:]
-        self._rows1 = np.vstack([self._rows1, reg.x1])
-        self._y1 = np.concatenate([self._y1, reg.y1])
-        self._rows2 = np.vstack([self._rows2, reg.x2])
-        self._y2 = np.concatenate([self._y2, reg.y2])
         updated = False
-        while True:
+        pos, n_new = 0, reg.y1.shape[0]
+        while pos < n_new:
+            n = self._y1.shape[0]
+            # rows still needed before the next identification (§3.2.1)
+            need = self.window - n if not self.identified else self.window + self.update_every - n
+            take = max(1, min(need, n_new - pos))
+            part = slice(pos, pos + take)
+            self._rows1 = np.vstack([self._rows1, reg.x1[part]])
+            self._y1 = np.concatenate([self._y1, reg.y1[part]])
+            self._rows2 = np.vstack([self._rows2, reg.x2[part]])
+            self._y2 = np.concatenate([self._y2, reg.y2[part]])
+            pos += take
             n = self._y1.shape[0]
             if not self.identified and n >= self.window:
                 self._trim(n - self.window)
             elif self.identified and n >= self.window + self.update_every:
-                self._trim(self.update_every)
+                self._trim(n - self.window)
             else:
-                break
+                continue
             reason = self._degenerate_window()
             if reason is not None:  # keep the previous model and say why
                 self.last_reason = reason
                 self._record(skipped=reason)
-                break
+                continue
             self._identify()
             self.identified = True
             updated = True
@@ -160,11 +185,7 @@ class _SlidingWindowNomoto:
 
     def _degenerate_window(self) -> str | None:
         """Why the window cannot identify the model (None when it can)."""
-        if np.ptp(self._rows1[:, 1]) == 0.0:
-            return "rudder angle constant over the window: no excitation (eq. (45)); model kept"
-        if not np.any(self._rows2[:, 0] != 0.0):
-            return "rudder never moves in the window: Tc not identifiable; model kept"
-        return None
+        return excitation_problem(self._rows1, self._rows2)
 
     def _trim(self, k: int) -> None:
         self._rows1, self._y1 = self._rows1[k:], self._y1[k:]
@@ -256,7 +277,7 @@ class LambdaLSSVM(_SlidingWindowNomoto):
             raise ValueError(f"index_unit must be 'deg' or 'rad', got {index_unit!r}")
         self.lambda_c = (lambda_c1, lambda_c2)
         self.c3, self.c4 = c3, c4
-        self._index_scale = DEG if index_unit == "deg" else 1.0
+        self._index_scale = RAD_TO_DEG if index_unit == "deg" else 1.0
         self.lambdas: tuple[float, float] = (0.0, 0.0)
 
     def change_index(self, x: np.ndarray, y: np.ndarray, sub: _SubModel) -> float:

@@ -16,12 +16,12 @@ its nominal model on ships without a closed-form Nomoto model (SPEC §8).
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 
+from shipgym.autopilot import nomoto2_first_order
 from shipgym.identification.lssvm import lssvm_primal
-from shipgym.identification.nomoto import IdentificationError
+from shipgym.identification.nomoto import IdentificationError, time_constants
 from shipgym.manoeuvres import ManoeuvreLog, zigzag
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2Params
@@ -42,7 +42,7 @@ class NomotoFit:
 
     def first_order(self) -> tuple[float, float]:
         """Nomoto's approximation K, T = T1 + T2 − T3."""
-        return self.K, self.T1 + self.T2 - self.T3
+        return nomoto2_first_order(self.K, self.T1, self.T2, self.T3)
 
     def as_nomoto2(self, base: Nomoto2Params | None = None, beta: float = 0.0) -> Nomoto2Params:
         """The fit as a nomoto2 parameter record (servo, speed, length from ``base``)."""
@@ -71,14 +71,13 @@ def fit_nomoto_zigzag(r: np.ndarray, delta: np.ndarray, h: float, C: float = C_Z
         raise IdentificationError(f"w_r = {w_r:.3g} ≥ 0: T1·T2 would not be positive")
     P = -h / w_r
     S = (1.0 - w_rdot) * P / h
-    disc = S * S - 4.0 * P
-    if disc < 0 or w_d == 0:
-        raise IdentificationError(f"no real T1, T2 (S² − 4P = {disc:.3g}) or K = 0")
-    root = math.sqrt(disc)
+    if w_d == 0:
+        raise IdentificationError("K = 0: the rudder has no effect in the data")
+    t1, t2 = time_constants(S, P)
     return NomotoFit(
         K=float(w_d * P / h),
-        T1=float((S + root) / 2.0),
-        T2=float((S - root) / 2.0),
+        T1=t1,
+        T2=t2,
         T3=float(w_ddot / w_d),
         d0=float(sol.bias * P / h),
     )

@@ -129,6 +129,10 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
         path = path_cls(config.path.waypoints)
     except ValueError as exc:
         raise ScenarioError(f"{origin}: key 'path.waypoints': {exc}") from exc
+    try:
+        model.initial_state(**config.initial_state.states)
+    except KeyError as exc:
+        raise ScenarioError(f"{origin}: key 'initial_state.states': {exc.args[0]}") from None
     fine = config.fine_step or model.fine_step
     period = config.control_period or model.control_period
     ratio = period / fine
