@@ -60,7 +60,9 @@ class PathTracker:
     def update(self, x: float, y: float) -> TrackFrame:
         wp = self._wp
         last_wp = wp[-1]
-        dist_goal = math.hypot(x - last_wp[0], y - last_wp[1])
+        # sqrt of squares (not hypot): the batched env computes the same, bit for bit
+        gx, gy = x - last_wp[0], y - last_wp[1]
+        dist_goal = math.sqrt(gx * gx + gy * gy)
         if self.is_curve:
             path: PchipPath = self.path
             s, e, angle, _ = path.project(x, y, s_hint=self.s, window=4.0 * self.radius)
@@ -84,7 +86,7 @@ class PathTracker:
             f.along_track,
             leg,
             self.path.next_leg_angle_change(leg),
-            math.hypot(x - nxt[0], y - nxt[1]),
+            math.sqrt((x - nxt[0]) ** 2 + (y - nxt[1]) ** 2),
             at_goal,
         )
         return self.frame

@@ -87,7 +87,7 @@ class ShipPathFollowEnv(gym.Env):
         scenario: Any = "rudder_aging",
         action_mode: str = "rudder",
         render_mode: str | None = None,
-        jit: bool = False,
+        compile: bool = True,
     ) -> None:
         if action_mode not in ("rudder", "guidance"):
             raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
@@ -109,7 +109,7 @@ class ShipPathFollowEnv(gym.Env):
         self._n = sc.substeps
         self._e_max = sc.max_cross_track
         self._max_steps = math.ceil(sc.config.time_limit / self._Ts - 1e-9)
-        self._integrator = PeriodIntegrator(self.model, self._h, self._n, jit=jit)
+        self._integrator = PeriodIntegrator(self.model, self._h, self._n, compile=compile)
         self._sensor = SensorModel(sc.config.sensors)
         self._tracker = PathTracker(sc.path, sc.acceptance_radius, sc.config.path.switching)
         self._ix = self.model.state_index("x")
@@ -243,7 +243,9 @@ class ShipPathFollowEnv(gym.Env):
         )
         self._psi_m, self._r_m = float(psi_m[-1]), float(r_m[-1])
         self._speed = (
-            math.hypot(xs[-1] - xs[-2], ys[-1] - ys[-2]) / self._h if self._n > 1 else self._u0
+            math.sqrt((xs[-1] - xs[-2]) ** 2 + (ys[-1] - ys[-2]) ** 2) / self._h
+            if self._n > 1
+            else self._u0
         )
         # --- path
         frame = self._tracker.update(px, py)

@@ -5,16 +5,17 @@ Function of the model's single right-hand side, with the parameter vector and th
 disturbance vector given *per substep* (so events, ramps and fine-rate disturbances act at
 the substep where they happen).  It is evaluated through CasADi's buffer interface on
 preallocated numpy arrays: no per-call conversions, ≈ 20 µs for 50 substeps of nomoto2 in
-CasADi's virtual machine, ≈ 5 µs when JIT-compiled (``jit=True`` needs a C compiler).
+CasADi's virtual machine, ≈ 5 µs compiled to C (``compile=True``, cached per machine by
+:mod:`shipgym.codegen`; bit-identical to the VM, tested).  :meth:`batched` maps the same
+function over N ships for the batched env.
 """
 
 from __future__ import annotations
 
-import shutil
-
 import casadi as ca
 import numpy as np
 
+from shipgym.codegen import compiled
 from shipgym.models.base import ShipModel
 
 
@@ -26,10 +27,13 @@ class PeriodIntegrator:
     at t0, t0 + h, …, t0 + n_sub·h (row 0 is the initial state).  A fresh copy.
     """
 
-    def __init__(self, model: ShipModel, h: float, n_sub: int, jit: bool = False) -> None:
+    def __init__(
+        self, model: ShipModel, h: float, n_sub: int, compile: bool = False, batch: int = 1
+    ) -> None:
         if h <= 0 or n_sub < 1:
             raise ValueError(f"need h > 0 and n_sub ≥ 1, got h={h}, n_sub={n_sub}")
-        self.model, self.h, self.n_sub, self.jit = model, float(h), int(n_sub), jit
+        self.model, self.h, self.n_sub = model, float(h), int(n_sub)
+        self.compile, self.batch = compile, int(batch)
         step = model.casadi_step(h)
         nx, nw, npar = model.n_states, model.n_disturbances, model.n_params
         x0 = ca.SX.sym("x0", nx)
@@ -41,35 +45,55 @@ class PeriodIntegrator:
         for i in range(n_sub):
             x = step(x, u, w[:, i], p[:, i])
             states.append(x)
-        options = {}
-        if jit and shutil.which("gcc") is not None:
-            options = {"jit": True, "compiler": "shell", "jit_options": {"flags": ["-O2"]}}
         self.function = ca.Function(
-            f"{model.name}_period", [x0, u, w, p], [ca.horzcat(*states)], options
+            f"{model.name}_period_{n_sub}", [x0, u, w, p], [ca.horzcat(*states)]
         )
-        self._x0 = np.zeros(nx)
-        self._u = np.zeros(len(model.input_names))
-        self._w = np.zeros((n_sub, nw))
-        self._p = np.zeros((n_sub, npar))
-        self._out = np.zeros((n_sub + 1, nx))  # row 0: x0, rows 1..: CasADi writes here
-        self._buffer, self._eval = self.function.buffer()
+        function = compiled(self.function) if compile else self.function
+        b = self.batch
+        if b > 1:  # the same function per ship: results bit-identical to the single call
+            function = function.map(b, "thread", 2)
+        nu = len(model.input_names)
+        self._x0 = np.zeros((b, nx))
+        self._u = np.zeros((b, nu))
+        self._w = np.zeros((b, n_sub, nw))
+        self._p = np.zeros((b, n_sub, npar))
+        self._out = np.zeros((b, n_sub + 1, nx))  # [:, 0]: x0; [:, 1:] written by CasADi
+        self._states = np.zeros((b, n_sub, nx))
+        self._buffer, self._eval = function.buffer()
         for i, array in enumerate((self._x0, self._u, self._w, self._p)):
             self._buffer.set_arg(i, memoryview(array))
-        self._buffer.set_res(0, memoryview(self._out[1:]))
+        self._buffer.set_res(0, memoryview(self._states))
+        self._keep = function
 
     def __call__(
         self, x0: np.ndarray, u: float | np.ndarray, w: np.ndarray, p: np.ndarray
     ) -> np.ndarray:
+        """One ship (batch = 1): (n_sub + 1, n_x) states; see the class docstring."""
+        return self.batched(x0, u, w, p)[0]
+
+    def batched(
+        self, x0: np.ndarray, u: float | np.ndarray, w: np.ndarray, p: np.ndarray
+    ) -> np.ndarray:
+        """All ships: x0 (B, n_x), u (B,), w (B, n_sub, n_w), p (B, n_sub, n_p) (broadcast)
+        → (B, n_sub + 1, n_x) states at t0, t0 + h, …, t0 + Ts.  A fresh array."""
         self._x0[:] = x0
-        self._out[0] = x0
-        self._u[:] = u
+        self._u[:] = np.reshape(u, (-1, 1)) if np.ndim(u) else u
         self._w[:] = w
         self._p[:] = p
         self._eval()
-        return self._out.copy()
+        out = np.empty_like(self._out)
+        out[:, 0] = self._x0
+        out[:, 1:] = self._states
+        return out
 
     def __getstate__(self) -> dict:
-        return {"model": self.model, "h": self.h, "n_sub": self.n_sub, "jit": self.jit}
+        return {
+            "model": self.model,
+            "h": self.h,
+            "n_sub": self.n_sub,
+            "compile": self.compile,
+            "batch": self.batch,
+        }
 
     def __setstate__(self, state: dict) -> None:
-        self.__init__(state["model"], state["h"], state["n_sub"], state["jit"])
+        self.__init__(**state)
