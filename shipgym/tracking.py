@@ -86,7 +86,7 @@ class PathTracker:
             f.along_track,
             leg,
             self.path.next_leg_angle_change(leg),
-            math.sqrt((x - nxt[0]) ** 2 + (y - nxt[1]) ** 2),
+            math.sqrt((x - nxt[0]) * (x - nxt[0]) + (y - nxt[1]) * (y - nxt[1])),
             at_goal,
         )
         return self.frame

@@ -294,13 +294,13 @@ class NMPC:
         x0[model.state_index("psi")] = info["heading"]
         x0[model.state_index("r")] = info["yaw_rate"]
         x0[model.state_index("r_dot")] = yaw_acceleration(
-            info["samples"], info["yaw_rate"], self.ctx.fine_step
+            info.get("samples", {}), info["yaw_rate"], self.ctx.fine_step
         )
         x0[model.state_index("delta")] = info["rudder_angle"]
         return x0
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        if self.identifier is not None and len(info["samples"]["t"]):
+        if self.identifier is not None and "samples" in info:
             self.identifier.update(info["samples"])
             self.params = self.identifier.params
         x, y = info["position"]

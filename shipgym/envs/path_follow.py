@@ -31,8 +31,9 @@ the substep starts t0, t0 + h, …, t0 + Ts − h, i.e. each sample's ``delta_c`
 command acting on [t, t + h).  Concatenated over an episode they form one uniform grid
 0, h, 2h, … without repeats; the state at t0 + Ts opens the next step's samples.  Measured
 values (ψ, r with sensor noise) are measured once per instant, so the first sample of a
-step equals the previous step's ``info["heading"]`` / ``info["yaw_rate"]``.  At reset (no
-period yet) and on a non-finite step the arrays are empty.
+step equals the previous step's ``info["heading"]`` / ``info["yaw_rate"]``.  The key is
+absent at reset (no period yet) and on a non-finite step, so that every ``samples`` array
+has the same length (vector envs stack infos across sub-envs).
 """
 
 from __future__ import annotations
@@ -190,8 +191,7 @@ class ShipPathFollowEnv(gym.Env):
         self._track = [(float(x[self._ix]), float(x[self._iy]))]
         self._log: dict[str, list[float]] = {name: [] for name in ARRAY_FIELDS}
         self._reached_goal = False
-        samples = {k: np.zeros(0) for k in SAMPLE_KEYS}  # no period integrated yet
-        info = self._info(frame, samples)
+        info = self._info(frame, None)  # no period integrated yet: no samples
         self._last_return_time = time.perf_counter()
         return self._observation(frame), info
 
@@ -243,7 +243,8 @@ class ShipPathFollowEnv(gym.Env):
         )
         self._psi_m, self._r_m = float(psi_m[-1]), float(r_m[-1])
         self._speed = (
-            math.sqrt((xs[-1] - xs[-2]) ** 2 + (ys[-1] - ys[-2]) ** 2) / self._h
+            math.sqrt((xs[-1] - xs[-2]) * (xs[-1] - xs[-2]) + (ys[-1] - ys[-2]) * (ys[-1] - ys[-2]))
+            / self._h
             if self._n > 1
             else self._u0
         )
@@ -256,7 +257,7 @@ class ShipPathFollowEnv(gym.Env):
         reward = -(
             abs(e) / self._L
             + self._w_psi * abs(heading_error_true)
-            + self._w_delta * (delta_c / self._dmax) ** 2
+            + self._w_delta * (delta_c / self._dmax) * (delta_c / self._dmax)
             + self._w_rate * dd * dd
         )
         terminated = False
@@ -338,9 +339,9 @@ class ShipPathFollowEnv(gym.Env):
         )
         return np.clip(obs, _OBS_LOW, _OBS_HIGH, out=obs)
 
-    def _info(self, frame: Any, samples: dict[str, np.ndarray]) -> dict[str, Any]:
+    def _info(self, frame: Any, samples: dict[str, np.ndarray] | None) -> dict[str, Any]:
         x = self._state
-        return {
+        info = {
             "t": self._t,
             "cross_track_error": frame.cross_track,
             "heading_error": float(wrap_angle(self._psi_m - frame.path_angle)),
@@ -350,14 +351,16 @@ class ShipPathFollowEnv(gym.Env):
             "rudder_command": self._delta_c,
             "position": (float(x[self._ix]), float(x[self._iy])),
             "waypoint_index": frame.leg,
-            "samples": samples,
         }
+        if samples is not None:
+            info["samples"] = samples
+        return info
 
     def _non_finite_step(self, frame: Any, delta_c: float, compute_time: float):
         """The plant produced NaN/inf: keep the last finite state and terminate with a reason.
 
         The penalty is that of leaving the corridor; the step is logged like any other, so
-        ``episode_metrics`` count it.  ``info["samples"]`` is empty (no valid samples).
+        ``episode_metrics`` count it.  ``info`` has no ``samples`` (none are valid).
         """
         reward = -(self._e_max / self._L) * (self._max_steps - self._step_count + 1)
         x = self._state
@@ -365,7 +368,7 @@ class ShipPathFollowEnv(gym.Env):
         self._record(
             frame.cross_track, heading_error, float(x[self._idelta]), delta_c, reward, compute_time
         )
-        info = self._info(frame, {k: np.zeros(0) for k in SAMPLE_KEYS})
+        info = self._info(frame, None)
         info["termination_reason"] = "non_finite_state"
         info["episode_metrics"] = self.episode_metrics()
         self._last_return_time = time.perf_counter()
