@@ -19,6 +19,7 @@ for _env_id, _scenario in ENV_IDS.items():
         register(
             id=_env_id,
             entry_point="shipgym.envs.path_follow:ShipPathFollowEnv",
+            vector_entry_point="shipgym.envs.vector:ShipPathFollowVectorEnv",
             kwargs={"scenario": _scenario},
         )
 

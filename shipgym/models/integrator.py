@@ -71,16 +71,36 @@ class PeriodIntegrator:
         """One ship (batch = 1): (n_sub + 1, n_x) states; see the class docstring."""
         return self.batched(x0, u, w, p)[0]
 
+    @property
+    def parameter_buffer(self) -> np.ndarray:
+        """The (B, n_sub, n_p) parameter input, to be filled in place (then passed back)."""
+        return self._p
+
+    @property
+    def disturbance_buffer(self) -> np.ndarray:
+        """The (B, n_sub, n_w) disturbance input, to be filled in place (then passed back)."""
+        return self._w
+
+    def substep_states(
+        self, x0: np.ndarray, u: float | np.ndarray, w: np.ndarray, p: np.ndarray
+    ) -> np.ndarray:
+        """Integrate all ships; returns the internal (B, n_sub, n_x) buffer of the states at
+        t0 + h, …, t0 + Ts (no copy: valid until the next call)."""
+        self._x0[:] = x0
+        self._u[:] = np.reshape(u, (-1, 1)) if np.ndim(u) else u
+        if w is not self._w:  # callers may fill the input buffers in place (no copy)
+            self._w[:] = w
+        if p is not self._p:
+            self._p[:] = p
+        self._eval()
+        return self._states
+
     def batched(
         self, x0: np.ndarray, u: float | np.ndarray, w: np.ndarray, p: np.ndarray
     ) -> np.ndarray:
         """All ships: x0 (B, n_x), u (B,), w (B, n_sub, n_w), p (B, n_sub, n_p) (broadcast)
         → (B, n_sub + 1, n_x) states at t0, t0 + h, …, t0 + Ts.  A fresh array."""
-        self._x0[:] = x0
-        self._u[:] = np.reshape(u, (-1, 1)) if np.ndim(u) else u
-        self._w[:] = w
-        self._p[:] = p
-        self._eval()
+        self.substep_states(x0, u, w, p)
         out = np.empty_like(self._out)
         out[:, 0] = self._x0
         out[:, 1:] = self._states

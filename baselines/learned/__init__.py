@@ -1,0 +1,1 @@
+"""Learned agents (stable-baselines3) and their plumbing."""
