@@ -125,7 +125,8 @@ def identification_log(
     while True:
         delta_c = excite(float(pid.act(obs, info)[0]) * ctx.rudder_limit)
         obs, _, terminated, truncated, info = env.step([np.clip(delta_c / ctx.rudder_limit, -1, 1)])
-        log.append(info["samples"])
+        if "samples" in info:  # absent on a diverged step
+            log.append(info["samples"])
         if terminated or truncated:
             return log, env.unwrapped.scenario
 

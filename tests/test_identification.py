@@ -373,3 +373,13 @@ def test_dropped_sample_restarts_the_difference_chain() -> None:
     # only the 4 rows touching sample 700 are lost; no row spans the gap
     assert dropped._y1.max() <= clean._y1.max() * (1 + 1e-12)
     assert "non-finite" in dropped.last_reason
+
+
+def test_degenerate_window_keeps_the_nu_rhythm() -> None:
+    """A held rudder: one skipped window per N_u rows, not one per row."""
+    lam = LambdaLSSVM(H)
+    for k in range(40):  # 40 periods of 50 samples, rudder held
+        n0 = 50 * k
+        lam.update_arrays(np.linspace(0, 1, 2000)[n0 : n0 + 50], np.full(50, 0.1), np.full(50, 0.1))
+    skipped = [e for e in lam.history if "skipped" in e]
+    assert len(skipped) == 1 + (2000 - 3 - 1200) // 50

@@ -321,9 +321,11 @@ class NMPC:
             ),
             guess,
         )
+        used = self.params
         if ok:
             self._good_params = self.params
         elif self._good_params is not self.params:
+            used = self._good_params
             # the identified model makes the prediction diverge: use the last one that worked
             self.model_fallbacks += 1
             plan, ok, _ = self.solver.solve(
@@ -339,7 +341,7 @@ class NMPC:
         else:  # fall back to the shifted last plan and count it
             self.failures += 1
             self.plan = guess
-        self.param_history.append({"t": info["t"], **self.params.as_dict()})
+        self.param_history.append({"t": info["t"], **used.as_dict()})
         delta_c = self.pe(float(self.plan[0]))
         return np.array([np.clip(delta_c / self.ctx.rudder_limit, -1.0, 1.0)], dtype=np.float32)
 

@@ -54,13 +54,20 @@ class SB3BatchedVecEnv(VecEnv):
         return None
 
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
+        """Attributes are shared by all ships of the batched env."""
         return [getattr(self.env, attr_name)] * len(self._indices(indices))
 
     def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+        self._all(indices, "set_attr")
         setattr(self.env, attr_name, value)
 
     def env_method(self, method_name: str, *args: Any, indices: Any = None, **kwargs: Any) -> list:
-        return [getattr(self.env, method_name)(*args, **kwargs)] * len(self._indices(indices))
+        self._all(indices, "env_method")
+        return [getattr(self.env, method_name)(*args, **kwargs)] * self.num_envs
+
+    def _all(self, indices: Any, what: str) -> None:
+        if sorted(self._indices(indices)) != list(range(self.num_envs)):
+            raise ValueError(f"{what}: the batched env acts on all ships at once, not on {indices}")
 
     def env_is_wrapped(self, wrapper_class: type, indices: Any = None) -> list[bool]:
         return [False] * len(self._indices(indices))

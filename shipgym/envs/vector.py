@@ -9,11 +9,16 @@ in the last bit), so that ``ShipPathFollowVectorEnv(N)`` equals N single envs un
 where randomness must be drawn per env in the single env's order (noisy sensors), for the
 rare parameter-event periods, and for the metrics of finished episodes.
 
-Autoreset follows Gymnasium's default NEXT_STEP mode.  ``info`` holds the scalar keys of the
-single env as arrays (no ``samples``: online identification runs on the single env);
-``termination_reason`` and ``episode_metrics`` are present, with their ``_``-masks, for the
-envs whose episode ended at that step.  Waypoint (polyline) paths only; a PCHIP scenario
-raises ValueError (use ``SyncVectorEnv``/``SubprocVecEnv`` over single envs there).
+Autoreset follows Gymnasium's default NEXT_STEP mode (``reset(options={"reset_mask": m})``
+resets only the masked envs).  ``info`` holds the scalar keys of the single env as arrays,
+in SyncVectorEnv's layout (``episode_metrics`` as a dict of arrays with ``_``-masks, present
+at the steps where an episode ended), except: ``position`` is an (N, 2) float array, there
+is no ``samples`` (online identification runs on the single env), and the episode metrics'
+``compute_ms_*`` are NaN (no per-env controller timing in a batch).  It is what
+``gym.make_vec("ShipPathFollow-v0", num_envs=N)`` returns by default (Gymnasium prefers a
+registered vector entry point); pass ``vectorization_mode="sync"`` for N single envs.
+Waypoint (polyline) paths only; a PCHIP scenario raises ValueError (use ``SyncVectorEnv`` /
+``SubprocVecEnv`` over single envs there).
 """
 
 from __future__ import annotations
@@ -140,6 +145,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._autoreset = np.zeros(num_envs, dtype=bool)
         self._log = np.zeros((len(ARRAY_FIELDS), num_envs, self._max_steps + 1))
         self._frame: dict[str, np.ndarray] = {}
+        self._started = False
 
     # ------------------------------------------------------------------ gym vector API
     def reset(
@@ -151,17 +157,24 @@ class ShipPathFollowVectorEnv(VectorEnv):
             if len(seed) != self.num_envs:
                 raise ValueError(f"need {self.num_envs} seeds, got {len(seed)}")
             seeds = list(seed)
+        mask = np.ones(self.num_envs, dtype=bool)
+        if options and "reset_mask" in options:  # as SyncVectorEnv: reset only these envs
+            mask = np.asarray(options["reset_mask"], dtype=bool)
+            if mask.shape != (self.num_envs,):
+                raise ValueError(f"reset_mask must have shape ({self.num_envs},)")
         for i, s in enumerate(seeds):
-            if s is not None or self._rngs[i] is None:
+            if mask[i] and (s is not None or self._rngs[i] is None):
                 self._rngs[i], _ = seeding.np_random(s)
-        everyone = np.ones(self.num_envs, dtype=bool)
-        self._reset_envs(everyone)
-        self._autoreset[:] = False
-        return self._observation(), self._info(everyone)
+        self._reset_envs(mask)
+        self._autoreset[mask] = False
+        self._started = True
+        return self._observation(), self._info(np.ones(self.num_envs, dtype=bool))
 
     def step(
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
         a = np.asarray(actions, dtype=np.float64).reshape(self.action_space.shape)
         bad = ~np.all(np.isfinite(a), axis=1)
         if np.any(bad):
@@ -183,7 +196,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         if self.action_mode == "rudder":
             delta_c = a[:, 0] * self._dmax
         else:
-            delta_c = self._autopilot(a)
+            delta_c = self._autopilot(a, live)
         delta_c = np.where(live, delta_c, self._delta_c)
         prev_delta_c = self._delta_c.copy()
         # --- true parameters of the period (per env: times differ after resets)
@@ -259,10 +272,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
             info["termination_reason"] = reasons
             info["_termination_reason"] = done
             if self.episode_metrics:
-                metrics = np.full(n, None, dtype=object)
-                for i in np.flatnonzero(done):
-                    metrics[i] = self._episode_metrics(i, bool(goal[i]))
-                info["episode_metrics"] = metrics
+                info["episode_metrics"] = self._stacked_metrics(done, goal)
                 info["_episode_metrics"] = done
         self._autoreset = done
         return self._observation(), rewards, terminated, truncated, info
@@ -361,7 +371,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
             for key, value in new.items():
                 self._frame[key] = np.where(mask, value, self._frame[key])
 
-    def _autopilot(self, a: np.ndarray) -> np.ndarray:
+    def _autopilot(self, a: np.ndarray, live: np.ndarray) -> np.ndarray:
         """The single env's guidance-mode PID, over all ships (guidance module, LOS)."""
         f = self._frame
         scale = 2.0 ** a[:, 0]
@@ -379,7 +389,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
         trial = self._kp * error - self._kd * self._r_m + self._ki * (self._integral + error * dt)
         lim = self._dmax
         inside = (-lim < trial) & (trial < lim)
-        self._integral = np.where(inside, self._integral + error * dt, self._integral)
+        # envs being autoreset this step ignore their action: their integral stays at 0
+        self._integral = np.where(inside & live, self._integral + error * dt, self._integral)
         raw = self._kp * error - self._kd * self._r_m + self._ki * self._integral
         return np.minimum(lim, np.maximum(-lim, raw))
 
@@ -421,6 +432,21 @@ class ShipPathFollowVectorEnv(VectorEnv):
         for key in list(info):
             info[f"_{key}"] = mask.copy()
         return info
+
+    def _stacked_metrics(self, done: np.ndarray, goal: np.ndarray) -> dict[str, np.ndarray]:
+        """Metrics of the finished envs in SyncVectorEnv's layout: key -> (N,) array, with a
+        ``_key`` mask."""
+        per_env = {
+            int(i): self._episode_metrics(int(i), bool(goal[i])) for i in np.flatnonzero(done)
+        }
+        stacked: dict[str, np.ndarray] = {}
+        for key in next(iter(per_env.values())):
+            values = np.zeros(self.num_envs)
+            for i, metrics in per_env.items():
+                values[i] = metrics[key]
+            stacked[key] = values
+            stacked[f"_{key}"] = done.copy()
+        return stacked
 
     def _episode_metrics(self, i: int, reached: bool) -> dict[str, Any]:
         k = int(self._steps[i])

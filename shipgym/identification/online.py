@@ -98,6 +98,7 @@ class _SlidingWindowNomoto:
         self._rows2 = np.zeros((0, 1))
         self._y2 = np.zeros(0)
         self.identified = False
+        self._window_full = False
         self.updates = 0
         self.last_reason: str | None = None
         self.history: list[dict[str, Any]] = []
@@ -157,8 +158,10 @@ class _SlidingWindowNomoto:
         pos, n_new = 0, reg.y1.shape[0]
         while pos < n_new:
             n = self._y1.shape[0]
-            # rows still needed before the next identification (§3.2.1)
-            need = self.window - n if not self.identified else self.window + self.update_every - n
+            # rows still needed before the next identification (§3.2.1): N_w the first time,
+            # then N_u at a time (also after a skipped, degenerate window)
+            full = self.identified or self._window_full
+            need = self.window + self.update_every - n if full else self.window - n
             take = max(1, min(need, n_new - pos))
             part = slice(pos, pos + take)
             self._rows1 = np.vstack([self._rows1, reg.x1[part]])
@@ -167,9 +170,10 @@ class _SlidingWindowNomoto:
             self._y2 = np.concatenate([self._y2, reg.y2[part]])
             pos += take
             n = self._y1.shape[0]
-            if not self.identified and n >= self.window:
+            if not full and n >= self.window:
                 self._trim(n - self.window)
-            elif self.identified and n >= self.window + self.update_every:
+                self._window_full = True
+            elif full and n >= self.window + self.update_every:
                 self._trim(n - self.window)
             else:
                 continue
