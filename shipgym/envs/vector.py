@@ -184,9 +184,6 @@ class ShipPathFollowVectorEnv(VectorEnv):
             )
         a = np.clip(a, -1.0, 1.0)
         n = self.num_envs
-        rewards = np.zeros(n)
-        terminated = np.zeros(n, dtype=bool)
-        truncated = np.zeros(n, dtype=bool)
         reasons = np.full(n, None, dtype=object)
         resetting = self._autoreset.copy()
         live = ~resetting
