@@ -70,9 +70,6 @@ OBS_NAMES = (
 _OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
 _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
 
-#: keys of ``info["samples"]``
-SAMPLE_KEYS = ("t", "psi", "r", "delta", "delta_c", "e")
-
 #: guidance action: a0 scales the scenario's R_LOS = nL (or look-ahead Δ) by 2^a0 ∈ [½, 2];
 #: a1 → course offset a1·30°.
 GUIDANCE_OFFSET_MAX = math.radians(30.0)
