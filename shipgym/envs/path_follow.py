@@ -149,7 +149,7 @@ class ShipPathFollowEnv(gym.Env):
         sc = self.scenario
         return ControllerContext(
             ship=self.model.name,
-            nominal_model=type(self.model)(sc.nominal_params),
+            nominal_model=self.model.with_params(sc.nominal_params),
             waypoints=np.array(sc.path.waypoints),
             path_type=sc.config.path.type,
             ship_length=self._L,

@@ -39,6 +39,9 @@ NUMPY = SimpleNamespace(
     sin=np.sin,
     cos=np.cos,
     tanh=np.tanh,
+    atan=np.arctan,
+    exp=np.exp,
+    sign=np.sign,
     sqrt=np.sqrt,
     abs=np.abs,
     atan2=np.arctan2,
@@ -54,6 +57,9 @@ CASADI = SimpleNamespace(
     sin=ca.sin,
     cos=ca.cos,
     tanh=ca.tanh,
+    atan=ca.atan,
+    exp=ca.exp,
+    sign=ca.sign,
     sqrt=ca.sqrt,
     abs=ca.fabs,
     atan2=ca.atan2,
@@ -158,11 +164,22 @@ class ShipModel(ABC):
     fine_step: ClassVar[float]
     #: unit readings the model accepts for config/paper numbers (first = default)
     unit_readings: ClassVar[tuple[str, ...]] = ("si",)
+    #: structural variants of the equations (first = default), e.g. a source code's
+    #: literal form and its corrected form; ``()`` when the model has one form
+    variants: ClassVar[tuple[str, ...]] = ()
 
-    def __init__(self, params: ParameterRecord | None = None) -> None:
+    def __init__(self, params: ParameterRecord | None = None, variant: str | None = None) -> None:
         self.params = params if params is not None else self.params_type()
         if not isinstance(self.params, self.params_type):
             raise TypeError(f"{self.name} needs {self.params_type.__name__}, got {params!r}")
+        if variant is not None and variant not in self.variants:
+            valid = list(self.variants) if self.variants else "none (the model has one form)"
+            raise ParameterError(f"{self.name}: unknown variant {variant!r}; valid: {valid}")
+        self.variant = variant if variant is not None else (self.variants or (None,))[0]
+
+    def with_params(self, params: ParameterRecord) -> ShipModel:
+        """The same model (class and variant) with other parameters."""
+        return type(self)(params, self.variant)
 
     @classmethod
     def config_to_si(cls, values: dict[str, float], unit_reading: str | None) -> dict[str, float]:
@@ -181,9 +198,11 @@ class ShipModel(ABC):
         return dict(values)
 
     @classmethod
-    def from_config(cls, values: dict[str, float], unit_reading: str | None = None) -> ShipModel:
+    def from_config(
+        cls, values: dict[str, float], unit_reading: str | None = None, variant: str | None = None
+    ) -> ShipModel:
         """The model with its default parameters overridden by ``values`` (config units)."""
-        return cls(cls.params_type().replace(**cls.config_to_si(values, unit_reading)))
+        return cls(cls.params_type().replace(**cls.config_to_si(values, unit_reading)), variant)
 
     # -- the one definition -------------------------------------------------------------
     @abstractmethod
@@ -224,6 +243,15 @@ class ShipModel(ABC):
                 raise KeyError(f"{self.name} has no state {key!r}; states: {self.state_names}")
             x[self.state_names.index(key)] = value
         return x
+
+    def cruise_state(self, **values: float) -> np.ndarray:
+        """Straight-ahead state at the nominal speed with the named entries set.
+
+        Start of every manoeuvre and scenario.  Kinematic models (speed a parameter) need
+        nothing more than :meth:`initial_state`; models with a surge state override this to
+        set u = U0 (and propeller speed, controller states) unless given in ``values``.
+        """
+        return self.initial_state(**values)
 
     def first_order_nomoto(self, params: ParameterRecord | None = None) -> tuple[float, float]:
         """First-order Nomoto (K [1/s], T [s]) of the model, for autopilot design.

@@ -90,7 +90,7 @@ class Scenario:
     def initial_state(self):
         cfg = self.config.initial_state
         values = {"x": cfg.x, "y": cfg.y, "psi": cfg.heading_deg * DEG, **cfg.states}
-        return self.model.initial_state(**values)
+        return self.model.cruise_state(**values)
 
 
 def _format_validation_error(err: ValidationError, origin: str) -> str:
@@ -110,7 +110,7 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
         )
     model_cls = MODELS[ship.model]
     try:
-        model = model_cls.from_config(ship.params, ship.unit_reading)
+        model = model_cls.from_config(ship.params, ship.unit_reading, ship.variant)
     except ParameterError as exc:
         raise ScenarioError(f"{origin}: key 'ship.params': {exc}") from exc
     events = []

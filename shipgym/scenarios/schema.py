@@ -26,6 +26,9 @@ class ShipConfig(_Strict):
         default=None, description="how the paper's units map to SI (nomoto2: si|degrees|…)"
     )
     params: dict[str, float] = Field(default_factory=dict)
+    variant: str | None = Field(
+        default=None, description="structural variant of the model's equations (esso_osaka: …)"
+    )
 
 
 class InitialState(_Strict):
