@@ -233,3 +233,45 @@ def bench_nmpc(scenarios: tuple[str, ...] = ("nominal", "rudder_aging", "current
         "solves": solves,
         "failures": failures,
     }
+
+
+def bench_training(
+    n_envs: int = 8, timesteps: int = 16_384, scenario: str = "rudder_aging", repeats: int = 1
+) -> dict[str, Any]:
+    """PPO training throughput (env steps/s, learning included) with the batched env vs
+    SB3's SubprocVecEnv over single envs: same scenario, number of envs, hyperparameters
+    (configs/agents/ppo.yaml with a fixed scenario) and machine, measured in the same run.
+
+    The first rollout of each run (process start-up, torch warm-up) is excluded.
+    """
+    from stable_baselines3 import PPO
+
+    from baselines.learned.agents import build_hyperparams, load_agent_config, make_training_env
+
+    config = load_agent_config("ppo")
+    figures: dict[str, Any] = {"n_envs": n_envs, "timesteps": timesteps, "scenario": scenario}
+    for kind in ("batched", "subproc", "dummy"):
+        env_config = config.env.model_copy(
+            update={"vec_env": kind, "scenario": scenario, "distribution": None, "n_envs": n_envs}
+        )
+        rates = []
+        for rep in range(repeats):
+            venv = make_training_env(env_config, seed=rep)
+            model = PPO(
+                config.policy,
+                venv,
+                seed=rep,
+                device="cpu",
+                **build_hyperparams(config, venv.action_space.shape[0]),
+            )
+            warm = model.n_steps * n_envs
+            model.learn(warm)
+            start = time.perf_counter()
+            model.learn(timesteps, reset_num_timesteps=False)
+            rates.append(timesteps / (time.perf_counter() - start))
+            venv.close()
+        figures[f"ppo_{kind}_env_steps_per_s"] = statistics.median(rates)
+    figures["batched_over_subproc"] = (
+        figures["ppo_batched_env_steps_per_s"] / figures["ppo_subproc_env_steps_per_s"]
+    )
+    return figures

@@ -50,12 +50,14 @@ def cmd_leaderboard(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from baselines.benchmarks import bench_env, bench_identification, bench_nmpc
+    from baselines.benchmarks import bench_env, bench_identification, bench_nmpc, bench_training
 
     if args.target == "env":
         figures = bench_env(repeats=args.repeats)
     elif args.target == "nmpc":
         figures = bench_nmpc()
+    elif args.target == "training":
+        figures = bench_training(repeats=args.repeats)
     else:
         figures = bench_identification()
     _emit(args, figures, "\n".join(_flatten_lines(figures)))
@@ -95,6 +97,60 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_evaluate(args: argparse.Namespace) -> int:
+    from baselines.leaderboard import markdown_table, run_leaderboard
+
+    rows = run_leaderboard(
+        suite=args.suite,
+        seeds=args.seeds,
+        out_dir=args.out,
+        backend=args.backend,
+        workers=args.workers,
+        controllers=[args.policy],
+        show_progress=not args.no_progress,
+    )
+    _emit(args, rows, markdown_table(rows))
+    return 0
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    from baselines.learned.agents import AGENT_DIR, load_agent_config
+    from baselines.learned.policy import POLICY_DIR
+    from baselines.learned.train import export_policy, train
+
+    if args.agent == "all":
+        if args.config:
+            raise ValueError("train all: --config applies to one agent")
+        names = sorted(p.stem for p in AGENT_DIR.glob("*.yaml"))
+    else:
+        names = [args.agent]
+    metas = []
+    for name in names:
+        config = load_agent_config(args.config or name)
+        if args.out is None:
+            out = f"results/agents/{config.name}"
+        else:
+            out = args.out if len(names) == 1 else f"{args.out}/{config.name}"
+        meta = train(
+            config,
+            out_dir=out,
+            seed=args.seed,
+            n_timesteps=args.timesteps,
+            resume=args.resume,
+            progress=not args.no_progress,
+        )
+        if args.ship:
+            meta["shipped_to"] = str(export_policy(out, POLICY_DIR / config.name))
+        meta["out_dir"] = out
+        metas.append(meta)
+    text = "\n".join(
+        f"{m['name']}: {m['env_steps']} env steps in {m['wall_time_s']:.0f} s -> {m['out_dir']}"
+        for m in metas
+    )
+    _emit(args, metas if len(metas) > 1 else metas[0], text)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shipgym", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -110,19 +166,53 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_leaderboard)
 
     p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
-    p.add_argument("paper", choices=["liu2019"], help="which paper")
+    p.add_argument("paper", choices=["liu2019", "morenosalinas2013"], help="which paper")
     p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
     p.set_defaults(func=cmd_reproduce)
 
+    p = sub.add_parser(
+        "train",
+        help="train an SB3 agent (configs/agents) with evaluation, checkpoints, TensorBoard",
+    )
+    p.add_argument("agent", help="agent config name in configs/agents (ppo, sac, …) or 'all'")
+    p.add_argument("--config", default=None, help="agent YAML (default configs/agents/AGENT.yaml)")
+    p.add_argument("--out", default=None, help="output directory (default results/agents/NAME)")
+    p.add_argument("--seed", type=int, default=None, help="override the config's seed")
+    p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
+    p.add_argument("--resume", action="store_true", help="continue from the newest checkpoint")
+    p.add_argument(
+        "--ship", action="store_true", help="export the best model to baselines/learned/policies"
+    )
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--json", action="store_true", help="print the training meta as JSON")
+    p.set_defaults(func=cmd_train)
+
+    p = sub.add_parser(
+        "evaluate", help="evaluate a controller or trained agent on a suite (leaderboard rows)"
+    )
+    p.add_argument("policy", help="controller name, shipped policy name or trained agent folder")
+    p.add_argument("--suite", default="default", help="suite name in configs/suites or a YAML path")
+    p.add_argument("--seeds", type=int, default=None, help="seeds per scenario (default: suite's)")
+    p.add_argument("--out", default="results/evaluate", help="output directory")
+    p.add_argument("--backend", choices=["local", "ray"], default="local")
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
+    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
+    p.set_defaults(func=cmd_evaluate)
+
     p = sub.add_parser("scenarios", help="list the scenario catalogue")
     p.add_argument("--json", action="store_true", help="print the names as a JSON list")
     p.set_defaults(func=cmd_scenarios)
 
     p = sub.add_parser("bench", help="benchmarks of SPEC §10")
-    p.add_argument("target", choices=["env", "nmpc", "identification"], help="what to benchmark")
+    p.add_argument(
+        "target",
+        choices=["env", "nmpc", "identification", "training"],
+        help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv)",
+    )
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--json", action="store_true", help="print the figures as a JSON object")
     p.set_defaults(func=cmd_bench)

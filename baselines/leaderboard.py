@@ -60,10 +60,33 @@ def load_suite(name_or_path: str) -> dict[str, Any]:
     return suite
 
 
+#: training-cost columns, present for learned agents only
+TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
+
+
+def controller_label(controller: str) -> str:
+    """The table name of a controller: its registry name, or a trained agent's folder name."""
+    path = Path(controller)
+    return path.stem if path.suffix == ".zip" else path.name if path.exists() else controller
+
+
+def scenario_split(scenario: str) -> str:
+    """``heldout`` for named held-out test scenarios (``heldout:3``), else ``catalogue``."""
+    return "heldout" if scenario.startswith("heldout:") else "catalogue"
+
+
+def suite_scenarios(spec: dict[str, Any]) -> list[str]:
+    """The suite's catalogue scenarios followed by ``heldout:0 … heldout:N-1``."""
+    n = int(spec.get("heldout_scenarios", 0))
+    return list(spec["scenarios"]) + [f"heldout:{i}" for i in range(n)]
+
+
 def run_job(job: tuple[str, str, int]) -> EpisodeResult:
     """One (controller, scenario, seed) episode; top-level so process pools can pickle it."""
     controller, scenario, seed = job
-    return evaluate(controller, scenario, [seed])[0]
+    result = evaluate(controller, scenario, [seed])[0]
+    result.controller = controller_label(controller)
+    return result
 
 
 def _run_local(jobs: list, workers: int, progress: Callable[[], None]) -> list[EpisodeResult]:
@@ -114,8 +137,9 @@ def run_leaderboard(
     if n_seeds < 1:
         raise ValueError(f"--seeds must be ≥ 1, got {n_seeds}")
     names = list(controllers) if controllers else list(spec["controllers"])
+    scenarios = suite_scenarios(spec)
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
-    jobs = [(c, s, seed) for s in spec["scenarios"] for c in names for seed in seed_list]
+    jobs = [(c, s, seed) for s in scenarios for c in names for seed in seed_list]
     bar = tqdm(total=len(jobs), desc="leaderboard", file=sys.stderr, disable=not show_progress)
     if backend == "local":
         results = _run_local(jobs, workers or os.cpu_count() or 1, lambda: bar.update(1))
@@ -124,7 +148,7 @@ def run_leaderboard(
     else:
         raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
     bar.close()
-    rows = aggregate_results(results, spec["scenarios"], names)
+    rows = aggregate_results(results, scenarios, [controller_label(c) for c in names])
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     write_tables(rows, out)
@@ -141,10 +165,12 @@ def aggregate_results(
             group = [r for r in results if r.scenario == scenario and r.controller == controller]
             if not group:
                 continue
-            agg = aggregate([r.metrics for r in group], COLUMNS)
+            keys = COLUMNS + tuple(k for k in TRAINING_COLUMNS if k in group[0].metrics)
+            agg = aggregate([r.metrics for r in group], keys)
             rows.append(
                 {
                     "scenario": scenario,
+                    "split": scenario_split(scenario),
                     "controller": controller,
                     "kind": group[0].kind,
                     "seeds": len(group),
@@ -174,7 +200,45 @@ def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
         writer = csv.DictWriter(fh, fieldnames=keys)
         writer.writeheader()
         writer.writerows(rows)
-    (out / "leaderboard.md").write_text(markdown_table(rows))
+    (out / "leaderboard.md").write_text(markdown_table(rows) + generalisation_table(rows))
+    (out / "generalisation.json").write_text(json.dumps(generalisation(rows), indent=2))
+
+
+def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per controller: mean ACE/L, return and success on catalogue vs held-out scenarios."""
+    out = []
+    for controller in dict.fromkeys(r["controller"] for r in rows):
+        entry: dict[str, Any] = {"controller": controller}
+        for split in ("catalogue", "heldout"):
+            group = [r for r in rows if r["controller"] == controller and r["split"] == split]
+            for key in ("ace_L", "return", "success"):
+                values = [r[key] for r in group if isinstance(r[key], float)]
+                entry[f"{split}_{key}"] = float(np.mean(values)) if values else math.nan
+        kinds = [r["kind"] for r in rows if r["controller"] == controller]
+        entry["kind"] = kinds[0]
+        out.append(entry)
+    return out
+
+
+def generalisation_table(rows: list[dict[str, Any]]) -> str:
+    """Markdown of :func:`generalisation` (empty when the suite has no held-out scenarios)."""
+    if not any(r["split"] == "heldout" for r in rows):
+        return ""
+    lines = [
+        "\n## Generalisation: catalogue vs held-out scenarios (mean over scenarios)\n",
+        "| controller | kind | ACE/L catalogue | ACE/L held-out | return catalogue | "
+        "return held-out | success catalogue | success held-out |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for g in generalisation(rows):
+        cells = [g["controller"], g["kind"]]
+        cells += [
+            _fmt(g[f"{split}_{key}"])
+            for key in ("ace_L", "return", "success")
+            for split in ("catalogue", "heldout")
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
 
 
 def markdown_table(rows: list[dict[str, Any]]) -> str:
@@ -192,14 +256,20 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
         "compute [ms]",
     ]
     keys = ["ace", "ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
+    head.append("training")
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         cells = [r["scenario"], r["controller"], r["kind"]]
         cells += [_fmt(r[k], r.get(f"{k}_std")) for k in keys]
+        cost = ""
+        if "train_env_steps" in r:
+            cost = f"{r['train_env_steps'] / 1e3:.0f} k steps, {r['train_wall_s'] / 60:.1f} min"
+        cells.append(cost)
         lines.append("| " + " | ".join(cells) + " |")
     note = (
         "\nMean ± std over seeds. t_c: moment (s of simulation time) from which |e| stays "
-        "below the threshold after the first parameter change; 'never' when it does not.\n"
+        "below the threshold after the first parameter change; 'never' when it does not. "
+        "training: env steps and wall time of a learned agent's training run.\n"
     )
     return "\n".join(lines) + "\n" + note
 
@@ -236,5 +306,5 @@ def plot_results(results: list[EpisodeResult], out: Path) -> None:
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
         axes[0].legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(out / f"{scenario}.png", dpi=90)
+        fig.savefig(out / f"{scenario.replace(':', '_')}.png", dpi=90)
         plt.close(fig)

@@ -23,4 +23,13 @@ for _env_id, _scenario in ENV_IDS.items():
             kwargs={"scenario": _scenario},
         )
 
-__all__ = ["ENV_IDS", "__version__"]
+#: training env: a new scenario from a distribution (configs/distributions) at every reset
+RANDOMIZED_ENV_ID = "ShipPathFollowRandomized-v0"
+if RANDOMIZED_ENV_ID not in registry:
+    register(
+        id=RANDOMIZED_ENV_ID,
+        entry_point="shipgym.envs.randomized:ShipPathFollowRandomizedEnv",
+        kwargs={"distribution": "train"},
+    )
+
+__all__ = ["ENV_IDS", "RANDOMIZED_ENV_ID", "__version__"]

@@ -18,6 +18,39 @@ import numpy as np
 from shipgym.codegen import compiled
 from shipgym.models.base import ShipModel
 
+#: (model class, variant, h, n_sub, compile, batch) -> period Function.  The function
+#: depends only on the model's equations (parameters are inputs), so envs that are rebuilt
+#: for new scenarios of the same ship (training distributions) share it.
+_FUNCTIONS: dict[tuple, ca.Function] = {}
+
+
+def _period_function(
+    model: ShipModel, h: float, n_sub: int, compile: bool, batch: int
+) -> ca.Function:
+    """The unrolled RK4 period of ``model`` (see :class:`PeriodIntegrator`), cached."""
+    key = (type(model), model.variant, h, n_sub, compile, batch)
+    cached = _FUNCTIONS.get(key)
+    if cached is not None:
+        return cached
+    step = model.casadi_step(h)
+    nx, nw, npar = model.n_states, model.n_disturbances, model.n_params
+    x0 = ca.SX.sym("x0", nx)
+    u = ca.SX.sym("u", len(model.input_names))
+    # transposed layouts: CasADi is column-major, numpy row-major
+    w = ca.SX.sym("w", nw, n_sub)
+    p = ca.SX.sym("p", npar, n_sub)
+    x, states = x0, []
+    for i in range(n_sub):
+        x = step(x, u, w[:, i], p[:, i])
+        states.append(x)
+    function = ca.Function(f"{model.name}_period_{n_sub}", [x0, u, w, p], [ca.horzcat(*states)])
+    if compile:
+        function = compiled(function)
+    if batch > 1:  # the same function per ship: results bit-identical to the single call
+        function = function.map(batch, "thread", 2)
+    _FUNCTIONS[key] = function
+    return function
+
 
 class PeriodIntegrator:
     """Integrate ``n_sub`` RK4 steps of length ``h`` [s] with the rudder command held.
@@ -34,24 +67,9 @@ class PeriodIntegrator:
             raise ValueError(f"need h > 0 and n_sub ≥ 1, got h={h}, n_sub={n_sub}")
         self.model, self.h, self.n_sub = model, float(h), int(n_sub)
         self.compile, self.batch = compile, int(batch)
-        step = model.casadi_step(h)
+        function = _period_function(model, self.h, self.n_sub, compile, self.batch)
         nx, nw, npar = model.n_states, model.n_disturbances, model.n_params
-        x0 = ca.SX.sym("x0", nx)
-        u = ca.SX.sym("u", len(model.input_names))
-        # transposed layouts: CasADi is column-major, numpy row-major
-        w = ca.SX.sym("w", nw, n_sub)
-        p = ca.SX.sym("p", npar, n_sub)
-        x, states = x0, []
-        for i in range(n_sub):
-            x = step(x, u, w[:, i], p[:, i])
-            states.append(x)
-        self.function = ca.Function(
-            f"{model.name}_period_{n_sub}", [x0, u, w, p], [ca.horzcat(*states)]
-        )
-        function = compiled(self.function) if compile else self.function
         b = self.batch
-        if b > 1:  # the same function per ship: results bit-identical to the single call
-            function = function.map(b, "thread", 2)
         nu = len(model.input_names)
         self._x0 = np.zeros((b, nx))
         self._u = np.zeros((b, nu))

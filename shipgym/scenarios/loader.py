@@ -168,7 +168,8 @@ def load_scenario_file(path: str | os.PathLike) -> Scenario:
 
 
 def load_scenario(spec: str | os.PathLike | Scenario | ScenarioConfig) -> Scenario:
-    """A scenario from a catalogue name, a YAML path, a Scenario or a ScenarioConfig."""
+    """A scenario from a catalogue name, a YAML path, a Scenario, a ScenarioConfig or the
+    name of a held-out test scenario ``"<distribution>:<index>"`` (``heldout:3``)."""
     if isinstance(spec, Scenario):
         return spec
     if isinstance(spec, ScenarioConfig):
@@ -182,6 +183,13 @@ def load_scenario(spec: str | os.PathLike | Scenario | ScenarioConfig) -> Scenar
     text = os.fspath(spec)
     if text.endswith((".yaml", ".yml")) or os.sep in text:
         return load_scenario_file(text)
+    if ":" in text:  # a named scenario of a test distribution, e.g. "heldout:3"
+        from shipgym.scenarios.sampling import DistributionError, sampled_scenario_config
+
+        try:
+            return build_scenario(sampled_scenario_config(text), text)
+        except DistributionError as exc:
+            raise ScenarioError(str(exc)) from None
     names = list_scenarios()
     if text not in names:
         raise ScenarioError(f"unknown scenario {text!r}; valid names: {', '.join(names)}")

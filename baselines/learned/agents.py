@@ -1,0 +1,165 @@
+"""Agent configs (rl-baselines3-zoo style YAML in ``configs/agents``) and their envs.
+
+A config names the algorithm, the policy, the number of env steps, the hyperparameters
+passed to the SB3 constructor, the training envs (a scenario distribution, or one fixed
+scenario for the batched env) and the periodic evaluation on held-out *validation*
+scenarios (never the ``heldout`` test set, which is kept for the leaderboard).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+REPO = Path(__file__).resolve().parents[2]
+AGENT_DIR = REPO / "configs" / "agents"
+
+ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class AgentEnvConfig(_Strict):
+    distribution: str | None = "train"  # scenario distribution (configs/distributions)
+    scenario: str | None = None  # or one fixed scenario (needed by vec_env: batched)
+    action_mode: Literal["rudder", "guidance"] = "rudder"
+    n_envs: int = Field(8, ge=1)
+    vec_env: Literal["dummy", "subproc", "batched"] = "subproc"
+    normalize_reward: bool = True  # VecNormalize(norm_obs=False): the obs is already scaled
+
+    @model_validator(mode="after")
+    def _one_source(self) -> AgentEnvConfig:
+        if (self.distribution is None) == (self.scenario is None):
+            raise ValueError("env: give exactly one of 'distribution' and 'scenario'")
+        if self.vec_env == "batched" and self.scenario is None:
+            raise ValueError("env.vec_env 'batched' steps one fixed scenario: set env.scenario")
+        return self
+
+
+class EvalConfig(_Strict):
+    distribution: str = "validation"
+    freq: int = Field(20_000, ge=1)  # env steps between evaluations
+    n_episodes: int = Field(8, ge=1)
+
+
+class AgentConfig(_Strict):
+    name: str
+    algo: Literal["ppo", "sac", "td3", "recurrent_ppo"]
+    policy: str = "MlpPolicy"
+    n_timesteps: int = Field(ge=1)
+    seed: int = Field(0, ge=0)
+    env: AgentEnvConfig = AgentEnvConfig()
+    hyperparams: dict[str, Any] = Field(default_factory=dict)
+    policy_kwargs: dict[str, Any] = Field(default_factory=dict)
+    eval: EvalConfig = EvalConfig()
+    checkpoint_freq: int = Field(50_000, ge=1)  # env steps between checkpoints
+
+
+def load_agent_config(name_or_path: str | os.PathLike) -> AgentConfig:
+    """An agent config by name (``configs/agents/<name>.yaml``) or path; errors name the key."""
+    text = os.fspath(name_or_path)
+    path = Path(text)
+    if not text.endswith((".yaml", ".yml")) and os.sep not in text:
+        path = AGENT_DIR / f"{text}.yaml"
+        if not path.is_file():
+            valid = ", ".join(sorted(p.stem for p in AGENT_DIR.glob("*.yaml")))
+            raise ValueError(f"unknown agent config {text!r}; valid: {valid}")
+    if not path.is_file():
+        raise ValueError(f"agent config not found: {path}")
+    try:
+        data = yaml.safe_load(path.read_text())
+        return AgentConfig.model_validate(data)
+    except yaml.YAMLError as exc:
+        raise ValueError(f"{path}: malformed YAML: {exc}") from None
+    except ValidationError as exc:
+        lines = [
+            f"{path}: key '{'.'.join(str(p) for p in e['loc']) or '<top level>'}': {e['msg']}"
+            for e in exc.errors()
+        ]
+        raise ValueError("\n".join(lines)) from None
+
+
+def algo_class(algo: str) -> type:
+    """The SB3 / sb3-contrib class of an algorithm id."""
+    if algo == "recurrent_ppo":
+        from sb3_contrib import RecurrentPPO
+
+        return RecurrentPPO
+    import stable_baselines3 as sb3
+
+    classes = {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}
+    if algo not in classes:
+        raise ValueError(f"unknown algorithm {algo!r}; valid: {', '.join(ALGOS)}")
+    return classes[algo]
+
+
+def _single_env_factory(source: dict[str, Any], action_mode: str):
+    def make() -> Any:
+        import gymnasium as gym
+
+        import shipgym
+
+        if source.get("scenario") is not None:
+            return gym.make(
+                "ShipPathFollow-v0", scenario=source["scenario"], action_mode=action_mode
+            )
+        return gym.make(
+            shipgym.RANDOMIZED_ENV_ID,
+            distribution=source["distribution"],
+            action_mode=action_mode,
+        )
+
+    return make
+
+
+def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
+    """The SB3 VecEnv of a config (DummyVecEnv / SubprocVecEnv / batched), seeded."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
+
+    if config.vec_env == "batched":
+        from baselines.learned.vec_env import SB3BatchedVecEnv
+        from shipgym.envs.vector import ShipPathFollowVectorEnv
+
+        venv = SB3BatchedVecEnv(
+            ShipPathFollowVectorEnv(config.n_envs, config.scenario, config.action_mode)
+        )
+    else:
+        factory = _single_env_factory(
+            {"scenario": config.scenario, "distribution": config.distribution},
+            config.action_mode,
+        )
+        cls = SubprocVecEnv if config.vec_env == "subproc" and config.n_envs > 1 else DummyVecEnv
+        venv = cls([factory] * config.n_envs)
+    venv.seed(seed)
+    return VecMonitor(venv)
+
+
+def make_eval_env(config: EvalConfig, action_mode: str) -> Any:
+    """One env cycling through the validation scenarios in order (deterministic)."""
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    factory = _single_env_factory({"distribution": config.distribution}, action_mode)
+    return DummyVecEnv([factory])
+
+
+def build_hyperparams(config: AgentConfig, n_actions: int) -> dict[str, Any]:
+    """SB3 constructor kwargs from the config (action noise objects built here)."""
+    kwargs = dict(config.hyperparams)
+    noise = kwargs.pop("action_noise", None)
+    if noise is not None:
+        import numpy as np
+        from stable_baselines3.common.noise import NormalActionNoise
+
+        if noise.get("type", "normal") != "normal":
+            raise ValueError(f"hyperparams.action_noise.type: only 'normal', got {noise}")
+        sigma = float(noise.get("sigma", 0.1))
+        kwargs["action_noise"] = NormalActionNoise(np.zeros(n_actions), sigma * np.ones(n_actions))
+    if config.policy_kwargs:
+        kwargs["policy_kwargs"] = dict(config.policy_kwargs)
+    return kwargs

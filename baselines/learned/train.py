@@ -1,0 +1,236 @@
+"""``shipgym train``: train an SB3 agent from a config, with evaluation and checkpoints.
+
+Output directory (default ``results/agents/<name>``)::
+
+    model.zip            final model            best_model.zip   best on validation scenarios
+    meta.json            algo, action mode, env steps, wall time, seed, versions
+    checkpoints/         ckpt_<steps>_steps.zip (+ replay buffer, VecNormalize, state.json)
+    eval/evaluations.npz validation returns over training       tb/  TensorBoard logs
+
+``resume=True`` continues from the newest checkpoint (model, replay buffer, reward
+normalisation and the wall-time counter) up to the config's ``n_timesteps``.
+:func:`export_policy` copies the best model and its meta into a policy directory (the
+shipped ones live in ``baselines/learned/policies``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from baselines.evaluation import EVAL_SEED_OFFSET
+from baselines.learned.agents import (
+    AgentConfig,
+    algo_class,
+    build_hyperparams,
+    load_agent_config,
+    make_eval_env,
+    make_training_env,
+)
+
+_CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
+
+
+def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
+    from stable_baselines3.common.callbacks import (
+        BaseCallback,
+        CallbackList,
+        CheckpointCallback,
+        EvalCallback,
+    )
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    class _Progress(BaseCallback):
+        """tqdm bar on stderr, and the wall-time counter saved beside each checkpoint."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.bar = None
+            self.start = time.perf_counter()
+
+        def _on_training_start(self) -> None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(
+                total=config.n_timesteps,
+                initial=self.model.num_timesteps,
+                desc=f"train {config.name}",
+                file=sys.stderr,
+                disable=not progress,
+                unit="step",
+            )
+
+        def _on_step(self) -> bool:
+            self.bar.update(self.model.num_timesteps - self.bar.n)
+            return True
+
+        def _on_training_end(self) -> None:
+            self.bar.close()
+
+        def wall(self) -> float:
+            return wall_offset + time.perf_counter() - self.start
+
+    progress_cb = _Progress()
+
+    class _Checkpoint(CheckpointCallback):
+        def _on_step(self) -> bool:
+            if self.n_calls % self.save_freq == 0:
+                state = {
+                    "num_timesteps": self.model.num_timesteps,
+                    "wall_time_s": progress_cb.wall(),
+                }
+                (out / "checkpoints").mkdir(parents=True, exist_ok=True)
+                (out / "checkpoints" / "state.json").write_text(json.dumps(state))
+            return super()._on_step()
+
+    off_policy = config.algo in ("sac", "td3")
+    checkpoint = _Checkpoint(
+        save_freq=max(config.checkpoint_freq // n_envs, 1),
+        save_path=str(out / "checkpoints"),
+        name_prefix="ckpt",
+        save_replay_buffer=off_policy,
+        save_vecnormalize=True,
+    )
+    eval_env = make_eval_env(config.eval, config.env.action_mode)
+    eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
+    evaluation = EvalCallback(
+        eval_env,
+        best_model_save_path=str(out),
+        log_path=str(out / "eval"),
+        eval_freq=max(config.eval.freq // n_envs, 1),
+        n_eval_episodes=config.eval.n_episodes,
+        deterministic=True,
+        verbose=0,
+    )
+    return CallbackList([progress_cb, checkpoint, evaluation]), progress_cb
+
+
+def latest_checkpoint(out: Path) -> tuple[Path, int] | None:
+    found = [
+        (p, int(m.group(1)))
+        for p in (out / "checkpoints").glob("ckpt_*_steps.zip")
+        if (m := _CKPT.search(p.name))
+    ]
+    return max(found, key=lambda item: item[1]) if found else None
+
+
+def train(
+    config: AgentConfig | str,
+    out_dir: str | Path | None = None,
+    seed: int | None = None,
+    n_timesteps: int | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    tensorboard: bool = True,
+) -> dict[str, Any]:
+    """Train (or resume) an agent; returns the meta written to ``out_dir/meta.json``."""
+    import stable_baselines3
+    import torch
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    import shipgym
+
+    if not isinstance(config, AgentConfig):
+        config = load_agent_config(config)
+    updates: dict[str, Any] = {}
+    if seed is not None:
+        updates["seed"] = seed
+    if n_timesteps is not None:
+        updates["n_timesteps"] = n_timesteps
+    if updates:
+        config = config.model_copy(update=updates)
+    if config.seed + config.env.n_envs > EVAL_SEED_OFFSET:
+        raise ValueError(
+            f"seed {config.seed} + n_envs {config.env.n_envs} would reach the evaluation seeds "
+            f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed"
+        )
+    out = Path(out_dir or f"results/agents/{config.name}")
+    out.mkdir(parents=True, exist_ok=True)
+    cls = algo_class(config.algo)
+    venv = make_training_env(config.env, config.seed)
+    gamma = float(config.hyperparams.get("gamma", 0.99))
+    previous = latest_checkpoint(out) if resume else None
+    if resume and previous is None:
+        raise ValueError(f"--resume: no checkpoint in {out / 'checkpoints'}")
+    wall_offset = 0.0
+    if previous is not None:
+        ckpt, steps = previous
+        if config.env.normalize_reward:
+            venv = VecNormalize.load(
+                str(out / "checkpoints" / f"ckpt_vecnormalize_{steps}_steps.pkl"), venv
+            )
+        model = cls.load(str(ckpt), env=venv, device="cpu")
+        buffer = out / "checkpoints" / f"ckpt_replay_buffer_{steps}_steps.pkl"
+        if buffer.is_file():
+            model.load_replay_buffer(str(buffer))
+        state_file = out / "checkpoints" / "state.json"
+        if state_file.is_file():
+            wall_offset = float(json.loads(state_file.read_text())["wall_time_s"])
+    else:
+        if config.env.normalize_reward:
+            venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
+        tb = None
+        if tensorboard:
+            try:
+                import tensorboard
+
+                tb = str(out / "tb")
+            except ImportError:
+                sys.stderr.write("tensorboard not installed: no TensorBoard logs\n")
+        model = cls(
+            config.policy,
+            venv,
+            seed=config.seed,
+            device="cpu",
+            tensorboard_log=tb,
+            verbose=0,
+            **build_hyperparams(config, venv.action_space.shape[0]),
+        )
+    callbacks, progress_cb = _callbacks(config, out, config.env.n_envs, progress, wall_offset)
+    remaining = config.n_timesteps - model.num_timesteps
+    if remaining > 0:
+        model.learn(
+            total_timesteps=remaining,
+            callback=callbacks,
+            reset_num_timesteps=previous is None,
+            tb_log_name=config.name,
+        )
+    model.save(str(out / "model.zip"))
+    meta = {
+        "name": config.name,
+        "algo": config.algo,
+        "action_mode": config.env.action_mode,
+        "env_steps": int(model.num_timesteps),
+        "wall_time_s": progress_cb.wall(),
+        "seed": config.seed,
+        "training": config.env.distribution or config.env.scenario,
+        "config": config.model_dump(),
+        "versions": {
+            "shipgym": shipgym.__version__,
+            "stable_baselines3": stable_baselines3.__version__,
+            "torch": torch.__version__,
+        },
+    }
+    (out / "meta.json").write_text(json.dumps(meta, indent=2))
+    venv.close()
+    return meta
+
+
+def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
+    """Copy the best model (else the final one) and meta.json into ``dest`` (a policy dir)."""
+    src = Path(out_dir)
+    model = src / "best_model.zip"
+    if not model.is_file():
+        model = src / "model.zip"
+    if not model.is_file() or not (src / "meta.json").is_file():
+        raise ValueError(f"{src}: no trained model (model.zip / meta.json) to export")
+    target = Path(dest)
+    target.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(model, target / "model.zip")
+    shutil.copyfile(src / "meta.json", target / "meta.json")
+    return target

@@ -1,0 +1,106 @@
+"""ShipPathFollow on a randomised scenario distribution (training envs for learned agents).
+
+Every ``reset`` draws a scenario from the distribution with the env's own seeded generator
+(train split: :func:`~shipgym.scenarios.sampling.train_scenario_seed`; test split: the
+named test scenarios in turn, or ``options={"index": i}``) and runs it in an ordinary
+:class:`~shipgym.envs.path_follow.ShipPathFollowEnv`: same observation, action, reward,
+``info`` and metrics.  The observation and action spaces do not depend on the scenario, so
+one policy serves the whole distribution.  ``reset(seed=s)`` is reproducible.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+
+from shipgym.envs.path_follow import ShipPathFollowEnv
+from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.sampling import (
+    ScenarioDistribution,
+    load_distribution,
+    train_rng,
+    train_scenario_seed,
+)
+
+
+class ShipPathFollowRandomizedEnv(gym.Env):
+    """A new scenario from ``distribution`` at every reset (module doc)."""
+
+    metadata: ClassVar[dict[str, Any]] = ShipPathFollowEnv.metadata
+
+    def __init__(
+        self,
+        distribution: str | ScenarioDistribution = "train",
+        action_mode: str = "rudder",
+        render_mode: str | None = None,
+        compile: bool = True,
+    ) -> None:
+        self.distribution = (
+            distribution
+            if isinstance(distribution, ScenarioDistribution)
+            else load_distribution(distribution)
+        )
+        self.action_mode = action_mode
+        self.render_mode = render_mode
+        self._compile = compile
+        self._next_test_index = 0
+        self._env = self._make_env(self._first_config())
+        self.action_space = self._env.action_space
+        self.observation_space = self._env.observation_space
+
+    def _first_config(self):
+        if self.distribution.split == "test":
+            return self.distribution.test_scenario(0)
+        return self.distribution.sample(train_rng(0))
+
+    def _make_env(self, config) -> ShipPathFollowEnv:
+        return ShipPathFollowEnv(
+            build_scenario(config, config.name),
+            action_mode=self.action_mode,
+            render_mode=self.render_mode,
+            compile=self._compile,
+        )
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        options = options or {}
+        if self.distribution.split == "test":
+            index = options.get("index", self._next_test_index)
+            self._next_test_index = (int(index) + 1) % len(self.distribution)
+            config = self.distribution.test_scenario(int(index))
+        else:
+            scenario_seed = train_scenario_seed(self.np_random)
+            config = self.distribution.sample(
+                train_rng(scenario_seed), name=f"{self.distribution.name}:train-{scenario_seed}"
+            )
+        self._env.close()
+        self._env = self._make_env(config)
+        episode_seed = int(self.np_random.integers(0, 2**31 - 1))
+        obs, info = self._env.reset(seed=episode_seed)
+        info["scenario"] = config.name
+        return obs, info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        return self._env.step(action)
+
+    # the single env's helpers, for controllers and the evaluation loop
+    @property
+    def scenario(self):
+        return self._env.scenario
+
+    @property
+    def controller_context(self):
+        return self._env.controller_context
+
+    def episode_metrics(self) -> dict[str, Any]:
+        return self._env.episode_metrics()
+
+    def render(self) -> np.ndarray | None:
+        return self._env.render()
+
+    def close(self) -> None:
+        self._env.close()

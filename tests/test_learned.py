@@ -1,0 +1,221 @@
+"""Learned agents: distributions and splits, randomized env, train → save → reload → evaluate."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import shipgym
+from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from baselines.leaderboard import run_job, run_leaderboard
+from baselines.learned.agents import AgentConfig, load_agent_config
+from baselines.learned.policy import LearnedPolicy
+from baselines.learned.train import export_policy, latest_checkpoint, train
+from shipgym.scenarios import ScenarioError, load_scenario
+from shipgym.scenarios.sampling import (
+    DistributionError,
+    load_distribution,
+    train_rng,
+    train_scenario_seed,
+)
+
+pytest.importorskip("stable_baselines3")
+
+
+def _config_key(config) -> str:
+    data = config.model_dump()
+    data.pop("name")
+    return json.dumps(data, sort_keys=True)
+
+
+def test_train_and_test_splits_share_no_scenario() -> None:
+    """500 training draws (from several env seeds) never hit a held-out/validation scenario."""
+    train = load_distribution("train")
+    tests = {}
+    for name in ("heldout", "validation"):
+        dist = load_distribution(name)
+        assert dist.split == "test"
+        for i in range(len(dist)):
+            tests[_config_key(dist.test_scenario(i))] = f"{name}:{i}"
+    assert len(tests) == len(load_distribution("heldout")) + len(load_distribution("validation"))
+    seen = set()
+    for env_seed in range(5):
+        rng = np.random.default_rng(env_seed)
+        for _ in range(100):
+            seed = train_scenario_seed(rng)
+            seen.add(seed)
+            key = _config_key(train.sample(train_rng(seed)))
+            assert key not in tests, f"training draw equals {tests[key]}"
+    assert len(seen) == 500  # distinct scenario seeds
+
+
+def test_heldout_contains_jumps_outside_the_training_ranges() -> None:
+    train = load_distribution("train").config
+    nominal = train.ships[0].params
+    tc_max = nominal["Tc"] * max(train.jumps.kinds["rudder_aging"].params["Tc"].range)
+    d0_min = nominal["d0"] + min(train.jumps.kinds["current_shift"].params["d0"].range)
+    heldout = load_distribution("heldout")
+    outside = 0
+    for i in range(len(heldout)):
+        sc = heldout.test_scenario(i)
+        for event in sc.events:
+            p = event.params
+            if p.get("Tc", 0.0) > tc_max * 1.01 or p.get("d0", 0.0) < d0_min or "T2" in p:
+                outside += 1
+    assert outside >= 3
+
+
+def test_named_heldout_scenarios_load_and_bad_names_fail() -> None:
+    sc = load_scenario("heldout:2")
+    assert sc.name == "heldout:2"
+    assert sc.config == load_scenario("heldout:2").config  # deterministic
+    with pytest.raises(ScenarioError, match="out of range"):
+        load_scenario("heldout:999")
+    with pytest.raises(ScenarioError, match="unknown distribution"):
+        load_scenario("nosuch:1")
+    with pytest.raises(ScenarioError, match="only test splits"):
+        load_scenario("train:0")
+
+
+def test_bad_distribution_file_names_the_key(tmp_path: Path) -> None:
+    data = yaml.safe_load(Path("configs/distributions/train.yaml").read_text())
+    data["path"]["leg_length_L"] = [20.0, 10.0]
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    with pytest.raises(DistributionError, match="leg_length_L"):
+        load_distribution(bad)
+
+
+def test_randomized_env_conforms_and_is_reproducible() -> None:
+    from gymnasium.utils.env_checker import check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    env = gym.make(shipgym.RANDOMIZED_ENV_ID)
+    check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(env.unwrapped)
+    obs_a, info_a = env.reset(seed=5)
+    traj_a = [env.step(np.array([0.3], dtype=np.float32))[0] for _ in range(20)]
+    obs_b, info_b = env.reset(seed=5)
+    traj_b = [env.step(np.array([0.3], dtype=np.float32))[0] for _ in range(20)]
+    assert info_a["scenario"] == info_b["scenario"]
+    np.testing.assert_array_equal(obs_a, obs_b)
+    np.testing.assert_array_equal(np.array(traj_a), np.array(traj_b))
+    _, info_c = env.reset(seed=6)
+    assert info_c["scenario"] != info_a["scenario"]
+
+
+def _tiny_config(**env: object) -> AgentConfig:
+    base = load_agent_config("ppo").model_dump()
+    base.update(
+        name="ppo_tiny",
+        n_timesteps=256,
+        hyperparams={"n_steps": 64, "batch_size": 64, "n_epochs": 2},
+        policy_kwargs={"net_arch": [16, 16]},
+        eval={"distribution": "validation", "freq": 128, "n_episodes": 1},
+        checkpoint_freq=128,
+    )
+    base["env"] = {**base["env"], "n_envs": 2, "vec_env": "dummy", **env}
+    return AgentConfig.model_validate(base)
+
+
+def _policy_params(directory: Path) -> list[np.ndarray]:
+    policy = LearnedPolicy(directory)
+    return [p.detach().numpy().copy() for p in policy.model.policy.parameters()]
+
+
+def test_ppo_trains_saves_reloads_and_evaluates_like_the_leaderboard(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    meta = train(_tiny_config(), out_dir=out, progress=False, tensorboard=False)
+    assert meta["env_steps"] == 256 and meta["algo"] == "ppo"
+    for name in ("model.zip", "best_model.zip", "meta.json"):
+        assert (out / name).is_file(), name
+    assert latest_checkpoint(out)[1] == 256
+    # same seed → same trained weights (determinism of the whole pipeline)
+    again = tmp_path / "again"
+    train(_tiny_config(), out_dir=again, progress=False, tensorboard=False)
+    (again / "best_model.zip").unlink()
+    (out / "best_model.zip").rename(out / "best.zip")  # compare the final models
+    for a, b in zip(_policy_params(out), _policy_params(again), strict=True):
+        np.testing.assert_array_equal(a, b)
+    # export → evaluate through the leaderboard's job function, twice: same numbers
+    shipped = export_policy(out, tmp_path / "policy")
+    first = run_job((str(shipped), "nominal", EVAL_SEED_OFFSET))
+    second = run_job((str(shipped), "nominal", EVAL_SEED_OFFSET))
+    assert first.kind == "learned" and first.controller == "policy"
+    assert first.metrics["train_env_steps"] == 256.0
+    for key in ("ace", "return", "rudder_travel"):
+        assert first.metrics[key] == second.metrics[key]
+    # the same episode through the plain evaluation loop
+    direct = evaluate(LearnedPolicy(shipped), "nominal", [EVAL_SEED_OFFSET])[0]
+    assert direct.metrics["return"] == first.metrics["return"]
+
+
+def test_training_resumes_from_the_last_checkpoint(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    config = _tiny_config()
+    train(config, out_dir=out, progress=False, tensorboard=False)
+    meta = train(config, out_dir=out, n_timesteps=384, resume=True, progress=False)
+    assert meta["env_steps"] == 384
+    assert meta["wall_time_s"] > 0
+    with pytest.raises(ValueError, match="no checkpoint"):
+        train(config, out_dir=tmp_path / "empty", resume=True, progress=False)
+
+
+def test_training_refuses_seeds_that_reach_the_evaluation_seeds(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="evaluation seeds"):
+        train(_tiny_config(), out_dir=tmp_path, seed=EVAL_SEED_OFFSET - 1, progress=False)
+
+
+def test_agent_configs_load_and_bad_ones_name_the_key(tmp_path: Path) -> None:
+    for name in ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3"):
+        config = load_agent_config(name)
+        assert config.name == name
+    data = yaml.safe_load(Path("configs/agents/ppo.yaml").read_text())
+    data["env"]["vec_env"] = "batched"  # batched needs a fixed scenario
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    with pytest.raises(ValueError, match="env"):
+        load_agent_config(bad)
+    with pytest.raises(ValueError, match="unknown agent config"):
+        load_agent_config("nosuch")
+
+
+def test_recurrent_policy_keeps_its_state_within_an_episode(tmp_path: Path) -> None:
+    base = _tiny_config().model_dump()
+    base.update(name="rppo_tiny", algo="recurrent_ppo", policy="MlpLstmPolicy")
+    base["hyperparams"] = {"n_steps": 64, "batch_size": 64, "n_epochs": 1}
+    base["policy_kwargs"] = {"net_arch": [16], "lstm_hidden_size": 8}
+    base["n_timesteps"] = 128
+    out = tmp_path / "rppo"
+    train(AgentConfig.model_validate(base), out_dir=out, progress=False, tensorboard=False)
+    result = evaluate(LearnedPolicy(out), "nominal", [EVAL_SEED_OFFSET])[0]
+    assert math.isfinite(result.metrics["return"])
+
+
+def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray")
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        yaml.safe_dump(
+            {"name": "tiny", "scenarios": ["nominal"], "controllers": ["pid_los", "zero_rudder"]}
+        )
+    )
+    local = run_leaderboard(
+        str(suite), seeds=2, out_dir=tmp_path / "a", workers=2, show_progress=False
+    )
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        remote = run_leaderboard(
+            str(suite), seeds=2, out_dir=tmp_path / "b", backend="ray", show_progress=False
+        )
+    finally:
+        ray.shutdown()
+    timing = ("compute_ms", "compute_ms_std")
+    strip = [{k: v for k, v in r.items() if k not in timing} for r in local]
+    assert strip == [{k: v for k, v in r.items() if k not in timing} for r in remote]
