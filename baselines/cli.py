@@ -151,6 +151,31 @@ def cmd_train(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_manoeuvre(args: argparse.Namespace) -> int:
+    import math
+    from pathlib import Path
+
+    from shipgym.manoeuvres import plot_manoeuvre, turning_circle, zigzag
+    from shipgym.models import MODELS
+
+    if args.ship not in MODELS:
+        raise ValueError(f"unknown ship {args.ship!r}; valid: {', '.join(sorted(MODELS))}")
+    model = MODELS[args.ship](variant=args.variant)
+    if args.kind == "turning":
+        default = min(35.0, math.degrees(model.rudder_limit))
+        log, figures = turning_circle(model, args.rudder if args.rudder is not None else default)
+    else:
+        rudder = args.rudder if args.rudder is not None else 20.0
+        log, figures = zigzag(model, rudder, args.switch if args.switch is not None else rudder)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    plot = out / f"{args.ship}_{args.kind}.png"
+    plot_manoeuvre(model, args.kind, log, figures, str(plot))
+    lines = [f"{k:22s} {v:.4g}" for k, v in figures.items()] + [f"plot: {plot}"]
+    _emit(args, figures, "\n".join(lines))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shipgym", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -202,6 +227,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
     p.set_defaults(func=cmd_evaluate)
+
+    p = sub.add_parser(
+        "manoeuvre", help="turning circle or zig-zag of a ship model, with figures and a plot"
+    )
+    p.add_argument("ship", help="ship model id (nomoto2, esso_osaka, mariner, blanke)")
+    p.add_argument("kind", choices=["turning", "zigzag"])
+    p.add_argument("--rudder", type=float, default=None, help="rudder angle [deg] (35 / 20)")
+    p.add_argument("--switch", type=float, default=None, help="zig-zag heading switch [deg]")
+    p.add_argument("--variant", default=None, help="model variant (e.g. esso_osaka literal)")
+    p.add_argument("--out", default="results/manoeuvres", help="directory of the plot")
+    p.add_argument("--json", action="store_true", help="print the figures as a JSON object")
+    p.set_defaults(func=cmd_manoeuvre)
 
     p = sub.add_parser("scenarios", help="list the scenario catalogue")
     p.add_argument("--json", action="store_true", help="print the names as a JSON list")

@@ -1,24 +1,55 @@
 """Guidance laws: pure functions from (pose, path geometry, parameters) to a desired heading.
 
-Floats in, floats out, using only the ``math`` module (they run every environment step).
 Sign conventions are those of :mod:`shipgym.paths`: ẋ = u cos ψ, ẏ = u sin ψ, path angle
 ψp = atan2(Δy, Δx), cross-track e > 0 left of the path, so ė = u sin(ψ − ψp)
-(Liu et al. 2019 eq. (7)).  All headings returned are wrapped to [−π, π).
+(Liu et al. 2019 eq. (7)).  Both vector-field papers use the same convention: Xu, Oliveira &
+Guedes Soares (2021) define ye by eq. (3) — the formula of :func:`shipgym.paths.segment_frame`
+— with ẏe = U sin(χ − γp) (eq. (8)), and Xu & Guedes Soares (2020) eq. (6) turns by
+atan(−ye/Δ); so their ``χf − sign(ye)·(…)`` is used as printed: a ship left of the path
+(ye > 0) is steered right (χd < χf), one right of it is steered left.  All headings returned
+are wrapped to [−π, π).
 
 Laws implemented:
 
 * LOS with a circle of radius R_LOS around the ship — Liu et al. (2019) eqs. (5)–(12);
-* look-ahead LOS — Xu & Guedes Soares (2020) eq. (6).
+* look-ahead LOS — Xu & Guedes Soares (2020) eq. (6);
+* vector field (VF) — Xu & Guedes Soares (2020) Algorithm 1: χd = χf − ρχe(|ye|/τ)^k inside
+  the transition region |ye| < τ, χd = χf − ρχe outside, ρ = sign(ye);
+* time-varying vector field (TVVF) — Xu, Oliveira & Guedes Soares (2021) eqs. (9), (48):
+  χd = γp − sgn(ye)·atan(|ye|^θ / Δ), θ = 0.05|ye| + 1.
 
-Vector-field guidance (Xu & Guedes Soares 2020 Algorithm 1; time-varying VF of Xu, Oliveira &
-Guedes Soares 2021 eqs. (9), (48)) is added by a later issue as further functions of the same
-shape: ``(cross_track, path_angle, params...) -> desired heading``.
+The LOS functions take floats and use the ``math`` module.  The VF and TVVF functions take
+floats *or* numpy arrays (the batched env evaluates them over N ships) and compute both with
+the same numpy ufuncs, so that a float result equals the matching element of an array result
+bit for bit (``math.atan``/``math.pow`` differ from numpy's SIMD ``arctan``/``power`` in the
+last bit for some inputs; tests/test_guidance_vf.py checks the identity).
+
+Choices where the papers are silent or ambiguous (explicit options, paper value as default):
+
+* VF exponent k: the paper states only k ≥ 1 (nomenclature) and gives no value; the default
+  k = 1 is the smallest admissible one, for which the field is linear in ye inside the
+  transition region and the convergence to the path exponential (k > 1 converges only
+  algebraically near the path).  τ = 2L and χe = π/2 are Algorithm 1's initial values; the
+  nomenclature's 0 < χe < π/2 is relaxed to χe ≤ π/2 to admit that initial value.
+* VF line 16 (course-rate feed-forward of Nelson et al. 2007, −(kχeU/(ατ))(|ye|/τ)^(k−1)·
+  sin(χ − χf)): α is not given in the paper, so the term is optional (``course_gain=None``
+  leaves it out, which is what the env does: it observes heading, not course).  The paper
+  prints sin(χ), the case χf = 0 of the path-relative sin(χ − χf) used here.
+* TVVF units: θ = 0.05|ye| + 1 with ye in metres, the paper's (scale-model) units; the law
+  is not dimensionally homogeneous, so for a full-scale ship θ grows large within a few
+  tens of metres.  ``error_unit`` measures ye and Δ in another unit (e.g. ship lengths);
+  the default 1 m is the paper's.
+* Crab angle: both papers subtract the drift angle β (ψd = χd − β).  The env observes
+  heading only, so ``sideslip`` defaults to 0 (the desired course is used as heading).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from shipgym.paths import segment_frame, wrap_angle
 
@@ -28,9 +59,17 @@ __all__ = [
     "los_point",
     "los_radius",
     "los_relative_heading",
+    "tvvf_heading",
+    "tvvf_theta",
+    "vector_field_heading",
 ]
 
 Point = Sequence[float]  # (x, y) [m]; tuples, lists or numpy arrays
+FloatOrArray = float | NDArray[np.float64]  # float in → float out; array in → array out
+
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+_HALF_PI = 0.5 * math.pi
 
 
 # --------------------------------------------------------------------------------------------
@@ -148,3 +187,149 @@ def lookahead_los_heading(
     if not lookahead > 0.0:
         raise ValueError(f"lookahead must be > 0, got {lookahead}")
     return wrap_angle(path_angle + math.atan(-cross_track / lookahead) - sideslip)
+
+
+# --------------------------------------------------------------------------------------------
+# Vector-field guidance — Xu & Guedes Soares (2020) §3; Xu, Oliveira & Guedes Soares (2021) §3
+# Floats or arrays, the same numpy operations for both (module doc).
+# --------------------------------------------------------------------------------------------
+def _wrapped(h: ArrayLike) -> FloatOrArray:
+    """``h`` wrapped to [−π, π), values already inside untouched; a float if 0-d.
+
+    The scalar branch uses the array branch's operations (np.mod, IEEE ± and comparisons)
+    on one number, so both give the same bits; it only skips the array machinery.
+    """
+    h = np.asarray(h)
+    if h.ndim == 0:
+        x = float(h)
+        if -_PI <= x < _PI:
+            return x
+        w = float(np.mod(x + _PI, _TWO_PI)) - _PI
+        return w - _TWO_PI if w >= _PI else w
+    w = np.mod(h + _PI, _TWO_PI) - _PI
+    w = np.where(w >= _PI, w - _TWO_PI, w)
+    return np.where((h >= -_PI) & (h < _PI), h, w)
+
+
+def _require(
+    ok: bool | np.bool_ | NDArray[np.bool_], name: str, value: ArrayLike, cond: str
+) -> None:
+    """ValueError naming ``name`` unless ``ok`` (a bool, or an array of them: all true)."""
+    if not (ok.all() if isinstance(ok, np.ndarray) else ok):
+        raise ValueError(f"{name} must be {cond}, got {value}")
+
+
+def vector_field_heading(
+    cross_track: ArrayLike,
+    path_angle: ArrayLike,
+    tau: ArrayLike,
+    entry_angle: float = _HALF_PI,
+    k: float = 1.0,
+    sideslip: ArrayLike = 0.0,
+    *,
+    course_gain: float | None = None,
+    speed: ArrayLike = 0.0,
+    course: ArrayLike | None = None,
+) -> FloatOrArray:
+    """Vector-field desired heading [rad] — Xu & Guedes Soares (2020) Algorithm 1.
+
+    With ρ = sign(ye) (line 3):
+
+    * |ye| ≥ τ (lines 8–11): χd = χf − ρχe, the constant entry angle towards the path;
+    * |ye| < τ (lines 13–14): χd = χf − ρχe(|ye|/τ)^k;
+    * ψd = χd − β, minus, if ``course_gain`` α is given and |ye| < τ, the course-rate
+      feed-forward of line 16: (kχeU/(ατ))(|ye|/τ)^(k−1)·sin(χ − χf) (module doc).
+
+    Outside the transition region the result is exactly the float χf ∓ χe − β (wrapping
+    leaves values already in [−π, π) untouched).
+
+    Args:
+        cross_track: ye [m], > 0 left of the path (float or array).
+        path_angle: χf [rad], path (tangent) angle at the reference point.
+        tau: τ [m], > 0, width of the transition region (2L in the paper).
+        entry_angle: χe [rad], 0 < χe ≤ π/2 (π/2 in the paper).
+        k: exponent, ≥ 1 (the paper gives no value; module doc).
+        sideslip: β [rad], course minus heading (χ = ψ + β, eq. (7)).
+        course_gain: α [1/s] of the course response χ̇ = α(χc − χ) assumed by line 16;
+            None (default) leaves the feed-forward term out.
+        speed: U [m/s], ship speed, used only with ``course_gain``.
+        course: χ [rad], ship course, required with ``course_gain``.
+
+    Returns:
+        ψd [rad] in [−π, π): a float for scalar inputs, else an array (broadcast shape).
+    """
+    e = np.asarray(cross_track, dtype=np.float64)
+    tau_a = np.asarray(tau, dtype=np.float64)
+    _require(tau_a > 0.0, "tau", tau, "> 0")
+    _require(0.0 < entry_angle <= _HALF_PI, "entry_angle", entry_angle, "in (0, π/2]")
+    _require(k >= 1.0, "k", k, "≥ 1")
+    rho = np.sign(e)
+    ratio = np.minimum(np.abs(e) / tau_a, 1.0)  # |ye|/τ, exactly 1 outside (1^k = 1)
+    psi_d = path_angle - rho * entry_angle * np.power(ratio, k) - sideslip
+    if course_gain is not None:
+        _require(course_gain > 0.0, "course_gain", course_gain, "> 0")
+        if course is None:
+            raise ValueError("course is required when course_gain is given")
+        gain = k * entry_angle * np.asarray(speed, dtype=np.float64) / (course_gain * tau_a)
+        feed = gain * np.power(ratio, k - 1.0) * np.sin(np.subtract(course, path_angle))
+        psi_d = psi_d - np.where(ratio < 1.0, feed, 0.0)
+    return _wrapped(psi_d)
+
+
+def tvvf_theta(cross_track: ArrayLike, slope: float = 0.05, offset: float = 1.0) -> FloatOrArray:
+    """θ(ye) = slope·|ye| + offset — Xu, Oliveira & Guedes Soares (2021) §5.2 (0.05, 1).
+
+    Non-decreasing in |ye| with θ(0) = offset ≥ 1, as Definition 1 requires; ``slope`` is per
+    unit of ye (1/m in the paper).
+    """
+    _require(slope >= 0.0, "theta slope", slope, "≥ 0")
+    _require(offset >= 1.0, "theta offset", offset, "≥ 1 (Definition 1: θ(0) ≥ 1)")
+    theta = slope * np.abs(np.asarray(cross_track, dtype=np.float64)) + offset
+    return float(theta) if theta.ndim == 0 else theta
+
+
+def tvvf_heading(
+    cross_track: ArrayLike,
+    path_angle: ArrayLike,
+    delta: ArrayLike,
+    theta: ArrayLike | None = None,
+    sideslip: ArrayLike = 0.0,
+    *,
+    theta_slope: float = 0.05,
+    theta_offset: float = 1.0,
+    error_unit: float = 1.0,
+) -> FloatOrArray:
+    """Time-varying vector-field desired heading [rad] — Xu, Oliveira & Guedes Soares (2021).
+
+    ψd = γp − sgn(ye)·atan(|ye|^θ / Δ) − β (eqs. (9), (48)), with ye and Δ expressed in
+    ``error_unit`` before the power (1 m: the paper).  θ ≡ 1 gives look-ahead LOS
+    (the remark after Definition 1; :func:`lookahead_los_heading`).  |ye|^θ may overflow to
+    inf far from the path, where the law saturates at γp ∓ π/2.
+
+    Args:
+        cross_track: ye [m], > 0 left of the path (float or array).
+        path_angle: γp [rad], path (tangent) angle at the reference point.
+        delta: Δ [m], > 0 (2L in the paper).
+        theta: θ, ≥ 1 (Definition 1), a number or an array broadcasting with ye; None
+            (default): θ = theta_slope·|ye| + theta_offset (:func:`tvvf_theta`).
+        sideslip: β [rad], course minus heading.
+        theta_slope, theta_offset: the default θ's slope (per error unit) and offset.
+        error_unit: [m], > 0, unit in which ye and Δ enter the law (module doc).
+
+    Returns:
+        ψd [rad] in [−π, π): a float for scalar inputs, else an array (broadcast shape).
+    """
+    e = np.asarray(cross_track, dtype=np.float64)
+    delta_a = np.asarray(delta, dtype=np.float64)
+    _require(delta_a > 0.0, "delta", delta, "> 0")
+    _require(error_unit > 0.0, "error_unit", error_unit, "> 0")
+    a = np.abs(e) / error_unit
+    if theta is None:
+        th = tvvf_theta(a, theta_slope, theta_offset)
+    else:
+        th = np.asarray(theta, dtype=np.float64)
+        _require(th >= 1.0, "theta", theta, "≥ 1 (Definition 1)")
+    with np.errstate(over="ignore"):  # |ye|^θ → inf far from the path: atan(inf) = π/2
+        ratio = np.power(a, th) / (delta_a / error_unit)
+    psi_d = path_angle - np.sign(e) * np.arctan(ratio) - sideslip
+    return _wrapped(psi_d)

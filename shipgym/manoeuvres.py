@@ -30,6 +30,8 @@ class ManoeuvreLog:
     delta: np.ndarray
     delta_c: np.ndarray
     h: float
+    #: every state at every sample, (n + 1, n_x), columns as the model's ``state_names``
+    states: np.ndarray | None = None
 
 
 def _simulate(
@@ -71,6 +73,7 @@ def _simulate(
         delta=states[:, model.state_index("delta")],
         delta_c=commands,
         h=h,
+        states=states,
     )
 
 
@@ -206,3 +209,25 @@ def turning_circle(
         figures["steady_diameter"] = 2.0 * u_ss / abs(r_ss)
         figures["speed_loss"] = 1.0 - u_ss / model.nominal_speed
     return log, figures
+
+
+def plot_manoeuvre(
+    model: ShipModel, kind: str, log: ManoeuvreLog, figures: dict[str, float], path: str
+) -> None:
+    """Track and heading/rudder time series of a manoeuvre, saved to ``path`` (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    axes[0].plot(log.y, log.x, lw=1.2)
+    axes[0].set(xlabel="y [m]", ylabel="x [m]", title=f"{model.name}: {kind} track")
+    axes[0].set_aspect("equal", adjustable="datalim")
+    axes[1].plot(log.t, np.degrees(log.psi), label="ψ [deg]")
+    axes[1].plot(log.t, np.degrees(log.delta), label="δ [deg]")
+    axes[1].set(xlabel="t [s]", title=", ".join(f"{k} {v:.4g}" for k, v in figures.items())[:90])
+    axes[1].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -23,4 +23,4 @@ def test_notebook_executes(path: Path, tmp_path: Path) -> None:
 
 
 def test_notebooks_exist() -> None:
-    assert {p.stem for p in NOTEBOOKS} >= {"quickstart", "leaderboard_walkthrough"}
+    assert {p.stem for p in NOTEBOOKS} >= {"quickstart", "leaderboard"}

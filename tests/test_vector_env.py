@@ -8,11 +8,13 @@ import pytest
 
 import shipgym  # noqa: F401
 from shipgym.envs.vector import ShipPathFollowVectorEnv
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import scenario_from_dict
 
 N = 4
 
 
-def sync_twin(scenario: str, mode: str) -> gym.vector.SyncVectorEnv:
+def sync_twin(scenario: str | Scenario, mode: str) -> gym.vector.SyncVectorEnv:
     return gym.vector.SyncVectorEnv(
         [
             lambda: gym.make("ShipPathFollow-v0", scenario=scenario, action_mode=mode)
@@ -50,11 +52,22 @@ def test_batched_env_equals_single_envs_bit_for_bit(scenario: str) -> None:
     assert finished >= N  # episodes ended and were reset along the way
 
 
-def test_guidance_mode_matches_to_rounding_through_autoresets() -> None:
+def nominal_with_law(law: str) -> Scenario:
+    """The nominal scenario with another guidance law (vector-field laws, SPEC §3)."""
+    data = load_scenario("nominal").config.model_dump()
+    data["name"] = f"nominal_{law}"
+    data["guidance"] = {"law": law}
+    return scenario_from_dict(data)
+
+
+@pytest.mark.parametrize("law", ["los", "vf", "tvvf"])
+def test_guidance_mode_matches_to_rounding_through_autoresets(law: str) -> None:
     """Guidance mode uses numpy's arcsin/power (SIMD, last-ulp differences from libm); on a
     non-chaotic scenario the two stay equal to rounding through episode ends and resets."""
-    batched = ShipPathFollowVectorEnv(N, "nominal", action_mode="guidance")
-    single = sync_twin("nominal", "guidance")
+    scenario = "nominal" if law == "los" else nominal_with_law(law)
+    batched = ShipPathFollowVectorEnv(N, scenario, action_mode="guidance")
+    single = sync_twin(scenario, "guidance")
+    assert batched.scenario.config.guidance.law == law
     batched.reset(seed=1)
     single.reset(seed=1)
     rng = np.random.default_rng(2)
@@ -126,3 +139,48 @@ def test_sb3_adapter_trains_ppo_and_autoresets_same_step() -> None:
     model = PPO("MlpPolicy", env, n_steps=32, batch_size=64, n_epochs=1, seed=0, device="cpu")
     model.learn(256)
     assert model.num_timesteps >= 256
+
+
+def stochastic_disturbance_scenario() -> Scenario:
+    """Nominal with a saturating Gauss–Markov current, waves and heading noise (SPEC §4)."""
+    data = load_scenario("nominal").config.model_dump()
+    data["name"] = "nominal_stochastic_disturbances"
+    data["time_limit"] = 15.0  # short episodes: autoresets re-draw the initial states
+    data["sensors"] = {"heading_noise_deg": 0.2}
+    data["disturbances"] = {
+        "current": {
+            "kind": "gauss_markov",
+            "speed": 0.1,
+            "direction_deg": 90.0,
+            "mu": 0.1,
+            "sigma": 0.03,
+            "max_speed": 0.15,
+            "direction_sigma_deg": 2.0,
+            "direction_max_deviation_deg": 10.0,
+        },
+        "waves": {"wind_speed": 1.0, "gain": 1.0},
+    }
+    return scenario_from_dict(data)
+
+
+def test_batched_env_equals_single_envs_with_stochastic_disturbances() -> None:
+    """Gauss–Markov current (hitting its bounds), waves and sensor noise: each env's noise is
+    drawn from its generator in the single env's order, the processes advance over all
+    ships at once; equal bit for bit, disturbance blocks included, through autoresets."""
+    scenario = stochastic_disturbance_scenario()
+    batched = ShipPathFollowVectorEnv(N, scenario)
+    single = sync_twin(scenario, "rudder")
+    np.testing.assert_array_equal(batched.reset(seed=5)[0], single.reset(seed=5)[0])
+    rng = np.random.default_rng(1)
+    resets = 0
+    for _ in range(100):
+        action = rng.uniform(-1, 1, (N, 1)).astype(np.float32)
+        out_b, out_s = batched.step(action), single.step(action)
+        for got, want in zip(out_b[:4], out_s[:4], strict=True):
+            np.testing.assert_array_equal(got, want)
+        for i, env in enumerate(single.envs):
+            np.testing.assert_array_equal(batched._w_block[i], env.unwrapped._w_block)
+        resets += int(np.sum(out_b[2] | out_b[3]))
+    assert resets >= N
+    speed = np.hypot(batched._w_block[..., 0], batched._w_block[..., 1])
+    assert np.ptp(batched._w_block[..., 2]) > 0 and speed.max() <= 0.15 + 1e-15

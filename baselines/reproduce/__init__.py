@@ -1,8 +1,8 @@
 """Re-runs of the source papers' experiments (``shipgym reproduce PAPER``)."""
 
-from baselines.reproduce import liu2019
+from baselines.reproduce import liu2019, morenosalinas2013
 
 #: paper id -> module with ``run(out_dir, seeds) -> rows``
-PAPERS = {"liu2019": liu2019}
+PAPERS = {"liu2019": liu2019, "morenosalinas2013": morenosalinas2013}
 
 __all__ = ["PAPERS"]

@@ -47,9 +47,14 @@ import numpy as np
 from gymnasium import spaces
 
 from shipgym.autopilot import HeadingPID, PIDGains
-from shipgym.disturbances import SensorModel, current_velocity
+from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs.context import ControllerContext
-from shipgym.guidance import lookahead_los_heading, los_desired_heading
+from shipgym.guidance import (
+    lookahead_los_heading,
+    los_desired_heading,
+    tvvf_heading,
+    vector_field_heading,
+)
 from shipgym.metrics import ARRAY_FIELDS, EpisodeLog, MetricSettings, compute_metrics
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.paths import wrap_angle
@@ -70,9 +75,34 @@ OBS_NAMES = (
 _OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
 _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
 
-#: guidance action: a0 scales the scenario's R_LOS = nL (or look-ahead Δ) by 2^a0 ∈ [½, 2];
-#: a1 → course offset a1·30°.
+#: guidance action: a0 scales the law's length scale (LOS R_LOS = nL, look-ahead / TVVF Δ,
+#: VF τ) by 2^a0 ∈ [½, 2]; a1 → course offset a1·30°.
 GUIDANCE_OFFSET_MAX = math.radians(30.0)
+
+
+def field_law_heading(
+    gcfg: Any, cross_track: Any, path_angle: Any, ship_length: float, scale: Any
+) -> Any:
+    """Desired heading [rad] of a scenario's VF or TVVF law for one ship (floats) or N ships
+    (arrays, the batched env): the same operations for both (shipgym.guidance module doc)."""
+    if gcfg.law == "vf":
+        return vector_field_heading(
+            cross_track,
+            path_angle,
+            gcfg.vf_tau_L * ship_length * scale,
+            math.radians(gcfg.vf_chi_e_deg),
+            gcfg.vf_k,
+        )
+    if gcfg.law == "tvvf":
+        return tvvf_heading(
+            cross_track,
+            path_angle,
+            gcfg.tvvf_delta_L * ship_length * scale,
+            theta_slope=gcfg.tvvf_theta_slope,
+            theta_offset=gcfg.tvvf_theta_offset,
+            error_unit=ship_length if gcfg.tvvf_error_unit == "L" else 1.0,
+        )
+    raise ValueError(f"not a vector-field guidance law: {gcfg.law!r}")
 
 
 class ShipPathFollowEnv(gym.Env):
@@ -116,12 +146,16 @@ class ShipPathFollowEnv(gym.Env):
         self._ir = self.model.state_index("r")
         self._idelta = self.model.state_index("delta")
         # per-substep disturbance and parameter blocks (rows = substeps)
+        # (disturbances: the mean current, refilled every period when time-varying)
+        self._disturbances = Disturbances(
+            sc.config.disturbances,
+            self.model.disturbance_names,
+            self._h,
+            self._n,
+            time_limit=sc.config.time_limit,
+        )
         self._w_block = np.zeros((self._n, self.model.n_disturbances))
-        cx, cy = current_velocity(sc.config.disturbances.current)
-        names = self.model.disturbance_names
-        if "current_x" in names:
-            self._w_block[:, names.index("current_x")] = cx
-            self._w_block[:, names.index("current_y")] = cy
+        self._w_block[:] = self._disturbances.constant_row()
         self._p_block = np.zeros((self._n, self.model.n_params))
         self._sample_offsets = self._h * np.arange(self._n)
         weights = sc.config.reward
@@ -175,6 +209,7 @@ class ShipPathFollowEnv(gym.Env):
         self._delta_c = 0.0
         self._p_block[:] = sc.schedule.vector_at(0.0)
         self._p_block_dirty = False
+        self._disturbances.reset(0, self.np_random)  # before the sensor's draws
         self._sensor.reset()
         if self.action_mode == "guidance":
             self._autopilot.reset()
@@ -215,7 +250,9 @@ class ShipPathFollowEnv(gym.Env):
         elif self._p_block_dirty:
             self._p_block[:] = sc.schedule.vector_at(t1)
             self._p_block_dirty = False
-        # --- plant
+        # --- disturbances of the period, then the plant
+        if self._disturbances.time_varying:
+            self._disturbances.fill_one(self._w_block, t0, self.np_random)
         trajectory = self._integrator(self._state, delta_c, self._w_block, self._p_block)
         self._step_count += 1
         self._t = self._step_count * self._Ts
@@ -308,10 +345,12 @@ class ShipPathFollowEnv(gym.Env):
             desired = los_desired_heading(
                 frame.cross_track, frame.path_angle, self._L, gcfg.los_radius_L * scale
             )
-        else:
+        elif gcfg.law == "lookahead_los":
             desired = lookahead_los_heading(
                 frame.cross_track, frame.path_angle, gcfg.lookahead_L * self._L * scale
             )
+        else:
+            desired = field_law_heading(gcfg, frame.cross_track, frame.path_angle, self._L, scale)
         desired += float(a[1]) * GUIDANCE_OFFSET_MAX
         return self._autopilot.command(desired, self._psi_m, self._r_m, self._Ts)
 

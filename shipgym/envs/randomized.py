@@ -87,17 +87,13 @@ class ShipPathFollowRandomizedEnv(gym.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         return self._env.step(action)
 
-    # the single env's helpers, for controllers and the evaluation loop
-    @property
-    def scenario(self):
-        return self._env.scenario
-
-    @property
-    def controller_context(self):
-        return self._env.controller_context
-
-    def episode_metrics(self) -> dict[str, Any]:
-        return self._env.episode_metrics()
+    def __getattr__(self, name: str) -> Any:
+        """The current scenario's env answers the rest (``scenario``, ``model``,
+        ``controller_context``, ``episode_metrics``, ``track``, …)."""
+        env = self.__dict__.get("_env")
+        if env is None or name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(env, name)
 
     def render(self) -> np.ndarray | None:
         return self._env.render()

@@ -6,7 +6,8 @@ observation and termination are numpy expressions over the N ships written with 
 operations as the single env (no ``hypot``/``arctan2`` whose SIMD versions differ from libm
 in the last bit), so that ``ShipPathFollowVectorEnv(N)`` equals N single envs under
 ``SyncVectorEnv`` bit for bit in rudder mode (tested).  Python loops over ships remain only
-where randomness must be drawn per env in the single env's order (noisy sensors), for the
+where randomness must be drawn per env in the single env's order (noisy sensors, the noise
+of stochastic disturbances, whose processes then advance over all ships at once), for the
 rare parameter-event periods, and for the metrics of finished episodes.
 
 Autoreset follows Gymnasium's default NEXT_STEP mode (``reset(options={"reset_mask": m})``
@@ -31,8 +32,8 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from shipgym.disturbances import SensorModel
-from shipgym.envs.path_follow import GUIDANCE_OFFSET_MAX, ShipPathFollowEnv
+from shipgym.disturbances import Disturbances, SensorModel
+from shipgym.envs.path_follow import GUIDANCE_OFFSET_MAX, ShipPathFollowEnv, field_law_heading
 from shipgym.metrics import ARRAY_FIELDS, EpisodeLog, compute_metrics
 
 _PI = math.pi
@@ -118,6 +119,14 @@ class ShipPathFollowVectorEnv(VectorEnv):
         )
         self._w_block = self._integrator.disturbance_buffer  # filled in place, never copied
         self._w_block[:] = proto._w_block
+        self._disturbances = Disturbances(
+            sc.config.disturbances,
+            proto.model.disturbance_names,
+            self._h,
+            self._n,
+            batch=num_envs,
+            time_limit=sc.config.time_limit,
+        )
         self._p_block = self._integrator.parameter_buffer
         self._p_dirty = np.zeros(num_envs, dtype=bool)
         self._sensors = [SensorModel(sc.config.sensors) for _ in range(num_envs)]
@@ -199,6 +208,13 @@ class ShipPathFollowVectorEnv(VectorEnv):
         # --- true parameters of the period (per env: times differ after resets)
         t0 = self._t.copy()
         self._refresh_parameters(t0, live)
+        # --- disturbances of the period: noise per env (its generator, the single env's
+        # order), the processes over all advancing ships at once
+        if self._disturbances.time_varying and np.any(live):
+            rows = np.flatnonzero(live)
+            dist = self._disturbances
+            noise = [dist.draw(self._rngs[i]) for i in rows] if dist.n_noise else None
+            dist.fill(self._w_block, t0[rows], None if noise is None else np.stack(noise), rows)
         # --- plant: one call for all ships
         # states at t0 + h … t0 + Ts (the integrator's buffer, valid until the next step)
         traj = self._integrator.substep_states(self._state, delta_c, self._w_block, self._p_block)
@@ -299,6 +315,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._log[:, mask] = 0.0
         for i in np.flatnonzero(mask):
             sensor = self._sensors[i]
+            self._disturbances.reset(i, self._rngs[i])  # before the sensor's draws
             sensor.reset()
             x = self._state[i]
             if self._ideal:
@@ -369,7 +386,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
                 self._frame[key] = np.where(mask, value, self._frame[key])
 
     def _autopilot(self, a: np.ndarray, live: np.ndarray) -> np.ndarray:
-        """The single env's guidance-mode PID, over all ships (guidance module, LOS)."""
+        """The single env's guidance-mode PID, over all ships (shipgym.guidance laws)."""
         f = self._frame
         scale = 2.0 ** a[:, 0]
         e, angle = f["cross_track"], f["path_angle"]
@@ -377,9 +394,11 @@ class ShipPathFollowVectorEnv(VectorEnv):
             n = self._gcfg.los_radius_L * scale
             radius = np.where(np.abs(e) <= n * self._L, n * self._L, np.abs(e) + self._L)
             desired = angle - np.arcsin(e / radius)
-        else:
+        elif self._gcfg.law == "lookahead_los":
             desired = angle + np.arctan(-e / (self._gcfg.lookahead_L * self._L * scale))
             desired = _wrap(desired)
+        else:  # VF / TVVF: the single env's own functions, evaluated over the N ships
+            desired = field_law_heading(self._gcfg, e, angle, self._L, scale)
         desired = desired + a[:, 1] * GUIDANCE_OFFSET_MAX
         error = _wrap(desired - self._psi_m)
         dt = self._Ts

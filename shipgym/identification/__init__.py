@@ -4,6 +4,7 @@ Public entry points: :func:`fit_nomoto2` (batch, Liu et al. 2019) and :class:`La
 (online, Algorithm 2), fed with ``info["samples"]`` of the env.
 """
 
+from shipgym.identification.blanke import BlankeFit, fit_blanke
 from shipgym.identification.continuous_ls import ContinuousLeastSquares
 from shipgym.identification.lssvm import (
     LSSVMSolution,
@@ -25,6 +26,7 @@ from shipgym.identification.online import LambdaLSSVM, PersistentExcitation, Wei
 from shipgym.identification.zigzag import NomotoFit, fit_nomoto_zigzag, zigzag_nomoto
 
 __all__ = [
+    "BlankeFit",
     "ContinuousLeastSquares",
     "IdentificationError",
     "LSSVMSolution",
@@ -32,6 +34,7 @@ __all__ = [
     "NomotoFit",
     "PersistentExcitation",
     "WeightedLSSVMOnline",
+    "fit_blanke",
     "fit_nomoto2",
     "fit_nomoto_zigzag",
     "forward_difference",

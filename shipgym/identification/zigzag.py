@@ -16,6 +16,7 @@ its nominal model on ships without a closed-form Nomoto model (SPEC §8).
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -89,3 +90,34 @@ def zigzag_nomoto(
     """Run a rudder_deg/rudder_deg zig-zag on ``model`` and fit the 2nd-order Nomoto model."""
     log, _ = zigzag(model, rudder_deg)
     return fit_nomoto_zigzag(log.r, log.delta, log.h, C), log
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_fit(cls: type, variant: str | None, params: tuple[float, ...], rudder_deg: float):
+    model = cls(cls.params_type.from_vector(params), variant)
+    fit, log = zigzag_nomoto(model, rudder_deg)
+    return fit, servo_time_constant(log)
+
+
+def servo_time_constant(log: ManoeuvreLog) -> float:
+    """Least-squares Tc [s] of δ̇ = (δc − δ)/Tc from a manoeuvre log (an effective value
+    when the real steering gear is rate-limited)."""
+    d_dot = np.diff(log.delta) / log.h
+    gap = log.delta_c[:-1] - log.delta[:-1]
+    denom = float(d_dot @ d_dot)
+    if denom == 0.0:
+        raise IdentificationError("the rudder never moves: no servo time constant")
+    return float(gap @ d_dot) / denom
+
+
+def ship_nomoto(model: ShipModel, rudder_deg: float = 20.0) -> tuple[NomotoFit, float]:
+    """The ship's 2nd-order Nomoto model and servo Tc [s] from its 20/20 zig-zag.
+
+    This is the one pipeline that gives model-based controllers their nominal model on
+    ships without a closed-form Nomoto model (Xu & Guedes Soares 2020 §5.2, SPEC §8):
+    computed from the model's own simulation, never typed in, cached per process for each
+    (model, variant, parameters).
+    """
+    return _cached_fit(
+        type(model), model.variant, tuple(model.params.to_vector().tolist()), float(rudder_deg)
+    )

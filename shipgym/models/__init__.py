@@ -8,15 +8,21 @@ from shipgym.models.base import (
     ShipModel,
     rk4_step,
 )
+from shipgym.models.blanke import Blanke, BlankeParams
+from shipgym.models.mariner import Mariner, MarinerParams
 from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params, UnitReading, params_from_paper
 
 #: model id -> class; the scenario loader and the env look models up here.
-MODELS: dict[str, type[ShipModel]] = {"nomoto2": Nomoto2}
+MODELS: dict[str, type[ShipModel]] = {"nomoto2": Nomoto2, "mariner": Mariner, "blanke": Blanke}
 
 __all__ = [
     "CASADI",
     "MODELS",
     "NUMPY",
+    "Blanke",
+    "BlankeParams",
+    "Mariner",
+    "MarinerParams",
     "Nomoto2",
     "Nomoto2Params",
     "ParameterError",

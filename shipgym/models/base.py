@@ -256,9 +256,15 @@ class ShipModel(ABC):
     def first_order_nomoto(self, params: ParameterRecord | None = None) -> tuple[float, float]:
         """First-order Nomoto (K [1/s], T [s]) of the model, for autopilot design.
 
-        Models without a closed form get theirs from a zig-zag identification.
+        Default: Nomoto's approximation of the 2nd-order model identified from the ship's
+        20/20 zig-zag (:func:`shipgym.identification.zigzag.ship_nomoto`); models with a
+        closed form override this.
         """
-        raise NotImplementedError(f"{self.name} has no closed-form first-order Nomoto model")
+        from shipgym.identification.zigzag import ship_nomoto
+
+        model = self if params is None else self.with_params(params)
+        fit, _ = ship_nomoto(model)
+        return fit.first_order()
 
     def __getstate__(self) -> dict[str, Any]:
         # CasADi functions are rebuilt on demand after unpickling

@@ -1,0 +1,53 @@
+"""Manoeuvre figures against closed forms (turning circle) and the CLI's JSON shape."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from baselines.cli import main
+from shipgym.manoeuvres import turning_circle, zigzag
+from shipgym.models import Nomoto2, Nomoto2Params
+
+
+def test_nomoto2_steady_turn_matches_the_closed_form() -> None:
+    """Steady state of eq. (1): r + β r³ = K δ + d0; diameter 2 u0 / r; no speed loss."""
+    p = Nomoto2Params()
+    delta = math.radians(20.0)
+    r_ss = brentq(lambda r: r + p.beta * r**3 - p.K * delta - p.d0, 0.0, 2.0)
+    _, fig = turning_circle(Nomoto2(p), 20.0)
+    assert fig["steady_turn_rate"] == pytest.approx(math.degrees(r_ss), rel=1e-4)
+    assert fig["steady_diameter"] == pytest.approx(2 * p.u0 / r_ss, rel=1e-4)
+    assert fig["speed_loss"] == pytest.approx(0.0, abs=1e-5)
+    # a kinematic ship turning at r_ss from straight ahead: transfer at 180° ≈ diameter
+    assert fig["tactical_diameter"] == pytest.approx(2 * p.u0 / r_ss, rel=0.1)
+    assert fig["t_90"] < fig["t_180"]
+
+
+def test_zigzag_overshoot_grows_with_the_ship_time_constant() -> None:
+    """A slower ship (larger T1) overshoots more in the same 20/20 zig-zag."""
+    fast = zigzag(Nomoto2(Nomoto2Params(T1=1.0, d0=0.0)), 20.0)[1]
+    slow = zigzag(Nomoto2(Nomoto2Params(T1=3.0, d0=0.0)), 20.0)[1]
+    assert 0 < fast["overshoot_1"] < slow["overshoot_1"]
+    assert fast["period"] < slow["period"]
+
+
+def test_manoeuvre_log_holds_every_state() -> None:
+    log, _ = zigzag(Nomoto2(), 10.0)
+    assert log.states.shape == (log.t.size, 6)
+    np.testing.assert_array_equal(log.states[:, 2], log.psi)
+
+
+def test_cli_manoeuvre_json(tmp_path, capsys) -> None:
+    assert main(["manoeuvre", "nomoto2", "turning", "--json", "--out", str(tmp_path)]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert {"advance", "transfer", "tactical_diameter", "steady_turn_rate"} <= set(figures)
+    assert (tmp_path / "nomoto2_turning.png").is_file()
+    assert main(["manoeuvre", "nomoto2", "zigzag", "--json", "--out", str(tmp_path)]) == 0
+    assert {"overshoot_1", "overshoot_2"} <= set(json.loads(capsys.readouterr().out))
+    assert main(["manoeuvre", "titanic", "zigzag"]) == 2
+    assert "unknown ship" in capsys.readouterr().err
