@@ -21,7 +21,9 @@ import yaml
 from tqdm import tqdm
 
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
+from baselines.registry import applies_to, controller_kind
 from shipgym.metrics import aggregate
+from shipgym.scenarios import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 SUITE_DIR = REPO / "configs" / "suites"
@@ -139,7 +141,14 @@ def run_leaderboard(
     names = list(controllers) if controllers else list(spec["controllers"])
     scenarios = suite_scenarios(spec)
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
-    jobs = [(c, s, seed) for s in scenarios for c in names for seed in seed_list]
+    ships = {s: load_scenario(s).model.name for s in scenarios}
+    jobs = [
+        (c, s, seed)
+        for s in scenarios
+        for c in names
+        if applies_to(controller_label(c), ships[s])
+        for seed in seed_list
+    ]
     bar = tqdm(total=len(jobs), desc="leaderboard", file=sys.stderr, disable=not show_progress)
     if backend == "local":
         results = _run_local(jobs, workers or os.cpu_count() or 1, lambda: bar.update(1))
@@ -163,7 +172,18 @@ def aggregate_results(
     for scenario in scenarios:
         for controller in controllers:
             group = [r for r in results if r.scenario == scenario and r.controller == controller]
-            if not group:
+            if not group:  # the controller does not apply to this scenario's ship: shown
+                rows.append(
+                    {
+                        "scenario": scenario,
+                        "split": scenario_split(scenario),
+                        "controller": controller,
+                        "kind": controller_kind(controller),
+                        "seeds": 0,
+                        "applies": False,
+                        **{k: None for key in COLUMNS for k in (key, f"{key}_std")},
+                    }
+                )
                 continue
             keys = COLUMNS + tuple(k for k in TRAINING_COLUMNS if k in group[0].metrics)
             agg = aggregate([r.metrics for r in group], keys)
@@ -173,6 +193,7 @@ def aggregate_results(
                     "split": scenario_split(scenario),
                     "controller": controller,
                     "kind": group[0].kind,
+                    "applies": True,
                     "seeds": len(group),
                     **{k: v for k, v in agg.items() if k != "n"},
                 }
@@ -195,9 +216,9 @@ def _fmt(value: Any, std: Any = None) -> str:
 
 def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
     (out / "leaderboard.json").write_text(json.dumps(rows, indent=2))
-    keys = list(rows[0].keys()) if rows else []
+    keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=keys)
+        writer = csv.DictWriter(fh, fieldnames=keys, restval="")
         writer.writeheader()
         writer.writerows(rows)
     (out / "leaderboard.md").write_text(markdown_table(rows) + generalisation_table(rows))
@@ -260,6 +281,9 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         cells = [r["scenario"], r["controller"], r["kind"]]
+        if not r.get("applies", True):
+            lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * len(keys)) + " |")
+            continue
         cells += [_fmt(r[k], r.get(f"{k}_std")) for k in keys]
         cost = ""
         if "train_env_steps" in r:
@@ -280,8 +304,6 @@ def plot_results(results: list[EpisodeResult], out: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from shipgym.scenarios import load_scenario
 
     for scenario in sorted({r.scenario for r in results}):
         sc = load_scenario(scenario)

@@ -22,6 +22,28 @@ CONTROLLERS: dict[str, tuple[Callable[..., Policy], str]] = {
 }
 
 
+#: ships a classical controller applies to (absent: every ship).  The NMPC family is
+#: built on the nomoto2 model structure it identifies online (Liu et al. 2019).
+APPLIES_TO: dict[str, tuple[str, ...]] = {
+    "nmpc": ("nomoto2",),
+    "nmpc_wlssvm": ("nomoto2",),
+    "nmpc_lambda_lssvm": ("nomoto2",),
+}
+
+
+def applies_to(controller: str, ship: str) -> bool:
+    """Whether ``controller`` runs on ``ship`` (learned agents and the rest: every ship)."""
+    ships = APPLIES_TO.get(controller)
+    return ships is None or ship in ships
+
+
+def controller_kind(controller: str) -> str:
+    """ "classical"/"reference" of a registered controller, else "learned"."""
+    if controller in CONTROLLERS:
+        return getattr(CONTROLLERS[controller][0], "kind", "classical")
+    return "learned"
+
+
 def make_controller(name: str, **settings: Any) -> tuple[Policy, str]:
     """A fresh controller and the action mode it needs; unknown names list the valid ones.
 

@@ -11,8 +11,12 @@ from gymnasium.envs.registration import register, registry
 
 __version__ = "0.1.0"
 
-#: env id -> default scenario; one id per ship as models land (SPEC §5)
-ENV_IDS: dict[str, str] = {"ShipPathFollow-v0": "rudder_aging"}
+#: env id -> default scenario: one id per ship, same contract and keyword arguments (SPEC §5)
+ENV_IDS: dict[str, str] = {
+    "ShipPathFollow-v0": "rudder_aging",
+    "ShipPathFollow-Mariner-v0": "mariner_track",
+    "ShipPathFollow-Blanke-v0": "blanke_current_shift",
+}
 
 for _env_id, _scenario in ENV_IDS.items():
     if _env_id not in registry:

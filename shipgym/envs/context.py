@@ -8,6 +8,7 @@ import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
+from shipgym.scenarios.schema import GuidanceConfig
 from shipgym.tracking import PathTracker
 
 
@@ -32,6 +33,8 @@ class ControllerContext:
     switching: str  # waypoint switching rule: "circle" | "along_track"
     los_radius_L: float  # n in R_LOS = nL
     action_mode: str  # "rudder" | "guidance"
+    #: the scenario's guidance settings (law, R_LOS, look-ahead, VF/TVVF parameters)
+    guidance: GuidanceConfig = dataclasses.field(default_factory=GuidanceConfig)
 
     @property
     def nominal_params(self) -> ParameterRecord:

@@ -195,6 +195,7 @@ class ShipPathFollowEnv(gym.Env):
             switching=sc.config.path.switching,
             los_radius_L=sc.config.guidance.los_radius_L,
             action_mode=self.action_mode,
+            guidance=sc.config.guidance,
         )
 
     # ------------------------------------------------------------------ gym API
