@@ -7,13 +7,16 @@ from pathlib import Path
 from typing import Any
 
 from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCWeightedLSSVM
-from baselines.classical.pid import PIDLOS
+from baselines.classical.pid import PIDLOS, PIDTVVF, PIDVF, PIDLookaheadLOS
 from baselines.classical.reference import RandomRudder, ZeroRudder
 from baselines.policy import Policy
 
 #: name -> (factory, action mode the controller drives)
 CONTROLLERS: dict[str, tuple[Callable[..., Policy], str]] = {
     "pid_los": (PIDLOS, "rudder"),
+    "pid_lookahead_los": (PIDLookaheadLOS, "rudder"),
+    "pid_vf": (PIDVF, "rudder"),
+    "pid_tvvf": (PIDTVVF, "rudder"),
     "nmpc": (NMPC, "rudder"),
     "nmpc_wlssvm": (NMPCWeightedLSSVM, "rudder"),
     "nmpc_lambda_lssvm": (NMPCLambdaLSSVM, "rudder"),
