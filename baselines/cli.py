@@ -191,7 +191,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_leaderboard)
 
     p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
-    p.add_argument("paper", choices=["liu2019", "morenosalinas2013"], help="which paper")
+    p.add_argument(
+        "paper", choices=["liu2019", "morenosalinas2013", "borkowski2018"], help="which paper"
+    )
     p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
     p.add_argument("--no-progress", action="store_true")

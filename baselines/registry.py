@@ -6,6 +6,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from baselines.classical.lqr import LQR, AdaptiveLQR
 from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCWeightedLSSVM
 from baselines.classical.pid import PIDLOS, PIDTVVF, PIDVF, PIDLookaheadLOS
 from baselines.classical.reference import RandomRudder, ZeroRudder
@@ -17,6 +18,8 @@ CONTROLLERS: dict[str, tuple[Callable[..., Policy], str]] = {
     "pid_lookahead_los": (PIDLookaheadLOS, "rudder"),
     "pid_vf": (PIDVF, "rudder"),
     "pid_tvvf": (PIDTVVF, "rudder"),
+    "lqr": (LQR, "rudder"),
+    "adaptive_lqr": (AdaptiveLQR, "rudder"),
     "nmpc": (NMPC, "rudder"),
     "nmpc_wlssvm": (NMPCWeightedLSSVM, "rudder"),
     "nmpc_lambda_lssvm": (NMPCLambdaLSSVM, "rudder"),

@@ -14,6 +14,7 @@ __version__ = "0.1.0"
 #: env id -> default scenario: one id per ship, same contract and keyword arguments (SPEC §5)
 ENV_IDS: dict[str, str] = {
     "ShipPathFollow-v0": "rudder_aging",
+    "ShipPathFollow-EssoOsaka-v0": "osaka_stochastic_current",
     "ShipPathFollow-Mariner-v0": "mariner_track",
     "ShipPathFollow-Blanke-v0": "blanke_current_shift",
 }

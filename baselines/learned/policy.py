@@ -52,6 +52,9 @@ class LearnedPolicy:
         zip_path = self.directory / "model.zip"
         if not zip_path.is_file():
             zip_path = self.directory / "best_model.zip"
+        import torch
+
+        torch.set_num_threads(1)  # one small MLP per episode; leaderboard workers share cores
         self.model = algo_class(self.meta["algo"]).load(str(zip_path), device="cpu")
         self.recurrent = self.meta["algo"] == "recurrent_ppo"
         self._state: Any = None

@@ -1,8 +1,12 @@
 """Re-runs of the source papers' experiments (``shipgym reproduce PAPER``)."""
 
-from baselines.reproduce import liu2019, morenosalinas2013
+from baselines.reproduce import borkowski2018, liu2019, morenosalinas2013
 
 #: paper id -> module with ``run(out_dir, seeds) -> rows``
-PAPERS = {"liu2019": liu2019, "morenosalinas2013": morenosalinas2013}
+PAPERS = {
+    "liu2019": liu2019,
+    "morenosalinas2013": morenosalinas2013,
+    "borkowski2018": borkowski2018,
+}
 
 __all__ = ["PAPERS"]

@@ -9,11 +9,17 @@ from shipgym.models.base import (
     rk4_step,
 )
 from shipgym.models.blanke import Blanke, BlankeParams
+from shipgym.models.esso_osaka import EssoOsaka, EssoOsakaParams
 from shipgym.models.mariner import Mariner, MarinerParams
 from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params, UnitReading, params_from_paper
 
 #: model id -> class; the scenario loader and the env look models up here.
-MODELS: dict[str, type[ShipModel]] = {"nomoto2": Nomoto2, "mariner": Mariner, "blanke": Blanke}
+MODELS: dict[str, type[ShipModel]] = {
+    "nomoto2": Nomoto2,
+    "mariner": Mariner,
+    "blanke": Blanke,
+    "esso_osaka": EssoOsaka,
+}
 
 __all__ = [
     "CASADI",
@@ -21,6 +27,8 @@ __all__ = [
     "NUMPY",
     "Blanke",
     "BlankeParams",
+    "EssoOsaka",
+    "EssoOsakaParams",
     "Mariner",
     "MarinerParams",
     "Nomoto2",
