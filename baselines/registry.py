@@ -6,6 +6,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
 from baselines.classical.lqr import LQR, AdaptiveLQR
 from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCWeightedLSSVM
 from baselines.classical.pid import PIDLOS, PIDTVVF, PIDVF, PIDLookaheadLOS
@@ -20,6 +21,8 @@ CONTROLLERS: dict[str, tuple[Callable[..., Policy], str]] = {
     "pid_tvvf": (PIDTVVF, "rudder"),
     "lqr": (LQR, "rudder"),
     "adaptive_lqr": (AdaptiveLQR, "rudder"),
+    "l1_backstepping": (L1Backstepping, "rudder"),
+    "adaptive_backstepping": (AdaptiveBackstepping, "rudder"),
     "nmpc": (NMPC, "rudder"),
     "nmpc_wlssvm": (NMPCWeightedLSSVM, "rudder"),
     "nmpc_lambda_lssvm": (NMPCLambdaLSSVM, "rudder"),

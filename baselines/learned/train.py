@@ -135,6 +135,7 @@ def train(
 
     import shipgym
 
+    torch.set_num_threads(1)  # small networks: threads only contend with the env workers
     if not isinstance(config, AgentConfig):
         config = load_agent_config(config)
     updates: dict[str, Any] = {}
