@@ -381,8 +381,10 @@ def test_constant_current_draws_nothing() -> None:
 
 def test_catalogue_loads_unchanged_with_a_constant_current() -> None:
     for name in list_scenarios():
-        current = load_scenario(name).config.disturbances.current
-        assert isinstance(current, ConstantCurrent)
+        scenario = load_scenario(name)
+        if scenario.model.name != "nomoto2":  # the other ships' scenarios choose theirs
+            continue
+        assert isinstance(scenario.config.disturbances.current, ConstantCurrent)
     data = nomoto_scenario({"current": {"speed": 0.2, "direction_deg": 10.0}})
     assert scenario_from_dict(data).config.disturbances.current.kind == "constant"
 

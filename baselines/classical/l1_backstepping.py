@@ -513,6 +513,8 @@ def high_frequency_power(signal: np.ndarray, period: float, cutoff: float) -> fl
 # --------------------------------------------------------------------------------------------
 # The controllers
 # --------------------------------------------------------------------------------------------
+#: where the low-pass filter C(s) acts (module doc, "Filter placement")
+FILTER_PLACEMENTS = ("command", "adaptive")
 #: the paper's ship: Esso Osaka 1:100 model, L = 325 m / 100, U0 = 0.41 m/s (§5.2)
 PAPER_SHIP_LENGTH = 3.25  # [m]
 PAPER_SHIP_SPEED = 0.41  # [m/s]
@@ -543,6 +545,9 @@ class L1BacksteppingSettings:
     projection_epsilon: float = 0.1
     filter_frequency: float = 0.25  # ω [rad/s]
     filter_damping: float = 1.0  # ζ
+    #: where C(s) acts (module doc, "Filter placement"): "command" (eq. (39) as printed: the
+    #: whole law) or "adaptive" (only the estimates' share of it, the standard L1 structure)
+    filter_placement: str = "command"
     drift_compensation: bool = True  # subtract the measured drift angle β (eq. (48))
     #: unit of ye and Δ in the TVVF law: None = the scenario's (context.guidance), "m", "L"
     error_unit: str | None = None
@@ -623,6 +628,10 @@ class L1Backstepping:
         if s.gain_transfer not in ("similarity", "literal"):
             raise ValueError(
                 f"gain_transfer must be 'similarity' or 'literal', got {s.gain_transfer!r}"
+            )
+        if s.filter_placement not in FILTER_PLACEMENTS:
+            raise ValueError(
+                f"filter_placement must be one of {FILTER_PLACEMENTS}, got {s.filter_placement!r}"
             )
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
@@ -737,8 +746,17 @@ class L1Backstepping:
             m, k, psi, r, (psi_d, psi_d_dot, psi_d_ddot), (rho, sigma, b)
         )
         limit = ctx.rudder_limit
-        law = min(limit, max(-limit, law))
-        command = self.filter.step(law) if self.filter is not None else law
+        if self.filter is not None and self.settings.filter_placement == "adaptive":
+            # δ = δ_nom + C(s)(δ − δ_nom), δ_nom the law at the initial (nominal) estimates
+            s = self.settings
+            nominal, _, _ = backstepping_rudder(
+                m, k, psi, r, (psi_d, psi_d_dot, psi_d_ddot), (s.rho0, s.sigma0, s.b0)
+            )
+            command = nominal + self.filter.step(law - nominal)
+            law = min(limit, max(-limit, law))
+        else:
+            law = min(limit, max(-limit, law))
+            command = self.filter.step(law) if self.filter is not None else law
         command = min(limit, max(-limit, command))
         self._record(
             t=float(info["t"]),
