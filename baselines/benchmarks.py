@@ -244,10 +244,13 @@ def bench_training(
 
     The first rollout of each run (process start-up, torch warm-up) is excluded.
     """
+    import torch
     from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecNormalize
 
     from baselines.learned.agents import build_hyperparams, load_agent_config, make_training_env
 
+    torch.set_num_threads(1)  # as `shipgym train`
     config = load_agent_config("ppo")
     figures: dict[str, Any] = {"n_envs": n_envs, "timesteps": timesteps, "scenario": scenario}
     for kind in ("batched", "subproc", "dummy"):
@@ -256,7 +259,9 @@ def bench_training(
         )
         rates = []
         for rep in range(repeats):
-            venv = make_training_env(env_config, seed=rep)
+            venv = VecNormalize(
+                make_training_env(env_config, seed=rep), norm_obs=False, norm_reward=True
+            )
             model = PPO(
                 config.policy,
                 venv,
@@ -266,9 +271,9 @@ def bench_training(
             )
             warm = model.n_steps * n_envs
             model.learn(warm)
-            start = time.perf_counter()
+            done, start = model.num_timesteps, time.perf_counter()
             model.learn(timesteps, reset_num_timesteps=False)
-            rates.append(timesteps / (time.perf_counter() - start))
+            rates.append((model.num_timesteps - done) / (time.perf_counter() - start))
             venv.close()
         figures[f"ppo_{kind}_env_steps_per_s"] = statistics.median(rates)
     figures["batched_over_subproc"] = (

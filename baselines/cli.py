@@ -6,14 +6,15 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from typing import Any
+
+from baselines.jsonout import dumps
 
 
 def _emit(args: argparse.Namespace, document: Any, text: str) -> None:
     if args.json:
-        sys.stdout.write(json.dumps(document) + "\n")
+        sys.stdout.write(dumps(document) + "\n")
     else:
         sys.stdout.write(text + "\n")
 
@@ -192,7 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
     p.add_argument(
-        "paper", choices=["liu2019", "morenosalinas2013", "borkowski2018"], help="which paper"
+        "paper",
+        choices=["liu2019", "morenosalinas2013", "borkowski2018", "xu2020", "xu2021"],
+        help="which paper",
     )
     p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
@@ -263,7 +266,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
-    except (ValueError, KeyError, RuntimeError) as exc:
+    except (ValueError, KeyError, RuntimeError, OSError) as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return 2
 

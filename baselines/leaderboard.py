@@ -7,7 +7,6 @@ pool; ``ray`` submits the same job function to a Ray cluster (``pip install ship
 from __future__ import annotations
 
 import csv
-import json
 import math
 import os
 import sys
@@ -21,7 +20,8 @@ import yaml
 from tqdm import tqdm
 
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
-from baselines.registry import applies_to, controller_kind
+from baselines.jsonout import dumps
+from baselines.registry import CONTROLLERS, applies_to, controller_kind
 from shipgym.metrics import aggregate
 from shipgym.scenarios import load_scenario
 
@@ -67,9 +67,32 @@ TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
 
 
 def controller_label(controller: str) -> str:
-    """The table name of a controller: its registry name, or a trained agent's folder name."""
+    """The table name of a controller: its registry name, or a trained agent's folder name
+    (the folder holding a ``.zip``, plus the zip's stem unless it is ``model``)."""
     path = Path(controller)
-    return path.stem if path.suffix == ".zip" else path.name if path.exists() else controller
+    if path.suffix == ".zip":
+        stem = "" if path.stem == "model" else f"/{path.stem}"
+        return f"{path.resolve().parent.name}{stem}"
+    return path.resolve().name if path.exists() else controller
+
+
+def check_controllers(names: list[str]) -> list[str]:
+    """The table labels of ``names``; a clear error, before any job runs, for a name that
+    is neither a controller nor a trained agent, and for two names with the same label."""
+    from baselines.learned.policy import shipped_policies
+
+    labels = []
+    for name in names:
+        if name not in CONTROLLERS and name not in shipped_policies() and not Path(name).exists():
+            raise ValueError(
+                f"unknown controller {name!r}; valid: {', '.join(sorted(CONTROLLERS))}, the "
+                f"learned policies {', '.join(shipped_policies())} or a trained agent's path"
+            )
+        labels.append(controller_label(name))
+    duplicates = sorted({label for label in labels if labels.count(label) > 1})
+    if duplicates:
+        raise ValueError(f"controllers {names} give the same table name(s) {duplicates}")
+    return labels
 
 
 def scenario_split(scenario: str) -> str:
@@ -88,6 +111,7 @@ def run_job(job: tuple[str, str, int]) -> EpisodeResult:
     controller, scenario, seed = job
     result = evaluate(controller, scenario, [seed])[0]
     result.controller = controller_label(controller)
+    result.scenario = scenario  # as the suite names it (a YAML path stays a path)
     return result
 
 
@@ -139,6 +163,7 @@ def run_leaderboard(
     if n_seeds < 1:
         raise ValueError(f"--seeds must be ≥ 1, got {n_seeds}")
     names = list(controllers) if controllers else list(spec["controllers"])
+    labels = check_controllers(names)
     scenarios = suite_scenarios(spec)
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
     ships = {s: load_scenario(s).model.name for s in scenarios}
@@ -157,7 +182,9 @@ def run_leaderboard(
     else:
         raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
     bar.close()
-    rows = aggregate_results(results, scenarios, [controller_label(c) for c in names])
+    # completion order varies between runs: aggregate in a fixed order (bit-stable means)
+    results.sort(key=lambda r: (r.scenario, r.controller, r.seed))
+    rows = aggregate_results(results, scenarios, labels)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     write_tables(rows, out)
@@ -215,28 +242,39 @@ def _fmt(value: Any, std: Any = None) -> str:
 
 
 def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
-    (out / "leaderboard.json").write_text(json.dumps(rows, indent=2))
+    (out / "leaderboard.json").write_text(dumps(rows, indent=2))
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")
         writer.writeheader()
         writer.writerows(rows)
     (out / "leaderboard.md").write_text(markdown_table(rows) + generalisation_table(rows))
-    (out / "generalisation.json").write_text(json.dumps(generalisation(rows), indent=2))
+    (out / "generalisation.json").write_text(dumps(generalisation(rows), indent=2))
 
 
 def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per controller: mean ACE/L, return and success on catalogue vs held-out scenarios."""
+    """Per controller: mean ACE/L, return and success on catalogue vs held-out scenarios.
+
+    Means are over the scenarios of each split on which *every* controller of the table
+    ran (so that all controllers are compared on the same set; ``*_scenarios`` counts them).
+    """
+    controllers = list(dict.fromkeys(r["controller"] for r in rows))
+    common = {}
+    for split in ("catalogue", "heldout"):
+        scenarios = dict.fromkeys(r["scenario"] for r in rows if r["split"] == split)
+        common[split] = [
+            s for s in scenarios if all(r.get("applies", True) for r in rows if r["scenario"] == s)
+        ]
     out = []
-    for controller in dict.fromkeys(r["controller"] for r in rows):
-        entry: dict[str, Any] = {"controller": controller}
+    for controller in controllers:
+        mine = [r for r in rows if r["controller"] == controller]
+        entry: dict[str, Any] = {"controller": controller, "kind": mine[0]["kind"]}
         for split in ("catalogue", "heldout"):
-            group = [r for r in rows if r["controller"] == controller and r["split"] == split]
+            group = [r for r in mine if r["scenario"] in common[split]]
+            entry[f"{split}_scenarios"] = len(group)
             for key in ("ace_L", "return", "success"):
                 values = [r[key] for r in group if isinstance(r[key], float)]
                 entry[f"{split}_{key}"] = float(np.mean(values)) if values else math.nan
-        kinds = [r["kind"] for r in rows if r["controller"] == controller]
-        entry["kind"] = kinds[0]
         out.append(entry)
     return out
 
@@ -245,13 +283,16 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
     """Markdown of :func:`generalisation` (empty when the suite has no held-out scenarios)."""
     if not any(r["split"] == "heldout" for r in rows):
         return ""
+    gen = generalisation(rows)
     lines = [
-        "\n## Generalisation: catalogue vs held-out scenarios (mean over scenarios)\n",
+        "\n## Generalisation: catalogue vs held-out scenarios\n\nMeans over the scenarios "
+        "of each split on which every controller ran "
+        f"({gen[0]['catalogue_scenarios']} catalogue, {gen[0]['heldout_scenarios']} held-out).\n",
         "| controller | kind | ACE/L catalogue | ACE/L held-out | return catalogue | "
         "return held-out | success catalogue | success held-out |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for g in generalisation(rows):
+    for g in gen:
         cells = [g["controller"], g["kind"]]
         cells += [
             _fmt(g[f"{split}_{key}"])

@@ -18,7 +18,7 @@ class Policy(Protocol):
     """
 
     name: str
-    kind: str  # "classical" | "learned" | "reference"
+    kind: str  # "classical" | "learned" (SPEC §9b)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
 

@@ -47,7 +47,7 @@ def applies_to(controller: str, ship: str) -> bool:
 
 
 def controller_kind(controller: str) -> str:
-    """ "classical"/"reference" of a registered controller, else "learned"."""
+    """``"classical"`` for a registered controller, else ``"learned"``."""
     if controller in CONTROLLERS:
         return getattr(CONTROLLERS[controller][0], "kind", "classical")
     return "learned"

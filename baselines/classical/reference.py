@@ -13,7 +13,7 @@ class ZeroRudder:
     """Always commands zero (rudder mode) / the default guidance action."""
 
     name = "zero_rudder"
-    kind = "reference"
+    kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self._dim = 1 if context.action_mode == "rudder" else 2
@@ -26,7 +26,7 @@ class RandomRudder:
     """Uniform random action in [-1, 1], seeded per episode."""
 
     name = "random"
-    kind = "reference"
+    kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self._dim = 1 if context.action_mode == "rudder" else 2

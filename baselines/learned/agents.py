@@ -13,16 +13,14 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
+
+from shipgym.scenarios.schema import _Strict
 
 REPO = Path(__file__).resolve().parents[2]
 AGENT_DIR = REPO / "configs" / "agents"
 
 ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class AgentEnvConfig(_Strict):
@@ -39,6 +37,16 @@ class AgentEnvConfig(_Strict):
             raise ValueError("env: give exactly one of 'distribution' and 'scenario'")
         if self.vec_env == "batched" and self.scenario is None:
             raise ValueError("env.vec_env 'batched' steps one fixed scenario: set env.scenario")
+        if self.distribution is not None:
+            from shipgym.scenarios.sampling import load_distribution
+
+            if load_distribution(self.distribution).split != "train":
+                raise ValueError(
+                    f"env.distribution {self.distribution!r} is a test split: agents train on "
+                    "a train split only"
+                )
+        if self.scenario is not None and ":" in self.scenario:
+            raise ValueError(f"env.scenario {self.scenario!r}: never train on test scenarios")
         return self
 
 
@@ -46,6 +54,15 @@ class EvalConfig(_Strict):
     distribution: str = "validation"
     freq: int = Field(20_000, ge=1)  # env steps between evaluations
     n_episodes: int = Field(8, ge=1)
+
+    @model_validator(mode="after")
+    def _not_the_test_set(self) -> EvalConfig:
+        if self.distribution == "heldout":
+            raise ValueError(
+                "eval.distribution: 'heldout' is the leaderboard's test set; select models "
+                "on 'validation'"
+            )
+        return self
 
 
 class AgentConfig(_Strict):
@@ -140,12 +157,15 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
     return VecMonitor(venv)
 
 
-def make_eval_env(config: EvalConfig, action_mode: str) -> Any:
-    """One env cycling through the validation scenarios in order (deterministic)."""
+def make_eval_env(config: EvalConfig, action_mode: str, seed: int) -> Any:
+    """One env cycling through the validation scenarios in order, seeded (reproducible
+    model selection)."""
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     factory = _single_env_factory({"distribution": config.distribution}, action_mode)
-    return DummyVecEnv([factory])
+    venv = DummyVecEnv([factory])
+    venv.seed(seed)
+    return venv
 
 
 def build_hyperparams(config: AgentConfig, n_actions: int) -> dict[str, Any]:

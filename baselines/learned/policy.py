@@ -24,34 +24,47 @@ def shipped_policies() -> list[str]:
     return sorted(p.name for p in POLICY_DIR.iterdir() if (p / "meta.json").is_file())
 
 
-def resolve_policy_dir(name_or_path: str | Path) -> Path:
-    """A shipped policy name or a directory / zip path → the policy directory."""
+def resolve_policy(name_or_path: str | Path) -> tuple[Path, Path]:
+    """A shipped policy name, a trained agent's directory or one of its ``.zip`` models
+    (``best_model.zip``, a checkpoint) → (model zip, meta.json).  A directory means its
+    ``model.zip`` (else ``best_model.zip``); ``meta.json`` is looked for beside the zip and
+    one folder up (checkpoints)."""
     path = Path(name_or_path)
-    if path.suffix == ".zip":
-        path = path.parent
-    if not path.is_dir():
+    if not path.exists() and (POLICY_DIR / str(name_or_path)).is_dir():
         path = POLICY_DIR / str(name_or_path)
-    if not (path / "meta.json").is_file():
+    if path.is_dir():
+        zip_path = path / "model.zip"
+        if not zip_path.is_file():
+            zip_path = path / "best_model.zip"
+    else:
+        zip_path = path
+    meta = next(
+        (
+            d / "meta.json"
+            for d in (zip_path.parent, zip_path.parent.parent)
+            if (d / "meta.json").is_file()
+        ),
+        None,
+    )
+    if not zip_path.is_file() or meta is None:
         raise ValueError(
-            f"{name_or_path!r} is not a trained policy (no meta.json); shipped: "
-            f"{', '.join(shipped_policies())}; train one with `shipgym train AGENT`"
+            f"{name_or_path!r} is not a trained policy (a model zip with a meta.json); "
+            f"shipped: {', '.join(shipped_policies())}; train one with `shipgym train AGENT`"
         )
-    return path
+    return zip_path, meta
 
 
 class LearnedPolicy:
-    """Loads ``model.zip`` (or ``best_model.zip``) and ``meta.json`` from a policy directory."""
+    """A trained agent from a policy directory or model zip (see :func:`resolve_policy`)."""
 
     kind = "learned"
 
     def __init__(self, path: str | Path, name: str | None = None) -> None:
-        self.directory = resolve_policy_dir(path)
-        self.meta: dict[str, Any] = json.loads((self.directory / "meta.json").read_text())
+        zip_path, meta = resolve_policy(path)
+        self.model_path = zip_path
+        self.meta: dict[str, Any] = json.loads(meta.read_text())
         self.name = name or self.meta["name"]
         self.action_mode: str = self.meta["action_mode"]
-        zip_path = self.directory / "model.zip"
-        if not zip_path.is_file():
-            zip_path = self.directory / "best_model.zip"
         import torch
 
         torch.set_num_threads(1)  # one small MLP per episode; leaderboard workers share cores

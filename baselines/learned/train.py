@@ -96,7 +96,7 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         save_replay_buffer=off_policy,
         save_vecnormalize=True,
     )
-    eval_env = make_eval_env(config.eval, config.env.action_mode)
+    eval_env = make_eval_env(config.eval, config.env.action_mode, seed=config.seed)
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
     evaluation = EvalCallback(
         eval_env,
@@ -107,6 +107,15 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         deterministic=True,
         verbose=0,
     )
+    previous = out / "eval" / "evaluations.npz"
+    if wall_offset > 0 and previous.is_file():  # resuming: keep the history and the best
+        import numpy as np
+
+        data = np.load(previous)
+        evaluation.evaluations_timesteps = data["timesteps"].tolist()
+        evaluation.evaluations_results = data["results"].tolist()
+        evaluation.evaluations_length = data["ep_lengths"].tolist()
+        evaluation.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
     return CallbackList([progress_cb, checkpoint, evaluation]), progress_cb
 
 
@@ -145,19 +154,32 @@ def train(
         updates["n_timesteps"] = n_timesteps
     if updates:
         config = config.model_copy(update=updates)
-    if config.seed + config.env.n_envs > EVAL_SEED_OFFSET:
-        raise ValueError(
-            f"seed {config.seed} + n_envs {config.env.n_envs} would reach the evaluation seeds "
-            f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed"
-        )
     out = Path(out_dir or f"results/agents/{config.name}")
     out.mkdir(parents=True, exist_ok=True)
     cls = algo_class(config.algo)
-    venv = make_training_env(config.env, config.seed)
-    gamma = float(config.hyperparams.get("gamma", 0.99))
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
         raise ValueError(f"--resume: no checkpoint in {out / 'checkpoints'}")
+    if previous is not None and previous[1] >= config.n_timesteps:
+        raise ValueError(
+            f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
+            f"{config.n_timesteps}: nothing to train (raise --timesteps)"
+        )
+    if previous is None and (out / "checkpoints").is_dir():  # a fresh run: no stale resume
+        shutil.rmtree(out / "checkpoints")
+        (out / "eval" / "evaluations.npz").unlink(missing_ok=True)
+    # a resumed run continues with fresh scenario draws: the env seeds move on by n_envs per
+    # checkpoint reached (still below the evaluation seeds)
+    env_seed = config.seed
+    if previous is not None:
+        env_seed += config.env.n_envs * (previous[1] // config.checkpoint_freq)
+    if env_seed + config.env.n_envs > EVAL_SEED_OFFSET:
+        raise ValueError(
+            f"training env seeds {env_seed}… would reach the evaluation seeds "
+            f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed"
+        )
+    venv = make_training_env(config.env, env_seed)
+    gamma = float(config.hyperparams.get("gamma", 0.99))
     wall_offset = 0.0
     if previous is not None:
         ckpt, steps = previous

@@ -24,7 +24,6 @@ J(t), e(t), δ(t) for the paper's guess; â(t), ĉ(t) for every guess, against t
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -33,6 +32,7 @@ import numpy as np
 
 from baselines.classical.lqr import LQR, AdaptiveLQR
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
+from baselines.jsonout import dumps
 from shipgym.metrics import DEFAULT_SETTINGS
 from shipgym.paths import wrap_angle
 from shipgym.scenarios import load_scenario, scenario_from_dict
@@ -137,7 +137,7 @@ def run(
     rows.append(
         _row("all", "adaptive_lqr", "adaptive_lower_J", all(r < 1.0 for r in ratios), True, seeds)
     )
-    (out / "borkowski2018.json").write_text(json.dumps(rows, indent=2))
+    (out / "borkowski2018.json").write_text(dumps(rows, indent=2))
     (out / "borkowski2018.md").write_text(markdown(rows))
     if plot:
         plot_runs(scenario, examples, case_name(*guesses[0]), out)

@@ -9,7 +9,6 @@ figure with the tracks, e(t), the identified parameters against the truth and λ
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ import numpy as np
 
 from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCWeightedLSSVM
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
+from baselines.jsonout import dumps
 from baselines.variants import scenario_variant
 
 CASES = {  # scenario -> (paper's case, parameters that change)
@@ -80,7 +80,7 @@ def run(
                         }
                     )
             plot_case(case, reading, scenario, episodes, out)
-    (out / "liu2019.json").write_text(json.dumps(rows, indent=2))
+    (out / "liu2019.json").write_text(dumps(rows, indent=2))
     (out / "liu2019.md").write_text(markdown(rows))
     return rows
 

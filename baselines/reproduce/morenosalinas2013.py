@@ -28,7 +28,6 @@ time series (measured, plant, identified).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -36,6 +35,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import butter, filtfilt
 
+from baselines.jsonout import dumps
 from shipgym.identification.blanke import BlankeFit, fit_blanke, simulate_commands
 from shipgym.manoeuvres import turning_circle, zigzag
 from shipgym.models.blanke import Blanke, regression_coefficients
@@ -182,10 +182,10 @@ def run(
                 "seeds": seeds,
             }
         )
-    (out / "morenosalinas2013.json").write_text(json.dumps(rows, indent=2))
+    (out / "morenosalinas2013.json").write_text(dumps(rows, indent=2))
     (out / "morenosalinas2013.md").write_text(markdown(rows))
     (out / "morenosalinas2013_coefficients.json").write_text(
-        json.dumps(_coefficient_table(plant, fits), indent=2)
+        dumps(_coefficient_table(plant, fits), indent=2)
     )
     if plot:
         plot_series(plant, truth, examples, step, out)

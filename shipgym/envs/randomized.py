@@ -69,9 +69,9 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         super().reset(seed=seed)
         options = options or {}
         if self.distribution.split == "test":
-            index = options.get("index", self._next_test_index)
-            self._next_test_index = (int(index) + 1) % len(self.distribution)
-            config = self.distribution.test_scenario(int(index))
+            index = int(options.get("index", self._next_test_index))
+            config = self.distribution.test_scenario(index)  # raises on a bad index
+            self._next_test_index = (index + 1) % len(self.distribution)
         else:
             scenario_seed = train_scenario_seed(self.np_random)
             config = self.distribution.sample(
@@ -80,9 +80,10 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         self._env.close()
         self._env = self._make_env(config)
         episode_seed = int(self.np_random.integers(0, 2**31 - 1))
-        obs, info = self._env.reset(seed=episode_seed)
-        info["scenario"] = config.name
-        return obs, info
+        # the scenario's name identifies its schedule: an attribute for logging, never in
+        # info or the observation (which controllers read)
+        self.scenario_name = config.name
+        return self._env.reset(seed=episode_seed)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         return self._env.step(action)

@@ -109,6 +109,12 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
             f"{origin}: key 'ship.model': unknown model {ship.model!r}; valid: {sorted(MODELS)}"
         )
     model_cls = MODELS[ship.model]
+    if ship.variant is not None and ship.variant not in model_cls.variants:
+        valid = list(model_cls.variants) or "none (the model has one form)"
+        raise ScenarioError(
+            f"{origin}: key 'ship.variant': unknown variant {ship.variant!r} of {ship.model}; "
+            f"valid: {valid}"
+        )
     try:
         model = model_cls.from_config(ship.params, ship.unit_reading, ship.variant)
     except ParameterError as exc:

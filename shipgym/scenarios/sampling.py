@@ -31,16 +31,9 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import (
-    AfterValidator,
-    BaseModel,
-    ConfigDict,
-    Field,
-    ValidationError,
-    model_validator,
-)
+from pydantic import AfterValidator, Field, ValidationError, model_validator
 
-from shipgym.scenarios.schema import ScenarioConfig
+from shipgym.scenarios.schema import ScenarioConfig, _Strict
 
 #: salts of the two seed spaces: test scenarios come from SeedSequence([TEST_SALT, ·, i]),
 #: training scenarios from SeedSequence([TRAIN_SALT, s]) with s drawn by the env
@@ -56,10 +49,6 @@ def _check_range(r: tuple[float, float]) -> tuple[float, float]:
 
 #: a [low, high] interval, validated
 Range = Annotated[tuple[float, float], AfterValidator(_check_range)]
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class JumpSpec(_Strict):
@@ -133,7 +122,22 @@ class DistributionConfig(_Strict):
         lo, hi = self.path.legs
         if lo < 1 or hi < lo:
             raise ValueError(f"path.legs must be [low ≥ 1, high ≥ low], got {self.path.legs}")
-        for ship in self.ships:
+        from shipgym.models import MODELS, ParameterError
+
+        for i, ship in enumerate(self.ships):
+            if ship.model not in MODELS:
+                raise ValueError(
+                    f"ships.{i}.model: unknown model {ship.model!r}; valid: {sorted(MODELS)}"
+                )
+            try:
+                MODELS[ship.model].from_config(ship.params, ship.unit_reading, ship.variant)
+            except ParameterError as exc:
+                raise ValueError(f"ships.{i}.params: {exc}") from None
+            for pname in ship.param_factors:
+                if pname not in ship.params:
+                    raise ValueError(
+                        f"ships.{i}.param_factors.{pname}: no nominal value in ships.{i}.params"
+                    )
             for kind_name, kind in self.jumps.kinds.items():
                 for pname, spec in kind.params.items():
                     if spec.mode != "value" and pname not in ship.params:
@@ -188,11 +192,7 @@ class ScenarioDistribution:
         c = self.config
         ship = c.ships[int(rng.integers(len(c.ships)))]
         params = dict(ship.params)
-        for pname, r in ship.param_factors.items():
-            if pname not in params:
-                raise DistributionError(
-                    f"{c.name}: key 'ships.params_factors.{pname}': no nominal value in params"
-                )
+        for pname, r in ship.param_factors.items():  # validated at load
             params[pname] = params[pname] * _uniform(rng, r)
         length, speed = _ship_scale(ship)
         waypoints, path_length = _sample_waypoints(c.path, length, rng)
