@@ -107,3 +107,42 @@ def test_nominal_models_come_from_the_ships_own_zigzag() -> None:
     # stronger turns meet more cubic damping
     assert 1.3 * K < K2 < 2 * K
     assert (K2, _) == ship_nomoto(mariner.with_params(faster))[0].first_order()
+
+
+CLASSICAL = [
+    "pid_los",
+    "pid_lookahead_los",
+    "pid_vf",
+    "pid_tvvf",
+    "lqr",
+    "adaptive_lqr",
+    "l1_backstepping",
+    "adaptive_backstepping",
+    "nmpc",
+    "nmpc_lambda_lssvm",
+]
+
+
+@pytest.mark.parametrize("ship", list(SHIP_IDS))
+def test_every_classical_controller_keeps_the_error_bounded_on_every_ship(ship: str) -> None:
+    """Short fixed-seed runs (60 control steps) of each controller that applies: the ship
+    stays inside the corridor and every number is finite; "does not apply" is explicit."""
+    from baselines.evaluation import evaluate
+    from baselines.registry import applies_to
+
+    config = load_scenario(gym.spec(SHIP_IDS[ship]).kwargs["scenario"]).config
+    data = config.model_dump(exclude_none=True)
+    data["time_limit"] = 60 * (config.control_period or MODELS[ship].control_period)
+    scenario = scenario_from_dict(data)
+    ran = 0
+    for name in CLASSICAL:
+        if not applies_to(name, ship):
+            assert name.startswith("nmpc") and ship != "nomoto2"
+            continue
+        result = evaluate(name, scenario, [0])[0]
+        e = result.trajectory["cross_track_error"]
+        assert np.all(np.isfinite(e)), name
+        assert result.metrics["termination_reason"] in ("time_limit", "goal"), name
+        assert np.abs(e).max() <= scenario.max_cross_track, name
+        ran += 1
+    assert ran >= 8

@@ -61,6 +61,17 @@ Choices where the paper is silent or ambiguous (options of :class:`L1Backsteppin
   period average of C(s)'s exact continuous output, (1/Ts)∫y dt (exact ZOH discretisation
   of C(s) augmented with ∫y, :class:`SecondOrderLowPass`); the filter states at the
   sample instants equal C(s)'s continuous response exactly.
+* **Filter placement** (``filter_placement``).  Eq. (39) writes δ_ctrl = C(s)δ with δ the
+  whole law (35), and §3.2 motivates it by the adaptation: "the adaption of uncertainties of
+  parameters may contain high-frequency signals"; Fig. 4 shows "control law with low-pass
+  filter".  Default ``"command"``: C(s) on the whole (saturated) law, as eq. (39) is
+  printed.  ``"adaptive"``: C(s) only on the estimates' share of the law,
+  δ = δ_nom + C(s)(δ − δ_nom) with δ_nom the law (35) at the initial estimates ρ̂ = σ̂ = 1,
+  b̂ = 0 (unsaturated, the sum saturated) — the standard L1 structure u = u_m + C(s)u_ad of
+  Hovakimyan & Cao (2010), the paper's ref. [21].  With exact nominal estimates the filtered
+  share is zero, so the linearised loop is that of ``adaptive_backstepping`` (stable); on
+  ``osaka_stochastic_current`` the estimates stay within 0.5 % of nominal and this variant
+  is indistinguishable from ``adaptive_backstepping`` (``shipgym reproduce xu2021``).
 * **Reference derivatives.**  ψ̇d and ψ̈d from the guidance law's analytic derivatives in
   ye along the kinematics ẏe = U·sin(χ − γp) (eq. (8)), ÿe = U·cos(χ − γp)·r (constant
   U, χ̇ ≈ r, β̇ ≈ 0); the leg switches' steps in γp, and the tangent rate on a PCHIP path,
