@@ -116,8 +116,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
 
 def cmd_train(args: argparse.Namespace) -> int:
     from baselines.learned.agents import AGENT_DIR, load_agent_config
-    from baselines.learned.policy import POLICY_DIR
-    from baselines.learned.train import export_policy, train
+    from baselines.learned.train import train_sweep
 
     if args.agent == "all":
         if args.config:
@@ -125,27 +124,33 @@ def cmd_train(args: argparse.Namespace) -> int:
         names = sorted(p.stem for p in AGENT_DIR.glob("*.yaml"))
     else:
         names = [args.agent]
-    metas = []
+    seeds = args.seed or [None]
+    if args.ship and len(seeds) > 1:
+        raise ValueError("--ship exports one policy per agent: give at most one --seed")
+    jobs = []
     for name in names:
         config = load_agent_config(args.config or name)
-        if args.out is None:
-            out = f"results/agents/{config.name}"
-        else:
-            out = args.out if len(names) == 1 else f"{args.out}/{config.name}"
-        meta = train(
-            config,
-            out_dir=out,
-            seed=args.seed,
-            n_timesteps=args.timesteps,
-            resume=args.resume,
-            progress=not args.no_progress,
-        )
-        if args.ship:
-            meta["shipped_to"] = str(export_policy(out, POLICY_DIR / config.name))
-        meta["out_dir"] = out
-        metas.append(meta)
+        for seed in seeds:
+            out = args.out or "results/agents"
+            if len(names) > 1 or args.out is None:
+                out = f"{out}/{config.name}"
+            if len(seeds) > 1:
+                out = f"{out}/seed_{seed}"
+            jobs.append(
+                {
+                    "config": config,
+                    "out_dir": out,
+                    "seed": seed,
+                    "n_timesteps": args.timesteps,
+                    "resume": args.resume,
+                    "progress": not args.no_progress and len(names) * len(seeds) == 1,
+                    "ship": args.ship,
+                }
+            )
+    metas = train_sweep(jobs, backend=args.backend, workers=args.workers)
     text = "\n".join(
-        f"{m['name']}: {m['env_steps']} env steps in {m['wall_time_s']:.0f} s -> {m['out_dir']}"
+        f"{m['name']} (seed {m['seed']}): {m['env_steps']} env steps in "
+        f"{m['wall_time_s']:.0f} s -> {m['out_dir']}"
         for m in metas
     )
     _emit(args, metas if len(metas) > 1 else metas[0], text)
@@ -210,7 +215,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("agent", help="agent config name in configs/agents (ppo, sac, …) or 'all'")
     p.add_argument("--config", default=None, help="agent YAML (default configs/agents/AGENT.yaml)")
     p.add_argument("--out", default=None, help="output directory (default results/agents/NAME)")
-    p.add_argument("--seed", type=int, default=None, help="override the config's seed")
+    p.add_argument(
+        "--seed",
+        type=int,
+        nargs="+",
+        default=None,
+        help="override the config's seed; several: a sweep",
+    )
+    p.add_argument("--workers", type=int, default=1, help="parallel training runs (local pool)")
+    p.add_argument("--backend", choices=["local", "ray"], default="local")
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
     p.add_argument("--resume", action="store_true", help="continue from the newest checkpoint")
     p.add_argument(

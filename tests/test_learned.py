@@ -211,13 +211,57 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
     local = run_leaderboard(
         str(suite), seeds=2, out_dir=tmp_path / "a", workers=2, show_progress=False
     )
+    from baselines.learned.train import train_sweep
+
+    job = {"config": _tiny_config(), "seed": 3, "n_timesteps": 128, "tensorboard": False}
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         remote = run_leaderboard(
             str(suite), seeds=2, out_dir=tmp_path / "b", backend="ray", show_progress=False
         )
+        # a training sweep job on Ray equals the same job run here
+        on_ray = train_sweep([{**job, "out_dir": str(tmp_path / "ray")}], backend="ray")
     finally:
         ray.shutdown()
+    here = train_sweep([{**job, "out_dir": str(tmp_path / "here")}])
+    assert on_ray[0]["env_steps"] == here[0]["env_steps"] == 128
+    for name in ("ray", "here"):
+        (tmp_path / name / "best_model.zip").unlink()
+    for x, y in zip(
+        _policy_params(tmp_path / "ray"), _policy_params(tmp_path / "here"), strict=True
+    ):
+        np.testing.assert_array_equal(x, y)
     timing = ("compute_ms", "compute_ms_std")
     strip = [{k: v for k, v in r.items() if k not in timing} for r in local]
     assert strip == [{k: v for k, v in r.items() if k not in timing} for r in remote]
+
+
+def test_training_sweep_gives_the_same_runs_in_a_process_pool(tmp_path: Path) -> None:
+    """Two seeds trained in a local process pool equal the same runs trained in turn."""
+    from baselines.learned.train import train_sweep
+
+    def jobs(root: Path) -> list[dict]:
+        return [
+            {
+                "config": _tiny_config(),
+                "out_dir": str(root / f"seed_{s}"),
+                "seed": s,
+                "n_timesteps": 128,
+                "tensorboard": False,
+            }
+            for s in (1, 2)
+        ]
+
+    pooled = train_sweep(jobs(tmp_path / "pool"), workers=2)
+    serial = train_sweep(jobs(tmp_path / "serial"), workers=1)
+    assert [m["seed"] for m in serial] == [1, 2]
+    assert [m["seed"] for m in pooled] == [1, 2] and [m["env_steps"] for m in pooled] == [128] * 2
+    for s in (1, 2):
+        for root in ("pool", "serial"):
+            (tmp_path / root / f"seed_{s}" / "best_model.zip").unlink()
+        a = _policy_params(tmp_path / "pool" / f"seed_{s}")
+        b = _policy_params(tmp_path / "serial" / f"seed_{s}")
+        for x, y in zip(a, b, strict=True):
+            np.testing.assert_array_equal(x, y)
+    with pytest.raises(ValueError, match="unknown backend"):
+        train_sweep(jobs(tmp_path / "x"), backend="slurm")

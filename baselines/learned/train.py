@@ -257,3 +257,57 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     shutil.copyfile(model, target / "model.zip")
     shutil.copyfile(src / "meta.json", target / "meta.json")
     return target
+
+
+def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
+    """One training run of a sweep (top-level: process pools and Ray pickle it).
+
+    ``job``: ``config`` (name, path or AgentConfig), ``out_dir``, optional ``seed``,
+    ``n_timesteps``, ``resume``, ``progress``, ``ship`` (export to the shipped policies).
+    """
+    from baselines.learned.policy import POLICY_DIR
+
+    config = job["config"]
+    if not isinstance(config, AgentConfig):
+        config = load_agent_config(config)
+    meta = train(
+        config,
+        out_dir=job["out_dir"],
+        seed=job.get("seed"),
+        n_timesteps=job.get("n_timesteps"),
+        resume=job.get("resume", False),
+        progress=job.get("progress", False),
+        tensorboard=job.get("tensorboard", True),
+    )
+    if job.get("ship"):
+        meta["shipped_to"] = str(export_policy(job["out_dir"], POLICY_DIR / config.name))
+    meta["out_dir"] = str(job["out_dir"])
+    return meta
+
+
+def train_sweep(
+    jobs: list[dict[str, Any]], backend: str = "local", workers: int = 1
+) -> list[dict[str, Any]]:
+    """Run training jobs (agents × seeds) sequentially, in a local process pool
+    (``workers`` > 1) or on Ray (``backend="ray"``, ``RAY_ADDRESS`` or a local instance);
+    the metas come back in job order.  Each run is seeded, so where it runs does not change
+    its result (tested)."""
+    if backend == "ray":
+        try:
+            import ray
+        except ImportError as exc:
+            raise RuntimeError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
+        import os
+
+        if not ray.is_initialized():
+            ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
+        remote = ray.remote(run_train_job)
+        return ray.get([remote.remote(job) for job in jobs])
+    if backend != "local":
+        raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
+    if workers <= 1 or len(jobs) == 1:
+        return [run_train_job(job) for job in jobs]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(run_train_job, jobs))
