@@ -36,8 +36,8 @@ identified Esso Osaka model K = 0.185 1/s, T1 = 7.8569 s, T2 = 0.3815 s, T3 = 0.
 not satisfy eq. (21) with the stated A = B = 4 (they give A = 8.76, B = 7.39); eq. (21) with
 A = B = 4 has the single real solution Kp = 2167.5, Kd = 541.7.  With A = B = 3 — "the ideal
 value" the paper names just before choosing (4, 4) — eq. (21) gives Kp = 547.85,
-Kd = 212.66: the printed numbers to all printed digits, listed Kd first.  So the printed
-gains are the (3, 3) design.  Default here: the stated design A = B = 4
+Kd = 212.66: the printed numbers truncated to one decimal (212.66 → 212.6), listed Kd
+first.  So the printed gains are the (3, 3) design.  Default here: the stated design A = B = 4
 (:data:`VYSHNEGRADSKY_AB_STATED`); :data:`VYSHNEGRADSKY_AB_PRINTED` = (3, 3) reproduces
 the printed gains.  The angle unit does not matter (Kp is rad/rad = deg/deg, Kd in s).
 

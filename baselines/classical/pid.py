@@ -34,9 +34,11 @@ Default tuning per controller (SPEC §8 lists pid_los and pid_vf as Vyshnegradsk
 
 Caveat on the Vyshnegradsky tuning for full-scale ships: the design places the closed-loop
 frequency ω0 = (K·Kp/(T1T2))^(1/3) from the fast time constant T2, and ignores the rudder
-servo and saturation, so on the zig-zag fits of mariner and blanke it asks for Kp ~ 10⁴–10⁵
-(the paper's own Esso Osaka design is Kp = 2167.5): the rudder then works bang-bang on the
-switching line Kp·ψ̃ = Kd·r.  That is what the method gives; no extra scaling is applied.
+servo and saturation, so on the zig-zag fits of mariner and blanke it asks for Kp ~
+10⁴–10⁵ (on the paper's own identified Esso Osaka model the stated A = B = 4 gives Kp =
+2167.5; the paper prints its A = B = 3 design, 547.8): the rudder then works bang-bang on
+the switching line Kp·ψ̃ = Kd·r. That is what the method gives; no extra scaling is
+applied.
 """
 
 from __future__ import annotations

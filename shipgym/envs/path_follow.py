@@ -80,6 +80,16 @@ _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
 GUIDANCE_OFFSET_MAX = math.radians(30.0)
 
 
+#: Xu, Oliveira & Guedes Soares (2021)'s ship: the 1:100 Esso Osaka model, L = 3.25 m
+TVVF_PAPER_SHIP_LENGTH = 3.25
+#: tvvf_error_unit → the unit [m] of ye and Δ in the TVVF law, for a ship of length L
+TVVF_ERROR_UNITS = {
+    "m": lambda L: 1.0,
+    "L": lambda L: L,
+    "similar": lambda L: L / TVVF_PAPER_SHIP_LENGTH,
+}
+
+
 def field_law_heading(
     gcfg: Any, cross_track: Any, path_angle: Any, ship_length: float, scale: Any
 ) -> Any:
@@ -100,7 +110,7 @@ def field_law_heading(
             gcfg.tvvf_delta_L * ship_length * scale,
             theta_slope=gcfg.tvvf_theta_slope,
             theta_offset=gcfg.tvvf_theta_offset,
-            error_unit=ship_length if gcfg.tvvf_error_unit == "L" else 1.0,
+            error_unit=TVVF_ERROR_UNITS[gcfg.tvvf_error_unit](ship_length),
         )
     raise ValueError(f"not a vector-field guidance law: {gcfg.law!r}")
 

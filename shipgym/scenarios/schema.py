@@ -71,7 +71,10 @@ class GuidanceConfig(_Strict):
     tvvf_delta_L: float = Field(2.0, gt=0)  # Δ = 2L
     tvvf_theta_slope: float = Field(0.05, ge=0)  # θ = slope·|ye| + offset, per error unit
     tvvf_theta_offset: float = Field(1.0, ge=1)  # θ(0) ≥ 1 (Definition 1)
-    tvvf_error_unit: Literal["m", "L"] = "m"  # unit of ye and Δ in |ye|^θ/Δ: paper metres
+    #: unit of ye and Δ in |ye|^θ/Δ: "m" as the paper; "L" ship lengths; "similar" the
+    #: paper's metre scaled to this ship, L/3.25 m (Xu et al. 2021's 3.25 m Esso Osaka
+    #: model), which is how the L1 controller transfers the law to other ships
+    tvvf_error_unit: Literal["m", "L", "similar"] = "m"
 
 
 class _CurrentBase(_Strict):
