@@ -32,20 +32,21 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_leaderboard(args: argparse.Namespace) -> int:
+    """``leaderboard`` (the suite's controllers) and ``evaluate`` (one policy on a suite)."""
     from baselines.leaderboard import markdown_table, run_leaderboard
 
+    policy = getattr(args, "policy", None)
     rows = run_leaderboard(
         suite=args.suite,
         seeds=args.seeds,
         out_dir=args.out,
         backend=args.backend,
         workers=args.workers,
+        controllers=[policy] if policy else None,
         show_progress=not args.no_progress,
     )
-    if args.json:
-        _emit(args, rows, "")
-    else:
-        sys.stdout.write(markdown_table(rows))
+    _emit(args, rows, markdown_table(rows))
+    if not args.json:
         sys.stderr.write(f"wrote {args.out}/leaderboard.md, .csv, .json and plots\n")
     return 0
 
@@ -95,22 +96,6 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         _emit(args, rows, "")
     else:
         sys.stdout.write(module.markdown(rows))
-    return 0
-
-
-def cmd_evaluate(args: argparse.Namespace) -> int:
-    from baselines.leaderboard import markdown_table, run_leaderboard
-
-    rows = run_leaderboard(
-        suite=args.suite,
-        seeds=args.seeds,
-        out_dir=args.out,
-        backend=args.backend,
-        workers=args.workers,
-        controllers=[args.policy],
-        show_progress=not args.no_progress,
-    )
-    _emit(args, rows, markdown_table(rows))
     return 0
 
 
@@ -244,7 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
     p.add_argument("--no-progress", action="store_true")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
-    p.set_defaults(func=cmd_evaluate)
+    p.set_defaults(func=cmd_leaderboard)
 
     p = sub.add_parser(
         "manoeuvre", help="turning circle or zig-zag of a ship model, with figures and a plot"

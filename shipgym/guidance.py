@@ -75,6 +75,17 @@ _HALF_PI = 0.5 * math.pi
 # --------------------------------------------------------------------------------------------
 # LOS guidance with an R_LOS circle — Liu et al. (2019) §2.2
 # --------------------------------------------------------------------------------------------
+#: Xu, Oliveira & Guedes Soares (2021)'s ship, the 1:100 Esso Osaka model: L = 3.25 m
+TVVF_PAPER_SHIP_LENGTH = 3.25
+#: scenario ``tvvf_error_unit`` → the unit [m] of ye and Δ in the TVVF law for a ship of
+#: length L: the paper's metre, a ship length, or the paper's metre scaled to the ship
+TVVF_ERROR_UNITS = {
+    "m": lambda L: 1.0,
+    "L": lambda L: L,
+    "similar": lambda L: L / TVVF_PAPER_SHIP_LENGTH,
+}
+
+
 def los_radius(cross_track: float, ship_length: float, n: float = 3.0) -> float:
     """LOS circle radius R_LOS [m] — Liu et al. (2019) eq. (12).
 

@@ -122,7 +122,7 @@ import scipy.signal
 from scipy.optimize import lsq_linear
 
 from shipgym.envs.context import ControllerContext
-from shipgym.guidance import tvvf_heading
+from shipgym.guidance import TVVF_PAPER_SHIP_LENGTH, tvvf_heading
 from shipgym.manoeuvres import zigzag
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2
@@ -527,7 +527,7 @@ def high_frequency_power(signal: np.ndarray, period: float, cutoff: float) -> fl
 #: where the low-pass filter C(s) acts (module doc, "Filter placement")
 FILTER_PLACEMENTS = ("command", "adaptive")
 #: the paper's ship: Esso Osaka 1:100 model, L = 325 m / 100, U0 = 0.41 m/s (§5.2)
-PAPER_SHIP_LENGTH = 3.25  # [m]
+PAPER_SHIP_LENGTH = TVVF_PAPER_SHIP_LENGTH  # [m], the 1:100 Esso Osaka model
 PAPER_SHIP_SPEED = 0.41  # [m/s]
 
 

@@ -12,10 +12,9 @@ import os
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, model_validator
 
-from shipgym.scenarios.schema import _Strict
+from shipgym.scenarios.schema import _Strict, load_yaml_model
 
 REPO = Path(__file__).resolve().parents[2]
 AGENT_DIR = REPO / "configs" / "agents"
@@ -89,17 +88,7 @@ def load_agent_config(name_or_path: str | os.PathLike) -> AgentConfig:
             raise ValueError(f"unknown agent config {text!r}; valid: {valid}")
     if not path.is_file():
         raise ValueError(f"agent config not found: {path}")
-    try:
-        data = yaml.safe_load(path.read_text())
-        return AgentConfig.model_validate(data)
-    except yaml.YAMLError as exc:
-        raise ValueError(f"{path}: malformed YAML: {exc}") from None
-    except ValidationError as exc:
-        lines = [
-            f"{path}: key '{'.'.join(str(p) for p in e['loc']) or '<top level>'}': {e['msg']}"
-            for e in exc.errors()
-        ]
-        raise ValueError("\n".join(lines)) from None
+    return load_yaml_model(path, AgentConfig, ValueError)
 
 
 def algo_class(algo: str) -> type:

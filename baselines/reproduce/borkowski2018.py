@@ -33,6 +33,7 @@ import numpy as np
 from baselines.classical.lqr import LQR, AdaptiveLQR
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
 from baselines.jsonout import dumps
+from baselines.reproduce.rows import reproduction_row as _row
 from shipgym.metrics import DEFAULT_SETTINGS
 from shipgym.paths import wrap_angle
 from shipgym.scenarios import load_scenario, scenario_from_dict
@@ -142,28 +143,6 @@ def run(
     if plot:
         plot_runs(scenario, examples, case_name(*guesses[0]), out)
     return rows
-
-
-def _row(
-    case: str,
-    controller: str,
-    metric: str,
-    ours: Any,
-    paper: Any,
-    seeds: int,
-    std: float | None = None,
-) -> dict[str, Any]:
-    row = {
-        "case": case,
-        "controller": controller,
-        "metric": metric,
-        "ours": float(ours) if isinstance(ours, np.floating) else ours,
-        "paper": paper,
-        "seeds": seeds,
-    }
-    if std is not None:
-        row["ours_std"] = float(std)
-    return row
 
 
 def _fmt(value: Any, digits: int = 4) -> str:

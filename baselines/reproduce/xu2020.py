@@ -63,6 +63,7 @@ import numpy as np
 from baselines.classical.pid import PIDVF, PIDLookaheadLOS
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
 from baselines.jsonout import dumps
+from baselines.reproduce.rows import reproduction_row
 from shipgym.autopilot import (
     VYSHNEGRADSKY_AB_PRINTED,
     VYSHNEGRADSKY_AB_STATED,
@@ -243,19 +244,9 @@ def _row(
     seeds: int,
     std: float | None = None,
 ) -> dict[str, Any]:
-    row: dict[str, Any] = {
-        "case": case,
-        "controller": controller,
-        "metric": metric,
-        "ours": float(ours),
-        "paper": paper,
-        "setting": setting,
-        "gains": gains,
-        "seeds": seeds,
-    }
-    if std is not None:
-        row["ours_std"] = float(std)
-    return row
+    return reproduction_row(
+        case, controller, metric, float(ours), paper, seeds, std, setting=setting, gains=gains
+    )
 
 
 def identification_rows(settings: tuple[str, ...], gains: tuple[str, ...]) -> list[dict]:

@@ -102,6 +102,7 @@ from baselines.classical.l1_backstepping import (
 from baselines.classical.pid import PIDTVVF
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
 from baselines.jsonout import dumps
+from baselines.reproduce.rows import reproduction_row as _row
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.models import MODELS
 from shipgym.paths import wrap_angle
@@ -464,28 +465,6 @@ def _mean_std(values: list[Any]) -> tuple[Any, float | None]:
     if np.isinf(a).any():
         return float(np.mean(a)), None
     return float(np.mean(a)), float(np.std(a))
-
-
-def _row(
-    case: str,
-    controller: str,
-    metric: str,
-    ours: Any,
-    paper: Any,
-    seeds: int,
-    std: float | None = None,
-) -> dict[str, Any]:
-    row = {
-        "case": case,
-        "controller": controller,
-        "metric": metric,
-        "ours": float(ours) if isinstance(ours, np.floating) else ours,
-        "paper": paper,
-        "seeds": seeds,
-    }
-    if std is not None:
-        row["ours_std"] = float(std)
-    return row
 
 
 #: a comparative claim holds when ours is at least this much lower (a difference that a

@@ -50,6 +50,7 @@ from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import (
+    TVVF_ERROR_UNITS,
     lookahead_los_heading,
     los_desired_heading,
     tvvf_heading,
@@ -78,16 +79,6 @@ _OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
 #: guidance action: a0 scales the law's length scale (LOS R_LOS = nL, look-ahead / TVVF Δ,
 #: VF τ) by 2^a0 ∈ [½, 2]; a1 → course offset a1·30°.
 GUIDANCE_OFFSET_MAX = math.radians(30.0)
-
-
-#: Xu, Oliveira & Guedes Soares (2021)'s ship: the 1:100 Esso Osaka model, L = 3.25 m
-TVVF_PAPER_SHIP_LENGTH = 3.25
-#: tvvf_error_unit → the unit [m] of ye and Δ in the TVVF law, for a ship of length L
-TVVF_ERROR_UNITS = {
-    "m": lambda L: 1.0,
-    "L": lambda L: L,
-    "similar": lambda L: L / TVVF_PAPER_SHIP_LENGTH,
-}
 
 
 def field_law_heading(

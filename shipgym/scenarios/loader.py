@@ -14,7 +14,7 @@ from pydantic import ValidationError
 from shipgym.models import MODELS, ParameterError, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
-from shipgym.scenarios.schema import ScenarioConfig
+from shipgym.scenarios.schema import ScenarioConfig, format_validation_error
 
 DEG = math.pi / 180.0
 
@@ -93,14 +93,6 @@ class Scenario:
         return self.model.cruise_state(**values)
 
 
-def _format_validation_error(err: ValidationError, origin: str) -> str:
-    lines = []
-    for item in err.errors():
-        key = ".".join(str(part) for part in item["loc"]) or "<top level>"
-        lines.append(f"{origin}: key '{key}': {item['msg']}")
-    return "\n".join(lines)
-
-
 def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenario:
     """SI objects from a validated config; errors name ``origin`` and the key."""
     ship = config.ship
@@ -158,7 +150,7 @@ def scenario_from_dict(data: Any, origin: str = "<dict>") -> Scenario:
     try:
         config = ScenarioConfig.model_validate(data)
     except ValidationError as exc:
-        raise ScenarioError(_format_validation_error(exc, origin)) from None
+        raise ScenarioError(format_validation_error(exc, origin)) from None
     return build_scenario(config, origin)
 
 

@@ -30,10 +30,9 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import yaml
-from pydantic import AfterValidator, Field, ValidationError, model_validator
+from pydantic import AfterValidator, Field, model_validator
 
-from shipgym.scenarios.schema import ScenarioConfig, _Strict
+from shipgym.scenarios.schema import ScenarioConfig, _Strict, load_yaml_model
 
 #: salts of the two seed spaces: test scenarios come from SeedSequence([TEST_SALT, ·, i]),
 #: training scenarios from SeedSequence([TRAIN_SALT, s]) with s drawn by the env
@@ -318,18 +317,7 @@ def load_distribution(name_or_path: str | os.PathLike) -> ScenarioDistribution:
             )
     if not path.is_file():
         raise DistributionError(f"distribution file not found: {path}")
-    try:
-        data = yaml.safe_load(path.read_text())
-        config = DistributionConfig.model_validate(data)
-    except yaml.YAMLError as exc:
-        raise DistributionError(f"{path}: malformed YAML: {exc}") from None
-    except ValidationError as exc:
-        lines = [
-            f"{path}: key '{'.'.join(str(p) for p in e['loc']) or '<top level>'}': {e['msg']}"
-            for e in exc.errors()
-        ]
-        raise DistributionError("\n".join(lines)) from None
-    return ScenarioDistribution(config)
+    return ScenarioDistribution(load_yaml_model(path, DistributionConfig, DistributionError))
 
 
 def sampled_scenario_config(name: str) -> ScenarioConfig:

@@ -10,9 +10,40 @@ model under the scenario's ``unit_reading``.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from pathlib import Path
+from typing import Annotated, Literal, TypeVar
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+import yaml
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+#: a validated config model
+M = TypeVar("M", bound=BaseModel)
+
+
+def format_validation_error(err: ValidationError, origin: str) -> str:
+    """One line per problem, naming the file (``origin``) and the key."""
+    lines = []
+    for item in err.errors():
+        key = ".".join(str(part) for part in item["loc"]) or "<top level>"
+        lines.append(f"{origin}: key '{key}': {item['msg']}")
+    return "\n".join(lines)
+
+
+def load_yaml_model(path: Path, model: type[M], error: type[Exception]) -> M:
+    """``model`` validated from the YAML file ``path``; ``error`` names the file and key."""
+    try:
+        return model.model_validate(yaml.safe_load(path.read_text()))
+    except yaml.YAMLError as exc:
+        raise error(f"{path}: malformed YAML: {exc}") from None
+    except ValidationError as exc:
+        raise error(format_validation_error(exc, str(path))) from None
 
 
 class _Strict(BaseModel):
