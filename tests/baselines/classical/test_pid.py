@@ -35,7 +35,7 @@ from shipgym.scenarios import scenario_from_dict
 ESSO = {"K": 0.185, "T1": 7.8569, "T2": 0.3815, "T3": 0.5297}
 NOMOTO2 = {"K": 0.5060, "T1": 1.2481, "T2": 0.1245, "T3": -0.0757}  # Liu et al. (2019) §4
 CONTROLLERS = (PIDLOS, PIDLookaheadLOS, PIDVF, PIDTVVF)
-MARINER_TRACK = Path(__file__).resolve().parents[1] / "configs/scenarios/mariner_track.yaml"
+MARINER_TRACK = Path(__file__).resolve().parents[3] / "configs/scenarios/mariner_track.yaml"
 
 
 def _closed_loop(K: float, T1: float, T2: float, T3: float, kp: float, kd: float) -> np.ndarray:
