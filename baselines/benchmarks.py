@@ -11,6 +11,11 @@ import numpy as np
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.models import MODELS
 
+#: issue 11's speed floors on the 2-core machine (steps/s, env-steps/s at N = 1024, µs)
+SINGLE_ENV_TARGET = 25_000
+BATCHED_ENV_TARGET = 350_000
+PCHIP_PROJECTION_TARGET_US = 20.0
+
 
 def bench_env(
     steps: int = 5000, repeats: int = 5, batch: int = 1024, batch_steps: int = 100
@@ -63,19 +68,57 @@ def bench_env(
             for _ in range(n_sub):
                 x = model.step_numpy(x, u, w, p, model.fine_step)
         brates.append(batch * n_sub * 5 / (time.perf_counter() - start))
+    projection = bench_pchip_projection(repeats=repeats, batch=batch)
     return {
         "single_env_steps_per_s": single,
-        "single_env_target_steps_per_s": 10_000,
-        "single_env_ratio_to_target": single / 10_000,
+        "single_env_target_steps_per_s": SINGLE_ENV_TARGET,
+        "single_env_ratio_to_target": single / SINGLE_ENV_TARGET,
         "batched_env_steps_per_s": batched,
         "batched_env_steps_per_s_with_episode_metrics": rates[True],
         "batched_ship_substeps_per_s": batched * n_sub,
-        "batched_env_target_steps_per_s": 250_000,
-        "batched_ratio_to_target": batched / 250_000,
+        "batched_env_target_steps_per_s": BATCHED_ENV_TARGET,
+        "batched_ratio_to_target": batched / BATCHED_ENV_TARGET,
         "numpy_rk4_ship_substeps_per_s": statistics.median(brates),
+        **projection,
         "batch_size": batch,
         "substeps_per_step": n_sub,
         "repeats": repeats,
+    }
+
+
+def bench_pchip_projection(
+    scenario: str = "rudder_aging_smooth", points: int = 2000, repeats: int = 5, batch: int = 1024
+) -> dict[str, float]:
+    """Closest-point tracking on a PCHIP path (the tracker's per-step projection): µs per
+    call for one ship along a ship-like track, and µs per ship for ``batch`` ships at once."""
+    from shipgym.scenarios import load_scenario
+    from shipgym.tracking import PathTracker
+
+    sc = load_scenario(scenario)
+    path = sc.path
+    s = np.linspace(0.0, path.length, points)
+    track = path.point(s) + 0.5 * sc.ship_length * np.sin(s / 7.0)[:, None]  # near the path
+    xs, ys = track[:, 0].tolist(), track[:, 1].tolist()
+    single, per_ship = [], []
+    for _ in range(repeats):
+        tracker = PathTracker(path, sc.acceptance_radius)
+        tracker.reset(xs[0], ys[0])
+        start = time.perf_counter()
+        for x, y in zip(xs, ys, strict=True):
+            tracker.update(x, y)
+        single.append(1e6 * (time.perf_counter() - start) / points)
+        many = PathTracker(path, sc.acceptance_radius, batch=batch)
+        shift = np.linspace(-0.5, 0.5, batch) * sc.ship_length
+        many.reset(track[0, 0] + shift, track[0, 1] + shift)
+        start = time.perf_counter()
+        for x, y in track[:: max(1, points // 100)]:
+            many.update(x + shift, y + shift)
+        calls = len(track[:: max(1, points // 100)])
+        per_ship.append(1e6 * (time.perf_counter() - start) / (calls * batch))
+    return {
+        "pchip_projection_us": statistics.median(single),
+        "pchip_projection_target_us": PCHIP_PROJECTION_TARGET_US,
+        "pchip_projection_batched_us_per_ship": statistics.median(per_ship),
     }
 
 

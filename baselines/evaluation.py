@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
@@ -43,10 +44,20 @@ def run_episode(
     policy: Policy,
     scenario: Any,
     seed: int,
-    action_mode: str = "rudder",
+    action_mode: str | None = None,
     env_id: str = ENV_ID,
+    after_episode: Callable[[Any], None] | None = None,
 ) -> EpisodeResult:
-    """Run one episode; the policy sees only obs, info and the controller context."""
+    """Run one episode; the policy sees only obs, info and the controller context.
+
+    ``action_mode``: the env's (None: the policy's ``action_mode``, else "rudder").
+    ``after_episode``: called with the unwrapped env after the last step, before it is
+    closed, to read the env's own episode logs (e.g. ``episode_disturbances()``).
+    Controller compute time is measured here, around each ``act`` call, never by the env:
+    ``compute_ms`` [ms] is its mean per step and ``compute_ms_max`` [ms] its maximum.
+    """
+    if action_mode is None:
+        action_mode = getattr(policy, "action_mode", "rudder")
     env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
     try:
         obs, info = env.reset(seed=seed)
@@ -64,12 +75,12 @@ def run_episode(
                 break
         metrics = dict(info["episode_metrics"])
         metrics["termination_reason"] = info.get("termination_reason")
-        # controller compute time = time spent in act(), measured here
-        metrics["compute_ms"] = 1e3 * float(np.mean(act_times))
-        metrics["compute_ms_max"] = 1e3 * float(np.max(act_times))
+        metrics.update(compute_time_metrics(act_times))
         stats = getattr(policy, "episode_stats", None)
         if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
             metrics.update(stats())
+        if after_episode is not None:
+            after_episode(base)
         traj = np.array(rows)
         trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
         return EpisodeResult(
@@ -82,6 +93,14 @@ def run_episode(
         )
     finally:
         env.close()
+
+
+def compute_time_metrics(act_times: list[float]) -> dict[str, float]:
+    """``compute_ms`` (mean) and ``compute_ms_max`` [ms] of the ``act`` durations [s]."""
+    return {
+        "compute_ms": 1e3 * float(np.mean(act_times)),
+        "compute_ms_max": 1e3 * float(np.max(act_times)),
+    }
 
 
 _TRAJ_KEYS = ("t", "x", "y", "cross_track_error", "heading", "rudder_angle", "rudder_command")
@@ -103,12 +122,17 @@ def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:
 def evaluate(
     controller: str | Policy, scenario: Any, seeds: list[int], **settings: Any
 ) -> list[EpisodeResult]:
-    """Evaluate a controller (registry name or Policy instance) on a scenario over seeds."""
+    """Evaluate a controller on a scenario over seeds.
+
+    ``controller``: a name :func:`~baselines.registry.make_controller` knows (made afresh
+    per seed with ``settings``) or a Policy instance (``settings`` may give its
+    ``action_mode``; default: the policy's own).
+    """
     results = []
     for seed in seeds:
         if isinstance(controller, str):
             policy, mode = make_controller(controller, **settings)
         else:
-            policy, mode = controller, settings.get("action_mode", "rudder")
+            policy, mode = controller, settings.get("action_mode")
         results.append(run_episode(policy, scenario, seed, mode))
     return results

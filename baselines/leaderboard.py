@@ -16,17 +16,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from tqdm import tqdm
 
+from baselines.errors import BackendError, ControllerError, RunError, check_seeds
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
 from baselines.jsonout import dumps
-from baselines.registry import CONTROLLERS, applies_to, controller_kind
+from baselines.registry import applies_to, controller_kind, is_controller, unknown_controller
+from baselines.suite import load_suite
 from shipgym.metrics import aggregate
 from shipgym.scenarios import load_scenario
-
-REPO = Path(__file__).resolve().parents[1]
-SUITE_DIR = REPO / "configs" / "suites"
 
 #: metric columns aggregated over seeds (mean and *_std)
 COLUMNS = (
@@ -41,25 +39,6 @@ COLUMNS = (
     "mean_abs_cross_track",
     "max_abs_cross_track",
 )
-
-
-def list_suites() -> list[str]:
-    return sorted(p.stem for p in SUITE_DIR.glob("*.yaml"))
-
-
-def load_suite(name_or_path: str) -> dict[str, Any]:
-    path = Path(name_or_path)
-    if not path.suffix:
-        path = SUITE_DIR / f"{name_or_path}.yaml"
-        if not path.is_file():
-            raise ValueError(f"unknown suite {name_or_path!r}; valid: {', '.join(list_suites())}")
-    if not path.is_file():
-        raise ValueError(f"suite file not found: {path}")
-    suite = yaml.safe_load(path.read_text())
-    for key in ("scenarios", "controllers"):
-        if not isinstance(suite, dict) or not isinstance(suite.get(key), list):
-            raise ValueError(f"{path}: key '{key}' must be a list")
-    return suite
 
 
 #: training-cost columns, present for learned agents only
@@ -79,31 +58,20 @@ def controller_label(controller: str) -> str:
 def check_controllers(names: list[str]) -> list[str]:
     """The table labels of ``names``; a clear error, before any job runs, for a name that
     is neither a controller nor a trained agent, and for two names with the same label."""
-    from baselines.learned.policy import shipped_policies
-
     labels = []
     for name in names:
-        if name not in CONTROLLERS and name not in shipped_policies() and not Path(name).exists():
-            raise ValueError(
-                f"unknown controller {name!r}; valid: {', '.join(sorted(CONTROLLERS))}, the "
-                f"learned policies {', '.join(shipped_policies())} or a trained agent's path"
-            )
+        if not is_controller(name):
+            raise ControllerError(unknown_controller(name))
         labels.append(controller_label(name))
     duplicates = sorted({label for label in labels if labels.count(label) > 1})
     if duplicates:
-        raise ValueError(f"controllers {names} give the same table name(s) {duplicates}")
+        raise RunError(f"controllers {names} give the same table name(s) {duplicates}")
     return labels
 
 
 def scenario_split(scenario: str) -> str:
     """``heldout`` for named held-out test scenarios (``heldout:3``), else ``catalogue``."""
     return "heldout" if scenario.startswith("heldout:") else "catalogue"
-
-
-def suite_scenarios(spec: dict[str, Any]) -> list[str]:
-    """The suite's catalogue scenarios followed by ``heldout:0 … heldout:N-1``."""
-    n = int(spec.get("heldout_scenarios", 0))
-    return list(spec["scenarios"]) + [f"heldout:{i}" for i in range(n)]
 
 
 def run_job(job: tuple[str, str, int]) -> EpisodeResult:
@@ -134,7 +102,7 @@ def _run_ray(jobs: list, progress: Callable[[], None]) -> list[EpisodeResult]:
     try:
         import ray
     except ImportError as exc:
-        raise RuntimeError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
+        raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
     if not ray.is_initialized():
         ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
     remote = ray.remote(run_job)
@@ -159,12 +127,11 @@ def run_leaderboard(
 ) -> list[dict[str, Any]]:
     """Run the suite, write leaderboard.{md,csv,json} and plots; return the aggregate rows."""
     spec = load_suite(suite)
-    n_seeds = int(seeds if seeds is not None else spec.get("seeds", 5))
-    if n_seeds < 1:
-        raise ValueError(f"--seeds must be ≥ 1, got {n_seeds}")
-    names = list(controllers) if controllers else list(spec["controllers"])
+    n_seeds = int(seeds if seeds is not None else spec.seeds)
+    check_seeds(n_seeds, "--seeds")
+    names = list(controllers) if controllers else list(spec.controllers)
     labels = check_controllers(names)
-    scenarios = suite_scenarios(spec)
+    scenarios = spec.all_scenarios()
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
     ships = {s: load_scenario(s).model.name for s in scenarios}
     jobs = [
@@ -180,7 +147,7 @@ def run_leaderboard(
     elif backend == "ray":
         results = _run_ray(jobs, lambda: bar.update(1))
     else:
-        raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
+        raise RunError(f"unknown backend {backend!r}; valid: local, ray")
     bar.close()
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
     results.sort(key=lambda r: (r.scenario, r.controller, r.seed))

@@ -23,3 +23,17 @@ class Policy(Protocol):
     def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray: ...
+
+
+def check_action_mode(policy: Any, context: ControllerContext) -> None:
+    """Raise unless the env runs in the action mode ``policy`` drives.
+
+    The mode is the policy's ``action_mode`` (set by its registration, or a learned
+    agent's training run); a policy without one drives the rudder.
+    """
+    mode = getattr(policy, "action_mode", "rudder")
+    if context.action_mode != mode:
+        raise ValueError(
+            f"{policy.name} drives action_mode {mode!r}, the env uses "
+            f"{context.action_mode!r}: make the env with action_mode={mode!r}"
+        )

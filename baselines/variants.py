@@ -2,27 +2,26 @@
 
 from __future__ import annotations
 
-import copy
 from typing import Any
 
-import yaml
-
-from shipgym.scenarios import Scenario, catalogue_dir, scenario_from_dict
+from shipgym.scenarios import Scenario, load_scenario
 
 
 def scenario_variant(
     name: str, unit_reading: str | None = None, noise_free: bool = False
 ) -> Scenario:
-    """Catalogue scenario ``name`` with its ship's unit reading replaced and/or no sensor model."""
-    data: dict[str, Any] = yaml.safe_load((catalogue_dir() / f"{name}.yaml").read_text())
-    data = copy.deepcopy(data)
-    tags = []
+    """Catalogue scenario ``name`` with its ship's unit reading replaced and/or no sensor model
+    (named ``name[unit_reading,noise_free]``)."""
+    scenario = load_scenario(name)
+    overrides: dict[str, Any] = {}
+    drop: list[str] = []
+    tags: list[str] = []
     if unit_reading is not None:
-        data.setdefault("ship", {})["unit_reading"] = unit_reading
+        overrides["ship"] = {"unit_reading": unit_reading}
         tags.append(unit_reading)
     if noise_free:
-        data.pop("sensors", None)
+        drop.append("sensors")
         tags.append("noise_free")
-    if tags:
-        data["name"] = f"{name}[{','.join(tags)}]"
-    return scenario_from_dict(data, data["name"])
+    if not tags:
+        return scenario
+    return scenario.with_overrides(overrides, name=f"{name}[{','.join(tags)}]", drop=drop)

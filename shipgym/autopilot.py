@@ -51,10 +51,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 
-from shipgym.paths import wrap_angle
+from shipgym.angles import wrap_angle
+from shipgym.numerics import SCALAR
 
 
 @dataclasses.dataclass(frozen=True)
@@ -79,12 +81,33 @@ class PIDGains:
         return cls(kp=kp, ki=kp * natural_frequency / 10.0, kd=kd)
 
 
+def pid_step(
+    gains: PIDGains,
+    integral: Any,
+    desired_heading: Any,
+    heading: Any,
+    yaw_rate: Any,
+    dt: float,
+    limit: float,
+    xp: Any = SCALAR,
+) -> tuple[Any, Any]:
+    """One period of the discrete PID heading autopilot, for one ship or N (``xp``).
+
+    δc = Kp·ψ̃ − Kd·r + Ki·∫ψ̃ clipped to ±limit [rad], ψ̃ = wrap(ψd − ψ) [rad], r [rad/s];
+    the integral [rad·s] accumulates ψ̃·dt only while the command would not saturate
+    (conditional integration, anti-windup).  Returns (δc, new integral).
+    """
+    error = wrap_angle(desired_heading - heading)
+    trial = gains.kp * error - gains.kd * yaw_rate + gains.ki * (integral + error * dt)
+    integral = xp.where((-limit < trial) & (trial < limit), integral + error * dt, integral)
+    raw = gains.kp * error - gains.kd * yaw_rate + gains.ki * integral
+    return xp.minimum(limit, xp.maximum(-limit, raw)), integral
+
+
 class HeadingPID:
-    """Discrete PID heading autopilot with rudder saturation and anti-windup.
+    """Discrete PID heading autopilot with rudder saturation and anti-windup (:func:`pid_step`).
 
     ``command`` is called once per control period dt [s]; returns δc [rad] in ±limit.
-    The integral only accumulates while the command is not saturated (conditional
-    integration).
     """
 
     def __init__(self, gains: PIDGains, rudder_limit: float) -> None:
@@ -96,22 +119,10 @@ class HeadingPID:
         self.integral = 0.0
 
     def command(self, desired_heading: float, heading: float, yaw_rate: float, dt: float) -> float:
-        error = float(wrap_angle(desired_heading - heading))
-        g = self.gains
-        unsaturated = g.kp * error - g.kd * yaw_rate + g.ki * (self.integral + error * dt)
-        limit = self.rudder_limit
-        if -limit < unsaturated < limit:
-            self.integral += error * dt
-        raw = g.kp * error - g.kd * yaw_rate + g.ki * self.integral
-        return min(limit, max(-limit, raw))
-
-
-def nomoto2_first_order(K: float, T1: float, T2: float, T3: float) -> tuple[float, float]:
-    """Nomoto's first-order approximation (K, T = T1 + T2 − T3) of the 2nd-order model."""
-    T = T1 + T2 - T3
-    if not math.isfinite(T) or T <= 0:
-        raise ValueError(f"first-order time constant T = T1 + T2 - T3 = {T} is not positive")
-    return K, T
+        delta_c, self.integral = pid_step(
+            self.gains, self.integral, desired_heading, heading, yaw_rate, dt, self.rudder_limit
+        )
+        return delta_c
 
 
 # --------------------------------------------------------------------------------------------

@@ -77,7 +77,7 @@ import numpy as np
 from scipy.linalg import expm, solve_discrete_lyapunov
 from scipy.signal import lfilter
 
-from shipgym.scenarios.schema import (
+from shipgym.disturbance_config import (
     ConstantCurrent,
     CurrentConfig,
     DisturbanceConfig,

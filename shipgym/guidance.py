@@ -46,14 +46,19 @@ Choices where the papers are silent or ambiguous (explicit options, paper value 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from shipgym.paths import segment_frame, wrap_angle
+from shipgym.angles import wrap_angle
+from shipgym.numerics import SCALAR
+from shipgym.paths import segment_frame
 
 __all__ = [
+    "GUIDANCE_LAWS",
+    "desired_heading",
     "lookahead_los_heading",
     "los_heading",
     "los_point",
@@ -204,24 +209,6 @@ def lookahead_los_heading(
 # Vector-field guidance — Xu & Guedes Soares (2020) §3; Xu, Oliveira & Guedes Soares (2021) §3
 # Floats or arrays, the same numpy operations for both (module doc).
 # --------------------------------------------------------------------------------------------
-def _wrapped(h: ArrayLike) -> FloatOrArray:
-    """``h`` wrapped to [−π, π), values already inside untouched; a float if 0-d.
-
-    The scalar branch uses the array branch's operations (np.mod, IEEE ± and comparisons)
-    on one number, so both give the same bits; it only skips the array machinery.
-    """
-    h = np.asarray(h)
-    if h.ndim == 0:
-        x = float(h)
-        if -_PI <= x < _PI:
-            return x
-        w = float(np.mod(x + _PI, _TWO_PI)) - _PI
-        return w - _TWO_PI if w >= _PI else w
-    w = np.mod(h + _PI, _TWO_PI) - _PI
-    w = np.where(w >= _PI, w - _TWO_PI, w)
-    return np.where((h >= -_PI) & (h < _PI), h, w)
-
-
 def _require(
     ok: bool | np.bool_ | NDArray[np.bool_], name: str, value: ArrayLike, cond: str
 ) -> None:
@@ -284,7 +271,7 @@ def vector_field_heading(
         gain = k * entry_angle * np.asarray(speed, dtype=np.float64) / (course_gain * tau_a)
         feed = gain * np.power(ratio, k - 1.0) * np.sin(np.subtract(course, path_angle))
         psi_d = psi_d - np.where(ratio < 1.0, feed, 0.0)
-    return _wrapped(psi_d)
+    return wrap_angle(psi_d)
 
 
 def tvvf_theta(cross_track: ArrayLike, slope: float = 0.05, offset: float = 1.0) -> FloatOrArray:
@@ -343,4 +330,119 @@ def tvvf_heading(
     with np.errstate(over="ignore"):  # |ye|^θ → inf far from the path: atan(inf) = π/2
         ratio = np.power(a, th) / (delta_a / error_unit)
     psi_d = path_angle - np.sign(e) * np.arctan(ratio) - sideslip
-    return _wrapped(psi_d)
+    return wrap_angle(psi_d)
+
+
+# --------------------------------------------------------------------------------------------
+# TVVF derivatives in ye — for controllers that feed ψ̇d, ψ̈d forward (Xu et al. 2021 eq. (35))
+# Floats only (math module): one ship per call.
+# --------------------------------------------------------------------------------------------
+def tvvf_heading_derivatives(
+    cross_track: float,
+    delta: float,
+    theta_slope: float = 0.05,
+    theta_offset: float = 1.0,
+    error_unit: float = 1.0,
+) -> tuple[float, float]:
+    """dψd/dye [rad/m] and d²ψd/dye² [rad/m²] of :func:`tvvf_heading` (default θ).
+
+    ψd = γp − sgn(ye)·atan(q(a)/D) − β, a = |ye|/unit, D = Δ/unit, q(a) = a^θ(a),
+    θ(a) = slope·a + offset.  With q' = q·(slope·ln a + θ/a) and
+    q'' = q'·(slope·ln a + θ/a) + q·(2·slope/a − θ/a²), F = atan(q/D) has
+    F' = (q'/D)/(1 + (q/D)²) and F'' = ((q''/D)(1 + (q/D)²) − 2(q/D)(q'/D)²)/(1 + (q/D)²)²;
+    dψd/dye = −F'(a)/unit and d²ψd/dye² = −sgn(ye)·F''(a)/unit².  a is floored at 1e-9
+    (the log singularity of q'' at ye = 0 has the small weight ``theta_slope``); far from the
+    path (q/D > 1e12) both derivatives are 0.  γp and β are held constant.
+
+    Args:
+        cross_track: ye [m], > 0 left of the path.
+        delta: Δ [m], > 0.
+        theta_slope, theta_offset: θ's slope (per error unit) and offset.
+        error_unit: [m], > 0, unit in which ye and Δ enter the law.
+    """
+    _require(delta > 0.0, "delta", delta, "> 0")
+    _require(error_unit > 0.0, "error_unit", error_unit, "> 0")
+    unit = error_unit
+    d = delta / unit
+    a = max(abs(cross_track) / unit, 1e-9)
+    th = theta_slope * a + theta_offset
+    log_a = math.log(a)
+    log_ratio = th * log_a - math.log(d)  # ln(q/D)
+    if log_ratio > math.log(1e12):
+        return 0.0, 0.0
+    g = math.exp(log_ratio)  # q/D
+    lam = theta_slope * log_a + th / a  # q'/q
+    g1 = g * lam  # q'/D
+    g2 = g1 * lam + g * (2.0 * theta_slope / a - th / (a * a))  # q''/D
+    den = 1.0 + g * g
+    f1 = g1 / den
+    f2 = (g2 * den - 2.0 * g * g1 * g1) / (den * den)
+    sign = 1.0 if cross_track > 0 else (-1.0 if cross_track < 0 else 0.0)
+    return -f1 / unit, -sign * f2 / (unit * unit)
+
+
+# --------------------------------------------------------------------------------------------
+# The law table: the only place a guidance law is added
+# --------------------------------------------------------------------------------------------
+def _los_law(g: Any, e: Any, path_angle: Any, L: float, scale: Any, xp: Any) -> Any:
+    """LOS, Liu et al. (2019) eqs. (9), (12): ψp − asin(e / R_LOS), R_LOS = nL or |e| + L."""
+    n_l = (g.los_radius_L * scale) * L
+    abs_e = xp.abs(e)
+    return path_angle - xp.arcsin(e / xp.where(abs_e <= n_l, n_l, abs_e + L))
+
+
+def _lookahead_law(g: Any, e: Any, path_angle: Any, L: float, scale: Any, xp: Any) -> Any:
+    """Look-ahead LOS, Xu & Guedes Soares (2020) eq. (6) with Δ = lookahead_L·L."""
+    return wrap_angle(path_angle + xp.arctan(-e / (g.lookahead_L * L * scale)))
+
+
+def _vf_law(g: Any, e: Any, path_angle: Any, L: float, scale: Any, xp: Any) -> Any:
+    """VF, Xu & Guedes Soares (2020) Algorithm 1 with τ = vf_tau_L·L (numpy for both)."""
+    return vector_field_heading(
+        e, path_angle, g.vf_tau_L * L * scale, math.radians(g.vf_chi_e_deg), g.vf_k
+    )
+
+
+def _tvvf_law(g: Any, e: Any, path_angle: Any, L: float, scale: Any, xp: Any) -> Any:
+    """TVVF, Xu, Oliveira & Guedes Soares (2021) eqs. (9), (48) with Δ = tvvf_delta_L·L."""
+    return tvvf_heading(
+        e,
+        path_angle,
+        g.tvvf_delta_L * L * scale,
+        theta_slope=g.tvvf_theta_slope,
+        theta_offset=g.tvvf_theta_offset,
+        error_unit=TVVF_ERROR_UNITS[g.tvvf_error_unit](L),
+    )
+
+
+#: law name (a scenario's ``guidance.law``) → ``law(settings, e [m], ψp [rad], L [m], scale,
+#: xp) -> ψd [rad]``: ``settings`` holds the law's parameters (a scenario's ``guidance:``
+#: block), ``scale`` multiplies its length scale (the guidance action's 2^a0), ``xp`` is
+#: SCALAR (floats) or ARRAY (arrays over ships) of :mod:`shipgym.numerics`.
+GUIDANCE_LAWS: dict[str, Callable[..., Any]] = {
+    "los": _los_law,
+    "lookahead_los": _lookahead_law,
+    "vf": _vf_law,
+    "tvvf": _tvvf_law,
+}
+
+
+def desired_heading(
+    settings: Any,
+    cross_track: Any,
+    path_angle: Any,
+    ship_length: float,
+    scale: Any = 1.0,
+    xp: Any = SCALAR,
+    law: str | None = None,
+) -> Any:
+    """Desired heading [rad] of the law ``law`` (default ``settings.law``) from the table
+    :data:`GUIDANCE_LAWS`, for one ship (floats) or N (arrays, ``xp=ARRAY``)."""
+    name = settings.law if law is None else law
+    try:
+        fn = GUIDANCE_LAWS[name]
+    except KeyError:
+        raise ValueError(
+            f"unknown guidance law {name!r}; valid: {', '.join(GUIDANCE_LAWS)}"
+        ) from None
+    return fn(settings, cross_track, path_angle, ship_length, scale, xp)

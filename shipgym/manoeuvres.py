@@ -12,10 +12,15 @@ from collections.abc import Callable
 
 import numpy as np
 
+from shipgym.errors import ShipgymError
 from shipgym.models.base import ShipModel
 from shipgym.models.integrator import PeriodIntegrator
 
 DEG = math.pi / 180.0
+
+
+class ManoeuvreError(ShipgymError, ValueError):
+    """A manoeuvre's settings are impossible (e.g. a zig-zag angle ≤ 0)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -96,7 +101,7 @@ def zigzag(
     switch = (switch_deg if switch_deg is not None else rudder_deg) * DEG
     rudder = rudder_deg * DEG
     if rudder <= 0 or switch <= 0:
-        raise ValueError("zig-zag rudder and switch angles must be > 0")
+        raise ManoeuvreError("zig-zag rudder and switch angles must be > 0")
     h = h if h is not None else model.fine_step
     duration = duration if duration is not None else 60.0 * model.length / model.nominal_speed
     ipsi = model.state_index("psi")

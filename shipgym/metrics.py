@@ -49,10 +49,7 @@ ARRAY_FIELDS: tuple[str, ...] = (
     "rudder_angle",
     "rudder_command",
     "reward",
-    "compute_time",
 )
-# Arrays that must be finite (compute_time may be NaN = unknown).
-_FINITE_FIELDS: tuple[str, ...] = ARRAY_FIELDS[:-1]
 
 
 @dataclass
@@ -70,14 +67,12 @@ class EpisodeLog:
         reward: per-step reward (dimensionless).
         ship_length: ship length L (m).
         dt: control period Ts (s).
-        compute_time: controller wall-clock time per step (s); NaN where unknown
-            (``None`` → all NaN).
         change_time: time of the first parameter change (s), ``None`` if nothing changes.
         reached_goal: whether the last waypoint was reached.
 
     Raises:
-        ValueError: empty log, unequal lengths, non-finite values (NaN/inf) in any array other
-            than ``compute_time``, non-increasing ``t``, or non-positive ``ship_length``/``dt``.
+        ValueError: empty log, unequal lengths, non-finite values (NaN/inf) in any array,
+            non-increasing ``t``, or non-positive ``ship_length``/``dt``.
             The message names the offending field.
     """
 
@@ -89,7 +84,6 @@ class EpisodeLog:
     reward: np.ndarray
     ship_length: float
     dt: float
-    compute_time: np.ndarray | None = None
     change_time: float | None = None
     reached_goal: bool = False
 
@@ -97,8 +91,6 @@ class EpisodeLog:
         n: int | None = None
         for name in ARRAY_FIELDS:
             value = getattr(self, name)
-            if name == "compute_time" and value is None:
-                continue
             try:
                 arr = np.asarray(value, dtype=np.float64)
             except (TypeError, ValueError) as exc:
@@ -108,8 +100,6 @@ class EpisodeLog:
             setattr(self, name, arr.copy())
             if n is None:
                 n = arr.shape[0]
-        if self.compute_time is None:
-            self.compute_time = np.full(n if n is not None else 0, np.nan)
         self.ship_length = float(self.ship_length)
         self.dt = float(self.dt)
         if self.change_time is not None:
@@ -135,7 +125,7 @@ class EpisodeLog:
                 raise ValueError(
                     f"EpisodeLog.{name}: length {arr.shape[0]} differs from len(t) = {n}"
                 )
-        for name in _FINITE_FIELDS:
+        for name in ARRAY_FIELDS:
             arr = getattr(self, name)
             bad = ~np.isfinite(arr)
             if bad.any():
@@ -158,8 +148,8 @@ class EpisodeLog:
         """Build a log from one dict per control step.
 
         Each record needs the keys ``t``, ``cross_track_error``, ``heading_error``,
-        ``rudder_angle``, ``rudder_command``, ``reward``; ``compute_time`` is optional (missing
-        or ``None`` → NaN). Other keys (e.g. the rest of an env ``info``) are ignored.
+        ``rudder_angle``, ``rudder_command``, ``reward``. Other keys (e.g. the rest of an env
+        ``info``) are ignored.
         ``scalars`` are the remaining constructor arguments: ``ship_length``, ``dt`` and
         optionally ``change_time``, ``reached_goal``.
 
@@ -170,14 +160,10 @@ class EpisodeLog:
             raise ValueError("EpisodeLog.t: empty episode log (no records)")
         columns: dict[str, list[float]] = {name: [] for name in ARRAY_FIELDS}
         for i, rec in enumerate(records):
-            for name in _FINITE_FIELDS:
+            for name in ARRAY_FIELDS:
                 if name not in rec:
                     raise ValueError(f"EpisodeLog.{name}: missing from record {i}")
                 columns[name].append(_to_float(rec[name], name, i))
-            ct = rec.get("compute_time")
-            columns["compute_time"].append(
-                math.nan if ct is None else _to_float(ct, "compute_time", i)
-            )
         arrays = {name: np.asarray(col, dtype=np.float64) for name, col in columns.items()}
         return cls(**arrays, **scalars)
 
@@ -280,8 +266,6 @@ def compute_metrics(
         success (bool): ``log.reached_goal``.
         steps (int): n.
         duration (s): n·dt.
-        compute_ms_mean, compute_ms_max (ms): of the known (non-NaN) compute times; NaN if
-            none is known.
 
     Raises:
         ValueError: invalid log (see :class:`EpisodeLog`), naming the field.
@@ -314,10 +298,6 @@ def compute_metrics(
     )
     J = float(np.sum(integrand) * log.dt)
 
-    ct = log.compute_time[np.isfinite(log.compute_time)]
-    ct_mean = float(np.mean(ct) * 1e3) if ct.size else math.nan
-    ct_max = float(np.max(ct) * 1e3) if ct.size else math.nan
-
     return {
         "ace": ace,
         "ace_L": ace / L,
@@ -339,8 +319,6 @@ def compute_metrics(
         "success": bool(log.reached_goal),
         "steps": int(n),
         "duration": float(n * log.dt),
-        "compute_ms_mean": ct_mean,
-        "compute_ms_max": ct_max,
     }
 
 
@@ -402,3 +380,28 @@ def aggregate(
         out[key] = mean
         out[f"{key}_std"] = std
     return out
+
+
+# --------------------------------------------------------------------------------------------
+# Spectral content of a signal (e.g. rudder activity above a filter corner)
+# --------------------------------------------------------------------------------------------
+def high_frequency_power(signal: np.ndarray, period: float, cutoff: float) -> float:
+    """Power of a signal above ``cutoff`` [rad/s]: ∫ PSD over f ≥ cutoff/2π [signal²].
+
+    Welch's one-sided power spectral density (scipy.signal.welch, Hann segments of up to
+    256 samples, mean removed) of ``signal`` sampled at ``period`` [s], integrated by the
+    trapezoid rule; √ of the result is the RMS of the signal's content above the cutoff
+    (Xu, Oliveira & Guedes Soares 2021 §3.2: C(s) removes the rudder's high frequencies).
+    """
+    from scipy.signal import welch  # only this metric needs scipy
+
+    x = np.asarray(signal, dtype=float)
+    if x.ndim != 1 or x.size < 8:
+        raise ValueError(f"need a 1-D signal of at least 8 samples, got shape {x.shape}")
+    if not (period > 0 and cutoff >= 0):
+        raise ValueError(f"need period > 0 and cutoff ≥ 0, got {period}, {cutoff}")
+    freq, psd = welch(x, fs=1.0 / period, nperseg=min(256, x.size))
+    high = freq >= cutoff / (2.0 * math.pi)
+    if high.sum() < 2:
+        return 0.0
+    return float(np.trapezoid(psd[high], freq[high]))

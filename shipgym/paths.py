@@ -26,12 +26,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal, overload
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import PchipInterpolator
-from scipy.optimize import minimize_scalar
+
+from shipgym.angles import wrap_angle
 
 __all__ = [
     "LegFrame",
@@ -39,36 +40,12 @@ __all__ = [
     "WaypointPath",
     "acceptance_circle_reached",
     "advance_leg",
+    "along_track",
     "along_track_reached",
+    "cross_track",
     "segment_frame",
     "wrap_angle",
 ]
-
-_PI = math.pi
-_TWO_PI = 2.0 * math.pi
-
-
-# --------------------------------------------------------------------------------------------
-# Angles
-# --------------------------------------------------------------------------------------------
-@overload
-def wrap_angle(a: float) -> float: ...
-@overload
-def wrap_angle(a: NDArray[np.floating]) -> NDArray[np.float64]: ...
-
-
-def wrap_angle(a):
-    """Wrap an angle [rad] (float or numpy array) to the half-open interval [−π, π)."""
-    if isinstance(a, (float, int)):  # also catches numpy float64 (a float subclass)
-        w = (a + _PI) % _TWO_PI - _PI
-        # Float modulo can round up to exactly 2π for tiny negative inputs (e.g. −1e-20).
-        return float(w - _TWO_PI) if w >= _PI else float(w)
-    arr = np.asarray(a, dtype=float)
-    w = np.mod(arr + _PI, _TWO_PI) - _PI
-    w = np.where(w >= _PI, w - _TWO_PI, w)
-    if w.ndim == 0:
-        return float(w)
-    return w
 
 
 # --------------------------------------------------------------------------------------------
@@ -91,6 +68,18 @@ class LegFrame:
     leg_length: float
 
 
+def along_track(rx: Any, ry: Any, c: Any, s: Any) -> Any:
+    """x_r = rx cos ψp + ry sin ψp [m] of the offset (rx, ry) from a point of the path, with
+    (c, s) = (cos ψp, sin ψp) — Borkowski (2018) eq. (25); floats or arrays."""
+    return rx * c + ry * s
+
+
+def cross_track(rx: Any, ry: Any, c: Any, s: Any) -> Any:
+    """e = −rx sin ψp + ry cos ψp [m], > 0 left of the path — Borkowski (2018) eq. (25);
+    floats or arrays.  The one signed cross-track formula of the package."""
+    return -rx * s + ry * c
+
+
 def segment_frame(
     x: float, y: float, p_start: tuple[float, float], p_end: tuple[float, float]
 ) -> LegFrame:
@@ -110,7 +99,9 @@ def segment_frame(
     rx = x - x0
     ry = y - y0
     # Borkowski (2018) eq. (25); the path angle is eq. (26) written as atan2.
-    return LegFrame(rx * c + ry * s, -rx * s + ry * c, math.atan2(dy, dx), length)
+    return LegFrame(
+        along_track(rx, ry, c, s), cross_track(rx, ry, c, s), math.atan2(dy, dx), length
+    )
 
 
 def _validate_waypoints(waypoints: ArrayLike) -> NDArray[np.float64]:
@@ -186,7 +177,9 @@ class WaypointPath:
         s = self._sin[leg]
         rx = x - self._x0[leg]
         ry = y - self._y0[leg]
-        return LegFrame(rx * c + ry * s, -rx * s + ry * c, self._angle[leg], self._len[leg])
+        return LegFrame(
+            along_track(rx, ry, c, s), cross_track(rx, ry, c, s), self._angle[leg], self._len[leg]
+        )
 
     def leg_angle(self, leg: int) -> float:
         """Path angle ψp [rad] of leg `leg`."""
@@ -242,8 +235,8 @@ class WaypointPath:
         p0 = self.waypoints[:-1]
         rx = x - p0[:, 0]
         ry = y - p0[:, 1]
-        along = rx * self._unit[:, 0] + ry * self._unit[:, 1]
-        cross = -rx * self._unit[:, 1] + ry * self._unit[:, 0]
+        along = along_track(rx, ry, self._unit[:, 0], self._unit[:, 1])
+        cross = cross_track(rx, ry, self._unit[:, 0], self._unit[:, 1])
         t = np.clip(along, 0.0, self.leg_lengths)
         d2 = (along - t) ** 2 + cross**2
         k = int(np.argmin(d2))
@@ -320,6 +313,14 @@ class PchipPath:
         self.waypoint_arc_lengths: NDArray[np.float64] = _readonly(sg[knot_idx].copy())
         self._tol_s = 1e-13 * max(1.0, self.length)
         self._tiny_speed = 1e-12
+        #: tangent angle [rad] at each waypoint (the outgoing one; the incoming at the end)
+        self.waypoint_angles: NDArray[np.float64] = _readonly(
+            np.asarray(self.angle(self.waypoint_arc_lengths), dtype=np.float64)
+        )
+        self.waypoint_arc_lengths_list: list[float] = self.waypoint_arc_lengths.tolist()
+        self.waypoint_angles_list: list[float] = self.waypoint_angles.tolist()
+        self.end: tuple[float, float] = (float(wp[-1, 0]), float(wp[-1, 1]))
+        self._cells = _CurveCells(self)
 
     def __repr__(self) -> str:
         return f"PchipPath(n_waypoints={self.waypoints.shape[0]}, length={self.length:.6g})"
@@ -415,73 +416,213 @@ class PchipPath:
         idx = np.searchsorted(self.waypoint_arc_lengths, float(s), side="right") - 1
         return int(np.clip(idx, 0, self.waypoints.shape[0] - 2))
 
+    # -- closest point, fast (the step core) ----------------------------------------------
+    def follow(self, x: Any, y: Any, s_hint: Any, window: float | None, xp: Any) -> CurvePoint:
+        """Closest point of the curve to ship position(s) (x, y) [m], for one ship or N.
+
+        The grid point nearest to the ship among those within ``window`` [m] of arc length
+        around ``s_hint`` [m] (and the next one out on each side; all of them with
+        ``window=None``) starts a safeguarded Newton iteration on g(t) = (P(t) − q)·P'(t) = 0
+        inside its two neighbouring grid cells (a fixed number of iterations: quadratic
+        convergence from within a cell; the grid point is kept if the iterate is farther).
+        Arc length s by 8-point Gauss–Legendre on the cell.  Written once for ``xp = SCALAR``
+        (floats) and ``xp = ARRAY`` (arrays over ships): the same IEEE operations in the
+        same order, so both give the same bits (:mod:`shipgym.numerics`).  About 15 µs for
+        one ship, ≈ 1 µs per ship for N = 1024 (the scipy search it replaces: ≈ 0.3–1 ms).
+        """
+        return self._cells.follow(x, y, s_hint, window, xp)
+
     # -- closest point --------------------------------------------------------------------
     def project(
         self, x: float, y: float, s_hint: float | None = None, window: float | None = None
     ) -> tuple[float, float, float, NDArray[np.float64]]:
-        """Closest point of the curve to (x, y) [m].
+        """Closest point of the curve to (x, y) [m] (:meth:`follow` for one ship).
 
         The search is global unless both `s_hint` and `window` [m] are given, in which case it
-        is restricted to arc lengths [s_hint − window, s_hint + window] ∩ [0, length] (use it
-        to follow the ship along self-approaching routes).  A coarse search over the arc-length
-        grid is refined with a bounded scalar minimisation of the squared distance.
+        is restricted to the grid points within `window` of arc length around `s_hint` (use it
+        to follow the ship along self-approaching routes).
 
         Returns (s, cross_track, path_angle, closest_point) as :meth:`WaypointPath.project`,
         with the signed cross-track e = −(x − x_c) sin ψ_c + (y − y_c) cos ψ_c relative to the
         tangent angle ψ_c at the closest point (x_c, y_c) — positive left of the path.
         """
-        tg, pg = self._tg, self._pg
-        if s_hint is not None and window is not None:
-            if window < 0.0:
-                raise ValueError(f"window must be >= 0, got {window}")
-            s_lo = max(0.0, float(s_hint) - window)
-            s_hi = min(self.length, float(s_hint) + window)
-            if s_lo > s_hi:  # hint outside the path: search at the nearest end
-                s_lo = s_hi = min(max(float(s_hint), 0.0), self.length)
-            t_lo, t_hi = self._t_of_s(np.array([s_lo, s_hi]))
-            inside = (tg > t_lo) & (tg < t_hi)
-            cand_t = np.concatenate(([t_lo], tg[inside], [t_hi]))
-            cand_p = np.vstack((self._p(np.array([t_lo])), pg[inside], self._p(np.array([t_hi]))))
+        from shipgym.numerics import SCALAR
+
+        local = s_hint is not None and window is not None
+        if local and window < 0.0:
+            raise ValueError(f"window must be >= 0, got {window}")
+        hint = float(s_hint) if local else 0.0
+        p = self.follow(float(x), float(y), hint, float(window) if local else None, SCALAR)
+        return p.s, p.cross_track, p.angle, np.array([p.x, p.y])
+
+
+@dataclass(frozen=True, slots=True)
+class CurvePoint:
+    """Closest point of a :class:`PchipPath` to a ship (floats, or arrays over N ships)."""
+
+    grid_index: Any  # nearest grid point
+    t: Any  # curve parameter (cumulative chord length) [m]
+    s: Any  # arc length [m]
+    x: Any  # closest point [m]
+    y: Any
+    ux: Any  # unit tangent (cos ψc, sin ψc)
+    uy: Any
+    angle: Any  # tangent angle ψc [rad] in [−π, π)
+    cross_track: Any  # e = −(x − x_c) sin ψc + (y − y_c) cos ψc [m], > 0 left of the path
+
+
+_NEWTON_ITERATIONS = 4
+
+
+class _CurveCells:
+    """Per-grid-cell cubic coefficients of a PCHIP path, as lists (one ship) and arrays (N).
+
+    Cell j spans grid parameters [tg[j], tg[j+1]] inside one PCHIP piece with origin o_j:
+    P(t) = ((c0 τ + c1) τ + c2) τ + c3, τ = t − o_j, for x and y.
+    """
+
+    def __init__(self, path: PchipPath) -> None:
+        tg = path._tg
+        knots = path._knots
+        coef = path._p.c  # (4, pieces, 2), highest power first
+        piece = np.clip(np.searchsorted(knots, tg[:-1], side="right") - 1, 0, coef.shape[1] - 1)
+        tables = {
+            "tg": tg,
+            "sg": path._sg,
+            "px": path._pg[:, 0],
+            "py": path._pg[:, 1],
+            "origin": knots[piece],
+            # fallback direction where the parametric speed vanishes (corners): grid angle
+            "grid_angle": path._tangent_angle(tg),
+        }
+        cells = [knots[piece]]  # origin, then per axis: c0..c3, P' (d0, d1), P'' (e0)
+        for axis in (0, 1):
+            c = coef[:, piece, axis]
+            cells += [c[0], c[1], c[2], c[3], 3.0 * c[0], 2.0 * c[1], 6.0 * c[0]]
+        self.arrays = dict(tables)
+        self.lists = {k: v.tolist() for k, v in tables.items()}
+        #: per cell: (origin, c0x, c1x, c2x, c3x, d0x, d1x, e0x, c0y, …, e0y)
+        self.cell_arrays = tuple(cells)
+        self.cell_tuples = list(zip(*(c.tolist() for c in cells), strict=True))
+        self.grid_ux = np.cos(tables["grid_angle"])
+        self.grid_uy = np.sin(tables["grid_angle"])
+        self.n_grid = tg.size
+        self.tiny = path._tiny_speed
+        self.gl = list(zip(_GL_NODES.tolist(), _GL_WEIGHTS.tolist(), strict=True))
+        self._widths: dict[float, int] = {}
+
+    def _window_width(self, window: float) -> int:
+        """Most grid points any arc-length window of ±``window`` [m] (plus the next point
+        out on each side) can hold: the candidate count of the batched search."""
+        if window not in self._widths:
+            sg = self.arrays["sg"]
+            lo = np.clip(np.searchsorted(sg, sg - window, side="right") - 1, 0, sg.size - 1)
+            hi = np.clip(np.searchsorted(sg, sg + window, side="right"), 0, sg.size - 1)
+            # windows centred between grid points hold at most one more point
+            self._widths[window] = int(np.max(hi - lo)) + 2
+        return self._widths[window]
+
+    def _cell(self, j: Any, xp: Any) -> tuple[Any, ...]:
+        """Cell coefficients: a tuple of floats (one ship) or of arrays gathered by j."""
+        if xp.batched:
+            return tuple(c[j] for c in self.cell_arrays)
+        return self.cell_tuples[j]
+
+    def follow(self, x: Any, y: Any, s_hint: Any, window: float | None, xp: Any) -> CurvePoint:
+        tab = self.arrays if xp.batched else self.lists
+        a = self.arrays
+        last = self.n_grid - 1
+        # -- coarse: nearest grid point among the candidates (first one on ties)
+        if window is None:
+            lo, hi = 0, last
         else:
-            cand_t, cand_p = tg, pg
-        d2 = (cand_p[:, 0] - x) ** 2 + (cand_p[:, 1] - y) ** 2
-        k = int(np.argmin(d2))
-        t_best = float(cand_t[k])
-        d2_best = float(d2[k])
-        a = float(cand_t[max(k - 1, 0)])
-        b = float(cand_t[min(k + 1, cand_t.size - 1)])
-        if b > a:
-            p = self._p
-
-            def dist2(t: float) -> float:
-                q = p(t)
-                return (float(q[0]) - x) ** 2 + (float(q[1]) - y) ** 2
-
-            res = minimize_scalar(
-                dist2, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * (b - a)}
+            lo = xp.clip_index(xp.searchsorted_right(tab["sg"], s_hint - window) - 1, 0, last)
+            hi = xp.clip_index(xp.searchsorted_right(tab["sg"], s_hint + window), 0, last)
+        if xp.batched:
+            width = self.n_grid if window is None else self._window_width(window)
+            idx = (
+                np.minimum(lo + np.arange(width), hi)
+                if window is None
+                else np.minimum(lo[:, None] + np.arange(width), hi[:, None])
             )
-            if res.fun < d2_best:
-                t_best, d2_best = float(res.x), float(res.fun)
-            # One Newton polish of g(t) = (P − q)·P' = 0, kept only if it stays in the bracket
-            # and does not increase the distance (Brent's tolerance is ~1e-8 relative in t).
-            q = p(t_best)
-            d1 = self._dp(t_best)
-            g = (float(q[0]) - x) * float(d1[0]) + (float(q[1]) - y) * float(d1[1])
-            d2v = self._ddp(t_best)
-            dg = float(d1[0]) ** 2 + float(d1[1]) ** 2
-            dg += (float(q[0]) - x) * float(d2v[0]) + (float(q[1]) - y) * float(d2v[1])
-            if dg > 0.0:
-                t_new = t_best - g / dg
-                if a <= t_new <= b and dist2(t_new) <= d2_best:
-                    t_best = t_new
-        t_arr = np.array([t_best])
-        s = float(self._s_of_t(t_arr)[0])
-        closest = self._p(t_arr)[0]
-        psi = float(self._tangent_angle(t_arr)[0])
-        rx = x - float(closest[0])
-        ry = y - float(closest[1])
-        cross = -rx * math.sin(psi) + ry * math.cos(psi)
-        return s, float(cross), psi, closest
+            idx = np.broadcast_to(idx, (np.size(x), width))
+            dx = a["px"][idx] - x[:, None]
+            dy = a["py"][idx] - y[:, None]
+            k = idx[np.arange(idx.shape[0]), np.argmin(dx * dx + dy * dy, axis=1)]
+        else:
+            dx = a["px"][lo : hi + 1] - x
+            dy = a["py"][lo : hi + 1] - y
+            k = lo + int(np.argmin(dx * dx + dy * dy))
+        tg = tab["tg"]
+        k_lo = xp.maximum(k - 1, 0)
+        k_hi = xp.minimum(k + 1, last)
+        t_lo, t_hi, t_k = tg[k_lo], tg[k_hi], tg[k]
+        gx, gy = tab["px"][k] - x, tab["py"][k] - y
+        d2_grid = gx * gx + gy * gy
+        # -- Newton on g(t) = (P − q)·P' inside [t_lo, t_hi]
+        t = t_k
+        for _ in range(_NEWTON_ITERATIONS):
+            j = xp.minimum(xp.where(t < t_k, k_lo, k), last - 1)
+            px, py, dpx, dpy, ddx, ddy = _cubic(self._cell(j, xp), t)
+            rx, ry = px - x, py - y
+            g = rx * dpx + ry * dpy
+            dg = dpx * dpx + dpy * dpy + rx * ddx + ry * ddy
+            positive = dg > 0.0
+            step = xp.where(positive, g / xp.where(positive, dg, 1.0), 0.0)
+            t = xp.minimum(xp.maximum(t - step, t_lo), t_hi)
+        j = xp.minimum(xp.where(t < t_k, k_lo, k), last - 1)
+        cell = self._cell(j, xp)
+        px, py, dpx, dpy, _, _ = _cubic(cell, t)
+        rx, ry = px - x, py - y
+        worse = rx * rx + ry * ry > d2_grid
+        if xp.batched or worse:  # keep the grid point (one ship: rarely)
+            t = xp.where(worse, t_k, t)
+            j = xp.where(worse, xp.minimum(k, last - 1), j)
+            cell = self._cell(j, xp)
+            px, py, dpx, dpy, _, _ = _cubic(cell, t)
+        # -- arc length: s_j + ∫_{tg_j}^{t} |P'| dt (8-point Gauss–Legendre, fixed order)
+        t_j = tg[j]
+        half = 0.5 * (t - t_j)
+        mid = 0.5 * (t + t_j)
+        acc = 0.0
+        for node, weight in self.gl:
+            qx, qy = _velocity(cell, mid + half * node)
+            acc = acc + weight * xp.sqrt(qx * qx + qy * qy)
+        s = tab["sg"][j] + half * acc
+        # -- tangent: P'/|P'| (the grid direction where P' vanishes, at corners)
+        speed = xp.sqrt(dpx * dpx + dpy * dpy)
+        stalled = speed <= self.tiny
+        safe = xp.where(stalled, 1.0, speed)
+        if xp.batched:
+            ux = np.where(stalled, self.grid_ux[k], dpx / safe)
+            uy = np.where(stalled, self.grid_uy[k], dpy / safe)
+        else:
+            ux = float(self.grid_ux[k]) if stalled else dpx / safe
+            uy = float(self.grid_uy[k]) if stalled else dpy / safe
+        angle = xp.where(stalled, tab["grid_angle"][k], xp.arctan2(dpy, dpx))
+        angle = wrap_angle(angle)
+        cross = -(x - px) * uy + (y - py) * ux
+        return CurvePoint(k, t, s, px, py, ux, uy, angle, cross)
+
+
+def _cubic(cell: tuple[Any, ...], t: Any) -> tuple[Any, ...]:
+    """P, P' and P'' of a cell (:attr:`_CurveCells.cell_tuples`) at parameter t, by Horner."""
+    o, c0x, c1x, c2x, c3x, d0x, d1x, e0x, c0y, c1y, c2y, c3y, d0y, d1y, e0y = cell
+    tau = t - o
+    return (
+        ((c0x * tau + c1x) * tau + c2x) * tau + c3x,
+        ((c0y * tau + c1y) * tau + c2y) * tau + c3y,
+        (d0x * tau + d1x) * tau + c2x,
+        (d0y * tau + d1y) * tau + c2y,
+        e0x * tau + d1x,
+        e0y * tau + d1y,
+    )
+
+
+def _velocity(cell: tuple[Any, ...], t: Any) -> tuple[Any, Any]:
+    """P'(t) of a cell (the integrand of the arc length)."""
+    tau = t - cell[0]
+    return (cell[5] * tau + cell[6]) * tau + cell[3], (cell[12] * tau + cell[13]) * tau + cell[10]
 
 
 # --------------------------------------------------------------------------------------------

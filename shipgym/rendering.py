@@ -44,14 +44,11 @@ def render_frame(env: Any, fig: Any, mode: str) -> tuple[Any, np.ndarray | None]
     ax.plot(wp[:, 0], wp[:, 1], "ko", ms=3)
     track = env.track
     ax.plot(track[:, 0], track[:, 1], "b-", lw=1.2, label="track")
-    x = env._state
-    hull = ship_outline(
-        float(x[env._ix]), float(x[env._iy]), float(x[env._ipsi]), env.scenario.ship_length
-    )
+    hull = ship_outline(*env.pose, env.scenario.ship_length)
     ax.fill(hull[:, 0], hull[:, 1], color="tab:red", alpha=0.8)
-    frame = env._tracker.frame
+    frame = env.frame
     ax.set_title(
-        f"{env.scenario.name}  t = {env._t:.1f} s  e = {frame.cross_track:+.3f} m", fontsize=9
+        f"{env.scenario.name}  t = {env.time:.1f} s  e = {frame.cross_track:+.3f} m", fontsize=9
     )
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x [m]")

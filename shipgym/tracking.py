@@ -1,106 +1,247 @@
 """Where the ship is relative to the path: active leg, cross-track error, look-ahead info.
 
-One tracker for both path types, used by the env (and by any controller that wants the
-same bookkeeping from measured positions).
+One tracker for both path types and for one ship or N: the single env, the batched env and
+the controllers that keep their own bookkeeping from measured positions all use
+:class:`PathTracker`.  Its pure functions (:func:`advance_legs`, :func:`polyline_frame`,
+:func:`curve_frame`) are written once for floats and arrays (``xp`` of
+:mod:`shipgym.numerics`), so one ship and the matching ship of a batch get the same bits.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 
-from shipgym.paths import PchipPath, WaypointPath, advance_leg, segment_frame, wrap_angle
+from shipgym.angles import wrap_angle
+from shipgym.numerics import ARRAY, SCALAR
+from shipgym.paths import CurvePoint, PchipPath, WaypointPath, along_track, cross_track
+
+SWITCHING_RULES = ("circle", "along_track")
 
 
 @dataclasses.dataclass(slots=True)
 class TrackFrame:
-    """Ship relative to the path at one instant (SI units)."""
+    """Ship relative to the path at one instant (SI units; floats, or arrays over N ships)."""
 
-    cross_track: float  # e [m], signed (positive left of the path)
-    path_angle: float  # ψp [rad] of the active leg / curve tangent
-    along_track: float  # progress along the active leg [m] (polyline) or arc length s (curve)
-    leg: int  # active leg (polyline) or waypoint interval (curve)
-    angle_change_next: float  # path-angle change to the next leg [rad]
-    distance_to_next: float  # distance to the next waypoint [m]
-    at_goal: bool  # final waypoint reached
+    cross_track: Any  # e [m], signed (positive left of the path)
+    path_angle: Any  # ψp [rad] of the active leg / curve tangent
+    along_track: Any  # progress along the active leg [m] (polyline) or arc length s (curve)
+    leg: Any  # active leg (polyline) or waypoint interval (curve)
+    angle_change_next: Any  # path-angle change to the next leg [rad]
+    distance_to_next: Any  # distance to the next waypoint [m]
+    at_goal: Any  # final waypoint reached
+
+
+@dataclasses.dataclass(frozen=True)
+class LegTable:
+    """Per-leg constants of a polyline: start/end points, unit direction (c, s) = (cos ψp,
+    sin ψp), length, angle and the angle change to the next leg; each a list (one ship) and
+    an array (N ships: gathered by the leg index array)."""
+
+    lists: dict[str, list[float]]
+    arrays: dict[str, np.ndarray]
+    last_leg: int
+    goal: tuple[float, float]
+
+    @classmethod
+    def of(cls, path: WaypointPath) -> LegTable:
+        wp = [(float(p[0]), float(p[1])) for p in path.waypoints]
+        legs = range(len(wp) - 1)
+        # math.hypot / math.atan2: exactly the numbers of shipgym.paths.segment_frame
+        length = [math.hypot(wp[i + 1][0] - wp[i][0], wp[i + 1][1] - wp[i][1]) for i in legs]
+        lists = {
+            "x0": [wp[i][0] for i in legs],
+            "y0": [wp[i][1] for i in legs],
+            "x1": [wp[i + 1][0] for i in legs],
+            "y1": [wp[i + 1][1] for i in legs],
+            "c": [(wp[i + 1][0] - wp[i][0]) / length[i] for i in legs],
+            "s": [(wp[i + 1][1] - wp[i][1]) / length[i] for i in legs],
+            "length": length,
+            "angle": [math.atan2(wp[i + 1][1] - wp[i][1], wp[i + 1][0] - wp[i][0]) for i in legs],
+            "change": [path.next_leg_angle_change(i) for i in legs],
+        }
+        arrays = {k: np.array(v) for k, v in lists.items()}
+        return cls(lists, arrays, len(wp) - 2, wp[-1])
+
+
+def advance_legs(
+    x: Any, y: Any, leg: Any, table: LegTable, radius: float, switching: str, xp: Any
+) -> Any:
+    """Active leg(s) after the switching rule at position(s) (x, y) [m].
+
+    Leg i ends at waypoint i + 1; while that waypoint counts as reached (``"circle"``: Liu et
+    al. 2019 eq. (13), (x − x_{i+1})² + (y − y_{i+1})² ≤ R0²; ``"along_track"``: Borkowski
+    2018 eq. (27), |P_i P_{i+1}| − x_r < R) the next leg becomes active, so several legs can
+    be skipped in one call; the last leg is never left.
+    """
+    tab = table.arrays if xp.batched else table.lists
+    last = table.last_leg
+    for _ in range(last):
+        if switching == "circle":
+            dx = x - tab["x1"][leg]
+            dy = y - tab["y1"][leg]
+            reached = dx * dx + dy * dy <= radius * radius
+        else:
+            along = along_track(
+                x - tab["x0"][leg], y - tab["y0"][leg], tab["c"][leg], tab["s"][leg]
+            )
+            reached = tab["length"][leg] - along < radius
+        step = reached & (leg < last)
+        if not xp.any(step):
+            break
+        leg = leg + step
+    return leg
+
+
+def polyline_frame(x: Any, y: Any, leg: Any, table: LegTable, radius: float, xp: Any) -> TrackFrame:
+    """Frame of position(s) (x, y) [m] on the active leg(s) (Borkowski 2018 eq. (25)).
+
+    The goal counts as reached on the last leg inside the acceptance circle of the final
+    waypoint or once abeam of it.
+    """
+    tab = table.arrays if xp.batched else table.lists
+    rx, ry = x - tab["x0"][leg], y - tab["y0"][leg]
+    c, s = tab["c"][leg], tab["s"][leg]
+    along = along_track(rx, ry, c, s)
+    gx, gy = x - table.goal[0], y - table.goal[1]
+    nx, ny = x - tab["x1"][leg], y - tab["y1"][leg]
+    at_goal = (leg == table.last_leg) & (
+        (xp.sqrt(gx * gx + gy * gy) <= radius) | (along >= tab["length"][leg])
+    )
+    return TrackFrame(
+        cross_track(rx, ry, c, s),
+        tab["angle"][leg],
+        along,
+        leg,
+        tab["change"][leg],
+        xp.sqrt(nx * nx + ny * ny),
+        at_goal,
+    )
+
+
+def curve_frame(x: Any, y: Any, point: CurvePoint, path: PchipPath, radius: float, xp: Any):
+    """Frame of position(s) (x, y) [m] at their closest point(s) on a PCHIP curve.
+
+    ``leg`` is the waypoint interval holding the closest point; the goal counts as reached
+    inside the acceptance circle of the final waypoint or at the end of the curve.
+    """
+    arc = path.waypoint_arc_lengths if xp.batched else path.waypoint_arc_lengths_list
+    angles = path.waypoint_angles if xp.batched else path.waypoint_angles_list
+    last = len(arc) - 2
+    leg = xp.clip_index(xp.searchsorted_right(arc, point.s) - 1, 0, last)
+    s_next = arc[leg + 1]
+    gx, gy = x - path.end[0], y - path.end[1]
+    at_goal = (xp.sqrt(gx * gx + gy * gy) <= radius) | (point.s >= path.length - 1e-9)
+    return TrackFrame(
+        point.cross_track,
+        point.angle,
+        point.s,
+        leg,
+        wrap_angle(angles[leg + 1] - point.angle),
+        s_next - point.s,
+        at_goal,
+    )
+
+
+def _select(mask: np.ndarray, new: Any, old: Any) -> Any:
+    """Field by field: ``new`` where ``mask``, else ``old`` (dataclasses of arrays)."""
+    return type(new)(
+        *(
+            np.where(mask, getattr(new, f.name), getattr(old, f.name))
+            for f in dataclasses.fields(new)
+        )
+    )
 
 
 class PathTracker:
-    """Active-leg bookkeeping with the waypoint switching rule of the scenario.
+    """Active-leg bookkeeping with the scenario's waypoint switching rule, for one ship
+    (``batch=None``: floats) or N ships (``batch=N``: arrays, updates masked per ship).
 
     For a polyline, the active leg switches by acceptance circle (Liu et al. 2019 eq. (13))
     or along-track distance (Borkowski 2018 eq. (27)) and the cross-track error is taken to
     the active leg, as in Liu et al. (2019).  For a PCHIP curve, the closest point is
-    searched in a window around the previous arc length.  The goal counts as reached on
-    the last leg when the ship is inside the acceptance circle of the final waypoint or has
-    passed abeam of it.
+    searched within 4 acceptance radii of arc length around the previous one
+    (:meth:`shipgym.paths.PchipPath.follow`; globally at reset).
     """
 
     def __init__(
-        self, path: WaypointPath | PchipPath, acceptance_radius: float, switching: str = "circle"
+        self,
+        path: WaypointPath | PchipPath,
+        acceptance_radius: float,
+        switching: str = "circle",
+        batch: int | None = None,
     ) -> None:
+        if switching not in SWITCHING_RULES:
+            raise ValueError(f"unknown switching rule {switching!r}; use one of {SWITCHING_RULES}")
         self.path = path
         self.radius = float(acceptance_radius)
         self.switching = switching
         self.is_curve = isinstance(path, PchipPath)
-        self.leg = 0
-        self.s = 0.0
-        self._wp = [(float(p[0]), float(p[1])) for p in path.waypoints]
+        self.batch = batch
+        self.xp = SCALAR if batch is None else ARRAY
+        zero = 0 if batch is None else np.zeros(batch, dtype=np.int64)
+        if self.is_curve:
+            self._window = 4.0 * self.radius  # arc length searched around the last point [m]
+            self.point: CurvePoint | None = None
+        else:
+            self._legs = LegTable.of(path)
+        self.leg = zero
         self.frame: TrackFrame | None = None
 
-    def reset(self, x: float, y: float) -> TrackFrame:
-        self.leg = 0
-        self.s = 0.0
-        if self.is_curve:
-            self.s = self.path.project(x, y)[0]
-        return self.update(x, y)
+    @property
+    def s(self) -> Any:
+        """Arc length [m] of the closest point (curves only)."""
+        return self.point.s
 
-    def update(self, x: float, y: float) -> TrackFrame:
-        wp = self._wp
-        last_wp = wp[-1]
-        # sqrt of squares (not hypot): the batched env computes the same, bit for bit
-        gx, gy = x - last_wp[0], y - last_wp[1]
-        dist_goal = math.sqrt(gx * gx + gy * gy)
+    def reset(self, x: Any, y: Any, mask: Any = None) -> TrackFrame:
+        """Start (the masked ships) at the first leg / the globally closest curve point."""
         if self.is_curve:
-            path: PchipPath = self.path
-            s, e, angle, _ = path.project(x, y, s_hint=self.s, window=4.0 * self.radius)
-            self.s = s
-            leg = path.segment_index(s)
-            s_next = float(path.waypoint_arc_lengths[leg + 1])
-            change = float(wrap_angle(path.angle(s_next) - angle))
-            self.leg = leg
-            at_goal = dist_goal <= self.radius or s >= path.length - 1e-9
-            self.frame = TrackFrame(e, angle, s, leg, change, s_next - s, at_goal)
-            return self.frame
-        self.leg = advance_leg(self.path, x, y, self.leg, self.radius, self.switching)
-        leg = self.leg
-        f = segment_frame(x, y, wp[leg], wp[leg + 1])
-        last = leg == len(wp) - 2
-        at_goal = last and (dist_goal <= self.radius or f.along_track >= f.leg_length)
-        nxt = wp[leg + 1]
-        self.frame = TrackFrame(
-            f.cross_track,
-            f.path_angle,
-            f.along_track,
-            leg,
-            self.path.next_leg_angle_change(leg),
-            math.sqrt((x - nxt[0]) * (x - nxt[0]) + (y - nxt[1]) * (y - nxt[1])),
-            at_goal,
+            return self._curve(x, y, None, mask)
+        self.leg = self._masked(
+            mask, 0 if self.batch is None else np.zeros_like(self.leg), self.leg
         )
-        return self.frame
+        return self.update(x, y, mask)
+
+    def update(self, x: Any, y: Any, mask: Any = None) -> TrackFrame:
+        """Frame at position(s) (x, y) [m]; with ``mask`` only the masked ships move on."""
+        if self.is_curve:
+            return self._curve(x, y, self._window, mask)
+        xp = self.xp
+        leg = advance_legs(x, y, self.leg, self._legs, self.radius, self.switching, xp)
+        self.leg = self._masked(mask, leg, self.leg)
+        return self._store(polyline_frame(x, y, self.leg, self._legs, self.radius, xp), mask)
+
+    def _curve(self, x: Any, y: Any, window: float | None, mask: Any) -> TrackFrame:
+        hint = 0.0 if window is None else self.point.s
+        point = self.path.follow(x, y, hint, window, self.xp)
+        if mask is not None and self.point is not None:
+            point = _select(mask, point, self.point)
+        self.point = point
+        frame = curve_frame(x, y, point, self.path, self.radius, self.xp)
+        self.leg = frame.leg
+        return self._store(frame, mask)
+
+    def _masked(self, mask: Any, new: Any, old: Any) -> Any:
+        return new if mask is None else np.where(mask, new, old)
+
+    def _store(self, frame: TrackFrame, mask: Any) -> TrackFrame:
+        if mask is not None and self.frame is not None:
+            frame = _select(mask, frame, self.frame)
+        self.frame = frame
+        return frame
 
     def cross_track_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-        """Cross-track errors [m] of sample positions relative to the current frame.
+        """Cross-track errors [m] of sample positions of one ship relative to its frame.
 
         Exact for a polyline (the active leg); for a curve, relative to the tangent line at
         the current closest point (accurate over one control period of travel).
         """
         f = self.frame
         if self.is_curve:
-            c = self.path.point(self.s)
-            x0, y0 = float(c[0]), float(c[1])
+            x0, y0 = self.point.x, self.point.y
         else:
-            x0, y0 = self._wp[self.leg]
-        return -(xs - x0) * math.sin(f.path_angle) + (ys - y0) * math.cos(f.path_angle)
+            x0, y0 = self._legs.lists["x0"][self.leg], self._legs.lists["y0"][self.leg]
+        return cross_track(xs - x0, ys - y0, math.cos(f.path_angle), math.sin(f.path_angle))

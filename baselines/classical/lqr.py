@@ -28,8 +28,9 @@ Choices where the paper is silent (all options of the controllers):
 
 * **Initial guess.** On ``mariner`` the paper's a0 = 0.02 1/s, c0 = 0.002 1/s² (§5; the
   plant's linear part is a1 = 0.018, a3 = 0.001).  On other ships, unless given, the guess is
-  the nominal model's first-order Nomoto approximation ``context.nominal_model.
-  first_order_nomoto()`` → (K, T): a0 = 1/T, c0 = K/T (for ṙ = (K·δ − r)/T).
+  the nominal model's first-order Nomoto approximation
+  ``shipgym.identification.first_order_nomoto(context.nominal_model)`` → (K, T): a0 = 1/T,
+  c0 = K/T (for ṙ = (K·δ − r)/T).
 * **λy on other ships.** ``lambda_y=None`` (default) is 1/2000·(172 m / L)², i.e. the paper's
   1/2000 for its 172 m Mariner and the same cost in ship lengths on other ships (with a and c
   in 1/s, 1/s², the Froude-scaled problem has the same gains in L and L/U units).  With the
@@ -63,8 +64,10 @@ from typing import Any
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
+from baselines.policy import check_action_mode
+from baselines.registry import register_controller
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import ContinuousLeastSquares
+from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
 
 #: Borkowski (2018) §5: initial estimates on the Mariner (a0 [1/s], c0 [1/s²])
@@ -140,10 +143,11 @@ def initial_guess(context: ControllerContext) -> tuple[float, float]:
     """Default (a0 [1/s], c0 [1/s²]): the paper's on the Mariner, else 1/T, K/T of the nominal."""
     if context.ship in PAPER_INITIAL_GUESS:
         return PAPER_INITIAL_GUESS[context.ship]
-    K, T = context.nominal_model.first_order_nomoto()
+    K, T = first_order_nomoto(context.nominal_model)
     return 1.0 / T, K / T
 
 
+@register_controller("lqr")
 class LQR:
     """Track-keeping LQR of Borkowski (2018) eq. (28)–(30) with a fixed model (a0, c0).
 
@@ -153,7 +157,6 @@ class LQR:
     ``resolve_tolerance``: relative change of (a, c, U) that triggers a new Riccati solve.
     """
 
-    name = "lqr"
     kind = "classical"
     adaptive = False
 
@@ -185,10 +188,7 @@ class LQR:
 
     # ------------------------------------------------------------------ episode
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
-        if context.action_mode != "rudder":
-            raise ValueError(
-                f"{self.name} drives the rudder; make the env with action_mode='rudder'"
-            )
+        check_action_mode(self, context)
         self.ctx = context
         a0, c0 = (self.a0, self.c0) if self.a0 is not None else initial_guess(context)
         self.guess = (float(a0), float(c0))
@@ -261,6 +261,7 @@ class LQR:
         return {"riccati_solves": float(self.solves)}
 
 
+@register_controller("adaptive_lqr")
 class AdaptiveLQR(LQR):
     """Borkowski (2018) adaptive LQR: the gain of the continuous-LS estimates (â, ĉ).
 
@@ -268,7 +269,6 @@ class AdaptiveLQR(LQR):
     F (estimates used by the gain clipped to [x0/F, x0·F]; None: off).
     """
 
-    name = "adaptive_lqr"
     adaptive = True
 
     def __init__(

@@ -38,6 +38,8 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
+from baselines.policy import check_action_mode
+from baselines.registry import register_controller
 from shipgym.codegen import compiled
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
@@ -246,10 +248,11 @@ def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) 
     return float(t @ (values - values.mean()) / (t @ t))
 
 
+@register_controller("nmpc", applies_to=("nomoto2",))
 class NMPC:
     """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019)."""
 
-    name: ClassVar[str] = "nmpc"
+    name: ClassVar[str]  # set by the registration
     kind: ClassVar[str] = "classical"
     identifier_type: ClassVar[type | None] = None
 
@@ -262,10 +265,7 @@ class NMPC:
         self.excitation = math.radians(excitation_deg if excitation_deg is not None else default)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
-        if context.action_mode != "rudder":
-            raise ValueError(
-                f"{self.name} drives the rudder; make the env with action_mode='rudder'"
-            )
+        check_action_mode(self, context)
         self.ctx = context
         self.solver = get_solver(
             context.nominal_model, self.settings, context.control_period, context.rudder_limit
@@ -311,7 +311,7 @@ class NMPC:
             if self.tracker.is_curve
             else tuple(self.ctx.waypoints[frame.leg])
         )
-        radius = self.ctx.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
+        radius = self.ctx.guidance.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
         x0 = self._state(info)
         guess = np.append(self.plan[1:], self.plan[-1])  # shifted previous solution
         start = time.perf_counter()
@@ -355,15 +355,15 @@ class NMPC:
         }
 
 
+@register_controller("nmpc_wlssvm", applies_to=("nomoto2",))
 class NMPCWeightedLSSVM(NMPC):
     """``nmpc_wlssvm``: NMPC with the model updated online by weighted LS-SVM."""
 
-    name = "nmpc_wlssvm"
     identifier_type = WeightedLSSVMOnline
 
 
+@register_controller("nmpc_lambda_lssvm", applies_to=("nomoto2",))
 class NMPCLambdaLSSVM(NMPC):
     """``nmpc_lambda_lssvm``: NMPC with the model updated by λ-LS-SVM (Algorithm 2)."""
 
-    name = "nmpc_lambda_lssvm"
     identifier_type = LambdaLSSVM

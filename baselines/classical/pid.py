@@ -10,14 +10,15 @@ scenario itself names:
 * ``pid_vf`` — Xu & Guedes Soares (2020) Algorithm 1 (τ, χe, k from the config);
 * ``pid_tvvf`` — Xu, Oliveira & Guedes Soares (2021) eqs. (9), (48) (Δ, θ, error unit).
 
-The VF and TVVF headings come from :func:`shipgym.envs.path_follow.field_law_heading`, the
-function the env's guidance mode uses, so a controller and the env agree bit for bit.
+The headings come from :func:`shipgym.guidance.desired_heading` (the law table the env's
+guidance mode uses), so a controller and the env agree bit for bit.
 
 The autopilot is the shared :class:`shipgym.autopilot.HeadingPID` with one of two tunings
 (``tuning=``), both computed from the nominal model in the controller context, never typed:
 
 * ``"pole_placement"`` — Xu, Oliveira & Guedes Soares (2021) §5.2 on the first-order
-  Nomoto model ``context.nominal_model.first_order_nomoto()``: ωn = 1 rad/s, ζ = 1;
+  Nomoto model ``shipgym.identification.first_order_nomoto(context.nominal_model)``:
+  ωn = 1 rad/s, ζ = 1;
 * ``"vyshnegradsky"`` — Xu & Guedes Soares (2020) §5.1–5.2 on the 2nd-order Nomoto model
   (A = B = 4, Ki = Kp/100; :func:`shipgym.autopilot.vyshnegradsky_gains`, whose docstring
   says why (3, 3) reproduces the paper's printed gains).  The 2nd-order model is the ship's
@@ -47,6 +48,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from baselines.policy import check_action_mode
+from baselines.registry import register_controller
 from shipgym.autopilot import (
     VYSHNEGRADSKY_AB_STATED,
     HeadingPID,
@@ -54,26 +57,11 @@ from shipgym.autopilot import (
     vyshnegradsky_gains,
 )
 from shipgym.envs.context import ControllerContext
-from shipgym.envs.path_follow import field_law_heading
-from shipgym.guidance import lookahead_los_heading, los_desired_heading
+from shipgym.guidance import desired_heading
+from shipgym.identification import first_order_nomoto, second_order_nomoto
 from shipgym.models.base import ShipModel
-from shipgym.models.nomoto2 import Nomoto2
 
 TUNINGS = ("pole_placement", "vyshnegradsky")
-
-
-def nominal_nomoto2(model: ShipModel) -> tuple[float, float, float, float]:
-    """2nd-order Nomoto (K [1/s], T1, T2, T3 [s]) of a nominal model, for autopilot design.
-
-    nomoto2: its own parameters; any other ship: the fit to its 20/20 zig-zag (cached).
-    """
-    if isinstance(model, Nomoto2):
-        p = model.params
-        return float(p.K), float(p.T1), float(p.T2), float(p.T3)
-    from shipgym.identification.zigzag import ship_nomoto
-
-    fit, _ = ship_nomoto(model)
-    return fit.K, fit.T1, fit.T2, fit.T3
 
 
 def design_gains(
@@ -88,11 +76,11 @@ def design_gains(
     Nomoto model (ωn [rad/s], ζ) or the Vyshnegradsky diagram on the 2nd-order one ((A, B),
     Ki = ki_ratio·Kp with ki_ratio [1/s])."""
     if tuning == "pole_placement":
-        K, T = model.first_order_nomoto()
+        K, T = first_order_nomoto(model)
         return PIDGains.from_nomoto(K, T, natural_frequency, damping)
     if tuning == "vyshnegradsky":
         A, B = vyshnegradsky_ab
-        return vyshnegradsky_gains(*nominal_nomoto2(model), A=A, B=B, ki_ratio=ki_ratio)
+        return vyshnegradsky_gains(*second_order_nomoto(model), A=A, B=B, ki_ratio=ki_ratio)
     raise ValueError(f"tuning must be one of {TUNINGS}, got {tuning!r}")
 
 
@@ -125,10 +113,7 @@ class _GuidedPID:
         self.ki_ratio = ki_ratio
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
-        if context.action_mode != "rudder":
-            raise ValueError(
-                f"{self.name} drives the rudder; make the env with action_mode='rudder'"
-            )
+        check_action_mode(self, context)
         self.ctx = context
         self.gains = design_gains(
             context.nominal_model,
@@ -144,13 +129,8 @@ class _GuidedPID:
         self._started = False
 
     def desired_heading(self, cross_track: float, path_angle: float) -> float:
-        """ψd [rad] of the controller's law for the current frame (module doc)."""
-        ctx, g = self.ctx, self._guidance
-        if self.law == "los":
-            return los_desired_heading(cross_track, path_angle, ctx.ship_length, ctx.los_radius_L)
-        if self.law == "lookahead_los":
-            return lookahead_los_heading(cross_track, path_angle, g.lookahead_L * ctx.ship_length)
-        return float(field_law_heading(g, cross_track, path_angle, ctx.ship_length, 1.0))
+        """ψd [rad] of the controller's law for the current frame (shipgym.guidance table)."""
+        return float(desired_heading(self._guidance, cross_track, path_angle, self.ctx.ship_length))
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         x, y = info["position"]
@@ -167,33 +147,33 @@ class _GuidedPID:
         return {"pid_kp": self.gains.kp, "pid_ki": self.gains.ki, "pid_kd": self.gains.kd}
 
 
+@register_controller("pid_los")
 class PIDLOS(_GuidedPID):
     """PID on LOS guidance; pole placement by default (the leaderboard's numbers)."""
 
-    name = "pid_los"
     law = "los"
     default_tuning = "pole_placement"
 
 
+@register_controller("pid_lookahead_los")
 class PIDLookaheadLOS(_GuidedPID):
     """PID on look-ahead LOS guidance; Vyshnegradsky by default (seed 001's comparison)."""
 
-    name = "pid_lookahead_los"
     law = "lookahead_los"
     default_tuning = "vyshnegradsky"
 
 
+@register_controller("pid_vf")
 class PIDVF(_GuidedPID):
     """PID on vector-field guidance; Vyshnegradsky by default (seed 001)."""
 
-    name = "pid_vf"
     law = "vf"
     default_tuning = "vyshnegradsky"
 
 
+@register_controller("pid_tvvf")
 class PIDTVVF(_GuidedPID):
     """PID on time-varying vector-field guidance; pole placement by default (seed 002)."""
 
-    name = "pid_tvvf"
     law = "tvvf"
     default_tuning = "pole_placement"

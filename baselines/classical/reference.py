@@ -6,13 +6,14 @@ from typing import Any
 
 import numpy as np
 
+from baselines.registry import register_controller
 from shipgym.envs.context import ControllerContext
 
 
+@register_controller("zero_rudder")
 class ZeroRudder:
     """Always commands zero (rudder mode) / the default guidance action."""
 
-    name = "zero_rudder"
     kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
@@ -22,10 +23,10 @@ class ZeroRudder:
         return np.zeros(self._dim, dtype=np.float32)
 
 
+@register_controller("random")
 class RandomRudder:
     """Uniform random action in [-1, 1], seeded per episode."""
 
-    name = "random"
     kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:

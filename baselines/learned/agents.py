@@ -9,20 +9,17 @@ scenarios (never the ``heldout`` test set, which is kept for the leaderboard).
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from shipgym.scenarios.schema import _Strict, load_yaml_model
-
-REPO = Path(__file__).resolve().parents[2]
-AGENT_DIR = REPO / "configs" / "agents"
+from baselines.errors import ConfigError
+from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
 
 ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
 
 
-class AgentEnvConfig(_Strict):
+class AgentEnvConfig(StrictModel):
     distribution: str | None = "train"  # scenario distribution (configs/distributions)
     scenario: str | None = None  # or one fixed scenario (needed by vec_env: batched)
     action_mode: Literal["rudder", "guidance"] = "rudder"
@@ -49,7 +46,7 @@ class AgentEnvConfig(_Strict):
         return self
 
 
-class EvalConfig(_Strict):
+class EvalConfig(StrictModel):
     distribution: str = "validation"
     freq: int = Field(20_000, ge=1)  # env steps between evaluations
     n_episodes: int = Field(8, ge=1)
@@ -64,7 +61,7 @@ class EvalConfig(_Strict):
         return self
 
 
-class AgentConfig(_Strict):
+class AgentConfig(StrictModel):
     name: str
     algo: Literal["ppo", "sac", "td3", "recurrent_ppo"]
     policy: str = "MlpPolicy"
@@ -79,16 +76,13 @@ class AgentConfig(_Strict):
 
 def load_agent_config(name_or_path: str | os.PathLike) -> AgentConfig:
     """An agent config by name (``configs/agents/<name>.yaml``) or path; errors name the key."""
-    text = os.fspath(name_or_path)
-    path = Path(text)
-    if not text.endswith((".yaml", ".yml")) and os.sep not in text:
-        path = AGENT_DIR / f"{text}.yaml"
-        if not path.is_file():
-            valid = ", ".join(sorted(p.stem for p in AGENT_DIR.glob("*.yaml")))
-            raise ValueError(f"unknown agent config {text!r}; valid: {valid}")
-    if not path.is_file():
-        raise ValueError(f"agent config not found: {path}")
-    return load_yaml_model(path, AgentConfig, ValueError)
+    file = resolve("agents", name_or_path, error=ConfigError)
+    return load_yaml_model(file, AgentConfig, ConfigError)
+
+
+def list_agent_configs() -> list[str]:
+    """Names of the packaged agent configs (``configs/agents``)."""
+    return list_names("agents")
 
 
 def algo_class(algo: str) -> type:

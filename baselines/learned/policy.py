@@ -13,7 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from baselines.errors import ControllerError
 from baselines.learned.agents import algo_class
+from baselines.policy import check_action_mode
 from shipgym.envs.context import ControllerContext
 
 POLICY_DIR = Path(__file__).resolve().parent / "policies"
@@ -47,7 +49,7 @@ def resolve_policy(name_or_path: str | Path) -> tuple[Path, Path]:
         None,
     )
     if not zip_path.is_file() or meta is None:
-        raise ValueError(
+        raise ControllerError(
             f"{name_or_path!r} is not a trained policy (a model zip with a meta.json); "
             f"shipped: {', '.join(shipped_policies())}; train one with `shipgym train AGENT`"
         )
@@ -74,11 +76,7 @@ class LearnedPolicy:
         self._start = True
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
-        if context.action_mode != self.action_mode:
-            raise ValueError(
-                f"policy {self.name!r} was trained for action_mode {self.action_mode!r}, "
-                f"the env uses {context.action_mode!r}"
-            )
+        check_action_mode(self, context)
         self._state = None
         self._start = True
 

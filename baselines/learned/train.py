@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from baselines.errors import BackendError, RunError
 from baselines.evaluation import EVAL_SEED_OFFSET
 from baselines.learned.agents import (
     AgentConfig,
@@ -159,9 +160,9 @@ def train(
     cls = algo_class(config.algo)
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
-        raise ValueError(f"--resume: no checkpoint in {out / 'checkpoints'}")
+        raise RunError(f"--resume: no checkpoint in {out / 'checkpoints'}")
     if previous is not None and previous[1] >= config.n_timesteps:
-        raise ValueError(
+        raise RunError(
             f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
             f"{config.n_timesteps}: nothing to train (raise --timesteps)"
         )
@@ -174,7 +175,7 @@ def train(
     if previous is not None:
         env_seed += config.env.n_envs * (previous[1] // config.checkpoint_freq)
     if env_seed + config.env.n_envs > EVAL_SEED_OFFSET:
-        raise ValueError(
+        raise RunError(
             f"training env seeds {env_seed}… would reach the evaluation seeds "
             f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed"
         )
@@ -251,7 +252,7 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     if not model.is_file():
         model = src / "model.zip"
     if not model.is_file() or not (src / "meta.json").is_file():
-        raise ValueError(f"{src}: no trained model (model.zip / meta.json) to export")
+        raise RunError(f"{src}: no trained model (model.zip / meta.json) to export")
     target = Path(dest)
     target.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(model, target / "model.zip")
@@ -296,7 +297,7 @@ def train_sweep(
         try:
             import ray
         except ImportError as exc:
-            raise RuntimeError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
+            raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
         import os
 
         if not ray.is_initialized():
@@ -304,7 +305,7 @@ def train_sweep(
         remote = ray.remote(run_train_job)
         return ray.get([remote.remote(job) for job in jobs])
     if backend != "local":
-        raise ValueError(f"unknown backend {backend!r}; valid: local, ray")
+        raise RunError(f"unknown backend {backend!r}; valid: local, ray")
     if workers <= 1 or len(jobs) == 1:
         return [run_train_job(job) for job in jobs]
     from concurrent.futures import ProcessPoolExecutor

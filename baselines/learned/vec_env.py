@@ -2,7 +2,10 @@
 
 SB3 does not accept Gymnasium vector envs (SPEC §5): this adapter exposes the batched env
 through SB3's interface, with SB3's same-step autoreset (the terminal observation goes to
-``info["terminal_observation"]``, truncation to ``info["TimeLimit.truncated"]``).
+``info["terminal_observation"]``, truncation to ``info["TimeLimit.truncated"]``) and one
+``info`` dict per ship with the keys a single env gives (``termination_reason`` and
+``episode_metrics`` at episode ends, so ``VecMonitor(info_keywords=...)`` works; ``position``
+as an (x, y) tuple; no ``samples``).
 """
 
 from __future__ import annotations
@@ -13,6 +16,28 @@ import numpy as np
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from shipgym.envs.vector import ShipPathFollowVectorEnv
+
+
+def per_env_infos(info: dict[str, Any], n: int) -> list[dict[str, Any]]:
+    """A Gymnasium vector ``info`` (arrays with ``_key`` masks) as n per-env dicts."""
+    infos: list[dict[str, Any]] = [{} for _ in range(n)]
+    for key, value in info.items():
+        if key.startswith("_"):
+            continue
+        mask = info.get(f"_{key}")
+        rows = range(n) if mask is None else np.flatnonzero(mask).tolist()
+        if isinstance(value, dict):
+            nested = per_env_infos(value, n)
+            for i in rows:
+                infos[i][key] = nested[i]
+        elif key == "position":
+            for i, (x, y) in zip(rows, value[list(rows)].tolist(), strict=True):
+                infos[i][key] = (x, y)
+        else:
+            column = value.tolist() if isinstance(value, np.ndarray) else list(value)
+            for i in rows:
+                infos[i][key] = column[i]
+    return infos
 
 
 class SB3BatchedVecEnv(VecEnv):
@@ -36,12 +61,10 @@ class SB3BatchedVecEnv(VecEnv):
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         obs, rewards, terminated, truncated, info = self.env.step(self._actions)
         dones = terminated | truncated
-        infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        infos = per_env_infos(info, self.num_envs)
         for i in np.flatnonzero(dones):
             infos[i]["terminal_observation"] = obs[i].copy()
             infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-            if "episode_metrics" in info:
-                infos[i]["episode_metrics"] = info["episode_metrics"][i]
         if np.any(dones):
             obs, _ = self.env.reset_finished()
         return obs, rewards.astype(np.float32), dones, infos

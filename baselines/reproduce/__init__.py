@@ -1,8 +1,17 @@
-"""Re-runs of the source papers' experiments (``shipgym reproduce PAPER``)."""
+"""Re-runs of the source papers' experiments (``shipgym reproduce PAPER``, SPEC §11).
+
+One package per paper, each with the parts of :mod:`baselines.reproduce.protocol` (the
+experiment, its claims, the markdown report, the figures) joined in its ``REPRODUCTION``;
+the rows are :func:`baselines.reproduce.rows.reproduction_row`'s, the tables
+:mod:`baselines.reproduce.report`'s.
+"""
 
 from baselines.reproduce import borkowski2018, liu2019, morenosalinas2013, xu2020, xu2021
+from baselines.reproduce.protocol import Outcome, Reproduction
 
-#: paper id -> module with ``run(out_dir, seeds) -> rows``
+#: paper id -> its package: ``REPRODUCTION`` (a :class:`Reproduction`) and, what
+#: :mod:`baselines.cli` calls, ``run(out_dir, seeds, progress) -> rows`` (writes the report)
+#: and ``markdown(rows) -> str``
 PAPERS = {
     "liu2019": liu2019,
     "morenosalinas2013": morenosalinas2013,
@@ -11,4 +20,4 @@ PAPERS = {
     "xu2021": xu2021,
 }
 
-__all__ = ["PAPERS"]
+__all__ = ["PAPERS", "Outcome", "Reproduction"]

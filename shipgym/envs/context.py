@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
-from shipgym.scenarios.schema import GuidanceConfig
+from shipgym.scenarios import Scenario
 from shipgym.tracking import PathTracker
 
 
@@ -31,10 +32,30 @@ class ControllerContext:
     fine_step: float  # h [s]
     acceptance_radius: float  # R0 [m]
     switching: str  # waypoint switching rule: "circle" | "along_track"
-    los_radius_L: float  # n in R_LOS = nL
     action_mode: str  # "rudder" | "guidance"
-    #: the scenario's guidance settings (law, R_LOS, look-ahead, VF/TVVF parameters)
-    guidance: GuidanceConfig = dataclasses.field(default_factory=GuidanceConfig)
+    #: the scenario's guidance settings (law, R_LOS = los_radius_L·L, look-ahead, VF/TVVF
+    #: parameters): a scenario's ``guidance:`` block
+    guidance: Any
+
+    @classmethod
+    def of(cls, scenario: Scenario, action_mode: str) -> ControllerContext:
+        """The context of ``scenario`` (its nominal model, path and timing)."""
+        sc = scenario
+        return cls(
+            ship=sc.model.name,
+            nominal_model=sc.model.with_params(sc.nominal_params),
+            waypoints=np.array(sc.path.waypoints),
+            path_type=sc.config.path.type,
+            ship_length=sc.ship_length,
+            nominal_speed=sc.model.nominal_speed,
+            rudder_limit=sc.model.rudder_limit,
+            control_period=sc.control_period,
+            fine_step=sc.fine_step,
+            acceptance_radius=sc.acceptance_radius,
+            switching=sc.config.path.switching,
+            action_mode=action_mode,
+            guidance=sc.config.guidance,
+        )
 
     @property
     def nominal_params(self) -> ParameterRecord:

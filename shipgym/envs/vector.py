@@ -1,30 +1,30 @@
 """Batched ShipPathFollow: N ships stepped in one call (SPEC §5 "Batched simulation").
 
-The plant of all N ships is one call of the compiled CasADi period function mapped over the
-ships (the single env's function, so the physics is bit-identical); guidance, reward,
-observation and termination are numpy expressions over the N ships written with the same
-operations as the single env (no ``hypot``/``arctan2`` whose SIMD versions differ from libm
-in the last bit), so that ``ShipPathFollowVectorEnv(N)`` equals N single envs under
-``SyncVectorEnv`` bit for bit in rudder mode (tested).  Python loops over ships remain only
-where randomness must be drawn per env in the single env's order (noisy sensors, the noise
-of stochastic disturbances, whose processes then advance over all ships at once), for the
-rare parameter-event periods, and for the metrics of finished episodes.
+Built from a scenario, like the single env (:class:`shipgym.envs.core.EnvParts`).  The plant
+of all N ships is one call of the compiled CasADi period function mapped over the ships (the
+single env's function, so the physics is bit-identical); tracking (polylines and PCHIP
+curves), every guidance law, the autopilot, reward, observation, termination and info are
+the step core's functions (:mod:`shipgym.envs.core`) evaluated on arrays, the same code the
+single env runs on floats, so that ``ShipPathFollowVectorEnv(N)`` equals N single envs
+under ``SyncVectorEnv`` bit for bit, in both action modes and on both path types (tested).
+
+Python loops over ships remain only where randomness must be drawn per env in the single
+env's order (noisy sensors, the noise of stochastic disturbances, whose processes then
+advance over all ships at once), for the rare parameter-event periods, and for the metrics
+of finished episodes.
 
 Autoreset follows Gymnasium's default NEXT_STEP mode (``reset(options={"reset_mask": m})``
 resets only the masked envs).  ``info`` holds the scalar keys of the single env as arrays,
 in SyncVectorEnv's layout (``episode_metrics`` as a dict of arrays with ``_``-masks, present
-at the steps where an episode ended), except: ``position`` is an (N, 2) float array, there
-is no ``samples`` (online identification runs on the single env), and the episode metrics'
-``compute_ms_*`` are NaN (no per-env controller timing in a batch).  It is what
+at the steps where an episode ended, with SyncVectorEnv's dtypes), except: ``position`` is
+an (N, 2) float array, there is no ``samples`` (online identification runs on the single
+env).  It is what
 ``gym.make_vec("ShipPathFollow-v0", num_envs=N)`` returns by default (Gymnasium prefers a
 registered vector entry point); pass ``vectorization_mode="sync"`` for N single envs.
-Waypoint (polyline) paths only; a PCHIP scenario raises ValueError (use ``SyncVectorEnv`` /
-``SubprocVecEnv`` over single envs there).
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, ClassVar
 
 import numpy as np
@@ -32,18 +32,13 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from shipgym.disturbances import Disturbances, SensorModel
-from shipgym.envs.path_follow import GUIDANCE_OFFSET_MAX, ShipPathFollowEnv, field_law_heading
-from shipgym.metrics import ARRAY_FIELDS, EpisodeLog, compute_metrics
-
-_PI = math.pi
-_TWO_PI = 2.0 * math.pi
-
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    """shipgym.paths.wrap_angle for arrays (same operations as its float branch)."""
-    w = np.mod(a + _PI, _TWO_PI) - _PI
-    return np.where(w >= _PI, w - _TWO_PI, w)
+from shipgym.angles import wrap_angle
+from shipgym.disturbances import SensorModel
+from shipgym.envs import core
+from shipgym.envs.core import LOG_FIELDS, OBS_HIGH, OBS_LOW
+from shipgym.metrics import compute_metrics
+from shipgym.numerics import ARRAY
+from shipgym.scenarios import load_scenario
 
 
 class ShipPathFollowVectorEnv(VectorEnv):
@@ -62,19 +57,19 @@ class ShipPathFollowVectorEnv(VectorEnv):
         compile: bool = True,
         render_mode: str | None = None,
         episode_metrics: bool = True,
+        max_episode_steps: int | None = None,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be ≥ 1, got {num_envs}")
+        if max_episode_steps is not None and not (
+            isinstance(max_episode_steps, int) and max_episode_steps >= 1
+        ):
+            raise ValueError(f"max_episode_steps must be an int ≥ 1, got {max_episode_steps!r}")
         if render_mode is not None:
             raise ValueError("the batched env does not render; use a single env for that")
-        # one single env supplies the validated scenario, spaces and constants
-        proto = ShipPathFollowEnv(scenario, action_mode, compile=compile)
-        sc = proto.scenario
-        if sc.config.path.type != "waypoints":
-            raise ValueError(
-                f"scenario {sc.name!r}: the batched env supports waypoint paths only "
-                f"(got {sc.config.path.type!r}); use SyncVectorEnv over single envs"
-            )
+        sc = load_scenario(scenario)
+        parts = core.EnvParts.build(sc, action_mode, compile, batch=num_envs)
+        self._parts = parts
         self.num_envs = num_envs
         self.scenario = sc
         self.action_mode = action_mode
@@ -82,78 +77,38 @@ class ShipPathFollowVectorEnv(VectorEnv):
         #: compute info["episode_metrics"] for finished envs (≈ 0.2 ms each; training loops
         #: that do not read them switch it off)
         self.episode_metrics = episode_metrics
-        self.single_observation_space = proto.observation_space
-        self.single_action_space = proto.action_space
-        self.observation_space = batch_space(proto.observation_space, num_envs)
-        self.action_space = batch_space(proto.action_space, num_envs)
-        self._proto = proto
-        self._n = proto._n
-        self._h, self._Ts = proto._h, proto._Ts
-        self._L, self._u0, self._dmax = proto._L, proto._u0, proto._dmax
-        self._e_max = proto._e_max
-        self._max_steps = proto._max_steps
-        self._idx = (proto._ix, proto._iy, proto._ipsi, proto._ir, proto._idelta)
-        self._obs_low, self._obs_high = proto.observation_space.low, proto.observation_space.high
-        # per-leg constants, computed exactly as shipgym.paths.segment_frame does
-        wp = [(float(p[0]), float(p[1])) for p in sc.path.waypoints]
-        legs = range(len(wp) - 1)
-        lengths = [math.hypot(wp[i + 1][0] - wp[i][0], wp[i + 1][1] - wp[i][1]) for i in legs]
-        self._leg_x0 = np.array([wp[i][0] for i in legs])
-        self._leg_y0 = np.array([wp[i][1] for i in legs])
-        self._leg_x1 = np.array([wp[i + 1][0] for i in legs])
-        self._leg_y1 = np.array([wp[i + 1][1] for i in legs])
-        self._leg_c = np.array([(wp[i + 1][0] - wp[i][0]) / lengths[i] for i in legs])
-        self._leg_s = np.array([(wp[i + 1][1] - wp[i][1]) / lengths[i] for i in legs])
-        self._leg_len = np.array(lengths)
-        self._leg_angle = np.array(
-            [math.atan2(wp[i + 1][1] - wp[i][1], wp[i + 1][0] - wp[i][0]) for i in legs]
-        )
-        self._leg_change = np.array([sc.path.next_leg_angle_change(i) for i in legs])
-        self._last_leg = len(wp) - 2
-        self._goal = wp[-1]
-        self._radius = sc.acceptance_radius
-        self._switching = sc.config.path.switching
-        # plant, parameters, disturbances
-        self._integrator = proto._integrator.__class__(
-            proto.model, self._h, self._n, compile=compile, batch=num_envs
-        )
+        self.single_observation_space = parts.observation_space
+        self.single_action_space = parts.action_space
+        self.observation_space = batch_space(parts.observation_space, num_envs)
+        self.action_space = batch_space(parts.action_space, num_envs)
+        self._k = k = parts.constants
+        #: truncation after this many steps (``gym.make_vec(..., max_episode_steps=M)``, as
+        #: the TimeLimit wrapper of single envs; the corridor penalty keeps the scenario's
+        #: time limit, as under that wrapper)
+        self.max_episode_steps = k.max_steps if max_episode_steps is None else max_episode_steps
+        self._tracker = parts.tracker
+        self._integrator = parts.integrator
+        self._disturbances = parts.disturbances
         self._w_block = self._integrator.disturbance_buffer  # filled in place, never copied
-        self._w_block[:] = proto._w_block
-        self._disturbances = Disturbances(
-            sc.config.disturbances,
-            proto.model.disturbance_names,
-            self._h,
-            self._n,
-            batch=num_envs,
-            time_limit=sc.config.time_limit,
-        )
+        self._w_block[:] = self._disturbances.constant_row()
         self._p_block = self._integrator.parameter_buffer
         self._p_dirty = np.zeros(num_envs, dtype=bool)
         self._sensors = [SensorModel(sc.config.sensors) for _ in range(num_envs)]
         self._ideal = self._sensors[0].ideal
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
-        if action_mode == "guidance":
-            g = proto._autopilot.gains
-            self._kp, self._ki, self._kd = g.kp, g.ki, g.kd
-            self._gcfg = sc.config.guidance
-        w = sc.config.reward
-        self._w_psi, self._w_delta = w.heading_weight, w.rudder_weight
-        self._w_rate, self._goal_bonus = w.rudder_rate_weight, w.goal_bonus
-        self._metric_settings = proto._metric_settings
         # state
-        n_x = proto.model.n_states
-        self._state = np.zeros((num_envs, n_x))
+        self._state = np.zeros((num_envs, sc.model.n_states))
         self._steps = np.zeros(num_envs, dtype=np.int64)
         self._t = np.zeros(num_envs)
         self._delta_c = np.zeros(num_envs)
         self._psi_m = np.zeros(num_envs)
         self._r_m = np.zeros(num_envs)
         self._speed = np.zeros(num_envs)
-        self._leg = np.zeros(num_envs, dtype=np.int64)
-        self._integral = np.zeros(num_envs)
+        self._integral = np.zeros(num_envs)  # guidance mode: the heading PIDs' integrals
         self._autoreset = np.zeros(num_envs, dtype=bool)
-        self._log = np.zeros((len(ARRAY_FIELDS), num_envs, self._max_steps + 1))
-        self._frame: dict[str, np.ndarray] = {}
+        self._log = np.zeros(
+            (len(LOG_FIELDS), num_envs, min(k.max_steps, self.max_episode_steps) + 1)
+        )
         self._started = False
 
     # ------------------------------------------------------------------ gym vector API
@@ -177,7 +132,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._reset_envs(mask)
         self._autoreset[mask] = False
         self._started = True
-        return self._observation(), self._info(np.ones(self.num_envs, dtype=bool))
+        return self._observation(), self._info()
 
     def step(
         self, actions: Any
@@ -192,17 +147,28 @@ class ShipPathFollowVectorEnv(VectorEnv):
                 "the env state is unchanged"
             )
         a = np.clip(a, -1.0, 1.0)
+        k = self._k
         n = self.num_envs
         reasons = np.full(n, None, dtype=object)
         resetting = self._autoreset.copy()
         live = ~resetting
         if np.any(resetting):
             self._reset_envs(resetting)
-        # --- action -> rudder command
+        # --- action -> rudder command; envs being autoreset ignore their action
         if self.action_mode == "rudder":
-            delta_c = a[:, 0] * self._dmax
+            delta_c = a[:, 0] * k.rudder_limit
         else:
-            delta_c = self._autopilot(a, live)
+            delta_c, integral = core.guidance_command(
+                a[:, 0],
+                a[:, 1],
+                self._tracker.frame,
+                self._psi_m,
+                self._r_m,
+                self._integral,
+                self._parts,
+                ARRAY,
+            )
+            self._integral = np.where(live, integral, self._integral)
         delta_c = np.where(live, delta_c, self._delta_c)
         prev_delta_c = self._delta_c.copy()
         # --- true parameters of the period (per env: times differ after resets)
@@ -222,46 +188,35 @@ class ShipPathFollowVectorEnv(VectorEnv):
         finite = np.all(np.isfinite(traj[:, -1]), axis=1)
         advance = live & finite
         self._steps = steps
-        self._t = np.where(live, steps * self._Ts, self._t)
+        self._t = np.where(live, steps * k.control_period, self._t)
         self._delta_c = np.where(live, delta_c, self._delta_c)
-        ix, iy, ipsi, ir, idel = self._idx
         self._state = np.where(advance[:, None], traj[:, -1], self._state)
         # --- sensors
         if self._ideal:
-            psi_m, r_m = traj[:, -1, ipsi], traj[:, -1, ir]
+            psi_m, r_m = traj[:, -1, k.ipsi], traj[:, -1, k.ir]
         else:
             psi_m, r_m = self._psi_m.copy(), self._r_m.copy()
             for i in np.flatnonzero(advance):
-                p_i, r_i = self._sensors[i].measure(traj[i, :, ipsi], traj[i, :, ir], self._rngs[i])
+                p_i, r_i = self._sensors[i].measure(
+                    traj[i, :, k.ipsi], traj[i, :, k.ir], self._rngs[i]
+                )
                 psi_m[i], r_m[i] = p_i[-1], r_i[-1]
         self._psi_m = np.where(advance, psi_m, self._psi_m)
         self._r_m = np.where(advance, r_m, self._r_m)
-        if self._n > 1:
-            dx = traj[:, -1, ix] - traj[:, -2, ix]
-            dy = traj[:, -1, iy] - traj[:, -2, iy]
-            self._speed = np.where(advance, np.sqrt(dx * dx + dy * dy) / self._h, self._speed)
-        # --- path
-        self._update_frame(advance)
-        f = self._frame
-        e = f["cross_track"]
-        heading_error = _wrap(self._state[:, ipsi] - f["path_angle"])
-        dd = (delta_c - prev_delta_c) / self._dmax
-        q = delta_c / self._dmax
-        reward = -(
-            np.abs(e) / self._L
-            + self._w_psi * np.abs(heading_error)
-            + self._w_delta * q * q
-            + self._w_rate * dd * dd
-        )
-        goal = advance & f["at_goal"]
-        corridor = advance & ~f["at_goal"] & (np.abs(e) > self._e_max)
-        reward = np.where(goal, reward + self._goal_bonus, reward)
-        left = self._max_steps - steps
-        reward = np.where(corridor, reward - (self._e_max / self._L) * left, reward)
+        if k.substeps > 1:
+            dx = traj[:, -1, k.ix] - traj[:, -2, k.ix]
+            dy = traj[:, -1, k.iy] - traj[:, -2, k.iy]
+            self._speed = np.where(advance, core.speed_over_ground(dx, dy, k, ARRAY), self._speed)
+        # --- path, reward (true state), termination
+        frame = self._tracker.update(self._state[:, k.ix], self._state[:, k.iy], advance)
+        heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
+        reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
+        reward, goal, corridor, truncated = core.terminate(reward, frame, steps, k, ARRAY)
+        truncated = truncated | ~(goal | corridor) & (steps >= self.max_episode_steps)
+        goal, corridor, truncated = goal & advance, corridor & advance, truncated & advance
         diverged = live & ~finite
-        reward = np.where(diverged, -(self._e_max / self._L) * (left + 1), reward)
+        reward = np.where(diverged, core.diverged_reward(steps, k), reward)
         terminated = goal | corridor | diverged
-        truncated = advance & ~terminated & (steps >= self._max_steps)
         rewards = np.where(live, reward, 0.0)
         reasons[goal] = "goal"
         reasons[corridor] = "corridor"
@@ -270,17 +225,12 @@ class ShipPathFollowVectorEnv(VectorEnv):
         # --- episode log (true values), one column per control step
         rows = np.flatnonzero(live)
         col = steps[rows] - 1
-        compute_time = np.full(rows.size, np.nan)
-        heading_log = np.where(
-            diverged, _wrap(self._state[:, ipsi] - f["path_angle"]), heading_error
-        )
-        for k, values in enumerate(
-            (self._t, e, heading_log, self._state[:, idel], delta_c, rewards)
+        for j, values in enumerate(
+            (self._t, frame.cross_track, heading_error, self._state[:, k.idelta], delta_c, rewards)
         ):
-            self._log[k, rows, col] = values[rows]
-        self._log[len(ARRAY_FIELDS) - 1, rows, col] = compute_time
+            self._log[j, rows, col] = values[rows]
         done = terminated | truncated
-        info = self._info(np.ones(n, dtype=bool))
+        info = self._info()
         if np.any(done):
             info["termination_reason"] = reasons
             info["_termination_reason"] = done
@@ -302,8 +252,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
 
     # ------------------------------------------------------------------ pieces
     def _reset_envs(self, mask: np.ndarray) -> None:
-        sc = self.scenario
-        ipsi, ir = self._idx[2], self._idx[3]
+        sc, k = self.scenario, self._k
         self._state[mask] = sc.initial_state()
         self._steps[mask] = 0
         self._t[mask] = 0.0
@@ -311,7 +260,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._integral[mask] = 0.0
         self._p_block[mask] = sc.schedule.vector_at(0.0)
         self._p_dirty[mask] = False
-        self._speed[mask] = self._u0
+        self._speed[mask] = k.nominal_speed
         self._log[:, mask] = 0.0
         for i in np.flatnonzero(mask):
             sensor = self._sensors[i]
@@ -319,159 +268,66 @@ class ShipPathFollowVectorEnv(VectorEnv):
             sensor.reset()
             x = self._state[i]
             if self._ideal:
-                self._psi_m[i], self._r_m[i] = x[ipsi], x[ir]
+                self._psi_m[i], self._r_m[i] = x[k.ipsi], x[k.ir]
             else:
-                p_i, r_i = sensor.measure(x[ipsi : ipsi + 1], x[ir : ir + 1], self._rngs[i])
+                p_i, r_i = sensor.measure(x[k.ipsi : k.ipsi + 1], x[k.ir : k.ir + 1], self._rngs[i])
                 self._psi_m[i], self._r_m[i] = p_i[0], r_i[0]
-        self._leg[mask] = 0
-        self._update_frame(mask)
+        self._tracker.reset(self._state[:, k.ix], self._state[:, k.iy], mask)
 
     def _refresh_parameters(self, t0: np.ndarray, live: np.ndarray) -> None:
-        """Parameter rows of the period [t0, t0 + Ts] per env (see ShipPathFollowEnv.step)."""
+        """Parameter rows of the period [t0, t0 + Ts] per env (core.refresh_parameters)."""
         schedule = self.scenario.schedule
         if not schedule.events:
             return
-        t1 = t0 + self._Ts
-        changing = np.zeros(self.num_envs, dtype=bool)
-        for event in schedule.events:
-            changing |= (event.end_time() >= t0 - 1e-9) & (event.time <= t1 + 1e-9)
+        changing = schedule.changing_on(t0, t0 + self._k.control_period)
         for i in np.flatnonzero(live & (changing | self._p_dirty)):
-            if changing[i]:
-                schedule.fill_matrix(float(t0[i]), self._h, self._p_block[i])
-                self._p_dirty[i] = True
-            else:
-                self._p_block[i] = schedule.vector_at(float(t1[i]))
-                self._p_dirty[i] = False
-
-    def _update_frame(self, mask: np.ndarray) -> None:
-        """Active legs (switching rule) and the leg frame for the envs in ``mask``."""
-        ix, iy = self._idx[0], self._idx[1]
-        x, y = self._state[:, ix], self._state[:, iy]
-        leg = self._leg
-        for _ in range(self._last_leg):  # may skip several waypoints, never past the last leg
-            nxt = np.minimum(leg, self._last_leg)
-            if self._switching == "circle":
-                dx = x - self._leg_x1[nxt]
-                dy = y - self._leg_y1[nxt]
-                reached = dx * dx + dy * dy <= self._radius * self._radius
-            else:
-                rx, ry = x - self._leg_x0[nxt], y - self._leg_y0[nxt]
-                along = rx * self._leg_c[nxt] + ry * self._leg_s[nxt]
-                reached = self._leg_len[nxt] - along < self._radius
-            step = mask & reached & (leg < self._last_leg)
-            if not np.any(step):
-                break
-            leg = leg + step
-        self._leg = leg
-        rx, ry = x - self._leg_x0[leg], y - self._leg_y0[leg]
-        c, s = self._leg_c[leg], self._leg_s[leg]
-        along = rx * c + ry * s
-        cross = -rx * s + ry * c
-        gx, gy = x - self._goal[0], y - self._goal[1]
-        dist_goal = np.sqrt(gx * gx + gy * gy)
-        nx_, ny_ = x - self._leg_x1[leg], y - self._leg_y1[leg]
-        last = leg == self._last_leg
-        at_goal = last & ((dist_goal <= self._radius) | (along >= self._leg_len[leg]))
-        new = {
-            "cross_track": cross,
-            "path_angle": self._leg_angle[leg],
-            "angle_change": self._leg_change[leg],
-            "distance_next": np.sqrt(nx_ * nx_ + ny_ * ny_),
-            "at_goal": at_goal,
-        }
-        if not self._frame:
-            self._frame = new
-        else:
-            for key, value in new.items():
-                self._frame[key] = np.where(mask, value, self._frame[key])
-
-    def _autopilot(self, a: np.ndarray, live: np.ndarray) -> np.ndarray:
-        """The single env's guidance-mode PID, over all ships (shipgym.guidance laws)."""
-        f = self._frame
-        scale = 2.0 ** a[:, 0]
-        e, angle = f["cross_track"], f["path_angle"]
-        if self._gcfg.law == "los":
-            n = self._gcfg.los_radius_L * scale
-            radius = np.where(np.abs(e) <= n * self._L, n * self._L, np.abs(e) + self._L)
-            desired = angle - np.arcsin(e / radius)
-        elif self._gcfg.law == "lookahead_los":
-            desired = angle + np.arctan(-e / (self._gcfg.lookahead_L * self._L * scale))
-            desired = _wrap(desired)
-        else:  # VF / TVVF: the single env's own functions, evaluated over the N ships
-            desired = field_law_heading(self._gcfg, e, angle, self._L, scale)
-        desired = desired + a[:, 1] * GUIDANCE_OFFSET_MAX
-        error = _wrap(desired - self._psi_m)
-        dt = self._Ts
-        trial = self._kp * error - self._kd * self._r_m + self._ki * (self._integral + error * dt)
-        lim = self._dmax
-        inside = (-lim < trial) & (trial < lim)
-        # envs being autoreset this step ignore their action: their integral stays at 0
-        self._integral = np.where(inside & live, self._integral + error * dt, self._integral)
-        raw = self._kp * error - self._kd * self._r_m + self._ki * self._integral
-        return np.minimum(lim, np.maximum(-lim, raw))
+            self._p_dirty[i] = core.refresh_parameters(
+                schedule, float(t0[i]), self._k, self._p_block[i], bool(self._p_dirty[i])
+            )
 
     def _observation(self) -> np.ndarray:
-        f = self._frame
-        idel = self._idx[4]
-        err = self._psi_m - f["path_angle"]
-        d = f["distance_next"]
-        obs = np.stack(
-            [
-                f["cross_track"] / self._e_max,
-                np.sin(err),
-                np.cos(err),
-                self._r_m / (2.0 * self._u0 / self._L),
-                self._state[:, idel] / self._dmax,
-                self._delta_c / self._dmax,
-                self._speed / self._u0,
-                f["angle_change"] / math.pi,
-                d / (d + 10.0 * self._L),
-            ],
-            axis=1,
-        ).astype(np.float32)
-        return np.clip(obs, self._obs_low, self._obs_high, out=obs)
+        k = self._k
+        columns = core.observation_columns(
+            self._tracker.frame,
+            self._psi_m,
+            self._r_m,
+            self._state[:, k.idelta],
+            self._delta_c,
+            self._speed,
+            k,
+            ARRAY,
+        )
+        obs = np.stack(columns, axis=1).astype(np.float32)
+        return np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
 
-    def _info(self, mask: np.ndarray) -> dict[str, Any]:
-        ix, iy, _, _, idel = self._idx
-        f = self._frame
-        info = {
-            "t": self._t.copy(),
-            "cross_track_error": f["cross_track"].copy(),
-            "heading_error": _wrap(self._psi_m - f["path_angle"]),
-            "heading": self._psi_m.copy(),
-            "yaw_rate": self._r_m.copy(),
-            "rudder_angle": self._state[:, idel].copy(),
-            "rudder_command": self._delta_c.copy(),
-            "position": self._state[:, [ix, iy]].copy(),
-            "waypoint_index": self._leg.copy(),
-        }
-        for key in list(info):
-            info[f"_{key}"] = mask.copy()
+    def _info(self) -> dict[str, Any]:
+        k = self._k
+        values = core.info_values(
+            self._t,
+            self._tracker.frame,
+            self._psi_m,
+            self._r_m,
+            self._state[:, k.idelta],
+            self._delta_c,
+            self._state[:, [k.ix, k.iy]],
+        )
+        info: dict[str, Any] = {}
+        every = np.ones(self.num_envs, dtype=bool)
+        for key, value in values.items():
+            info[key] = np.array(value, copy=True)
+            info[f"_{key}"] = every.copy()
         return info
 
-    def _stacked_metrics(self, done: np.ndarray, goal: np.ndarray) -> dict[str, np.ndarray]:
-        """Metrics of the finished envs in SyncVectorEnv's layout: key -> (N,) array, with a
-        ``_key`` mask."""
-        per_env = {
-            int(i): self._episode_metrics(int(i), bool(goal[i])) for i in np.flatnonzero(done)
-        }
-        stacked: dict[str, np.ndarray] = {}
-        for key in next(iter(per_env.values())):
-            values = np.zeros(self.num_envs)
-            for i, metrics in per_env.items():
-                values[i] = metrics[key]
-            stacked[key] = values
-            stacked[f"_{key}"] = done.copy()
+    def _stacked_metrics(self, done: np.ndarray, goal: np.ndarray) -> dict[str, Any]:
+        """Metrics of the finished envs in SyncVectorEnv's layout and dtypes (key → (N,)
+        array with a ``_key`` mask), by Gymnasium's own ``VectorEnv._add_info``."""
+        stacked: dict[str, Any] = {}
+        for i in np.flatnonzero(done):
+            stacked = self._add_info(stacked, self._episode_metrics(int(i), bool(goal[i])), int(i))
         return stacked
 
     def _episode_metrics(self, i: int, reached: bool) -> dict[str, Any]:
-        k = int(self._steps[i])
-        columns = {name: self._log[j, i, :k].copy() for j, name in enumerate(ARRAY_FIELDS)}
-        log = EpisodeLog(
-            **columns,
-            change_time=self.scenario.change_time,
-            ship_length=self._L,
-            reached_goal=reached,
-            dt=self._Ts,
-        )
-        return compute_metrics(log, self._metric_settings)
+        n = int(self._steps[i])
+        columns = {name: self._log[j, i, :n].copy() for j, name in enumerate(LOG_FIELDS)}
+        log = core.episode_log(columns, self.scenario, reached)
+        return compute_metrics(log, self._parts.metric_settings)

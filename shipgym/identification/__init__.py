@@ -1,7 +1,8 @@
 """Identification toolkit (SPEC §7): LS-SVM, λ-LS-SVM online, continuous LS, zig-zag fits.
 
 Public entry points: :func:`fit_nomoto2` (batch, Liu et al. 2019) and :class:`LambdaLSSVM`
-(online, Algorithm 2), fed with ``info["samples"]`` of the env.
+(online, Algorithm 2), fed with ``info["samples"]`` of the env; :func:`first_order_nomoto`
+and :func:`second_order_nomoto`, a ship's nominal model for controller design.
 """
 
 from shipgym.identification.blanke import BlankeFit, fit_blanke
@@ -14,6 +15,7 @@ from shipgym.identification.lssvm import (
     robust_weights,
     weighted_lssvm,
 )
+from shipgym.identification.nominal import first_order_nomoto, second_order_nomoto
 from shipgym.identification.nomoto import (
     IdentificationError,
     fit_nomoto2,
@@ -34,6 +36,7 @@ __all__ = [
     "NomotoFit",
     "PersistentExcitation",
     "WeightedLSSVMOnline",
+    "first_order_nomoto",
     "fit_blanke",
     "fit_nomoto2",
     "fit_nomoto_zigzag",
@@ -44,6 +47,7 @@ __all__ = [
     "params_from_theta1",
     "robust_scale",
     "robust_weights",
+    "second_order_nomoto",
     "theta1_from_params",
     "weighted_lssvm",
     "zigzag_nomoto",

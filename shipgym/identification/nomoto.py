@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from shipgym.errors import ShipgymError
 from shipgym.identification.lssvm import LSSVMSolution, lssvm_primal, weighted_lssvm
 from shipgym.models.nomoto2 import Nomoto2Params
 
@@ -32,7 +33,7 @@ from shipgym.models.nomoto2 import Nomoto2Params
 GAMMA = 1e15
 
 
-class IdentificationError(ValueError):
+class IdentificationError(ShipgymError, ValueError):
     """The data cannot identify the model (degenerate, too short, non-physical result)."""
 
 

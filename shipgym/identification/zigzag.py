@@ -20,12 +20,11 @@ import functools
 
 import numpy as np
 
-from shipgym.autopilot import nomoto2_first_order
 from shipgym.identification.lssvm import lssvm_primal
 from shipgym.identification.nomoto import IdentificationError, time_constants
 from shipgym.manoeuvres import ManoeuvreLog, zigzag
 from shipgym.models.base import ShipModel
-from shipgym.models.nomoto2 import Nomoto2Params
+from shipgym.models.nomoto2 import Nomoto2Params, nomoto2_first_order
 
 #: regularisation factor of Xu & Guedes Soares (2020) §5.2
 C_ZIGZAG = 2544.0

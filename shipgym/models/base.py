@@ -24,8 +24,10 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
+from shipgym.errors import ShipgymError
 
-class ParameterError(ValueError):
+
+class ParameterError(ShipgymError, ValueError):
     """A model parameter is non-physical (e.g. a time constant ≤ 0)."""
 
 
@@ -253,18 +255,14 @@ class ShipModel(ABC):
         """
         return self.initial_state(**values)
 
-    def first_order_nomoto(self, params: ParameterRecord | None = None) -> tuple[float, float]:
-        """First-order Nomoto (K [1/s], T [s]) of the model, for autopilot design.
+    def closed_form_nomoto(self) -> tuple[float, float, float, float] | None:
+        """The 2nd-order Nomoto model (K [1/s], T1, T2, T3 [s]) in closed form, or None.
 
-        Default: Nomoto's approximation of the 2nd-order model identified from the ship's
-        20/20 zig-zag (:func:`shipgym.identification.zigzag.ship_nomoto`); models with a
-        closed form override this.
+        None (the default): the model has none, and
+        :func:`shipgym.identification.second_order_nomoto` identifies it from the ship's
+        20/20 zig-zag instead.
         """
-        from shipgym.identification.zigzag import ship_nomoto
-
-        model = self if params is None else self.with_params(params)
-        fit, _ = ship_nomoto(model)
-        return fit.first_order()
+        return None
 
     def __getstate__(self) -> dict[str, Any]:
         # CasADi functions are rebuilt on demand after unpickling

@@ -26,8 +26,7 @@ import math
 from types import SimpleNamespace
 from typing import Any, ClassVar
 
-from shipgym.autopilot import nomoto2_first_order
-from shipgym.models.base import ParameterRecord, ShipModel
+from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
 
 DEG = math.pi / 180.0
 
@@ -99,6 +98,15 @@ def params_from_paper(
     return base.replace(**paper_to_si(paper, reading))
 
 
+def nomoto2_first_order(K: float, T1: float, T2: float, T3: float) -> tuple[float, float]:
+    """Nomoto's first-order approximation (K [1/s], T = T1 + T2 − T3 [s]) of the 2nd-order
+    model T1·T2·r̈ + (T1 + T2)·ṙ + r = K·(δ + T3·δ̇)."""
+    T = T1 + T2 - T3
+    if not math.isfinite(T) or T <= 0:
+        raise ParameterError(f"first-order time constant T = T1 + T2 - T3 = {T} is not positive")
+    return K, T
+
+
 class Nomoto2(ShipModel):
     """nomoto2: 0.95 m scale ship of Liu et al. (2019), 2nd-order nonlinear Nomoto + servo."""
 
@@ -141,10 +149,10 @@ class Nomoto2(ShipModel):
             ]
         )
 
-    def first_order_nomoto(self, params: ParameterRecord | None = None) -> tuple[float, float]:
-        """Nomoto's approximation K, T = T1 + T2 − T3 of the second-order model."""
-        p = params if params is not None else self.params
-        return nomoto2_first_order(p.K, p.T1, p.T2, p.T3)
+    def closed_form_nomoto(self) -> tuple[float, float, float, float]:
+        """The model's own K [1/s], T1, T2, T3 [s]: it *is* a 2nd-order Nomoto model."""
+        p = self.params
+        return p.K, p.T1, p.T2, p.T3
 
     @property
     def length(self) -> float:

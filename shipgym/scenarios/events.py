@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from shipgym.models.base import ParameterRecord
+from shipgym.models.base import ParameterError, ParameterRecord
 
 _EPS = 1e-9  # s, tolerance on event times against accumulated float time
 
@@ -21,6 +21,14 @@ class ParameterEvent:
     kind: str = "step"
     duration: float = 0.0
 
+    def __post_init__(self) -> None:
+        if self.kind not in ("step", "ramp"):
+            raise ParameterError(f"event kind must be 'step' or 'ramp', got {self.kind!r}")
+        if not (math.isfinite(self.time) and self.time >= 0):
+            raise ParameterError(f"event time must be finite and ≥ 0 s, got {self.time}")
+        if self.kind == "ramp" and not (math.isfinite(self.duration) and self.duration > 0):
+            raise ParameterError(f"a ramp event needs a finite duration > 0 s, got {self.duration}")
+
     def end_time(self) -> float:
         return self.time + (self.duration if self.kind == "ramp" else 0.0)
 
@@ -29,7 +37,7 @@ class ParameterSchedule:
     """True parameters over time: the nominal record changed by a list of events.
 
     Every intermediate record is validated on construction (a non-physical jump fails when
-    the scenario loads, not mid-episode).
+    the scenario loads, not mid-episode), and no event may start while a ramp is running.
     """
 
     def __init__(self, nominal: ParameterRecord, events: list[ParameterEvent]) -> None:
@@ -41,7 +49,13 @@ class ParameterSchedule:
         self._before: list[np.ndarray] = []
         self._after: list[np.ndarray] = []
         current = nominal
-        for event in self.events:
+        for i, event in enumerate(self.events):
+            previous = self.events[i - 1] if i else None
+            if previous is not None and event.time < previous.end_time() - _EPS:
+                raise ParameterError(
+                    f"the event at {event.time} s starts during the ramp from "
+                    f"{previous.time} s to {previous.end_time()} s"
+                )
             self._before.append(current.to_vector())
             current = current.replace(**event.values)  # validates
             self._after.append(current.to_vector())
@@ -68,8 +82,15 @@ class ParameterSchedule:
         return type(self.nominal).from_vector(self.vector_at(t))
 
     def is_constant_on(self, t0: float, t1: float) -> bool:
-        """True when no event starts or is ramping within [t0, t1]."""
+        """True when no event starts or is ramping within [t0, t1] [s]."""
         return all(e.end_time() < t0 - _EPS or e.time > t1 + _EPS for e in self.events)
+
+    def changing_on(self, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+        """:meth:`is_constant_on` negated, elementwise over arrays of periods [t0, t1] [s]."""
+        changing = np.zeros(np.shape(t0), dtype=bool)
+        for e in self.events:
+            changing |= (e.end_time() >= t0 - _EPS) & (e.time <= t1 + _EPS)
+        return changing
 
     def fill_matrix(self, t0: float, h: float, out: np.ndarray) -> None:
         """Fill ``out`` (n, n_p): row i = parameters of the substep starting at t0 + i·h."""

@@ -5,35 +5,39 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from pathlib import Path as FilePath
+from collections.abc import Iterable, Mapping
+from importlib.resources.abc import Traversable
 from typing import Any
 
-import yaml
-from pydantic import ValidationError
-
+from shipgym.config import (
+    ConfigError,
+    catalogue,
+    is_path,
+    list_names,
+    load_yaml_model,
+    resolve,
+    validate_model,
+)
 from shipgym.models import MODELS, ParameterError, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
-from shipgym.scenarios.schema import ScenarioConfig, format_validation_error
+from shipgym.scenarios.schema import ScenarioConfig
 
 DEG = math.pi / 180.0
 
 
-class ScenarioError(ValueError):
+class ScenarioError(ConfigError):
     """A scenario cannot be found or is malformed; the message names the file and key."""
 
 
-def catalogue_dir() -> FilePath:
-    """``configs/scenarios`` of the repository (override with ``SHIPGYM_SCENARIO_DIR``)."""
-    override = os.environ.get("SHIPGYM_SCENARIO_DIR")
-    if override:
-        return FilePath(override)
-    return FilePath(__file__).resolve().parents[2] / "configs" / "scenarios"
+def catalogue_dir() -> Traversable:
+    """The packaged scenario catalogue, ``configs/scenarios``."""
+    return catalogue("scenarios")
 
 
 def list_scenarios() -> list[str]:
     """Names of the catalogue scenarios."""
-    return sorted(p.stem for p in catalogue_dir().glob("*.yaml"))
+    return list_names("scenarios")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,6 +96,23 @@ class Scenario:
         values = {"x": cfg.x, "y": cfg.y, "psi": cfg.heading_deg * DEG, **cfg.states}
         return self.model.cruise_state(**values)
 
+    def with_overrides(
+        self,
+        overrides: Mapping[str, Any] | None = None,
+        *,
+        name: str | None = None,
+        drop: Iterable[str] = (),
+    ) -> Scenario:
+        """This scenario with its config changed: the ``drop`` sections (dotted keys, e.g.
+        ``"sensors"``) back to their defaults, then ``overrides`` deep-merged (mappings merge
+        key by key: ``{"ship": {"params": {"Tc": 0.2}}}`` keeps the other parameters), then
+        ``name``; validated and built like a loaded file."""
+        if name is not None:
+            overrides = {**(overrides or {}), "name": name}
+        origin = name or f"{self.name} (overrides)"
+        config = self.config.with_overrides(overrides, drop, origin, ScenarioError)
+        return build_scenario(config, origin)
+
 
 def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenario:
     """SI objects from a validated config; errors name ``origin`` and the key."""
@@ -143,52 +164,38 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
 
 
 def scenario_from_dict(data: Any, origin: str = "<dict>") -> Scenario:
-    if not isinstance(data, dict):
-        raise ScenarioError(
-            f"{origin}: expected a mapping at the top level, got {type(data).__name__}"
-        )
-    try:
-        config = ScenarioConfig.model_validate(data)
-    except ValidationError as exc:
-        raise ScenarioError(format_validation_error(exc, origin)) from None
-    return build_scenario(config, origin)
+    """A scenario from a mapping of the YAML keys; errors name ``origin`` and the key."""
+    return build_scenario(validate_model(data, ScenarioConfig, origin, ScenarioError), origin)
 
 
-def load_scenario_file(path: str | os.PathLike) -> Scenario:
-    file = FilePath(path)
-    if not file.is_file():
-        raise ScenarioError(f"scenario file not found: {file}")
-    try:
-        data = yaml.safe_load(file.read_text())
-    except yaml.YAMLError as exc:
-        raise ScenarioError(f"{file}: malformed YAML: {exc}") from None
-    return scenario_from_dict(data, str(file))
+def load_scenario_file(path: str | os.PathLike | Traversable) -> Scenario:
+    """A scenario from a YAML file (:func:`shipgym.config.resolve` finds it)."""
+    file = resolve("scenarios", path, error=ScenarioError)
+    return build_scenario(load_yaml_model(file, ScenarioConfig, ScenarioError), str(file))
 
 
-def load_scenario(spec: str | os.PathLike | Scenario | ScenarioConfig) -> Scenario:
-    """A scenario from a catalogue name, a YAML path, a Scenario, a ScenarioConfig or the
-    name of a held-out test scenario ``"<distribution>:<index>"`` (``heldout:3``)."""
+def load_scenario(
+    spec: str | os.PathLike | Traversable | Scenario | ScenarioConfig | Mapping[str, Any],
+) -> Scenario:
+    """A scenario from a catalogue name, a YAML path, a Scenario, a ScenarioConfig, a mapping
+    of the YAML keys or the name of a held-out test scenario ``"<distribution>:<index>"``
+    (``heldout:3``)."""
     if isinstance(spec, Scenario):
         return spec
     if isinstance(spec, ScenarioConfig):
         return build_scenario(spec)
-    if isinstance(spec, dict):
+    if isinstance(spec, Mapping):
         return scenario_from_dict(spec)
-    if not isinstance(spec, str | os.PathLike):
-        raise ScenarioError(
-            f"scenario must be a catalogue name, a YAML path or a Scenario, got {spec!r}"
-        )
-    text = os.fspath(spec)
-    if text.endswith((".yaml", ".yml")) or os.sep in text:
-        return load_scenario_file(text)
-    if ":" in text:  # a named scenario of a test distribution, e.g. "heldout:3"
+    if isinstance(spec, str) and ":" in spec and not is_path(spec):
+        # a named scenario of a test distribution, e.g. "heldout:3"
         from shipgym.scenarios.sampling import DistributionError, sampled_scenario_config
 
         try:
-            return build_scenario(sampled_scenario_config(text), text)
+            return build_scenario(sampled_scenario_config(spec), spec)
         except DistributionError as exc:
             raise ScenarioError(str(exc)) from None
-    names = list_scenarios()
-    if text not in names:
-        raise ScenarioError(f"unknown scenario {text!r}; valid names: {', '.join(names)}")
-    return load_scenario_file(catalogue_dir() / f"{text}.yaml")
+    if not isinstance(spec, str | os.PathLike | Traversable):
+        raise ScenarioError(
+            f"scenario must be a catalogue name, a YAML path or a Scenario, got {spec!r}"
+        )
+    return load_scenario_file(spec)

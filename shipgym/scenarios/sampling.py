@@ -26,13 +26,13 @@ from __future__ import annotations
 import math
 import os
 import zlib
-from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
-from shipgym.scenarios.schema import ScenarioConfig, _Strict, load_yaml_model
+from shipgym.config import ConfigError, StrictModel, list_names, load_yaml_model, resolve
+from shipgym.scenarios.schema import ScenarioConfig
 
 #: salts of the two seed spaces: test scenarios come from SeedSequence([TEST_SALT, ·, i]),
 #: training scenarios from SeedSequence([TRAIN_SALT, s]) with s drawn by the env
@@ -50,7 +50,7 @@ def _check_range(r: tuple[float, float]) -> tuple[float, float]:
 Range = Annotated[tuple[float, float], AfterValidator(_check_range)]
 
 
-class JumpSpec(_Strict):
+class JumpSpec(StrictModel):
     """One parameter's change: new value = base·factor (``factor``), base + x (``add``)
     or x (``value``), x uniform in ``range``."""
 
@@ -58,7 +58,7 @@ class JumpSpec(_Strict):
     range: Range
 
 
-class JumpKind(_Strict):
+class JumpKind(StrictModel):
     """A named kind of event (e.g. rudder aging) changing one or more parameters together."""
 
     weight: float = Field(1.0, gt=0)
@@ -67,13 +67,13 @@ class JumpKind(_Strict):
     ramp_duration: Range = (2.0, 10.0)
 
 
-class JumpsConfig(_Strict):
+class JumpsConfig(StrictModel):
     probability: float = Field(0.8, ge=0, le=1)  # chance that an episode has a jump
     time: Range = (8.0, 30.0)  # s
     kinds: dict[str, JumpKind] = Field(default_factory=dict)
 
 
-class PathSampling(_Strict):
+class PathSampling(StrictModel):
     legs: tuple[int, int] = (2, 4)  # number of legs, inclusive
     leg_length_L: Range = (10.0, 20.0)
     turn_deg: Range = (-90.0, 90.0)  # heading change at each inner waypoint
@@ -82,18 +82,18 @@ class PathSampling(_Strict):
     time_factor: float = Field(1.6, gt=1)  # time limit = factor · length / U0 + 10 s
 
 
-class CurrentSampling(_Strict):
+class CurrentSampling(StrictModel):
     probability: float = Field(0.0, ge=0, le=1)
     speed: Range = (0.0, 0.0)  # m/s
     direction_deg: Range = (0.0, 360.0)
 
 
-class SensorSampling(_Strict):
+class SensorSampling(StrictModel):
     heading_noise_deg: Range = (0.0, 0.0)
     outlier_probability: Range = (0.0, 0.0)
 
 
-class ShipSampling(_Strict):
+class ShipSampling(StrictModel):
     model: str = "nomoto2"
     unit_reading: str | None = None
     variant: str | None = None
@@ -101,7 +101,7 @@ class ShipSampling(_Strict):
     param_factors: dict[str, Range] = Field(default_factory=dict)  # nominal·U(range)
 
 
-class DistributionConfig(_Strict):
+class DistributionConfig(StrictModel):
     name: str
     description: str = ""
     split: Literal["train", "test"]
@@ -147,20 +147,13 @@ class DistributionConfig(_Strict):
         return self
 
 
-class DistributionError(ValueError):
+class DistributionError(ConfigError):
     """A distribution cannot be found or is malformed (names the file and key)."""
 
 
-def distribution_dir() -> Path:
-    """``configs/distributions`` of the repository (``SHIPGYM_DISTRIBUTION_DIR`` overrides)."""
-    override = os.environ.get("SHIPGYM_DISTRIBUTION_DIR")
-    if override:
-        return Path(override)
-    return Path(__file__).resolve().parents[2] / "configs" / "distributions"
-
-
 def list_distributions() -> list[str]:
-    return sorted(p.stem for p in distribution_dir().glob("*.yaml"))
+    """Names of the packaged distributions (``configs/distributions``)."""
+    return list_names("distributions")
 
 
 def _uniform(rng: np.random.Generator, r: Range) -> float:
@@ -307,17 +300,8 @@ def _sample_waypoints(
 
 def load_distribution(name_or_path: str | os.PathLike) -> ScenarioDistribution:
     """A distribution by name (``configs/distributions/<name>.yaml``) or YAML path."""
-    text = os.fspath(name_or_path)
-    path = Path(text)
-    if not text.endswith((".yaml", ".yml")) and os.sep not in text:
-        path = distribution_dir() / f"{text}.yaml"
-        if not path.is_file():
-            raise DistributionError(
-                f"unknown distribution {text!r}; valid: {', '.join(list_distributions())}"
-            )
-    if not path.is_file():
-        raise DistributionError(f"distribution file not found: {path}")
-    return ScenarioDistribution(load_yaml_model(path, DistributionConfig, DistributionError))
+    file = resolve("distributions", name_or_path, error=DistributionError)
+    return ScenarioDistribution(load_yaml_model(file, DistributionConfig, DistributionError))
 
 
 def sampled_scenario_config(name: str) -> ScenarioConfig:

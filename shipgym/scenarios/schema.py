@@ -4,53 +4,46 @@ Validated once, at the boundary (pydantic, unknown keys rejected), so that a bad
 with an error naming the file and the key.  Values are in the units of the config files:
 metres, seconds, degrees where a key says ``_deg``; ship parameters in the units of the
 model's source paper (for nomoto2: Liu et al. 2019, d0 in °/s), converted to SI by the
-model under the scenario's ``unit_reading``.
+model under the scenario's ``unit_reading``.  The ``disturbances`` and ``sensors`` sections
+are the models of :mod:`shipgym.disturbance_config` (re-exported here).
 """
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
-from typing import Annotated, Literal, TypeVar
+from typing import Literal
 
-import yaml
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Field,
-    ValidationError,
-    field_validator,
-    model_validator,
+from pydantic import Field, field_validator, model_validator
+
+from shipgym.config import StrictModel
+from shipgym.disturbance_config import (
+    ConstantCurrent,
+    CurrentConfig,
+    DisturbanceConfig,
+    GaussMarkovCurrent,
+    SensorConfig,
+    TwoPhaseCurrent,
+    WaveConfig,
 )
 
-#: a validated config model
-M = TypeVar("M", bound=BaseModel)
+__all__ = [
+    "ConstantCurrent",
+    "CurrentConfig",
+    "DisturbanceConfig",
+    "EventConfig",
+    "GaussMarkovCurrent",
+    "GuidanceConfig",
+    "InitialState",
+    "PathConfig",
+    "RewardConfig",
+    "ScenarioConfig",
+    "SensorConfig",
+    "ShipConfig",
+    "TwoPhaseCurrent",
+    "WaveConfig",
+]
 
 
-def format_validation_error(err: ValidationError, origin: str) -> str:
-    """One line per problem, naming the file (``origin``) and the key."""
-    lines = []
-    for item in err.errors():
-        key = ".".join(str(part) for part in item["loc"]) or "<top level>"
-        lines.append(f"{origin}: key '{key}': {item['msg']}")
-    return "\n".join(lines)
-
-
-def load_yaml_model(path: Path, model: type[M], error: type[Exception]) -> M:
-    """``model`` validated from the YAML file ``path``; ``error`` names the file and key."""
-    try:
-        return model.model_validate(yaml.safe_load(path.read_text()))
-    except yaml.YAMLError as exc:
-        raise error(f"{path}: malformed YAML: {exc}") from None
-    except ValidationError as exc:
-        raise error(format_validation_error(exc, str(path))) from None
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class ShipConfig(_Strict):
+class ShipConfig(StrictModel):
     """Which model, its parameters (paper units) and the unit reading of those numbers."""
 
     model: str = "nomoto2"
@@ -63,14 +56,14 @@ class ShipConfig(_Strict):
     )
 
 
-class InitialState(_Strict):
+class InitialState(StrictModel):
     x: float = 0.0  # m
     y: float = 0.0  # m
     heading_deg: float = 0.0  # deg
     states: dict[str, float] = Field(default_factory=dict)  # other states, SI
 
 
-class PathConfig(_Strict):
+class PathConfig(StrictModel):
     type: Literal["waypoints", "pchip"] = "waypoints"
     waypoints: list[tuple[float, float]]
     switching: Literal["circle", "along_track"] = "circle"
@@ -84,7 +77,7 @@ class PathConfig(_Strict):
         return v
 
 
-class GuidanceConfig(_Strict):
+class GuidanceConfig(StrictModel):
     """Guidance law the env uses for its heading reference (observation, guidance mode).
 
     Laws and their parameters are those of :mod:`shipgym.guidance` (its module doc has the
@@ -108,146 +101,7 @@ class GuidanceConfig(_Strict):
     tvvf_error_unit: Literal["m", "L", "similar"] = "m"
 
 
-class _CurrentBase(_Strict):
-    speed: float = Field(0.0, ge=0)  # (mean) current speed [m/s]
-    direction_deg: float = 0.0  # (mean) direction the current flows TO [deg]
-    #: extra yaw bias in the model's ``yaw_disturbance`` unit per m/s of current speed
-    #: (nomoto2: rad/s per m/s, added to d0 as Liu et al. (2019) Case 2 does); 0 = off.
-    #: Meant for kinematic-current models; 3-DOF models already feel the current through
-    #: their relative velocities (shipgym.disturbances module doc).
-    yaw_bias_per_speed: float = 0.0
-
-
-class ConstantCurrent(_CurrentBase):
-    """Constant current (the default when ``kind`` is omitted)."""
-
-    kind: Literal["constant"] = "constant"
-
-
-class _GaussMarkovFields(_CurrentBase):
-    """First-order Gauss–Markov speed and direction (data file §4.3; Fossen 2011 §8.3).
-
-    V = V̄ + x with ẋ + μx = σw (w unit white noise), state saturated to [min_speed,
-    max_speed]; direction β = β̄ + d with ḋ + μ₂d = σ₂w₂, |d| ≤ direction_max_deviation_deg.
-    Stationary std σ/√(2μ), correlation time 1/μ.  μ, σ are not given by the sources: the
-    defaults (1/μ = 50 s, std 0.02 m/s, constant direction) are our assumption.
-    """
-
-    mu: float = Field(0.02, gt=0)  # μ [1/s]
-    sigma: float = Field(0.004, ge=0)  # σ, white-noise intensity √ [m/s/√s]
-    min_speed: float = Field(0.0, ge=0)  # [m/s]
-    max_speed: float | None = Field(None, gt=0)  # [m/s]; None: no upper bound
-    direction_mu: float = Field(0.02, gt=0)  # μ₂ [1/s]
-    direction_sigma_deg: float = Field(0.0, ge=0)  # σ₂ [deg/√s]; 0: constant direction
-    direction_max_deviation_deg: float | None = Field(None, gt=0, le=180)  # |d| bound [deg]
-
-    def _mean_speeds(self) -> dict[str, float]:
-        return {"speed": self.speed}
-
-    @model_validator(mode="after")
-    def _bounds_consistent(self) -> _GaussMarkovFields:
-        hi = math.inf if self.max_speed is None else self.max_speed
-        if self.min_speed > hi:
-            raise ValueError(f"min_speed ({self.min_speed}) > max_speed ({self.max_speed})")
-        for key, value in self._mean_speeds().items():
-            if not self.min_speed <= value <= hi:
-                raise ValueError(
-                    f"{key} ({value}) must lie within [min_speed, max_speed] = "
-                    f"[{self.min_speed}, {self.max_speed}]"
-                )
-        return self
-
-
-class GaussMarkovCurrent(_GaussMarkovFields):
-    """Gauss–Markov current about the mean ``speed`` / ``direction_deg``."""
-
-    kind: Literal["gauss_markov"]
-    speed: float = Field(ge=0)  # mean speed V̄ [m/s] (required)
-
-
-class TwoPhaseCurrent(_GaussMarkovFields):
-    """Two-phase stochastic current, Xu et al. (2021) §5.2: constant direction 180°, a weak
-    phase oscillating about 0.1 m/s, then a stronger one of mean 0.2 m/s.  The paper does not
-    give the switch time nor the fluctuation: ``switch_time`` (None: half the scenario's
-    time limit), ``transition_time`` (linear ramp of the mean, 0: a step) and the
-    Gauss–Markov fluctuation shared by both phases are our options.
-    """
-
-    kind: Literal["two_phase"]
-    speed: float = Field(0.1, ge=0)  # first-phase mean [m/s]
-    second_speed: float = Field(0.2, ge=0)  # second-phase mean [m/s]
-    direction_deg: float = 180.0  # β_c = 180°
-    switch_time: float | None = Field(None, ge=0)  # [s]; None: time_limit / 2
-    transition_time: float = Field(0.0, ge=0)  # [s]
-
-    def _mean_speeds(self) -> dict[str, float]:
-        return {"speed": self.speed, "second_speed": self.second_speed}
-
-
-#: ``disturbances.current``: a constant, Gauss–Markov or two-phase current, by ``kind``.
-CurrentConfig = Annotated[
-    ConstantCurrent | GaussMarkovCurrent | TwoPhaseCurrent, Field(discriminator="kind")
-]
-
-
-class WaveConfig(_Strict):
-    """Wave-induced yaw disturbance: Fossen's 2nd-order wave filter (data file §4.3).
-
-    h(s) = K_w s/(s² + 2λω₀s + ω₀²), K_w = 2λω₀σ_w, σ_w² = max S(ω), ω₀ the modal frequency
-    of the sea-state spectrum: ``pierson_moskowitz`` (from ``wind_speed``) or ``ittc`` (from
-    ``significant_height`` and ``modal_period``).  The filter output y [m] (one-sided PSD
-    |h(jω)|², peak S(ω₀)) enters the plant as ``yaw_disturbance = gain·y``: ``gain`` is in
-    the model's yaw_disturbance unit per metre: nomoto2 rad/s per m (added to the yaw bias
-    d0); mariner, esso_osaka, blanke rad/s² per m (added to ṙ; see each model's module doc).
-    No source gives the gain, so it has no default.
-    """
-
-    spectrum: Literal["pierson_moskowitz", "ittc"] = "pierson_moskowitz"
-    wind_speed: float | None = Field(None, gt=0)  # V₁₉.₅ [m/s] (pierson_moskowitz)
-    significant_height: float | None = Field(None, gt=0)  # H_s [m] (ittc)
-    modal_period: float | None = Field(None, gt=0)  # T₀ [s] (ittc)
-    damping: float = Field(0.1, gt=0, lt=1)  # λ (Fossen: 0.1)
-    gain: float  # [yaw_disturbance unit / m]
-
-    @model_validator(mode="after")
-    def _spectrum_inputs(self) -> WaveConfig:
-        needs = {
-            "pierson_moskowitz": ("wind_speed",),
-            "ittc": ("significant_height", "modal_period"),
-        }
-        for spectrum, keys in needs.items():
-            for key in keys:
-                given = getattr(self, key) is not None
-                if spectrum == self.spectrum and not given:
-                    raise ValueError(f"spectrum {self.spectrum!r} needs {key}")
-                if spectrum != self.spectrum and given:
-                    raise ValueError(f"{key} does not apply to spectrum {self.spectrum!r}")
-        return self
-
-
-class DisturbanceConfig(_Strict):
-    """Environmental disturbances (shipgym.disturbances): current and waves."""
-
-    current: CurrentConfig = ConstantCurrent()
-    waves: WaveConfig | None = None  # None: calm sea
-
-    @field_validator("current", mode="before")
-    @classmethod
-    def _constant_by_default(cls, v: object) -> object:
-        if isinstance(v, dict) and "kind" not in v:
-            return {**v, "kind": "constant"}
-        return v
-
-
-class SensorConfig(_Strict):
-    heading_noise_deg: float = Field(0.0, ge=0)  # std of Gaussian heading noise
-    yaw_rate_noise_deg_s: float = Field(0.0, ge=0)
-    outlier_probability: float = Field(0.0, ge=0, le=1)  # per fine sample
-    outlier_magnitude_deg: tuple[float, float] = (5.0, 15.0)  # |spike| range on heading
-    dropout_probability: float = Field(0.0, ge=0, le=1)  # per fine sample: hold last value
-
-
-class EventConfig(_Strict):
+class EventConfig(StrictModel):
     """At ``time`` the true plant parameters change (step, or linear ramp over ``duration``)."""
 
     time: float = Field(ge=0)
@@ -264,7 +118,7 @@ class EventConfig(_Strict):
         return self
 
 
-class RewardConfig(_Strict):
+class RewardConfig(StrictModel):
     """r = −(|e|/L + w_ψ|ψ̃| + w_δ(δc/δmax)² + w_Δ(Δδc/δmax)²), SPEC §5."""
 
     heading_weight: float = Field(0.1, ge=0)
@@ -274,7 +128,7 @@ class RewardConfig(_Strict):
     max_cross_track_L: float = Field(10.0, gt=0)  # corridor half-width in ship lengths
 
 
-class ScenarioConfig(_Strict):
+class ScenarioConfig(StrictModel):
     name: str
     description: str = ""
     source: str = ""

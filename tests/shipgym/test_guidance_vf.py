@@ -13,7 +13,7 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 
 import shipgym  # noqa: F401
-from shipgym.autopilot import HeadingPID
+from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym.envs.path_follow import GUIDANCE_OFFSET_MAX
 from shipgym.guidance import (
     lookahead_los_heading,
@@ -21,6 +21,7 @@ from shipgym.guidance import (
     tvvf_theta,
     vector_field_heading,
 )
+from shipgym.identification import first_order_nomoto
 from shipgym.paths import wrap_angle
 from shipgym.scenarios import ScenarioError, load_scenario
 from shipgym.scenarios.loader import scenario_from_dict
@@ -388,14 +389,14 @@ def test_env_guidance_mode_uses_the_law(guidance: dict, law) -> None:
     env = gym.make(
         "ShipPathFollow-v0", scenario=scenario_from_dict(_nominal(guidance)), action_mode="guidance"
     ).unwrapped
-    env.reset(seed=0)
+    _, info = env.reset(seed=0)
     L = env.scenario.ship_length
+    gains = PIDGains.from_nomoto(*first_order_nomoto(env.model, env.scenario.nominal_params))
+    pid = HeadingPID(gains, env.model.rudder_limit)
     for a0, a1 in [(0.0, 0.0), (0.5, -0.25), (-1.0, 1.0)]:  # exact in float32
-        frame = env._tracker.frame
-        pid = HeadingPID(env._autopilot.gains, env._autopilot.rudder_limit)
-        pid.integral = env._autopilot.integral
+        frame = env.frame
         desired = law(frame.cross_track, frame.path_angle, L, 2.0**a0) + a1 * GUIDANCE_OFFSET_MAX
-        want = pid.command(desired, env._psi_m, env._r_m, env._Ts)
+        want = pid.command(desired, info["heading"], info["yaw_rate"], env.scenario.control_period)
         *_, info = env.step(np.array([a0, a1], dtype=np.float32))
         assert info["rudder_command"] == pytest.approx(want, rel=1e-12, abs=1e-15)
 

@@ -23,6 +23,7 @@ from baselines.cli import build_parser
 from baselines.evaluation import run_episode
 from baselines.reproduce import PAPERS, borkowski2018
 from shipgym.envs.context import ControllerContext
+from shipgym.identification import first_order_nomoto
 from shipgym.models.mariner import MarinerParams
 from shipgym.scenarios import load_scenario, scenario_from_dict
 
@@ -97,24 +98,10 @@ def test_defaults_are_the_papers_on_the_mariner() -> None:
     nominal = load_scenario("nominal")
 
     def context(sc) -> ControllerContext:  # type: ignore[no-untyped-def]
-        return ControllerContext(
-            ship=sc.model.name,
-            nominal_model=sc.model,
-            waypoints=np.asarray(sc.path.waypoints),
-            path_type="waypoints",
-            ship_length=sc.ship_length,
-            nominal_speed=sc.model.nominal_speed,
-            rudder_limit=sc.model.rudder_limit,
-            control_period=sc.control_period,
-            fine_step=sc.fine_step,
-            acceptance_radius=sc.acceptance_radius,
-            switching=sc.config.path.switching,
-            los_radius_L=3.0,
-            action_mode="rudder",
-        )
+        return ControllerContext.of(sc, "rudder")
 
     assert initial_guess(context(mariner)) == (0.02, 0.002)
-    K, T = nominal.model.first_order_nomoto()
+    K, T = first_order_nomoto(nominal.model)
     assert initial_guess(context(nominal)) == pytest.approx((1 / T, K / T))
 
 

@@ -16,7 +16,6 @@ from baselines.classical.pid import (
     PIDVF,
     PIDLookaheadLOS,
     design_gains,
-    nominal_nomoto2,
 )
 from baselines.evaluation import evaluate
 from shipgym.autopilot import (
@@ -28,6 +27,7 @@ from shipgym.autopilot import (
     vyshnegradsky_solutions,
 )
 from shipgym.guidance import tvvf_heading, vector_field_heading
+from shipgym.identification import first_order_nomoto, second_order_nomoto
 from shipgym.models import Mariner, Nomoto2
 from shipgym.scenarios import scenario_from_dict
 
@@ -119,7 +119,7 @@ def test_vyshnegradsky_bad_input(kwargs: dict, match: str) -> None:
 def test_pole_placement_places_the_pd_poles(wn: float, zeta: float) -> None:
     """Xu, Oliveira & Guedes Soares (2021) §5.2 gains on T·ṙ + r = Kδ: the PD loop
     T s² + (1 + K·Kd) s + K·Kp has its poles at −ζωn ± ωn√(ζ² − 1)."""
-    K, T = Nomoto2().first_order_nomoto()
+    K, T = first_order_nomoto(Nomoto2())
     g = PIDGains.from_nomoto(K, T, wn, zeta)
     assert g.ki == pytest.approx(wn**3 * T / (10.0 * K), rel=1e-12)  # Ki = ωn³T/(10K)
     poles = np.sort_complex(np.roots([T, 1.0 + K * g.kd, K * g.kp]))
@@ -140,14 +140,14 @@ def test_default_tunings_and_nominal_models() -> None:
         "vyshnegradsky",
         "pole_placement",
     ]
-    assert nominal_nomoto2(Nomoto2()) == pytest.approx(tuple(NOMOTO2.values()))
-    K, T = Nomoto2().first_order_nomoto()
+    assert second_order_nomoto(Nomoto2()) == pytest.approx(tuple(NOMOTO2.values()))
+    K, T = first_order_nomoto(Nomoto2())
     assert design_gains(Nomoto2(), "pole_placement") == PIDGains.from_nomoto(K, T)
     assert design_gains(Nomoto2(), "vyshnegradsky") == vyshnegradsky_gains(**NOMOTO2)
     with pytest.raises(ValueError, match="tuning"):
         PIDVF(tuning="ziegler")
     # the mariner design comes from its zig-zag fit and still has (A, B) = (4, 4)
-    fit = nominal_nomoto2(Mariner())
+    fit = second_order_nomoto(Mariner())
     g = design_gains(Mariner(), "vyshnegradsky")
     poly = nomoto2_pd_characteristic(*fit, g.kp, g.kd)
     np.testing.assert_allclose(vyshnegradsky_parameters(poly), (4.0, 4.0), atol=1e-9)

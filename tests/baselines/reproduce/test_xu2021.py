@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import math
 
-import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -60,8 +59,8 @@ def test_short_run_rows_markdown_and_files(short_run) -> None:  # type: ignore[n
 def test_episode_figures_match_the_leaderboard_metrics() -> None:
     """The per-phase figures count the same steps as shipgym.metrics: over the whole
     episode, ACE, mean |ψ̃| and mean |δ| equal the leaderboard's metrics."""
-    scenario = xu2021._scenario(120.0)
-    recorder = xu2021._Recorded(AdaptiveBackstepping(), xu2021.AB)
+    scenario = xu2021.build_scenario(120.0)
+    recorder = xu2021.Recorded(AdaptiveBackstepping(), xu2021.AB)
     result = run_episode(recorder, scenario, 10_000)
     fig = xu2021.episode_figures(scenario, result, recorder)["episode"]
     m = result.metrics
@@ -124,7 +123,7 @@ def test_loop_margins_of_an_integrator_and_a_first_order_lag() -> None:
 def test_adaptive_filter_placement_with_frozen_estimates_is_adaptive_backstepping() -> None:
     """filter_placement="adaptive" filters only δ − δ_nom: with the adaptation frozen at
     the nominal estimates that share is 0 and the commands equal the unfiltered law's."""
-    scenario = xu2021._scenario(60.0)
+    scenario = xu2021.build_scenario(60.0)
     frozen = {"gamma_rho": 0.0, "gamma_sigma": 0.0, "gamma_b": 0.0}
     a = run_episode(L1Backstepping(filter_placement="adaptive", **frozen), scenario, 3)
     b = run_episode(AdaptiveBackstepping(**frozen), scenario, 3)
@@ -135,21 +134,27 @@ def test_adaptive_filter_placement_with_frozen_estimates_is_adaptive_backsteppin
         L1Backstepping(filter_placement="estimates")
 
 
-def test_current_series_is_the_episode_current() -> None:
-    """The regenerated current equals the block the env fed the plant, period by period,
-    and steps from about 0.1 to about 0.2 m/s at the switch."""
-    scenario = xu2021._scenario(200.0)
-    env = gym.make("ShipPathFollow-v0", scenario=scenario)
-    env.reset(seed=7)
-    base = env.unwrapped
-    names = base.model.disturbance_names
-    ix, iy = names.index("current_x"), names.index("current_y")
-    seen = []
-    for _ in range(400):
-        env.step(np.zeros(1, dtype=np.float32))
-        seen.append(np.hypot(base._w_block[:, ix], base._w_block[:, iy]).copy())
-    env.close()
-    t, speed = xu2021.current_speed_series(scenario, 7, 400)
-    np.testing.assert_array_equal(speed, np.concatenate(seen))
-    before, after = speed[t < 100.0].mean(), speed[t >= 100.0].mean()
+def test_current_is_read_from_the_env_log_after_the_episode() -> None:
+    """The figure's current is the env's own log, read after the episode: on the fine grid
+    (h apart from t = 0, n_sub samples per step), the same under two controllers with one
+    seed (its draws do not depend on the actions), from about 0.1 to about 0.2 m/s at the
+    switch."""
+    scenario = xu2021.build_scenario(200.0)
+    logs, results = [], []
+    for policy in (AdaptiveBackstepping(), xu2021.CONTROLLERS[xu2021.PID]()):
+        log = xu2021.DisturbanceLog()
+        results.append(run_episode(policy, scenario, 7, after_episode=log.read))
+        logs.append(log.episodes[0])
+    steps = min(r.metrics["steps"] for r in results)
+    h = float(logs[0]["t"][1])  # the fine step
+    n_sub = round(scenario.control_period / h)
+    assert n_sub * h == pytest.approx(scenario.control_period, rel=1e-12)
+    for log, result in zip(logs, results, strict=True):
+        assert log["t"].size == result.metrics["steps"] * n_sub
+        np.testing.assert_allclose(log["t"], h * np.arange(log["t"].size), atol=1e-9)
+    n = steps * n_sub
+    t, speed = xu2021.current_speed(logs[0])
+    np.testing.assert_array_equal(speed[:n], xu2021.current_speed(logs[1])[1][:n])
+    switch = xu2021.switch_time(scenario)
+    before, after = speed[t < switch].mean(), speed[t >= switch].mean()
     assert 0.05 < before < 0.15 and 0.15 < after < 0.25

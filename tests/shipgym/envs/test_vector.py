@@ -23,64 +23,76 @@ def sync_twin(scenario: str | Scenario, mode: str) -> gym.vector.SyncVectorEnv:
     )
 
 
-@pytest.mark.parametrize("scenario", ["nominal", "rudder_aging", "maneuverability_change"])
-def test_batched_env_equals_single_envs_bit_for_bit(scenario: str) -> None:
-    """Rudder mode, same seeds and actions, through episode ends and autoresets; the noisy
-    Case 3 included (per-env random streams in the single env's order)."""
-    batched = ShipPathFollowVectorEnv(N, scenario)
-    single = sync_twin(scenario, "rudder")
-    obs_b, _ = batched.reset(seed=3)
-    obs_s, _ = single.reset(seed=3)
+def assert_twins_equal(
+    scenario: str | Scenario, mode: str, steps: int, seed: int = 3, min_episodes: int = N
+) -> None:
+    """Same seeds and actions into the batched env and N single envs under SyncVectorEnv:
+    observations, rewards, terminations, every info key and every episode metric equal bit
+    for bit at every step, through episode ends and NEXT_STEP autoresets."""
+    batched = ShipPathFollowVectorEnv(N, scenario, action_mode=mode)
+    single = sync_twin(scenario, mode)
+    obs_b, info_b = batched.reset(seed=seed)
+    obs_s, info_s = single.reset(seed=seed)
     np.testing.assert_array_equal(obs_b, obs_s)
-    rng = np.random.default_rng(0)
-    finished = 0
-    for _ in range(300):
-        action = rng.uniform(-1, 1, (N, 1)).astype(np.float32)
+    rng = np.random.default_rng(seed)
+    episodes = 0
+    n_act = batched.single_action_space.shape[0]
+    for _ in range(steps):
+        action = rng.uniform(-1, 1, (N, n_act)).astype(np.float32)
         out_b, out_s = batched.step(action), single.step(action)
         for got, want in zip(out_b[:4], out_s[:4], strict=True):
             np.testing.assert_array_equal(got, want)
-        for key in ("t", "cross_track_error", "heading", "yaw_rate", "rudder_angle"):
-            np.testing.assert_array_equal(out_b[4][key], out_s[4][key])
-        positions = np.array([np.asarray(pos, dtype=float) for pos in out_s[4]["position"]])
-        np.testing.assert_array_equal(out_b[4]["position"], positions)
-        if "episode_metrics" in out_s[4]:
-            for i in np.flatnonzero(out_s[4]["_episode_metrics"]):
-                finished += 1
-                for key in ("ace", "return", "steps", "max_abs_cross_track"):
-                    got = out_b[4]["episode_metrics"][key][i]  # SyncVectorEnv's layout
-                    assert got == out_s[4]["episode_metrics"][key][i]
-    assert finished >= N  # episodes ended and were reset along the way
+        info_b, info_s = out_b[4], out_s[4]
+        assert set(info_b) == set(info_s) - {"samples", "_samples"}
+        for key in info_b:
+            if key == "position":
+                want = np.array([np.asarray(p, dtype=float) for p in info_s[key]])
+                np.testing.assert_array_equal(info_b[key], want)
+            elif key == "episode_metrics":
+                metrics_b, metrics_s = info_b[key], info_s[key]
+                assert set(metrics_b) == set(metrics_s)
+                for name in metrics_s:  # SyncVectorEnv's layout and dtypes
+                    assert metrics_b[name].dtype == metrics_s[name].dtype, name
+                    np.testing.assert_array_equal(metrics_b[name], metrics_s[name], err_msg=name)
+            else:
+                np.testing.assert_array_equal(info_b[key], info_s[key], err_msg=key)
+        episodes += int(np.sum(out_b[2] | out_b[3]))
+    assert episodes >= min_episodes  # episodes ended and were reset along the way
 
 
-def nominal_with_law(law: str) -> Scenario:
-    """The nominal scenario with another guidance law (vector-field laws, SPEC §3)."""
-    data = load_scenario("nominal").config.model_dump()
-    data["name"] = f"nominal_{law}"
-    data["guidance"] = {"law": law}
-    return scenario_from_dict(data)
+@pytest.mark.parametrize("scenario", ["nominal", "rudder_aging", "maneuverability_change"])
+def test_batched_env_equals_single_envs_bit_for_bit(scenario: str) -> None:
+    """Rudder mode on polylines; the noisy Case 3 included (per-env random streams in the
+    single env's order)."""
+    assert_twins_equal(scenario, "rudder", 300)
 
 
-@pytest.mark.parametrize("law", ["los", "vf", "tvvf"])
-def test_guidance_mode_matches_to_rounding_through_autoresets(law: str) -> None:
-    """Guidance mode uses numpy's arcsin/power (SIMD, last-ulp differences from libm); on a
-    non-chaotic scenario the two stay equal to rounding through episode ends and resets."""
-    scenario = "nominal" if law == "los" else nominal_with_law(law)
-    batched = ShipPathFollowVectorEnv(N, scenario, action_mode="guidance")
-    single = sync_twin(scenario, "guidance")
-    assert batched.scenario.config.guidance.law == law
-    batched.reset(seed=1)
-    single.reset(seed=1)
-    rng = np.random.default_rng(2)
-    resets = 0
-    for _ in range(600):
-        action = rng.uniform(-1.0, 1.0, (N, 2)).astype(np.float32)
-        out_b, out_s = batched.step(action), single.step(action)
-        np.testing.assert_allclose(out_b[0], out_s[0], rtol=0, atol=1e-5)
-        np.testing.assert_allclose(out_b[1], out_s[1], rtol=1e-7, atol=1e-9)
-        np.testing.assert_array_equal(out_b[2], out_s[2])
-        np.testing.assert_array_equal(out_b[3], out_s[3])
-        resets += int(np.sum(out_b[2] | out_b[3]))
-    assert resets >= N
+def with_law(scenario: str, law: str, time_limit: float | None = None) -> Scenario:
+    """A catalogue scenario with another guidance law (SPEC §3) and time limit."""
+    overrides: dict = {"guidance": {"law": law}}
+    if time_limit is not None:
+        overrides["time_limit"] = time_limit
+    return load_scenario(scenario).with_overrides(overrides, name=f"{scenario}_{law}")
+
+
+LAWS = ["los", "lookahead_los", "vf", "tvvf"]
+
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("scenario", ["nominal", "rudder_aging_smooth"])
+def test_guidance_mode_equal_bit_for_bit_for_every_law_and_path_type(
+    law: str, scenario: str
+) -> None:
+    """Every guidance law on a polyline and on a PCHIP curve: the law table, the autopilot
+    and the tracker run on arrays exactly as on floats (libm's asin/atan/atan2/pow mapped
+    over the elements: shipgym.numerics)."""
+    assert_twins_equal(with_law(scenario, law, time_limit=60.0), "guidance", 400)
+
+
+@pytest.mark.parametrize("scenario", ["rudder_aging_smooth", "osaka_curved"])
+def test_rudder_mode_equal_bit_for_bit_on_pchip_paths(scenario: str) -> None:
+    """The vectorised closest-point projection on PCHIP curves (two ships, two routes)."""
+    assert_twins_equal(with_law(scenario, "los", time_limit=40.0), "rudder", 250)
 
 
 def test_reset_mask_and_step_before_reset() -> None:
@@ -107,11 +119,6 @@ def test_make_vec_uses_the_batched_env_and_rejects_bad_actions() -> None:
     with pytest.raises(ValueError, match=r"envs \[1\]"):
         env.step(bad)
     np.testing.assert_array_equal(env.unwrapped._state, before)
-
-
-def test_pchip_scenarios_are_refused_with_a_clear_error() -> None:
-    with pytest.raises(ValueError, match="waypoint paths only"):
-        ShipPathFollowVectorEnv(2, "rudder_aging_smooth")
 
 
 def test_sb3_adapter_trains_ppo_and_autoresets_same_step() -> None:
@@ -184,3 +191,44 @@ def test_batched_env_equals_single_envs_with_stochastic_disturbances() -> None:
     assert resets >= N
     speed = np.hypot(batched._w_block[..., 0], batched._w_block[..., 1])
     assert np.ptp(batched._w_block[..., 2]) > 0 and speed.max() <= 0.15 + 1e-15
+
+
+def test_make_vec_takes_max_episode_steps_like_the_time_limit_wrapper() -> None:
+    env = gym.make_vec("ShipPathFollow-v0", num_envs=3, max_episode_steps=50)
+    env.reset(seed=0)
+    for step in range(1, 51):
+        _, _, terminated, truncated, info = env.step(np.zeros((3, 1), dtype=np.float32))
+        assert not terminated.any()
+        assert truncated.all() == (step == 50)
+    assert list(info["termination_reason"]) == ["time_limit"] * 3
+    assert (info["episode_metrics"]["steps"] == 50).all()
+    with pytest.raises(ValueError, match="max_episode_steps"):
+        ShipPathFollowVectorEnv(2, "nominal", max_episode_steps=0)
+
+
+def test_sb3_adapter_gives_each_env_the_single_env_info_keys() -> None:
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from baselines.learned.vec_env import SB3BatchedVecEnv
+
+    env = VecMonitor(
+        SB3BatchedVecEnv(ShipPathFollowVectorEnv(N, "nominal")),
+        info_keywords=("termination_reason",),
+    )
+    env.seed(0)
+    env.reset()
+    single = gym.make("ShipPathFollow-v0", scenario="nominal")
+    _, single_info = single.reset(seed=0)
+    for _ in range(400):
+        env.step_async(np.ones((N, 1), dtype=np.float32))
+        _, _, dones, infos = env.step_wait()
+        assert set(infos[0]) >= set(single_info) - {"samples"}
+        assert isinstance(infos[0]["position"], tuple)
+        if dones.any():
+            i = int(np.flatnonzero(dones)[0])
+            reason = infos[i]["termination_reason"]
+            assert reason in ("goal", "corridor", "time_limit")
+            assert infos[i]["episode"]["termination_reason"] == reason  # VecMonitor's record
+            break
+    else:
+        pytest.fail("no episode ended")

@@ -90,25 +90,6 @@ def test_esso_osaka_identified_nomoto_matches_xu_2020() -> None:
     assert 0 < fit.T2 < 1.0 and 0 < fit.T3 < 1.0
 
 
-def test_nominal_models_come_from_the_ships_own_zigzag() -> None:
-    """first_order_nomoto of a ship without a closed form is the zig-zag fit (no typed
-    numbers), cached per model, and follows the nominal parameters it is given."""
-    mariner = MODELS["mariner"]()
-    K, T = mariner.first_order_nomoto()
-    fit, servo = ship_nomoto(mariner)
-    assert (K, T) == fit.first_order()
-    # the de Wit-Oppe linear part: K = a3/a1 = 0.056 1/s, T = 1/a1 = 55.6 s; the 20/20
-    # fit also sees the cubic damping a2·r³, which lowers both
-    assert 0.03 < K < 0.056 and 30.0 < T < 55.6
-    assert servo > 1.0  # the 0.066 rad/s rate limit makes the effective servo slow
-    faster = mariner.params.replace(a3=2 * mariner.params.a3)
-    K2, _ = mariner.first_order_nomoto(faster)
-    # twice the rudder effectiveness: a larger gain, less than doubled because the
-    # stronger turns meet more cubic damping
-    assert 1.3 * K < K2 < 2 * K
-    assert (K2, _) == ship_nomoto(mariner.with_params(faster))[0].first_order()
-
-
 CLASSICAL = [
     "pid_los",
     "pid_lookahead_los",

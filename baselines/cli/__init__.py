@@ -1,0 +1,55 @@
+"""The ``shipgym`` console script (SPEC §9b).
+
+``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+
+from baselines.cli import bench, leaderboard, manoeuvre, reproduce, scenarios, train
+from shipgym.errors import ShipgymError
+
+#: the subcommands' parser builders, in the order ``shipgym --help`` lists them
+SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
+    leaderboard.add_leaderboard_parser,
+    reproduce.add_parser,
+    train.add_parser,
+    leaderboard.add_evaluate_parser,
+    manoeuvre.add_parser,
+    scenarios.add_parser,
+    bench.add_parser,
+)
+
+#: exit code of a bad input (a :class:`ShipgymError`), as argparse's own usage errors
+EXIT_USAGE = 2
+#: exit code after Ctrl-C (128 + SIGINT)
+EXIT_INTERRUPTED = 130
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="shipgym", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    for add_parser in SUBCOMMANDS:
+        add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one subcommand; a :class:`ShipgymError` (bad input) prints one line and exits 2,
+    any other exception is a bug and keeps its traceback."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except ShipgymError as exc:
+        sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        sys.stderr.write(f"shipgym {args.command}: interrupted\n")
+        return EXIT_INTERRUPTED
+
+
+__all__ = ["build_parser", "main"]

@@ -1,0 +1,51 @@
+"""``shipgym bench TARGET``: the benchmarks of SPEC §10."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from typing import Any
+
+from baselines import benchmarks
+from baselines.cli.options import add_json_option, emit
+
+#: bench target -> the benchmark run with the parsed options (``--repeats``)
+BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
+    "env": lambda args: benchmarks.bench_env(repeats=args.repeats),
+    "nmpc": lambda args: benchmarks.bench_nmpc(),
+    "identification": lambda args: benchmarks.bench_identification(),
+    "training": lambda args: benchmarks.bench_training(repeats=args.repeats),
+}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="benchmarks of SPEC §10")
+    p.add_argument(
+        "target",
+        choices=list(BENCHES),
+        help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv)",
+    )
+    p.add_argument("--repeats", type=int, default=5)
+    add_json_option(p, "print the figures as a JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the benchmark, print its figures (nested keys joined by dots)."""
+    figures = BENCHES[args.target](args)
+    emit(args, figures, "\n".join(flatten_lines(figures)))
+    return 0
+
+
+def flatten_lines(figures: dict[str, Any], prefix: str = "") -> list[str]:
+    """``name value`` lines of nested figures, names joined by dots."""
+    lines = []
+    for key, value in figures.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            lines.extend(flatten_lines(value, name + "."))
+        elif isinstance(value, float):
+            lines.append(f"{name:60s} {value:,.4g}")
+        else:
+            lines.append(f"{name:60s} {value}")
+    return lines

@@ -1,0 +1,60 @@
+"""``shipgym manoeuvre SHIP KIND``: turning circle or zig-zag of a ship model."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+from baselines.cli.options import add_json_option, emit
+from baselines.errors import RunError
+from shipgym.manoeuvres import ManoeuvreLog, plot_manoeuvre, turning_circle, zigzag
+from shipgym.models import MODELS, ShipModel
+
+Manoeuvre = Callable[[ShipModel, argparse.Namespace], tuple[ManoeuvreLog, dict[str, float]]]
+
+
+def _turning(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
+    """Turning circle at --rudder [deg] (default 35° or the ship's rudder limit)."""
+    default = min(35.0, math.degrees(model.rudder_limit))
+    return turning_circle(model, args.rudder if args.rudder is not None else default)
+
+
+def _zigzag(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
+    """--rudder/--switch zig-zag [deg] (default 20/20; the switch defaults to the rudder)."""
+    rudder = args.rudder if args.rudder is not None else 20.0
+    return zigzag(model, rudder, args.switch if args.switch is not None else rudder)
+
+
+#: manoeuvre kind -> the run on a ship with the parsed options
+MANOEUVRES: dict[str, Manoeuvre] = {"turning": _turning, "zigzag": _zigzag}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "manoeuvre", help="turning circle or zig-zag of a ship model, with figures and a plot"
+    )
+    p.add_argument("ship", help=f"ship model id ({', '.join(MODELS)})")
+    p.add_argument("kind", choices=list(MANOEUVRES))
+    p.add_argument("--rudder", type=float, default=None, help="rudder angle [deg] (35 / 20)")
+    p.add_argument("--switch", type=float, default=None, help="zig-zag heading switch [deg]")
+    p.add_argument("--variant", default=None, help="model variant (e.g. esso_osaka literal)")
+    p.add_argument("--out", default="results/manoeuvres", help="directory of the plot")
+    add_json_option(p, "print the figures as a JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the manoeuvre, save its plot, print the figures."""
+    if args.ship not in MODELS:
+        raise RunError(f"unknown ship {args.ship!r}; valid: {', '.join(sorted(MODELS))}")
+    model = MODELS[args.ship](variant=args.variant)
+    log, figures = MANOEUVRES[args.kind](model, args)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    plot = out / f"{args.ship}_{args.kind}.png"
+    plot_manoeuvre(model, args.kind, log, figures, str(plot))
+    lines = [f"{k:22s} {v:.4g}" for k, v in figures.items()] + [f"plot: {plot}"]
+    emit(args, figures, "\n".join(lines))
+    return 0

@@ -1,0 +1,38 @@
+"""``shipgym reproduce PAPER``: re-run a source paper's experiment (SPEC §11)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from baselines.cli.options import add_json_option, add_progress_option, emit
+from baselines.reproduce import PAPERS
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
+    p.add_argument("paper", choices=list(PAPERS), help="which paper")
+    p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
+    p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
+    add_progress_option(p)
+    add_json_option(p, "print the rows as JSON on stdout")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the paper's cases, print its markdown table (or the rows with ``--json``)."""
+    from tqdm import tqdm
+
+    module = PAPERS[args.paper]
+    bar = tqdm(desc=f"reproduce {args.paper}", file=sys.stderr, disable=args.no_progress)
+    rows = module.run(
+        out_dir=args.out or f"results/reproduce/{args.paper}",
+        seeds=args.seeds,
+        progress=lambda: bar.update(1),
+    )
+    bar.close()
+    if args.json:
+        emit(args, rows, "")
+    else:
+        sys.stdout.write(module.markdown(rows))
+    return 0

@@ -1,0 +1,86 @@
+"""``shipgym train AGENT``: train SB3 agents (configs/agents), one run or a sweep."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from baselines.cli.options import add_backend_option, add_json_option, add_progress_option, emit
+from baselines.errors import RunError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "train",
+        help="train an SB3 agent (configs/agents) with evaluation, checkpoints, TensorBoard",
+    )
+    p.add_argument("agent", help="agent config name in configs/agents (ppo, sac, …) or 'all'")
+    p.add_argument("--config", default=None, help="agent YAML (default configs/agents/AGENT.yaml)")
+    p.add_argument("--out", default=None, help="output directory (default results/agents/NAME)")
+    p.add_argument(
+        "--seed",
+        type=int,
+        nargs="+",
+        default=None,
+        help="override the config's seed; several: a sweep",
+    )
+    p.add_argument("--workers", type=int, default=1, help="parallel training runs (local pool)")
+    add_backend_option(p)
+    p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
+    p.add_argument("--resume", action="store_true", help="continue from the newest checkpoint")
+    p.add_argument(
+        "--ship", action="store_true", help="export the best model to baselines/learned/policies"
+    )
+    add_progress_option(p)
+    add_json_option(p, "print the training meta as JSON")
+    p.set_defaults(func=run)
+
+
+def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
+    """One job per (agent, seed) with its output directory (``train_sweep``'s input)."""
+    from baselines.learned.agents import list_agent_configs, load_agent_config
+
+    if args.agent == "all":
+        if args.config:
+            raise RunError("train all: --config applies to one agent")
+        names = list_agent_configs()
+    else:
+        names = [args.agent]
+    seeds = args.seed or [None]
+    if args.ship and len(seeds) > 1:
+        raise RunError("--ship exports one policy per agent: give at most one --seed")
+    jobs = []
+    for name in names:
+        config = load_agent_config(args.config or name)
+        for seed in seeds:
+            out = args.out or "results/agents"
+            if len(names) > 1 or args.out is None:
+                out = f"{out}/{config.name}"
+            if len(seeds) > 1:
+                out = f"{out}/seed_{seed}"
+            jobs.append(
+                {
+                    "config": config,
+                    "out_dir": out,
+                    "seed": seed,
+                    "n_timesteps": args.timesteps,
+                    "resume": args.resume,
+                    "progress": not args.no_progress and len(names) * len(seeds) == 1,
+                    "ship": args.ship,
+                }
+            )
+    return jobs
+
+
+def run(args: argparse.Namespace) -> int:
+    """Train every job, print one line per run (or the meta(s) with ``--json``)."""
+    from baselines.learned.train import train_sweep
+
+    metas = train_sweep(training_jobs(args), backend=args.backend, workers=args.workers)
+    text = "\n".join(
+        f"{m['name']} (seed {m['seed']}): {m['env_steps']} env steps in "
+        f"{m['wall_time_s']:.0f} s -> {m['out_dir']}"
+        for m in metas
+    )
+    emit(args, metas if len(metas) > 1 else metas[0], text)
+    return 0

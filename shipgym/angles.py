@@ -1,0 +1,41 @@
+"""Angles: the one wrap to [−π, π) of the package, for floats and numpy arrays.
+
+The bottom layer of :mod:`shipgym` (imports nothing of the package).  Values already inside
+[−π, π) are returned untouched (bit for bit), so wrapping is the identity on its range; the
+others are reduced with one floating modulo.  The float branch uses the array branch's
+operations (``np.mod``-equivalent ``%`` on IEEE doubles, the same comparisons), so a float
+result equals the matching element of an array result bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import overload
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["TWO_PI", "wrap_angle"]
+
+_PI = math.pi
+TWO_PI = 2.0 * math.pi
+
+
+@overload
+def wrap_angle(a: float) -> float: ...
+@overload
+def wrap_angle(a: NDArray[np.floating]) -> NDArray[np.float64]: ...
+def wrap_angle(a):
+    """Wrap an angle [rad] (float or numpy array) to the half-open interval [−π, π)."""
+    if isinstance(a, (float, int)):  # also catches numpy float64 (a float subclass)
+        a = float(a)
+        if -_PI <= a < _PI:
+            return a
+        w = (a + _PI) % TWO_PI - _PI
+        # Float modulo can round up to exactly 2π for tiny negative inputs (e.g. −1e-20).
+        return w - TWO_PI if w >= _PI else w
+    arr = np.asarray(a, dtype=np.float64)
+    w = np.mod(arr + _PI, TWO_PI) - _PI
+    w = np.where(w >= _PI, w - TWO_PI, w)
+    w = np.where((arr >= -_PI) & (arr < _PI), arr, w)
+    return float(w) if w.ndim == 0 else w

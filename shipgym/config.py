@@ -1,0 +1,196 @@
+"""Config files: where they are (one resolver) and how they are read (one YAML loader).
+
+The packaged catalogue is the repository's top-level ``configs/``, installed as the package
+data ``shipgym.configs`` and found through :mod:`importlib.resources` (from a wheel or an
+editable install alike).  Its folders are the *kinds*: ``scenarios``, ``distributions``,
+``suites``, ``agents``.
+
+Name or path.  A bare name (``rudder_aging``) is the packaged file
+``configs/<kind>/<name>.yaml``.  Anything that looks like a path (it contains a separator or
+ends in ``.yaml``/``.yml``) is that file; a relative path is read against ``relative_to``
+when given (a suite's folder, for the scenario files it lists), else against the working
+directory.
+
+Every config model derives from :class:`StrictModel` (unknown keys rejected, frozen) and is
+read by :func:`load_yaml_model`, whose errors name the file, the line where the YAML fails,
+and the bad key.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping
+from importlib.resources import files
+from importlib.resources.abc import Traversable
+from pathlib import Path
+from typing import Any, Self, TypeVar
+
+import yaml
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from shipgym.errors import ShipgymError
+
+#: kind (folder of configs/) -> what one file of it is called in messages
+KINDS: dict[str, str] = {
+    "agents": "agent config",
+    "distributions": "distribution",
+    "scenarios": "scenario",
+    "suites": "suite",
+}
+
+#: a config file: a filesystem path, or a packaged resource
+ConfigFile = Path | Traversable
+
+#: a validated config model
+M = TypeVar("M", bound=BaseModel)
+
+
+class ConfigError(ShipgymError, ValueError):
+    """A config file cannot be found or is malformed; the message names the file and key."""
+
+
+class StrictModel(BaseModel):
+    """Base of every config model: unknown keys are errors, instances are frozen."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    def with_overrides(
+        self,
+        overrides: Mapping[str, Any] | None = None,
+        drop: Iterable[str] = (),
+        origin: str = "<overrides>",
+        error: type[Exception] = ConfigError,
+    ) -> Self:
+        """A validated copy: the ``drop`` keys (dotted, e.g. ``"sensors"``) removed, so that
+        their defaults apply, then ``overrides`` deep-merged (mappings merge key by key,
+        any other value replaces).  Errors name ``origin`` and the key."""
+        data = self.model_dump()
+        for dotted in drop:
+            *parents, last = dotted.split(".")
+            node: Any = data
+            for part in parents:
+                node = node.get(part) if isinstance(node, dict) else None
+            if not isinstance(node, dict) or last not in node:
+                raise error(f"{origin}: cannot drop {dotted!r}: no such key")
+            del node[last]
+        return validate_model(deep_merge(data, overrides or {}), type(self), origin, error)
+
+
+def deep_merge(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
+    """``base`` updated by ``overrides``: nested mappings merge, other values replace."""
+    out = dict(base)
+    for key, value in overrides.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = deep_merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+# --------------------------------------------------------------------- the resolver
+
+
+def _check_kind(kind: str) -> str:
+    if kind not in KINDS:
+        raise ConfigError(f"unknown config kind {kind!r}; valid: {', '.join(KINDS)}")
+    return KINDS[kind]
+
+
+def catalogue(kind: str) -> Traversable:
+    """The packaged folder ``configs/<kind>``."""
+    _check_kind(kind)
+    return files("shipgym.configs") / kind
+
+
+def list_names(kind: str) -> list[str]:
+    """Names of the packaged configs of ``kind`` (file stems), sorted."""
+    return sorted(
+        entry.name.rsplit(".", 1)[0]
+        for entry in catalogue(kind).iterdir()
+        if entry.is_file() and entry.name.endswith((".yaml", ".yml"))
+    )
+
+
+def is_path(text: str) -> bool:
+    """True when ``text`` names a file rather than a packaged config."""
+    separators = {"/", os.sep, os.altsep} - {None}
+    return text.endswith((".yaml", ".yml")) or any(s in text for s in separators)
+
+
+def resolve(
+    kind: str,
+    name_or_path: str | os.PathLike | Traversable,
+    relative_to: str | os.PathLike | None = None,
+    error: type[Exception] = ConfigError,
+) -> ConfigFile:
+    """The file of a config: a packaged name or a path (module doc).
+
+    ``relative_to`` (a folder, or a file whose folder is meant) anchors relative paths;
+    ``error`` is the exception raised, its message naming the kind, what was asked and, for
+    an unknown name, the valid names.
+    """
+    noun = _check_kind(kind)
+    if not isinstance(name_or_path, str | os.PathLike):  # a packaged resource already
+        if not name_or_path.is_file():
+            raise error(f"{noun} file not found: {name_or_path}")
+        return name_or_path
+    text = os.fspath(name_or_path)
+    if is_path(text):
+        path = Path(text).expanduser()
+        if relative_to is not None and not path.is_absolute():
+            base = Path(relative_to)
+            path = (base if base.is_dir() else base.parent) / path
+        if not path.is_file():
+            raise error(f"{noun} file not found: {path}")
+        return path
+    for suffix in (".yaml", ".yml"):
+        entry = catalogue(kind) / f"{text}{suffix}"
+        if entry.is_file():
+            return entry
+    raise error(f"unknown {noun} {text!r} (configs/{kind}); valid: {', '.join(list_names(kind))}")
+
+
+# --------------------------------------------------------------------- the loader
+
+
+def format_validation_error(err: ValidationError, origin: str) -> str:
+    """One line per problem, naming the file (``origin``) and the key."""
+    lines = []
+    for item in err.errors():
+        key = ".".join(str(part) for part in item["loc"]) or "<top level>"
+        lines.append(f"{origin}: key '{key}': {item['msg']}")
+    return "\n".join(lines)
+
+
+def read_yaml(file: ConfigFile, error: type[Exception] = ConfigError) -> Any:
+    """The parsed YAML of ``file``; malformed YAML fails naming the file and the line."""
+    try:
+        text = file.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise error(f"{file}: cannot read: {exc.strerror or exc}") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        what = ", ".join(str(p) for p in (exc.context, exc.problem) if p)
+        raise error(f"{file}{where}: malformed YAML: {what}") from None
+    except yaml.YAMLError as exc:
+        raise error(f"{file}: malformed YAML: {exc}") from None
+
+
+def validate_model(
+    data: Any, model: type[M], origin: str, error: type[Exception] = ConfigError
+) -> M:
+    """``model`` validated from ``data``; errors name ``origin`` and the key."""
+    if not isinstance(data, Mapping):
+        raise error(f"{origin}: expected a mapping at the top level, got {type(data).__name__}")
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise error(format_validation_error(exc, origin)) from None
+
+
+def load_yaml_model(file: ConfigFile, model: type[M], error: type[Exception] = ConfigError) -> M:
+    """``model`` validated from the YAML file ``file`` (use :func:`resolve` to find it)."""
+    return validate_model(read_yaml(file, error), model, str(file), error)

@@ -1,0 +1,322 @@
+"""The step core of ShipPathFollow: one definition for the single and the batched env.
+
+In the spirit of Gymnasium's functional env (``gymnasium.experimental.functional``): the
+pieces of one control period that are not the plant — the action's rudder command, the
+parameters of the period, the reward (SPEC §5), termination, the observation and ``info`` —
+are pure functions of floats (one ship, ``xp = SCALAR``) or arrays (N ships,
+``xp = ARRAY``) of :mod:`shipgym.numerics`.  :class:`~shipgym.envs.path_follow.ShipPathFollowEnv`
+calls them for one ship, :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` for N; both
+build their parts from a scenario with :class:`EnvParts`.  Tracking is
+:class:`shipgym.tracking.PathTracker`, guidance :data:`shipgym.guidance.GUIDANCE_LAWS`, the
+autopilot :func:`shipgym.autopilot.pid_step`: the same code for one ship and N.
+
+Reward per step, from the *true* state (the score, the same for everyone):
+
+    r = −( |e|/L + w_ψ·|ψ̃| + w_δ·(δc/δmax)² + w_Δ·(Δδc/δmax)² )
+
+plus ``goal_bonus`` when the last waypoint is reached (terminated), and, when the ship
+leaves the corridor |e| > e_max (terminated), a penalty equal to the cost of staying at the
+corridor edge for the rest of the time limit, (e_max/L)·(steps left), so that leaving is
+never cheaper than staying; a non-finite plant state terminates with the same penalty
+counted from the step before.  The time limit truncates.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from shipgym.angles import wrap_angle
+from shipgym.autopilot import PIDGains, pid_step
+from shipgym.disturbances import Disturbances
+from shipgym.guidance import desired_heading
+from shipgym.identification import first_order_nomoto
+from shipgym.metrics import EpisodeLog, MetricSettings
+from shipgym.models.integrator import PeriodIntegrator
+from shipgym.scenarios import Scenario
+from shipgym.scenarios.events import ParameterSchedule
+from shipgym.tracking import PathTracker, TrackFrame
+
+ACTION_MODES = ("rudder", "guidance")
+
+OBS_NAMES = (
+    "cross_track",
+    "sin_heading_error",
+    "cos_heading_error",
+    "yaw_rate",
+    "rudder_angle",
+    "last_rudder_command",
+    "speed",
+    "next_angle_change",
+    "next_distance",
+)
+OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
+OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
+
+#: guidance action: a0 scales the law's length scale (LOS R_LOS = nL, look-ahead / TVVF Δ,
+#: VF τ) by 2^a0 ∈ [½, 2]; a1 → course offset a1·30°.
+GUIDANCE_OFFSET_MAX = math.radians(30.0)
+
+#: the per-control-step columns both envs log for the episode metrics (true values)
+LOG_FIELDS = ("t", "cross_track_error", "heading_error", "rudder_angle", "rudder_command", "reward")
+
+
+@dataclasses.dataclass(frozen=True)
+class StepConstants:
+    """Numbers of a scenario that the step core reads (SI units)."""
+
+    ship_length: float  # L [m]
+    nominal_speed: float  # u0 [m/s]
+    rudder_limit: float  # δmax [rad]
+    control_period: float  # Ts [s]
+    fine_step: float  # h [s]
+    substeps: int  # Ts / h
+    max_cross_track: float  # e_max [m], corridor half-width
+    max_steps: int  # time limit in control periods
+    heading_weight: float  # w_ψ
+    rudder_weight: float  # w_δ
+    rudder_rate_weight: float  # w_Δ
+    goal_bonus: float
+    ix: int  # state indices of x, y, ψ, r, δ
+    iy: int
+    ipsi: int
+    ir: int
+    idelta: int
+
+    @classmethod
+    def of(cls, sc: Scenario) -> StepConstants:
+        model, w = sc.model, sc.config.reward
+        return cls(
+            ship_length=sc.ship_length,
+            nominal_speed=model.nominal_speed,
+            rudder_limit=model.rudder_limit,
+            control_period=sc.control_period,
+            fine_step=sc.fine_step,
+            substeps=sc.substeps,
+            max_cross_track=sc.max_cross_track,
+            max_steps=math.ceil(sc.config.time_limit / sc.control_period - 1e-9),
+            heading_weight=w.heading_weight,
+            rudder_weight=w.rudder_weight,
+            rudder_rate_weight=w.rudder_rate_weight,
+            goal_bonus=w.goal_bonus,
+            **{f"i{n}": model.state_index(n) for n in ("x", "y", "psi", "r", "delta")},
+        )
+
+
+@dataclasses.dataclass
+class EnvParts:
+    """Everything an env builds from its scenario, for one ship (``batch=None``) or N."""
+
+    scenario: Scenario
+    action_mode: str
+    constants: StepConstants
+    integrator: PeriodIntegrator
+    disturbances: Disturbances
+    tracker: PathTracker
+    observation_space: spaces.Box
+    action_space: spaces.Box
+    metric_settings: MetricSettings
+    autopilot_gains: PIDGains | None  # guidance mode: the heading PID's gains
+
+    @classmethod
+    def build(
+        cls, scenario: Scenario, action_mode: str, compile: bool, batch: int | None = None
+    ) -> EnvParts:
+        if action_mode not in ACTION_MODES:
+            raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
+        sc = scenario
+        k = StepConstants.of(sc)
+        model = sc.model
+        integrator = PeriodIntegrator(
+            model, k.fine_step, k.substeps, compile=compile, batch=1 if batch is None else batch
+        )
+        disturbances = Disturbances(
+            sc.config.disturbances,
+            model.disturbance_names,
+            k.fine_step,
+            k.substeps,
+            batch=1 if batch is None else batch,
+            time_limit=sc.config.time_limit,
+        )
+        tracker = PathTracker(sc.path, sc.acceptance_radius, sc.config.path.switching, batch)
+        gains = None
+        if action_mode == "guidance":
+            # pole placement on the nominal model's first-order Nomoto (K, T): never the truth
+            gains = PIDGains.from_nomoto(*first_order_nomoto(model, sc.nominal_params))
+        n_act = 1 if action_mode == "rudder" else 2
+        return cls(
+            scenario=sc,
+            action_mode=action_mode,
+            constants=k,
+            integrator=integrator,
+            disturbances=disturbances,
+            tracker=tracker,
+            observation_space=spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32),
+            action_space=spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32),
+            metric_settings=MetricSettings(convergence_threshold=sc.config.convergence_threshold),
+            autopilot_gains=gains,
+        )
+
+
+# ---------------------------------------------------------------------------------- action
+def guidance_command(
+    a0: Any,
+    a1: Any,
+    frame: TrackFrame,
+    heading: Any,
+    yaw_rate: Any,
+    integral: Any,
+    parts: EnvParts,
+    xp: Any,
+) -> tuple[Any, Any]:
+    """Guidance mode: ψd of the scenario's law with its length scale × 2^a0 plus a1·30°,
+    then the heading PID (measured ψ [rad], r [rad/s]).  Returns (δc [rad], new integral)."""
+    k = parts.constants
+    desired = desired_heading(
+        parts.scenario.config.guidance,
+        frame.cross_track,
+        frame.path_angle,
+        k.ship_length,
+        xp.exp2(a0),
+        xp,
+    )
+    desired = desired + a1 * GUIDANCE_OFFSET_MAX
+    return pid_step(
+        parts.autopilot_gains,
+        integral,
+        desired,
+        heading,
+        yaw_rate,
+        k.control_period,
+        k.rudder_limit,
+        xp,
+    )
+
+
+# ---------------------------------------------------------------------------------- plant inputs
+def refresh_parameters(
+    schedule: ParameterSchedule, t0: float, k: StepConstants, block: np.ndarray, dirty: bool
+) -> bool:
+    """Write one ship's true parameters of the period [t0, t0 + Ts] into ``block``
+    (n_sub, n_p): row i at t0 + i·h while an event acts on the period, else the value at
+    its end (only once after an event).  Returns the new ``dirty`` flag."""
+    t1 = t0 + k.control_period
+    if not schedule.is_constant_on(t0, t1):
+        schedule.fill_matrix(t0, k.fine_step, block)
+        return True
+    if dirty:
+        block[:] = schedule.vector_at(t1)
+    return False
+
+
+def speed_over_ground(dx: Any, dy: Any, k: StepConstants, xp: Any) -> Any:
+    """U [m/s] from the displacement (dx, dy) [m] over the last substep h."""
+    return xp.sqrt(dx * dx + dy * dy) / k.fine_step
+
+
+# ---------------------------------------------------------------------------------- reward
+def step_reward(
+    cross_track: Any, heading_error: Any, delta_c: Any, prev_delta_c: Any, k: StepConstants, xp: Any
+) -> Any:
+    """The per-step reward from the true e [m] and ψ̃ [rad] (module doc), before bonuses."""
+    q = delta_c / k.rudder_limit
+    dd = (delta_c - prev_delta_c) / k.rudder_limit
+    return -(
+        xp.abs(cross_track) / k.ship_length
+        + k.heading_weight * xp.abs(heading_error)
+        + k.rudder_weight * q * q
+        + k.rudder_rate_weight * dd * dd
+    )
+
+
+def terminate(
+    reward: Any, frame: TrackFrame, steps: Any, k: StepConstants, xp: Any
+) -> tuple[Any, Any, Any, Any]:
+    """Goal, corridor and time limit after ``steps`` control periods (module doc).
+
+    Returns (reward with bonus / penalty, goal, corridor, truncated).
+    """
+    goal = frame.at_goal
+    corridor = xp.logical_not(goal) & (xp.abs(frame.cross_track) > k.max_cross_track)
+    reward = xp.where(goal, reward + k.goal_bonus, reward)
+    left = k.max_steps - steps
+    reward = xp.where(corridor, reward - (k.max_cross_track / k.ship_length) * left, reward)
+    truncated = xp.logical_not(goal | corridor) & (steps >= k.max_steps)
+    return reward, goal, corridor, truncated
+
+
+def diverged_reward(steps: Any, k: StepConstants) -> Any:
+    """Reward of a step whose plant state went non-finite: the corridor penalty counted
+    from before the step."""
+    return -(k.max_cross_track / k.ship_length) * (k.max_steps - steps + 1)
+
+
+# ---------------------------------------------------------------------------------- observation
+def observation_columns(
+    frame: TrackFrame,
+    heading: Any,
+    yaw_rate: Any,
+    rudder_angle: Any,
+    rudder_command: Any,
+    speed: Any,
+    k: StepConstants,
+    xp: Any,
+) -> tuple[Any, ...]:
+    """The 9 observation entries (OBS_NAMES) from measurements (ψ, r) and the frame.
+
+    0 e/e_max, 1–2 sin/cos of ψ − ψp, 3 r/(2u0/L), 4 δ/δmax, 5 last δc/δmax, 6 U/u0,
+    7 path-angle change to the next leg /π, 8 d_next/(d_next + 10L); clipped by the caller.
+    """
+    err = heading - frame.path_angle
+    d = frame.distance_to_next
+    return (
+        frame.cross_track / k.max_cross_track,
+        xp.sin(err),
+        xp.cos(err),
+        yaw_rate / (2.0 * k.nominal_speed / k.ship_length),
+        rudder_angle / k.rudder_limit,
+        rudder_command / k.rudder_limit,
+        speed / k.nominal_speed,
+        frame.angle_change_next / math.pi,
+        d / (d + 10.0 * k.ship_length),
+    )
+
+
+def info_values(
+    t: Any,
+    frame: TrackFrame,
+    heading: Any,
+    yaw_rate: Any,
+    rudder_angle: Any,
+    rudder_command: Any,
+    position: Any,
+) -> dict[str, Any]:
+    """The per-step ``info`` keys (measured ψ and r; e and the leg from the tracker)."""
+    return {
+        "t": t,
+        "cross_track_error": frame.cross_track,
+        "heading_error": wrap_angle(heading - frame.path_angle),
+        "heading": heading,
+        "yaw_rate": yaw_rate,
+        "rudder_angle": rudder_angle,
+        "rudder_command": rudder_command,
+        "position": position,
+        "waypoint_index": frame.leg,
+    }
+
+
+def episode_log(
+    columns: dict[str, np.ndarray], scenario: Scenario, reached_goal: bool
+) -> EpisodeLog:
+    """The metrics' episode log from the LOG_FIELDS columns of one ship."""
+    return EpisodeLog(
+        **columns,
+        change_time=scenario.change_time,
+        ship_length=scenario.ship_length,
+        reached_goal=reached_goal,
+        dt=scenario.control_period,
+    )

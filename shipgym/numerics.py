@@ -1,0 +1,106 @@
+"""Operation sets for code written once for one ship (floats) and for N ships (arrays).
+
+The step core (:mod:`shipgym.tracking`, :mod:`shipgym.guidance`, :mod:`shipgym.autopilot`,
+:mod:`shipgym.envs.core`) takes an ``xp`` argument: :data:`SCALAR` for the single env, which
+runs on Python floats (fast: no numpy-scalar overhead), or :data:`ARRAY` for the batched env.
+Arithmetic (``+ − * /``), comparisons, ``sqrt`` and ``abs`` are correctly rounded IEEE
+operations in both, so results agree bit for bit; the transcendental functions of
+:data:`SCALAR` are libm's (``math``), those of :data:`ARRAY` numpy's, which may use SIMD
+implementations that differ from libm in the last bit: :data:`ARRAY` therefore maps libm's
+``asin``, ``atan``, ``atan2`` and ``pow(2, ·)`` over the elements (≈ 60 ns each) and keeps
+numpy's ``sin`` and ``cos``, which equal libm's here (checked by
+tests/shipgym/test_numerics.py).  So the single env and the batched env agree bit for bit.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ARRAY", "SCALAR", "ArrayOps", "ScalarOps"]
+
+
+def _exp2(a: float) -> float:
+    """2^a by libm's pow (Python's ``**`` on floats)."""
+    return 2.0**a
+
+
+class ScalarOps:
+    """Python floats and bools (one ship)."""
+
+    batched = False
+    sqrt = staticmethod(math.sqrt)
+    abs = staticmethod(abs)
+    sin = staticmethod(math.sin)
+    cos = staticmethod(math.cos)
+    arcsin = staticmethod(math.asin)
+    arctan = staticmethod(math.atan)
+    arctan2 = staticmethod(math.atan2)
+    exp2 = staticmethod(_exp2)
+    minimum = staticmethod(min)
+    maximum = staticmethod(max)
+    logical_not = staticmethod(lambda c: not c)
+
+    @staticmethod
+    def where(cond: Any, a: Any, b: Any) -> Any:
+        return a if cond else b
+
+    @staticmethod
+    def any(cond: Any) -> bool:
+        return bool(cond)
+
+    @staticmethod
+    def searchsorted_right(table: Any, value: float) -> int:
+        """Index i with table[i-1] ≤ value < table[i] (``numpy.searchsorted(side="right")``)."""
+        return bisect.bisect_right(table, value)
+
+    @staticmethod
+    def clip_index(i: int, lo: int, hi: int) -> int:
+        return lo if i < lo else hi if i > hi else i
+
+
+def _elementwise(f: Any) -> Any:
+    """numpy-array version of the libm function ``f`` (same bits as ``f`` on each element)."""
+
+    def apply(*args: Any) -> np.ndarray:
+        arrays = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in args))
+        shape = arrays[0].shape
+        flat = [a.ravel().tolist() for a in arrays]
+        return np.fromiter(map(f, *flat), np.float64, arrays[0].size).reshape(shape)
+
+    apply.__doc__ = f"libm's {f.__name__} over the elements of numpy arrays."
+    return staticmethod(apply)
+
+
+class ArrayOps:
+    """numpy arrays over N ships."""
+
+    batched = True
+    sqrt = staticmethod(np.sqrt)
+    abs = staticmethod(np.abs)
+    sin = staticmethod(np.sin)
+    cos = staticmethod(np.cos)
+    arcsin = _elementwise(math.asin)
+    arctan = _elementwise(math.atan)
+    arctan2 = _elementwise(math.atan2)
+    exp2 = _elementwise(_exp2)
+    minimum = staticmethod(np.minimum)
+    logical_not = staticmethod(np.logical_not)
+    maximum = staticmethod(np.maximum)
+    where = staticmethod(np.where)
+    any = staticmethod(np.any)
+
+    @staticmethod
+    def searchsorted_right(table: Any, value: Any) -> Any:
+        return np.searchsorted(table, value, side="right")
+
+    @staticmethod
+    def clip_index(i: Any, lo: int, hi: int) -> Any:
+        return np.clip(i, lo, hi)
+
+
+SCALAR = ScalarOps()
+ARRAY = ArrayOps()

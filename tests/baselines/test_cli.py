@@ -1,0 +1,230 @@
+"""The ``shipgym`` console script: subcommands, one-line errors, ``--json`` (SPEC §9b)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from baselines.cli import build_parser, main
+from baselines.errors import ControllerError
+from shipgym.scenarios import ScenarioError
+
+
+def _subcommands() -> list[str]:
+    (action,) = (a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return list(action.choices)
+
+
+def _error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
+    """The one stderr line of a bad input, checked for its shape; returns the message."""
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    prefix = f"shipgym {command}: error: "
+    assert err.startswith(prefix), err
+    return err.removeprefix(prefix).rstrip("\n")
+
+
+def test_every_subcommand_is_listed() -> None:
+    assert _subcommands() == [
+        "leaderboard",
+        "reproduce",
+        "train",
+        "evaluate",
+        "manoeuvre",
+        "scenarios",
+        "bench",
+    ]
+
+
+@pytest.mark.parametrize("command", _subcommands())
+def test_help_of_every_subcommand(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main([command, "--help"])
+    assert exit_info.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"usage: shipgym {command}")
+    assert "--json" in out
+
+
+def test_choices_come_from_the_registries() -> None:
+    from baselines.cli.bench import BENCHES
+    from baselines.cli.manoeuvre import MANOEUVRES
+    from baselines.reproduce import PAPERS
+    from shipgym.models import MODELS
+
+    parser = build_parser()
+    assert parser.parse_args(["reproduce", "xu2021"]).paper == "xu2021"
+    for paper in PAPERS:
+        assert parser.parse_args(["reproduce", paper]).paper == paper
+    for target in BENCHES:
+        assert parser.parse_args(["bench", target]).target == target
+    for ship in MODELS:
+        for kind in MANOEUVRES:
+            args = parser.parse_args(["manoeuvre", ship, kind])
+            assert (args.ship, args.kind) == (ship, kind)
+
+
+def test_python_dash_m_runs_the_cli() -> None:
+    done = subprocess.run(
+        [sys.executable, "-m", "baselines.cli", "scenarios", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert "rudder_aging" in json.loads(done.stdout)
+
+
+def test_cli_scenarios_json(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["scenarios", "--json"]) == 0
+    names = json.loads(capsys.readouterr().out)
+    assert {"nominal", "rudder_aging", "current_shift", "maneuverability_change"} <= set(names)
+
+
+def test_unknown_controller_is_one_line_and_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["evaluate", "nope", "--suite", "smoke", "--no-progress"]) == 2
+    message = _error_line(capsys, "evaluate")
+    assert message.startswith("unknown controller 'nope'; valid:") and "pid_los" in message
+
+
+def test_unknown_scenario_is_one_line_and_exit_2(
+    tmp_path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    smoke = yaml.safe_load(Path("configs/suites/smoke.yaml").read_text())
+    smoke.update(scenarios=["no_such_scenario"], heldout_scenarios=0, controllers=["zero_rudder"])
+    suite = tmp_path / "suite.yaml"
+    suite.write_text(yaml.safe_dump(smoke))
+    code = main(["leaderboard", "--suite", str(suite), "--out", str(tmp_path), "--no-progress"])
+    assert code == 2
+    assert "no_such_scenario" in _error_line(capsys, "leaderboard")
+
+
+def test_cli_bad_suite_is_a_clear_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["leaderboard", "--suite", "nope", "--no-progress"]) == 2
+    assert "valid: default" in _error_line(capsys, "leaderboard")
+
+
+def test_bad_option_values_are_one_line_errors(
+    tmp_path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = ["--out", str(tmp_path)]
+    assert main(["reproduce", "liu2019", "--seeds", "0", "--no-progress", *out]) == 2
+    assert _error_line(capsys, "reproduce") == "seeds must be ≥ 1, got 0"
+    assert main(["manoeuvre", "nomoto2", "zigzag", "--rudder", "-5", *out]) == 2
+    assert "must be > 0" in _error_line(capsys, "manoeuvre")
+    assert main(["manoeuvre", "nomoto2", "zigzag", "--variant", "nope", *out]) == 2
+    assert "unknown variant" in _error_line(capsys, "manoeuvre")
+    assert main(["train", "all", "--config", "x.yaml"]) == 2
+    assert _error_line(capsys, "train") == "train all: --config applies to one agent"
+
+
+def test_a_project_error_from_deep_inside_is_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import shipgym.scenarios
+
+    def broken() -> list[str]:
+        raise ScenarioError("configs/scenarios: unreadable")
+
+    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", broken)
+    assert main(["scenarios"]) == 2
+    assert _error_line(capsys, "scenarios") == "configs/scenarios: unreadable"
+
+
+def test_a_bug_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Only project errors (bad input) become one line: anything else propagates."""
+    import shipgym.scenarios
+
+    def buggy() -> list[str]:
+        raise TypeError("a real bug")
+
+    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", buggy)
+    with pytest.raises(TypeError, match="a real bug"):
+        main(["scenarios"])
+    # a built-in KeyError that is not a ControllerError is a bug too
+    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", lambda: {}["missing"])
+    with pytest.raises(KeyError):
+        main(["scenarios"])
+
+
+def test_ctrl_c_is_one_line_and_exit_130(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import shipgym.scenarios
+
+    def interrupted() -> list[str]:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", interrupted)
+    assert main(["scenarios"]) == 130
+    assert capsys.readouterr().err == "shipgym scenarios: interrupted\n"
+
+
+def test_controller_error_reads_as_its_message() -> None:
+    """A KeyError's str() is the repr of its key; the controller error prints its message."""
+    error = ControllerError("unknown controller 'x'")
+    assert isinstance(error, KeyError) and str(error) == "unknown controller 'x'"
+
+
+def test_cli_leaderboard_json_is_one_document(tmp_path, capsys) -> None:
+    code = main(
+        [
+            "leaderboard",
+            "--suite",
+            "smoke",
+            "--seeds",
+            "1",
+            "--out",
+            str(tmp_path),
+            "--json",
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert isinstance(rows, list) and rows
+    ran = [r for r in rows if r["applies"]]
+    assert all(isinstance(r["ace"], float) and math.isfinite(r["ace"]) for r in ran)
+
+
+def test_cli_bench_env_json(capsys) -> None:
+    assert main(["bench", "env", "--repeats", "1", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["single_env_steps_per_s"] > 0
+    assert figures["batched_env_steps_per_s"] > 0
+
+
+def test_cli_bench_identification_json(capsys) -> None:
+    """SPEC §9b: one JSON object; per case and identifier, errors, convergence time and µs."""
+    assert main(["bench", "identification", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert {"rudder_aging", "current_shift", "maneuverability_change"} <= set(figures)
+    aging = figures["rudder_aging"]
+    for name in ("lambda_lssvm", "weighted_lssvm"):
+        assert aging[name]["update_us_median"] > 0
+        assert aging[name]["final_relative_error"]["Tc"] < 0.05
+    assert aging["lambda_lssvm"]["t_within_10pct"] <= aging["weighted_lssvm"]["t_within_10pct"]
+
+
+def test_cli_bench_nmpc_json(capsys) -> None:
+    assert main(["bench", "nmpc", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert 0 < figures["nmpc_median_ms"] <= figures["nmpc_p99_ms"]
+    assert figures["failures"] == 0 and figures["solves"] > 100
+
+
+def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
+    """SPEC §9b shape: case, controller, metric, ours, paper; all three cases and controllers."""
+    assert main(["reproduce", "liu2019", "--out", str(tmp_path), "--json", "--no-progress"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert {"case", "controller", "metric", "ours", "paper"} <= set(rows[0])
+    assert {r["case"] for r in rows} == {"rudder_aging", "current_shift", "maneuverability_change"}
+    assert {r["controller"] for r in rows} == {"nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"}
+    assert {r["metric"] for r in rows} == {"ace", "t_c"}
+    assert (tmp_path / "liu2019.md").is_file() and (tmp_path / "rudder_aging_si.png").is_file()

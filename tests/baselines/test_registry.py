@@ -1,0 +1,205 @@
+"""The controller registry: one registration per controller (SPEC §8, §13 "Enter a controller")."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+import baselines
+from baselines import registry
+from baselines.classical.pid import PIDLOS
+from baselines.classical.reference import ZeroRudder
+from baselines.evaluation import run_episode
+from baselines.registry import (
+    CONTROLLERS,
+    applies_to,
+    controller_kind,
+    make_controller,
+    register_controller,
+)
+from shipgym.envs.context import ControllerContext
+
+#: the contract: every built-in controller's name, action mode and ships (None: all)
+BUILTINS = {
+    "pid_los": ("rudder", None),
+    "pid_lookahead_los": ("rudder", None),
+    "pid_vf": ("rudder", None),
+    "pid_tvvf": ("rudder", None),
+    "lqr": ("rudder", None),
+    "adaptive_lqr": ("rudder", None),
+    "l1_backstepping": ("rudder", None),
+    "adaptive_backstepping": ("rudder", None),
+    "nmpc": ("rudder", ("nomoto2",)),
+    "nmpc_wlssvm": ("rudder", ("nomoto2",)),
+    "nmpc_lambda_lssvm": ("rudder", ("nomoto2",)),
+    "zero_rudder": ("rudder", None),
+    "random": ("rudder", None),
+}
+
+
+@pytest.fixture
+def scratch_registry() -> Iterator[None]:
+    """Controllers registered inside a test are gone after it."""
+    saved = dict(registry._RECORDS)
+    yield
+    registry._RECORDS.clear()
+    registry._RECORDS.update(saved)
+
+
+def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in metrics.items() if not k.startswith("compute_ms")}
+
+
+def test_builtin_controllers_keep_their_names_modes_and_ships() -> None:
+    table = {name: (r.action_mode, r.applies_to) for name, r in CONTROLLERS.items()}
+    assert table == BUILTINS
+    assert {controller_kind(name) for name in BUILTINS} == {"classical"}
+
+
+@pytest.mark.parametrize("name", sorted(BUILTINS))
+def test_made_controller_carries_its_registered_name(name: str) -> None:
+    policy, mode = make_controller(name)
+    assert policy.name == name
+    assert mode == BUILTINS[name][0]
+
+
+def test_the_registry_is_read_only() -> None:
+    with pytest.raises(TypeError):
+        CONTROLLERS["pid_los"] = CONTROLLERS["lqr"]  # type: ignore[index]
+
+
+def test_register_controller_is_exported_from_baselines() -> None:
+    assert baselines.register_controller is register_controller
+
+
+def test_decorator_registers_a_class_and_gives_it_the_name(scratch_registry: None) -> None:
+    @register_controller("test_hold_zero")
+    class HoldZero(ZeroRudder):
+        """Zero rudder under another name (no name attribute of its own)."""
+
+    assert HoldZero.name == "test_hold_zero"
+    assert ZeroRudder.name == "zero_rudder"  # the parent keeps its own
+    assert CONTROLLERS["test_hold_zero"].factory is HoldZero
+    policy, mode = make_controller("test_hold_zero")
+    assert isinstance(policy, HoldZero) and mode == "rudder"
+
+
+def test_decorator_on_a_factory_function(scratch_registry: None) -> None:
+    @register_controller("test_pid_vyshnegradsky")
+    def pid_vyshnegradsky(**settings: Any) -> PIDLOS:
+        return PIDLOS(tuning="vyshnegradsky", **settings)
+
+    assert callable(pid_vyshnegradsky)  # the decorator returns the function
+    policy, _ = make_controller("test_pid_vyshnegradsky")
+    assert policy.name == "test_pid_vyshnegradsky" and policy.tuning == "vyshnegradsky"
+    assert PIDLOS.name == "pid_los"  # the class is not renamed by a factory's registration
+
+
+def test_user_factory_runs_through_the_loop_beside_a_builtin(scratch_registry: None) -> None:
+    """A factory registered at runtime is made by name and scored by the evaluation loop."""
+
+    def stiff_pid(**settings: Any) -> PIDLOS:
+        return PIDLOS(natural_frequency=2.0, **settings)
+
+    assert register_controller("test_stiff_pid", stiff_pid) is stiff_pid
+    user, user_mode = make_controller("test_stiff_pid")
+    builtin, builtin_mode = make_controller("pid_los")
+    mine = run_episode(user, "nominal", seed=0, action_mode=user_mode)
+    theirs = run_episode(builtin, "nominal", seed=0, action_mode=builtin_mode)
+    assert (mine.controller, theirs.controller) == ("test_stiff_pid", "pid_los")
+    assert mine.metrics["termination_reason"] == theirs.metrics["termination_reason"] == "goal"
+    # ωn = 2 rad/s instead of 1: other gains, another episode
+    assert mine.metrics["pid_kp"] > theirs.metrics["pid_kp"]
+    assert mine.metrics["ace"] != theirs.metrics["ace"]
+
+
+def test_a_renamed_controller_scores_as_the_original(scratch_registry: None) -> None:
+    """Registration changes the name only: the same actions give the same metrics."""
+    register_controller("test_zero", lambda: ZeroRudder())  # a class has one name: alias it
+    policy, _ = make_controller("test_zero")
+    renamed = run_episode(policy, "nominal", seed=0)
+    original = run_episode(make_controller("zero_rudder")[0], "nominal", seed=0)
+    assert _without_compute_time(renamed.metrics) == _without_compute_time(original.metrics)
+
+
+def test_registered_action_mode_reaches_the_env(scratch_registry: None) -> None:
+    """A zero action in guidance mode is the env's PID LOS: it reaches the goal, where the
+    zero rudder (rudder mode) leaves the corridor."""
+    register_controller("test_zero_guidance", lambda: ZeroRudder(), action_mode="guidance")
+    policy, mode = make_controller("test_zero_guidance")
+    assert mode == policy.action_mode == "guidance"
+    assert run_episode(policy, "nominal", seed=0).metrics["termination_reason"] == "goal"
+    zero, _ = make_controller("zero_rudder")
+    assert run_episode(zero, "nominal", seed=0).metrics["termination_reason"] != "goal"
+
+
+def test_a_controller_refuses_an_env_in_another_action_mode() -> None:
+    policy, _ = make_controller("lqr")
+    with pytest.raises(ValueError, match="action_mode 'rudder'"):
+        run_episode(policy, "nominal", seed=0, action_mode="guidance")
+
+
+def test_duplicate_name_names_both_factories(scratch_registry: None) -> None:
+    def other_pid() -> PIDLOS:
+        return PIDLOS()
+
+    with pytest.raises(ValueError, match=r"'pid_los' is taken.*PIDLOS.*other_pid"):
+        register_controller("pid_los", other_pid)
+    assert CONTROLLERS["pid_los"].factory is PIDLOS  # unchanged
+
+
+def test_registering_the_same_controller_again_is_harmless() -> None:
+    assert register_controller("pid_los", PIDLOS) is PIDLOS
+    assert CONTROLLERS["pid_los"].factory is PIDLOS
+
+
+def test_a_class_declaring_another_name_is_refused(scratch_registry: None) -> None:
+    class Named:
+        name = "something_else"
+        kind = "classical"
+
+        def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
+
+        def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+            return np.zeros(1, dtype=np.float32)
+
+    with pytest.raises(ValueError, match="declares name = 'something_else'"):
+        register_controller("test_named", Named)
+    assert "test_named" not in CONTROLLERS
+
+
+def test_bad_registrations_are_clear_errors(scratch_registry: None) -> None:
+    with pytest.raises(ValueError, match="action_mode must be one of"):
+        register_controller("test_bad_mode", ZeroRudder, action_mode="thrust")
+    with pytest.raises(ValueError, match=r"unknown ship\(s\) \['titanic'\]"):
+        register_controller("test_bad_ship", ZeroRudder, applies_to=("titanic",))
+    with pytest.raises(TypeError, match="not a string"):
+        register_controller("test_str_ship", ZeroRudder, applies_to="mariner")
+    assert not {"test_bad_mode", "test_bad_ship", "test_str_ship"} & set(CONTROLLERS)
+
+
+def test_unknown_controller_lists_valid_names() -> None:
+    with pytest.raises(KeyError, match="pid_los") as err:
+        make_controller("nope")
+    assert all(name in str(err.value) for name in BUILTINS)
+    assert "ppo" in str(err.value)  # the shipped learned policies too
+
+
+def test_applies_to_follows_the_registration(scratch_registry: None) -> None:
+    for name in ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"):
+        assert applies_to(name, "nomoto2")
+        assert not any(applies_to(name, ship) for ship in ("mariner", "blanke", "esso_osaka"))
+    assert applies_to("pid_los", "mariner") and applies_to("ppo", "mariner")
+    register_controller("test_mariner_only", lambda: ZeroRudder(), applies_to=["mariner"])
+    assert CONTROLLERS["test_mariner_only"].applies_to == ("mariner",)
+    assert applies_to("test_mariner_only", "mariner")
+    assert not applies_to("test_mariner_only", "nomoto2")
+
+
+def test_learned_policies_resolve_by_name() -> None:
+    policy, mode = make_controller("ppo")
+    assert policy.kind == controller_kind("ppo") == "learned"
+    assert mode == policy.action_mode == policy.meta["action_mode"]

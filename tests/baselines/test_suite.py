@@ -1,0 +1,113 @@
+"""Tests for the typed suite model (configs/suites) and its loader."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from baselines.errors import ConfigError
+from baselines.suite import SuiteConfig, list_suites, load_suite
+from shipgym.config import list_names
+
+
+def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
+    file = tmp_path / name
+    file.parent.mkdir(parents=True, exist_ok=True)
+    file.write_text(text)
+    return file
+
+
+def test_packaged_suites_load() -> None:
+    assert list_suites() == list_names("suites") == ["default", "smoke"]
+    smoke = load_suite("smoke")
+    assert smoke == SuiteConfig(
+        name="smoke",
+        scenarios=["rudder_aging", "mariner_track"],
+        heldout_scenarios=1,
+        controllers=["nmpc_lambda_lssvm", "pid_los", "ppo", "zero_rudder"],
+        seeds=2,
+    )
+    assert smoke.all_scenarios() == ["rudder_aging", "mariner_track", "heldout:0"]
+
+
+def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
+    text = (Path(__file__).resolve().parents[2] / "configs/suites/smoke.yaml").read_text()
+    assert load_suite(write(tmp_path, text)) == load_suite("smoke")
+
+
+def test_relative_scenario_paths_are_read_against_the_suite_folder(
+    tmp_path: Path, monkeypatch
+) -> None:
+    scenario = write(tmp_path, "name: mine\n", "suites/scenarios/mine.yaml")
+    suite = write(
+        tmp_path,
+        "name: s\nscenarios: [nominal, scenarios/mine.yaml, heldout:2]\ncontrollers: [pid_los]\n",
+        "suites/s.yaml",
+    )
+    monkeypatch.chdir(tmp_path)
+    loaded = load_suite(str(suite))
+    assert loaded.scenarios == ["nominal", str(scenario), "heldout:2"]
+
+
+def test_unknown_key_is_named(tmp_path: Path) -> None:
+    file = write(tmp_path, "name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\nseed: 3\n")
+    with pytest.raises(ConfigError, match=r"suite\.yaml: key 'seed': Extra inputs"):
+        load_suite(file)
+
+
+@pytest.mark.parametrize("controllers", ["", "controllers: []\n"])
+def test_a_suite_without_controllers_is_an_error(tmp_path: Path, controllers: str) -> None:
+    file = write(tmp_path, f"name: s\nscenarios: [nominal]\n{controllers}")
+    with pytest.raises(ConfigError, match=r"suite\.yaml: key 'controllers'"):
+        load_suite(file)
+
+
+def test_a_suite_without_scenarios_is_an_error(tmp_path: Path) -> None:
+    file = write(tmp_path, "name: s\ncontrollers: [pid_los]\n")
+    with pytest.raises(ConfigError, match="needs 'scenarios' or 'heldout_scenarios'"):
+        load_suite(file)
+    only_heldout = write(tmp_path, "name: s\nheldout_scenarios: 2\ncontrollers: [pid_los]\n")
+    assert load_suite(only_heldout).all_scenarios() == ["heldout:0", "heldout:1"]
+
+
+def test_bad_yaml_names_file_and_line(tmp_path: Path) -> None:
+    file = write(tmp_path, "name: s\nscenarios: [nominal\ncontrollers: [pid_los]\n")
+    with pytest.raises(ConfigError, match="malformed YAML") as info:
+        load_suite(file)
+    assert str(info.value).startswith(f"{file}, line 3,")
+
+
+def test_unknown_scenario_names_suite_key_and_valid_names(tmp_path: Path) -> None:
+    file = write(
+        tmp_path,
+        yaml.safe_dump(
+            {"name": "s", "scenarios": ["nominal", "nomnal"], "controllers": ["pid_los"]}
+        ),
+    )
+    with pytest.raises(ConfigError) as info:
+        load_suite(file)
+    msg = str(info.value)
+    assert msg.startswith(f"{file}: key 'scenarios.1': unknown scenario 'nomnal'")
+    assert "rudder_aging" in msg
+
+
+def test_unknown_suite_lists_the_suites() -> None:
+    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, smoke"):
+        load_suite("nope")
+
+
+@pytest.mark.parametrize(
+    ("extra", "key"), [("seeds: 0\n", "seeds"), ("heldout_scenarios: -1\n", "heldout_scenarios")]
+)
+def test_counts_are_validated(tmp_path: Path, extra: str, key: str) -> None:
+    file = write(tmp_path, f"name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\n{extra}")
+    with pytest.raises(ConfigError, match=f"key '{key}'"):
+        load_suite(file)
+
+
+def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
+    file = write(tmp_path, "name: s\nscenarios: [nominal, nominal]\ncontrollers: [pid_los]\n")
+    with pytest.raises(ConfigError, match="more than once"):
+        load_suite(file)

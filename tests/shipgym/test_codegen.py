@@ -1,0 +1,112 @@
+"""shipgym.codegen: CasADi functions compiled to C once, cached on disk, same results."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from shipgym import codegen
+from shipgym.models import Nomoto2
+
+needs_compiler = pytest.mark.skipif(
+    shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C compiler"
+)
+
+
+@pytest.fixture
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A fresh ``$SHIPGYM_CACHE`` with compilation enabled."""
+    monkeypatch.setenv("SHIPGYM_CACHE", str(tmp_path))
+    monkeypatch.delenv("SHIPGYM_NO_COMPILE", raising=False)
+    return tmp_path
+
+
+def _step() -> ca.Function:
+    """nomoto2's RK4 step: sin, cos, products and sums of the model's one rhs."""
+    return Nomoto2().casadi_step(0.01)
+
+
+def _random_inputs(rng: np.random.Generator) -> list[np.ndarray]:
+    model = Nomoto2()
+    x = rng.normal(size=model.n_states)
+    u = rng.uniform(-0.5, 0.5, size=1)
+    w = rng.normal(scale=0.1, size=model.n_disturbances)
+    p = model.params.to_vector() * rng.uniform(0.5, 1.5, size=model.n_params)
+    return [x, u, w, p]
+
+
+def test_cache_dir_follows_the_environment(cache: Path) -> None:
+    assert codegen.cache_dir() == cache
+
+
+@needs_compiler
+def test_compiled_function_equals_the_vm_bit_for_bit(cache: Path) -> None:
+    vm = _step()
+    fast = codegen.compiled(vm)
+    assert fast is not vm and list(cache.glob("*.so"))
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        args = _random_inputs(rng)
+        np.testing.assert_array_equal(np.array(fast(*args)), np.array(vm(*args)))
+
+
+@needs_compiler
+def test_the_cached_library_is_reused(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A second request for the same code and flags loads the cached library: no compiler
+    run, the file untouched."""
+    codegen.compiled(_step())
+    (library,) = cache.glob("*.so")
+    stamp = library.stat().st_mtime_ns
+
+    def no_compiler(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the compiler ran although the library was cached")
+
+    monkeypatch.setattr(subprocess, "run", no_compiler)
+    again = codegen.compiled(_step())
+    assert list(cache.glob("*.so")) == [library] and library.stat().st_mtime_ns == stamp
+    args = _random_inputs(np.random.default_rng(1))
+    np.testing.assert_array_equal(np.array(again(*args)), np.array(_step()(*args)))
+
+
+@needs_compiler
+def test_other_flags_compile_another_library(cache: Path) -> None:
+    codegen.compiled(_step())
+    codegen.compiled(_step(), flags=("-O0",))
+    assert len(list(cache.glob("*.so"))) == 2
+
+
+def test_no_compile_returns_the_function_itself(
+    cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("SHIPGYM_NO_COMPILE", "1")
+    function = _step()
+    assert codegen.compiled(function) is function
+    assert not list(cache.iterdir())
+
+
+def test_without_a_compiler_the_function_is_returned(
+    cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    function = _step()
+    assert codegen.compiled(function) is function
+
+
+def test_a_failed_compilation_warns_and_returns_the_function(
+    cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(shutil, "which", lambda name: "/usr/bin/false-compiler")
+
+    def failing(command: list[str], **kwargs: object) -> None:
+        raise subprocess.CalledProcessError(1, command)
+
+    monkeypatch.setattr(subprocess, "run", failing)
+    function = _step()
+    with pytest.warns(UserWarning, match="using CasADi's VM"):
+        assert codegen.compiled(function) is function
+    assert not list(cache.glob("*.so"))
