@@ -175,13 +175,16 @@ def identification_log(
 
 
 def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str, Any]:
-    """Parameter error and time per update of each online identifier on the three cases.
+    """Parameter error and time per update of each online identifier on the three cases,
+    with both front ends of the regression (``differences``, the paper's; ``svf``, outlier
+    filter + state-variable filter: keys ending in ``_svf``).
 
     For every case: relative error of each changed parameter at the end of the episode,
     the first time after the change from which the changed parameters (β excepted: it is
     not identifiable at these yaw rates, README) stay within 10 % (``inf`` if never), and
-    the median / p99 µs per window update.  Batch ``fit_nomoto2``
-    on the post-change data is reported beside them.
+    the median / p99 µs per window update; for λ-LS-SVM also how many updates before the
+    change have λ¹ > λc¹ (false detections) and the first time after it that λ¹ > λc¹.
+    Batch ``fit_nomoto2`` on the post-change data is reported beside them.
     """
     import math
 
@@ -192,6 +195,7 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
         fit_nomoto2,
     )
 
+    identifiers = (("lambda_lssvm", LambdaLSSVM), ("weighted_lssvm", WeightedLSSVMOnline))
     out: dict[str, Any] = {}
     for case, changed in JUMP_CASES.items():
         log, sc = identification_log(case, seed, excitation_deg)
@@ -199,53 +203,66 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
         h = sc.fine_step
         change = sc.change_time
         row: dict[str, Any] = {}
-        for name, cls in (("lambda_lssvm", LambdaLSSVM), ("weighted_lssvm", WeightedLSSVMOnline)):
-            ident = cls(h, sc.nominal_params)
-            times = []
-            for samples in log:
-                start = time.perf_counter()
-                if ident.update(samples):
-                    times.append(time.perf_counter() - start)
-            errors = {
-                k: abs(getattr(ident.params, k) - getattr(truth, k)) / abs(getattr(truth, k))
-                for k in changed
-            }
-            within = math.inf
-            for entry in ident.history:
-                ok = entry["t"] > change and all(
-                    abs(entry[k] - getattr(truth, k)) <= 0.1 * abs(getattr(truth, k))
-                    for k in changed
-                    if k != "beta"
-                )
-                if ok and within == math.inf:
-                    within = entry["t"]
-                elif not ok and entry["t"] > change:
-                    within = math.inf
-            row[name] = {
-                "final_relative_error": errors,
-                "t_within_10pct": within,
-                "update_us_median": 1e6 * statistics.median(times) if times else math.nan,
-                "update_us_p99": 1e6 * float(np.percentile(times, 99)) if times else math.nan,
-                "updates": len(times),
-            }
-        samples = {k: np.concatenate([s[k] for s in log]) for k in ("t", "psi", "delta", "delta_c")}
-        after = samples["t"] >= change
-        try:
-            fit = fit_nomoto2(
-                samples["psi"][after],
-                samples["delta"][after],
-                samples["delta_c"][after],
-                h,
-                base=sc.nominal_params,
-            )
-            row["batch_fit_nomoto2"] = {
-                "final_relative_error": {
-                    k: abs(getattr(fit, k) - getattr(truth, k)) / abs(getattr(truth, k))
+        for front_end, suffix in (("differences", ""), ("svf", "_svf")):
+            for name, cls in identifiers:
+                ident = cls(h, sc.nominal_params, front_end=front_end)
+                times = []
+                for samples in log:
+                    start = time.perf_counter()
+                    if ident.update(samples):
+                        times.append(time.perf_counter() - start)
+                errors = {
+                    k: abs(getattr(ident.params, k) - getattr(truth, k)) / abs(getattr(truth, k))
                     for k in changed
                 }
+                within = math.inf
+                for entry in ident.history:
+                    ok = entry["t"] > change and all(
+                        abs(entry[k] - getattr(truth, k)) <= 0.1 * abs(getattr(truth, k))
+                        for k in changed
+                        if k != "beta"
+                    )
+                    if ok and within == math.inf:
+                        within = entry["t"]
+                    elif not ok and entry["t"] > change:
+                        within = math.inf
+                figures = {
+                    "final_relative_error": errors,
+                    "t_within_10pct": within,
+                    "update_us_median": 1e6 * statistics.median(times) if times else math.nan,
+                    "update_us_p99": 1e6 * float(np.percentile(times, 99)) if times else math.nan,
+                    "updates": len(times),
+                }
+                if isinstance(ident, LambdaLSSVM):
+                    over = [
+                        e["t"] for e in ident.history if e.get("lambda1", 0.0) > ident.lambda_c[0]
+                    ]
+                    figures["lambda1_detections_before_change"] = sum(t <= change for t in over)
+                    figures["lambda1_first_detection_after_change"] = min(
+                        (t for t in over if t > change), default=math.inf
+                    )
+                row[name + suffix] = figures
+            samples = {
+                k: np.concatenate([s[k] for s in log]) for k in ("t", "psi", "delta", "delta_c")
             }
-        except IdentificationError as exc:
-            row["batch_fit_nomoto2"] = {"error": str(exc)}
+            after = samples["t"] >= change
+            try:
+                fit = fit_nomoto2(
+                    samples["psi"][after],
+                    samples["delta"][after],
+                    samples["delta_c"][after],
+                    h,
+                    base=sc.nominal_params,
+                    front_end=front_end,
+                )
+                row["batch_fit_nomoto2" + suffix] = {
+                    "final_relative_error": {
+                        k: abs(getattr(fit, k) - getattr(truth, k)) / abs(getattr(truth, k))
+                        for k in changed
+                    }
+                }
+            except IdentificationError as exc:
+                row["batch_fit_nomoto2" + suffix] = {"error": str(exc)}
         out[case] = row
     return out
 

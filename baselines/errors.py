@@ -13,8 +13,10 @@ from shipgym.errors import ShipgymError
 
 
 class ControllerError(ShipgymError, KeyError):
-    """A controller name is neither a registered controller, a shipped learned policy nor a
-    trained agent's directory; the message lists the valid names."""
+    """A controller cannot be made as named: an unknown name (the message lists the valid
+    ones), a spec whose module, file or attribute is missing or not a Policy, a broken
+    plug-in entry point, a model zip or ``meta.json`` that is unreadable or contradicts
+    itself (the message names the file and key)."""
 
     def __str__(self) -> str:  # the message as written, not KeyError's repr of it
         return Exception.__str__(self)
@@ -30,10 +32,23 @@ class BackendError(ShipgymError, RuntimeError):
     """The requested execution backend is not installed (Ray)."""
 
 
+def check_count(count: int, option: str) -> None:
+    """Raise :class:`RunError` unless a count (``--seeds``, ``--repeats``, ``--timesteps``)
+    is at least 1; the message names the option."""
+    if count < 1:
+        raise RunError(f"{option} must be ≥ 1, got {count}")
+
+
 def check_seeds(seeds: int, option: str = "seeds") -> None:
     """Raise :class:`RunError` unless the number of seeds is at least 1."""
-    if seeds < 1:
-        raise RunError(f"{option} must be ≥ 1, got {seeds}")
+    check_count(seeds, option)
 
 
-__all__ = ["BackendError", "ConfigError", "ControllerError", "RunError", "check_seeds"]
+__all__ = [
+    "BackendError",
+    "ConfigError",
+    "ControllerError",
+    "RunError",
+    "check_count",
+    "check_seeds",
+]

@@ -11,6 +11,7 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
+from baselines.plugins import ControllerEntry, ControllerSpec
 from baselines.policy import Policy
 from baselines.registry import make_controller
 
@@ -21,7 +22,8 @@ EVAL_SEED_OFFSET = 10_000
 
 @dataclasses.dataclass
 class EpisodeResult:
-    """Metrics and trajectory of one (controller, scenario, seed) episode."""
+    """Metrics and trajectory of one (controller, scenario, seed) episode; ``training_seed``:
+    the seed a learned policy was trained with (None for the rest)."""
 
     controller: str
     kind: str
@@ -29,6 +31,7 @@ class EpisodeResult:
     seed: int
     metrics: dict[str, Any]
     trajectory: dict[str, np.ndarray]
+    training_seed: int | None = None
 
     def row(self) -> dict[str, Any]:
         return {
@@ -90,9 +93,20 @@ def run_episode(
             seed=seed,
             metrics=metrics,
             trajectory=trajectory,
+            training_seed=training_seed(policy),
         )
     finally:
         env.close()
+
+
+def training_seed(policy: Policy) -> int | None:
+    """The seed ``policy`` was trained with: its ``training_seed`` attribute, else the
+    ``seed`` of its training meta (learned policies); None when it has neither."""
+    seed = getattr(policy, "training_seed", None)
+    meta = getattr(policy, "meta", None)
+    if seed is None and isinstance(meta, dict):
+        seed = meta.get("seed")
+    return int(seed) if seed is not None else None
 
 
 def compute_time_metrics(act_times: list[float]) -> dict[str, float]:
@@ -120,17 +134,17 @@ def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:
 
 
 def evaluate(
-    controller: str | Policy, scenario: Any, seeds: list[int], **settings: Any
+    controller: ControllerSpec | Policy, scenario: Any, seeds: list[int], **settings: Any
 ) -> list[EpisodeResult]:
     """Evaluate a controller on a scenario over seeds.
 
-    ``controller``: a name :func:`~baselines.registry.make_controller` knows (made afresh
-    per seed with ``settings``) or a Policy instance (``settings`` may give its
-    ``action_mode``; default: the policy's own).
+    ``controller``: a name, spec or long form :func:`~baselines.registry.make_controller`
+    knows (made afresh per seed with ``settings``) or a Policy instance (``settings`` may
+    give its ``action_mode``; default: the policy's own).
     """
     results = []
     for seed in seeds:
-        if isinstance(controller, str):
+        if isinstance(controller, str | ControllerEntry):
             policy, mode = make_controller(controller, **settings)
         else:
             policy, mode = controller, settings.get("action_mode")

@@ -2,6 +2,8 @@
 
 Jobs are independent (controller, scenario, seed) tasks.  ``local`` runs them in a process
 pool; ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+The parent records each episode as it arrives (:mod:`baselines.runs`: ``run.json``,
+``episodes.jsonl``), and the tables are aggregated from that record.
 """
 
 from __future__ import annotations
@@ -9,20 +11,24 @@ from __future__ import annotations
 import csv
 import math
 import os
+import signal
 import sys
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import closing
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from tqdm import tqdm
 
-from baselines.errors import BackendError, ControllerError, RunError, check_seeds
+from baselines.errors import BackendError, RunError, check_seeds
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
 from baselines.jsonout import dumps
-from baselines.registry import applies_to, controller_kind, is_controller, unknown_controller
+from baselines.registry import applies_to, controller_kind, controller_label
+from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
 from baselines.suite import load_suite
+from shipgym.config import is_path
 from shipgym.metrics import aggregate
 from shipgym.scenarios import load_scenario
 
@@ -45,27 +51,16 @@ COLUMNS = (
 TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
 
 
-def controller_label(controller: str) -> str:
-    """The table name of a controller: its registry name, or a trained agent's folder name
-    (the folder holding a ``.zip``, plus the zip's stem unless it is ``model``)."""
-    path = Path(controller)
-    if path.suffix == ".zip":
-        stem = "" if path.stem == "model" else f"/{path.stem}"
-        return f"{path.resolve().parent.name}{stem}"
-    return path.resolve().name if path.exists() else controller
-
-
 def check_controllers(names: list[str]) -> list[str]:
     """The table labels of ``names``; a clear error, before any job runs, for a name that
     is neither a controller nor a trained agent, and for two names with the same label."""
-    labels = []
-    for name in names:
-        if not is_controller(name):
-            raise ControllerError(unknown_controller(name))
-        labels.append(controller_label(name))
+    labels = [controller_label(name) for name in names]  # resolves each: a clear error
     duplicates = sorted({label for label in labels if labels.count(label) > 1})
     if duplicates:
-        raise RunError(f"controllers {names} give the same table name(s) {duplicates}")
+        raise RunError(
+            f"controllers {names} give the same table name(s) {duplicates}: give each its "
+            "own name (a suite's long form {controller: ..., name: ...})"
+        )
     return labels
 
 
@@ -83,22 +78,31 @@ def run_job(job: tuple[str, str, int]) -> EpisodeResult:
     return result
 
 
-def _run_local(jobs: list, workers: int, progress: Callable[[], None]) -> list[EpisodeResult]:
+def _quiet_worker() -> None:
+    """Pool workers ignore Ctrl-C (the parent stops them): no traceback from each."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _iter_local(jobs: list, workers: int) -> Iterator[EpisodeResult]:
+    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes)."""
     if workers <= 1:
-        out = []
         for job in jobs:
-            out.append(run_job(job))
-            progress()
-        return out
-    out = []
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+            yield run_job(job)
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker)
+    try:
         for fut in as_completed([pool.submit(run_job, j) for j in jobs]):
-            out.append(fut.result())
-            progress()
-    return out
+            yield fut.result()
+    except BaseException:  # Ctrl-C, a failed job, or the consumer stopped: stop the workers
+        workers_running = list((pool._processes or {}).values())  # shutdown forgets them
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers_running:
+            process.terminate()
+        raise
+    pool.shutdown()
 
 
-def _run_ray(jobs: list, progress: Callable[[], None]) -> list[EpisodeResult]:
+def _iter_ray(jobs: list) -> Iterator[EpisodeResult]:
     try:
         import ray
     except ImportError as exc:
@@ -107,13 +111,57 @@ def _run_ray(jobs: list, progress: Callable[[], None]) -> list[EpisodeResult]:
         ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
     remote = ray.remote(run_job)
     pending = [remote.remote(j) for j in jobs]
-    out = []
-    while pending:
-        done, pending = ray.wait(pending)
-        out.extend(ray.get(done))
-        for _ in done:
-            progress()
-    return out
+    try:
+        while pending:
+            done, pending = ray.wait(pending)
+            yield from ray.get(done)
+    except BaseException:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        raise
+
+
+def iter_results(jobs: list, backend: str, workers: int) -> Iterator[EpisodeResult]:
+    """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), in completion order."""
+    if backend == "local":
+        return _iter_local(jobs, workers)
+    if backend == "ray":
+        return _iter_ray(jobs)
+    raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
+
+
+def _job_key(job: tuple[str, str, int]) -> tuple[str, str, int]:
+    """(scenario, table name, seed): the key of the job's record in ``episodes.jsonl``."""
+    controller, scenario, seed = job
+    return (scenario, controller_label(controller), seed)
+
+
+def suite_record(
+    spec: Any, names: list[str], scenarios: Mapping[str, Any], seed_list: list[int]
+) -> dict[str, Any]:
+    """The resolved suite as ``run.json`` keeps it: seeds, controllers (table name, how the
+    suite names it, kind), each scenario's settings and the pairs that do not apply."""
+    ships = {s: sc.model.name for s, sc in scenarios.items()}
+    controllers = [
+        {
+            "name": controller_label(c),
+            "controller": c if isinstance(c, str) else c.model_dump(),  # the long form
+            "kind": controller_kind(controller_label(c)),
+        }
+        for c in names
+    ]
+    return {
+        "name": spec.name,
+        "seeds": seed_list,
+        "controllers": controllers,
+        "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
+        "does_not_apply": [
+            [s, c["name"]]
+            for s in scenarios
+            for c in controllers
+            if not applies_to(c["name"], ships[s])
+        ],
+    }
 
 
 def run_leaderboard(
@@ -124,55 +172,119 @@ def run_leaderboard(
     workers: int | None = None,
     controllers: Iterable[str] | None = None,
     show_progress: bool = True,
+    resume: bool = False,
+    force: bool = False,
+    command: list[str] | None = None,
+    on_episode: Callable[[EpisodeResult], None] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the suite, write leaderboard.{md,csv,json} and plots; return the aggregate rows."""
+    """Run the suite, write leaderboard.{md,csv,json}, generalisation.json and plots; return
+    the aggregate rows.
+
+    ``out_dir`` must be empty unless ``resume`` (run only the jobs missing from its
+    ``episodes.jsonl``) or ``force`` (clear its earlier outputs); ``command``: the argv
+    recorded in ``run.json`` (default ``sys.argv``); ``on_episode``: called in this process
+    after each episode is recorded.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
+    """
+    check_out_dir(out_dir, resume=resume, force=force)  # before any work
+    if backend not in BACKENDS:
+        raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
     spec = load_suite(suite)
     n_seeds = int(seeds if seeds is not None else spec.seeds)
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
-    labels = check_controllers(names)
-    scenarios = spec.all_scenarios()
+    check_controllers(names)
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
-    ships = {s: load_scenario(s).model.name for s in scenarios}
+    scenarios = {s: load_scenario(s) for s in spec.all_scenarios()}
+    record = suite_record(spec, names, scenarios, seed_list)
+    skip = {tuple(pair) for pair in record["does_not_apply"]}
     jobs = [
         (c, s, seed)
         for s in scenarios
         for c in names
-        if applies_to(controller_label(c), ships[s])
+        if (s, controller_label(c)) not in skip
         for seed in seed_list
     ]
-    bar = tqdm(total=len(jobs), desc="leaderboard", file=sys.stderr, disable=not show_progress)
-    if backend == "local":
-        results = _run_local(jobs, workers or os.cpu_count() or 1, lambda: bar.update(1))
-    elif backend == "ray":
-        results = _run_ray(jobs, lambda: bar.update(1))
-    else:
-        raise RunError(f"unknown backend {backend!r}; valid: local, ray")
-    bar.close()
+    log = RunLog.open(
+        out_dir,
+        command=sys.argv if command is None else command,
+        suite=record,
+        jobs=len(jobs),
+        resume=resume,
+        force=force,
+    )
+    todo = [job for job in jobs if _job_key(job) not in log.done]
+    bar = tqdm(
+        total=len(jobs),
+        initial=len(jobs) - len(todo),
+        desc="leaderboard",
+        file=sys.stderr,
+        disable=not show_progress,
+    )
+    with (
+        log.recording(),
+        closing(iter_results(todo, backend, workers or os.cpu_count() or 1)) as results,
+    ):
+        try:
+            for result in results:
+                log.append(result, keep_trajectory=result.seed == seed_list[0])
+                bar.update(1)
+                if on_episode is not None:
+                    on_episode(result)
+        finally:
+            bar.close()
+        return write_results(log.folder, log.record["suite"], load_results(log.folder))
+
+
+def load_results(folder: str | os.PathLike) -> list[EpisodeResult]:
+    """The episodes recorded in a run folder's ``episodes.jsonl`` (trajectories if kept)."""
+    return [episode_result(r, folder) for r in read_episodes(folder)]
+
+
+def write_results(
+    out: str | os.PathLike, suite: Mapping[str, Any], results: list[EpisodeResult]
+) -> list[dict[str, Any]]:
+    """Tables and plots into ``out`` from episode results and a suite as ``run.json`` keeps
+    it (:func:`suite_record`); returns the rows."""
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
-    results.sort(key=lambda r: (r.scenario, r.controller, r.seed))
-    rows = aggregate_results(results, scenarios, labels)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    write_tables(rows, out)
-    plot_results(results, out)
+    results = sorted(results, key=lambda r: (r.scenario, r.controller, r.seed))
+    kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
+    rows = aggregate_results(
+        results,
+        list(suite["scenarios"]),
+        list(kinds),
+        kinds=kinds,
+        not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
+    )
+    write_tables(rows, Path(out))
+    plot_results(results, Path(out), suite["scenarios"])
     return rows
 
 
 def aggregate_results(
-    results: list[EpisodeResult], scenarios: list[str], controllers: list[str]
+    results: list[EpisodeResult],
+    scenarios: list[str],
+    controllers: list[str],
+    kinds: Mapping[str, str] | None = None,
+    not_applicable: set[tuple[str, str]] | None = None,
 ) -> list[dict[str, Any]]:
+    """One row per (scenario, controller): means and ``*_std`` over seeds, or "does not
+    apply".  ``kinds``: controller kinds (default: the registry's); ``not_applicable``: the
+    (scenario, controller) pairs that do not apply (None: every pair without episodes);
+    a pair without episodes that is not listed has no row (a partial or merged record)."""
     rows = []
     for scenario in scenarios:
         for controller in controllers:
             group = [r for r in results if r.scenario == scenario and r.controller == controller]
+            listed = not_applicable is None or (scenario, controller) in not_applicable
+            if not group and not listed:
+                continue  # not run (yet): no row
             if not group:  # the controller does not apply to this scenario's ship: shown
                 rows.append(
                     {
                         "scenario": scenario,
                         "split": scenario_split(scenario),
                         "controller": controller,
-                        "kind": controller_kind(controller),
+                        "kind": (kinds or {}).get(controller) or controller_kind(controller),
                         "seeds": 0,
                         "applies": False,
                         **{k: None for key in COLUMNS for k in (key, f"{key}_std")},
@@ -226,12 +338,11 @@ def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     ran (so that all controllers are compared on the same set; ``*_scenarios`` counts them).
     """
     controllers = list(dict.fromkeys(r["controller"] for r in rows))
+    ran = {(r["scenario"], r["controller"]) for r in rows if r.get("applies", True)}
     common = {}
     for split in ("catalogue", "heldout"):
         scenarios = dict.fromkeys(r["scenario"] for r in rows if r["split"] == split)
-        common[split] = [
-            s for s in scenarios if all(r.get("applies", True) for r in rows if r["scenario"] == s)
-        ]
+        common[split] = [s for s in scenarios if all((s, c) in ran for c in controllers)]
     out = []
     for controller in controllers:
         mine = [r for r in rows if r["controller"] == controller]
@@ -306,18 +417,29 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n" + note
 
 
-def plot_results(results: list[EpisodeResult], out: Path) -> None:
-    """Per scenario: tracks over the path, e(t) and δ(t) of the first seed of each controller."""
+def plot_file(scenario: str) -> str:
+    """The plot's file name for a scenario: inside the run's folder, whatever the scenario is
+    (``heldout:0`` → ``heldout_0.png``, a YAML path → its stem)."""
+    name = Path(scenario).stem if is_path(scenario) else scenario
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".png"
+
+
+def plot_results(
+    results: list[EpisodeResult], out: Path, scenarios: Mapping[str, Any] | None = None
+) -> None:
+    """Per scenario: tracks over the path, e(t) and δ(t) of the first seed of each controller
+    whose trajectory was kept.  ``scenarios``: name → settings (as ``run.json`` records
+    them; default: each scenario loaded by name)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    for scenario in sorted({r.scenario for r in results}):
-        sc = load_scenario(scenario)
+    for scenario in sorted({r.scenario for r in results if r.trajectory}):
+        sc = load_scenario(scenarios[scenario] if scenarios else scenario)
         first: dict[str, EpisodeResult] = {}
         for r in sorted(results, key=lambda r: r.seed):
-            if r.scenario == scenario:
+            if r.scenario == scenario and r.trajectory:
                 first.setdefault(r.controller, r)
         fig, axes = plt.subplots(1, 3, figsize=(15, 4))
         pts = sc.path.point(np.linspace(0, sc.path.length, 300))
@@ -336,5 +458,5 @@ def plot_results(results: list[EpisodeResult], out: Path) -> None:
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
         axes[0].legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(out / f"{scenario.replace(':', '_')}.png", dpi=90)
+        fig.savefig(out / plot_file(scenario), dpi=90)
         plt.close(fig)

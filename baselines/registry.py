@@ -13,18 +13,40 @@ and action mode (a class as class attributes, a factory function's policy as att
 set on it).
 The built-in controllers register when their modules are imported, which this module does
 (so the registry is full once ``baselines.registry`` is imported).
+
+Every other controller is found by :func:`resolve_controller` (all that :func:`make_controller`
+accepts): an installed plug-in's entry point, a spec ``module.path:Attr`` or
+``path/to/file.py:Attr`` (:mod:`baselines.plugins`), the long form of a suite (a display
+name and settings), a learned policy or SB3 model zip (:mod:`baselines.learned.policy`).  A
+controller only ever gets ``reset(context, seed)`` and ``act(obs, info)`` from the
+evaluation loop, whatever its origin.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
+import inspect
+import types
 from collections.abc import Callable, Mapping, Sequence
+from importlib.metadata import EntryPoint
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TypeVar, overload
 
 from baselines.errors import ControllerError
+from baselines.plugins import (
+    ControllerEntry,
+    ControllerSpec,
+    as_entry,
+    entry_point_names,
+    find_entry_point,
+    load_entry_point,
+    load_spec,
+    looks_like_path,
+    parse_spec,
+)
 from baselines.policy import Policy
 from shipgym.envs.core import ACTION_MODES
 from shipgym.models import MODELS
@@ -39,6 +61,9 @@ BUILTIN_MODULES = (
 )
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])
+
+#: what a controller is (SPEC §9b)
+KINDS = ("classical", "learned")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -114,7 +139,7 @@ def register_controller(
         name=name,
         factory=factory,
         action_mode=action_mode,
-        applies_to=_ships(name, applies_to),
+        applies_to=_ships(f"controller {name!r}", applies_to),
         kind=getattr(factory, "kind", "classical"),
     )
     existing = _RECORDS.get(name)
@@ -138,17 +163,17 @@ def register_controller(
     return factory
 
 
-def _ships(name: str, applies_to: Sequence[str] | None) -> tuple[str, ...] | None:
-    """``applies_to`` as a tuple of known ship ids; a clear error for anything else."""
+def _ships(who: str, applies_to: Sequence[str] | None) -> tuple[str, ...] | None:
+    """``applies_to`` as a tuple of known ship ids; a clear error (naming ``who``) for
+    anything else."""
     if applies_to is None:
         return None
     if isinstance(applies_to, str):
-        raise TypeError(f"controller {name!r}: applies_to is a list of ship ids, not a string")
+        raise TypeError(f"{who}: applies_to is a list of ship ids, not a string")
     unknown = [s for s in applies_to if s not in MODELS]
     if unknown:
         raise ValueError(
-            f"controller {name!r}: unknown ship(s) {unknown} in applies_to; "
-            f"valid: {', '.join(sorted(MODELS))}"
+            f"{who}: unknown ship(s) {unknown} in applies_to; valid: {', '.join(sorted(MODELS))}"
         )
     return tuple(applies_to)
 
@@ -159,66 +184,290 @@ def _qualname(factory: Callable[..., Any]) -> str:
     return f"{module}.{qualname}" if module else qualname
 
 
-def applies_to(controller: str, ship: str) -> bool:
-    """Whether ``controller`` runs on ``ship`` (learned agents and the rest: every ship)."""
-    record = _RECORDS.get(controller)
+# --------------------------------------------------------------------- any controller
+
+#: table name -> record of the controllers resolved in this process that are not
+#: registered (specs, learned policies), so that a table name finds its ships and kind
+_RESOLVED: dict[str, ControllerRecord] = {}
+
+
+def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
+    """The record of any controller a run accepts, its ``name`` the table name.
+
+    ``controller`` (short form, a string, or the long form :class:`ControllerEntry`) is
+    looked up as, in turn: a registered controller; a shipped learned policy (``ppo``, …);
+    a spec ``module.path:Attr`` / ``path/to/file.py:Attr`` naming a Policy class, a factory
+    function or a Policy instance; an installed plug-in (entry point group
+    ``shipgym.controllers``, loaded and registered on first use); a trained agent's folder
+    or an SB3 model zip.  The long form's ``name`` renames it and its ``settings`` are
+    bound to the factory (checked against its signature here, before any episode).
+    Anything else is a :class:`ControllerError` that lists the valid names.
+    """
+    entry = as_entry(controller)
+    base = _record_of(entry.controller)
+    record = dataclasses.replace(
+        base,
+        name=entry.name or base.name,
+        factory=functools.partial(base.factory, **entry.settings)
+        if entry.settings
+        else base.factory,
+    )
+    _check_settings(base, entry)
+    registered = _RECORDS.get(record.name)
+    if registered is None:
+        _RESOLVED[record.name] = record
+    elif registered is not base:
+        raise ControllerError(
+            f"controller {entry.controller!r} would be shown as {record.name!r}, the name of "
+            f"a registered controller ({_qualname(registered.factory)}): give it another "
+            "name (its name attribute, or the suite's long form {controller: ..., name: ...})"
+        )
+    return record
+
+
+def _record_of(text: str) -> ControllerRecord:
+    """The record a controller string means (see :func:`resolve_controller`)."""
+    from baselines.learned.policy import shipped_policies
+
+    record = _RECORDS.get(text)
+    if record is not None:
+        return record
+    if text in shipped_policies():
+        return _learned_record(text)
+    spec = parse_spec(text)
+    if spec is not None:
+        return _plugin_record(load_spec(spec), f"controller {text!r}", spec.attr.split(".")[-1])
+    entry_point = None if looks_like_path(text) else find_entry_point(text)
+    if entry_point is not None:
+        return _entry_point_record(entry_point)
+    if text.endswith(".py"):
+        raise ControllerError(
+            f"controller {text!r} is a Python file: name the Policy in it, {text}:ClassName"
+        )
+    if Path(text).expanduser().exists():
+        return _learned_record(text)
+    if looks_like_path(text):
+        raise ControllerError(
+            f"controller {text!r}: no such file or folder ({Path(text).expanduser().absolute()})"
+        )
+    raise ControllerError(unknown_controller(text))
+
+
+def _learned_record(name_or_path: str) -> ControllerRecord:
+    """A shipped policy, trained agent's folder or model zip, its files checked now."""
+    from baselines.learned.policy import LearnedPolicy, policy_label, read_policy
+
+    files = read_policy(name_or_path)
+    label = policy_label(name_or_path)
+    return ControllerRecord(
+        name=label,
+        factory=functools.partial(LearnedPolicy, name_or_path, name=label),
+        action_mode=files.model.action_mode,
+        kind=LearnedPolicy.kind,
+    )
+
+
+def _entry_point_record(entry_point: EntryPoint) -> ControllerRecord:
+    """An installed plug-in, loaded and registered under its entry point's name, with the
+    traits its object carries (``action_mode``, ``applies_to``, ``kind``)."""
+    origin = f"entry point {entry_point.name!r} = {entry_point.value!r}"
+    obj = load_entry_point(entry_point)
+    if entry_point.name not in _RECORDS:  # its module may register it itself on import
+        traits = _traits(obj, origin)
+        try:
+            register_controller(
+                entry_point.name,
+                traits.factory,
+                action_mode=traits.action_mode,
+                applies_to=traits.applies_to,
+            )
+        except (TypeError, ValueError) as exc:
+            raise ControllerError(f"{origin}: {exc}") from None
+    return _RECORDS[entry_point.name]
+
+
+def _plugin_record(obj: Any, origin: str, default_name: str) -> ControllerRecord:
+    """The record of an object a spec names: its registration if it has one, else one made
+    from its traits, named by its own ``name`` or ``default_name``."""
+    registered = next((r for r in _RECORDS.values() if _same_definition(r.factory, obj)), None)
+    if registered is not None:
+        return registered
+    traits = _traits(obj, origin)
+    return ControllerRecord(
+        name=traits.name or default_name,
+        factory=traits.factory,
+        action_mode=traits.action_mode,
+        applies_to=traits.applies_to,
+        kind=traits.kind,
+    )
+
+
+def _same_definition(factory: Any, obj: Any) -> bool:
+    """Whether ``obj`` is ``factory``, or the same class or function loaded from the same
+    source file under another module name (a file spec of an installed plug-in)."""
+    if factory is obj:
+        return True
+    if not (isinstance(obj, type | types.FunctionType) and type(obj) is type(factory)):
+        return False
+    try:
+        files = {Path(inspect.getfile(f)).resolve() for f in (factory, obj)}
+    except (TypeError, OSError):  # built-in, or defined without a file
+        return False
+    return len(files) == 1 and factory.__qualname__ == obj.__qualname__
+
+
+@dataclasses.dataclass(frozen=True)
+class _Traits:
+    """What a plug-in object says about itself."""
+
+    factory: Callable[..., Policy]
+    name: str | None
+    action_mode: str
+    applies_to: tuple[str, ...] | None
+    kind: str
+
+
+def _traits(obj: Any, origin: str) -> _Traits:
+    """The factory and traits of a Policy class, a factory function or a Policy instance;
+    anything else, and bad traits, are a :class:`ControllerError` naming ``origin``."""
+    is_policy = all(callable(getattr(obj, method, None)) for method in ("reset", "act"))
+    if isinstance(obj, type):
+        if not is_policy:
+            raise ControllerError(
+                f"{origin}: class {obj.__qualname__} is not a Policy (it needs reset(context, "
+                "seed=None) and act(obs, info))"
+            )
+        factory, name = obj, vars(obj).get("name")  # an inherited name is its parent's
+    elif is_policy:
+        factory, name = _returning(obj), getattr(obj, "name", None)
+    elif callable(obj):
+        factory, name = obj, getattr(obj, "name", None)
+    else:
+        raise ControllerError(
+            f"{origin} is a {type(obj).__name__}, not a Policy class, a factory function or a "
+            "Policy instance"
+        )
+    action_mode = getattr(obj, "action_mode", "rudder")
+    kind = getattr(obj, "kind", "classical")
+    ships = getattr(obj, "applies_to", None)
+    if action_mode not in ACTION_MODES:
+        raise ControllerError(
+            f"{origin}: action_mode must be one of {ACTION_MODES}, got {action_mode!r}"
+        )
+    if kind not in KINDS:
+        raise ControllerError(f"{origin}: kind must be one of {KINDS}, got {kind!r}")
+    if not (ships is None or isinstance(ships, list | tuple)):
+        raise ControllerError(f"{origin}: applies_to is a list of ship ids, got {ships!r}")
+    try:
+        applies = _ships(origin, ships)
+    except ValueError as exc:
+        raise ControllerError(str(exc)) from None
+    return _Traits(
+        factory=factory,
+        name=name if isinstance(name, str) and name else None,
+        action_mode=action_mode,
+        applies_to=applies,
+        kind=kind,
+    )
+
+
+def _returning(policy: Policy) -> Callable[[], Policy]:
+    """A factory that returns the Policy instance ``policy`` (reset before every episode)."""
+
+    def factory() -> Policy:
+        return policy
+
+    factory.kind = getattr(policy, "kind", "classical")  # type: ignore[attr-defined]
+    return factory
+
+
+def _check_settings(record: ControllerRecord, entry: ControllerEntry) -> None:
+    """Raise unless the factory of ``record`` accepts ``entry.settings`` as keywords (the
+    rest may come with :func:`make_controller`)."""
+    try:
+        signature = inspect.signature(record.factory)
+    except (TypeError, ValueError):  # a builtin or extension callable: nothing to check
+        return
+    try:
+        signature.bind_partial(**entry.settings)
+    except TypeError as exc:
+        raise ControllerError(
+            f"controller {entry.controller!r}: settings {dict(entry.settings)} do not fit "
+            f"{_qualname(record.factory)}{signature}: {exc}"
+        ) from None
+
+
+def controller_label(controller: ControllerSpec) -> str:
+    """The table name of a controller: its registered name or its own ``name`` (a spec's
+    attribute name when it has none), the long form's ``name``, a learned policy's name
+    (a trained agent's folder name; for a zip the folder holding it, plus the zip's stem
+    unless it is ``model``)."""
+    return resolve_controller(controller).name
+
+
+def _known(controller: ControllerSpec) -> ControllerRecord | None:
+    """The record of a table name or controller resolved before, else resolved now (None
+    when it is none)."""
+    if isinstance(controller, str):
+        record = _RECORDS.get(controller) or _RESOLVED.get(controller)
+        if record is not None:
+            return record
+    try:
+        return resolve_controller(controller)
+    except ControllerError:
+        return None
+
+
+def applies_to(controller: ControllerSpec, ship: str) -> bool:
+    """Whether ``controller`` (a controller or a table name) runs on ``ship`` (learned
+    agents and the rest: every ship)."""
+    record = _known(controller)
     return record is None or record.applies_to is None or ship in record.applies_to
 
 
-def controller_kind(controller: str) -> str:
-    """``"classical"`` for a registered controller (unless it says otherwise), else
-    ``"learned"``."""
-    record = _RECORDS.get(controller)
+def controller_kind(controller: ControllerSpec) -> str:
+    """``"classical"`` for a registered or plug-in controller (unless it says otherwise),
+    ``"learned"`` for learned policies and anything unknown."""
+    record = _known(controller)
     return record.kind if record is not None else "learned"
 
 
-def is_controller(name: str) -> bool:
-    """Whether ``name`` is a registered controller, a shipped learned policy or a path."""
-    return name in _RECORDS or _learned_policy_path(name) is not None
-
-
-def _learned_policy_path(name: str) -> Path | None:
-    """The folder or zip of the learned policy ``name`` means (a shipped policy's name
-    before a path of the same name); None when it is neither."""
-    from baselines.learned.policy import POLICY_DIR, shipped_policies
-
-    if name in shipped_policies():
-        return POLICY_DIR / name
-    return Path(name) if Path(name).exists() else None
+def is_controller(name: ControllerSpec) -> bool:
+    """Whether :func:`resolve_controller` accepts ``name``."""
+    try:
+        resolve_controller(name)
+    except ControllerError:
+        return False
+    return True
 
 
 def unknown_controller(name: str) -> str:
     """The error message for a name :func:`is_controller` rejects: the valid names."""
     from baselines.learned.policy import shipped_policies
 
+    plugins = [n for n in entry_point_names() if n not in _RECORDS]
+    installed = f", the installed plug-ins {', '.join(plugins)}" if plugins else ""
     return (
-        f"unknown controller {name!r}; valid: {', '.join(sorted(_RECORDS))}, the learned "
-        f"policies {', '.join(shipped_policies())} or a trained agent's path"
+        f"unknown controller {name!r}; valid: {', '.join(sorted(_RECORDS))}{installed}, the "
+        f"learned policies {', '.join(shipped_policies())}, a spec module.path:Attr or "
+        "path/to/file.py:Attr, or a trained agent's folder or model zip"
     )
 
 
-def make_controller(name: str, **settings: Any) -> tuple[Policy, str]:
+def make_controller(name: ControllerSpec, **settings: Any) -> tuple[Policy, str]:
     """A fresh controller and the action mode it needs; unknown names list the valid ones.
 
-    ``name`` is a registered controller (made with ``settings``), a shipped learned policy
-    (``ppo``, …, in ``baselines/learned/policies``) or the path of a trained agent.
+    ``name``: anything :func:`resolve_controller` accepts (made with ``settings``, after
+    the long form's own); the policy carries the table name and the action mode.
     """
-    record = _RECORDS.get(name)
-    if record is not None:
-        policy = record.factory(**settings)
-        for attr in ("name", "action_mode"):  # a factory function's policy learns them here
-            if getattr(policy, attr, None) != getattr(record, attr):
-                setattr(policy, attr, getattr(record, attr))
-        if not hasattr(policy, "kind"):
-            policy.kind = record.kind
-        return policy, record.action_mode
-    path = _learned_policy_path(name)
-    if path is not None:
-        from baselines.learned.policy import LearnedPolicy
-
-        policy = LearnedPolicy(path)
-        return policy, policy.action_mode
-    raise ControllerError(unknown_controller(name))
+    record = resolve_controller(name)
+    policy = record.factory(**settings)
+    for attr in ("name", "action_mode"):  # a factory function's policy learns them here
+        if getattr(policy, attr, None) != getattr(record, attr):
+            setattr(policy, attr, getattr(record, attr))
+    if not hasattr(policy, "kind"):
+        policy.kind = record.kind
+    return policy, record.action_mode
 
 
 for _module in BUILTIN_MODULES:

@@ -5,11 +5,24 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Annotated, Any
 
-from pydantic import Field, model_validator
+from pydantic import Discriminator, Field, Tag, model_validator
 
 from baselines.errors import ConfigError
+from baselines.plugins import ControllerEntry, ControllerSpec, anchored
 from shipgym.config import ConfigFile, StrictModel, is_path, list_names, load_yaml_model, resolve
+
+
+def _controller_form(value: Any) -> str:
+    return "long form" if isinstance(value, dict | ControllerEntry) else "short form"
+
+
+#: a suite's controller: a string, or the long form (errors name the form they read)
+SuiteController = Annotated[
+    Annotated[str, Tag("short form")] | Annotated[ControllerEntry, Tag("long form")],
+    Discriminator(_controller_form),
+]
 
 
 class SuiteConfig(StrictModel):
@@ -17,15 +30,20 @@ class SuiteConfig(StrictModel):
 
     ``scenarios``: catalogue names, named test scenarios (``heldout:3``) or YAML paths (a
     relative path is read against the suite file's folder); ``heldout_scenarios`` N adds
-    ``heldout:0 … heldout:N-1``; ``controllers``: registered controllers, shipped learned
-    policies or trained agents' paths; ``seeds``: evaluation seeds per (controller, scenario).
+    ``heldout:0 … heldout:N-1``; ``controllers``: what ``shipgym evaluate`` accepts
+    (registered controllers, installed plug-ins, specs ``module.path:Attr`` /
+    ``path/to/file.py:Attr``, shipped learned policies, trained agents' folders, SB3 model
+    zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
+    {keyword: value}}`` (:class:`~baselines.plugins.ControllerEntry`); a relative file path
+    among them is read against the suite file's folder.  ``seeds``: evaluation seeds per
+    (controller, scenario).
     """
 
     name: str
     description: str = ""
     scenarios: list[str] = Field(default_factory=list)
     heldout_scenarios: int = Field(0, ge=0)
-    controllers: list[str] = Field(min_length=1)
+    controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1)
 
     @model_validator(mode="after")
@@ -66,4 +84,15 @@ def load_suite(name_or_path: str | os.PathLike) -> SuiteConfig:
     file = resolve("suites", name_or_path, error=ConfigError)
     suite = load_yaml_model(file, SuiteConfig, ConfigError)
     scenarios = [_scenario_entry(s, file, i) for i, s in enumerate(suite.scenarios)]
-    return suite.model_copy(update={"scenarios": scenarios})
+    controllers = [_controller_entry(c, file) for c in suite.controllers]
+    return suite.model_copy(update={"scenarios": scenarios, "controllers": controllers})
+
+
+def _controller_entry(entry: ControllerSpec, file: ConfigFile) -> ControllerSpec:
+    """A suite's controller with a relative file path anchored at the suite's folder."""
+    if not isinstance(file, Path):  # a packaged suite names its controllers
+        return entry
+    folder = file.resolve().parent
+    if isinstance(entry, str):
+        return anchored(entry, folder)
+    return entry.model_copy(update={"controller": anchored(entry.controller, folder)})

@@ -50,9 +50,10 @@ class ConfigError(ShipgymError, ValueError):
 
 
 class StrictModel(BaseModel):
-    """Base of every config model: unknown keys are errors, instances are frozen."""
+    """Base of every config model: unknown keys are errors, instances are frozen, and every
+    float is finite (``.inf`` / ``.nan`` are rejected naming the key)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     def with_overrides(
         self,

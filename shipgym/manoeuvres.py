@@ -20,7 +20,20 @@ DEG = math.pi / 180.0
 
 
 class ManoeuvreError(ShipgymError, ValueError):
-    """A manoeuvre's settings are impossible (e.g. a zig-zag angle ≤ 0)."""
+    """A manoeuvre's settings are impossible (a zig-zag angle ≤ 0, a rudder angle beyond the
+    ship's limit)."""
+
+
+def check_rudder(model: ShipModel, rudder_deg: float) -> float:
+    """``rudder_deg`` in rad; a rudder beyond the ship's limit is an error, not clipped
+    (the plant would saturate it silently and the figures would belong to another angle)."""
+    limit = model.rudder_limit
+    if not math.isfinite(rudder_deg) or abs(rudder_deg) * DEG > limit * (1.0 + 1e-9):
+        raise ManoeuvreError(
+            f"rudder {rudder_deg}° is beyond the {model.name} rudder limit "
+            f"±{math.degrees(limit):.4g}°"
+        )
+    return rudder_deg * DEG
 
 
 @dataclasses.dataclass(frozen=True)
@@ -96,11 +109,12 @@ def zigzag(
     the switch angle), ``time_overshoot_1``/``_2`` (s, of the heading extremes),
     ``period`` (s, between the first and third switch) and ``time_to_first_switch`` (s).
     Stops after ``n_switches`` or ``duration`` seconds (default: 60 ship lengths of
-    travel).  Heading is measured from the initial course, positive as the model's ψ.
+    travel).  Heading is measured from the initial course, positive as the model's ψ.  A
+    rudder beyond the ship's limit is a :class:`ManoeuvreError`.
     """
     switch = (switch_deg if switch_deg is not None else rudder_deg) * DEG
-    rudder = rudder_deg * DEG
-    if rudder <= 0 or switch <= 0:
+    rudder = check_rudder(model, rudder_deg)
+    if not rudder > 0 or not math.isfinite(switch) or not switch > 0:
         raise ManoeuvreError("zig-zag rudder and switch angles must be > 0")
     h = h if h is not None else model.fine_step
     duration = duration if duration is not None else 60.0 * model.length / model.nominal_speed
@@ -153,12 +167,13 @@ def _crossing(t: np.ndarray, values: np.ndarray, level: float) -> float | None:
 
 def turning_circle(
     model: ShipModel,
-    rudder_deg: float = 35.0,
+    rudder_deg: float | None = None,
     execute_time: float = 0.0,
     duration: float | None = None,
     h: float | None = None,
 ) -> tuple[ManoeuvreLog, dict[str, float]]:
-    """Turning circle: straight ahead at nominal speed, δc = rudder_deg from ``execute_time``.
+    """Turning circle: straight ahead at nominal speed, δc = rudder_deg from ``execute_time``
+    (default 35° or the ship's smaller rudder limit; beyond the limit: :class:`ManoeuvreError`).
 
     Figures (SI; distances from the execute point along / across the approach course,
     times from execute; the turn direction is whichever way the ship turns):
@@ -170,7 +185,9 @@ def turning_circle(
     """
     h = h if h is not None else model.fine_step
     duration = duration if duration is not None else 200.0 * model.length / model.nominal_speed
-    rudder = rudder_deg * DEG
+    if rudder_deg is None:
+        rudder_deg = min(35.0, math.degrees(model.rudder_limit))
+    rudder = check_rudder(model, rudder_deg)
     ipsi = model.state_index("psi")
     psi0 = float(model.cruise_state()[ipsi])
     k_exec = round(execute_time / h)

@@ -261,7 +261,7 @@ def test_every_project_error_is_a_shipgym_error() -> None:
         for node in ast.walk(ast.parse(path.read_text()))
         if isinstance(node, ast.ClassDef) and node.name.endswith("Error")
     }
-    assert ("shipgym.identification.nomoto", "IdentificationError") in errors
+    assert ("shipgym.identification.errors", "IdentificationError") in errors
     for module, name in sorted(errors):
         cls = getattr(importlib.import_module(module), name)
         assert issubclass(cls, ShipgymError), f"{module}.{name} is not a ShipgymError"

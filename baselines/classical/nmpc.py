@@ -25,7 +25,10 @@ prediction or plan) the shifted last plan is applied and counted as ``solver_fai
 On a PCHIP path the "leg" is the tangent at the closest point.
 
 Adaptive variants update the model parameters from ``info["samples"]`` each step with the
-weighted LS-SVM or λ-LS-SVM online identifier, with persistent excitation (eq. (45)).
+weighted LS-SVM or λ-LS-SVM online identifier, with persistent excitation (eq. (45)).  The
+``*_svf`` variants (``nmpc_wlssvm_svf``, ``nmpc_lambda_lssvm_svf``; an extension beyond the
+paper) give the identifier the outlier + state-variable-filter front end
+(``front_end="svf"``, :mod:`shipgym.identification.front_end`), which survives heading noise.
 """
 
 from __future__ import annotations
@@ -255,6 +258,8 @@ class NMPC:
     name: ClassVar[str]  # set by the registration
     kind: ClassVar[str] = "classical"
     identifier_type: ClassVar[type | None] = None
+    #: options of the identifier (e.g. its front end)
+    identifier_options: ClassVar[dict[str, Any]] = {}
 
     def __init__(
         self, settings: NMPCSettings | None = None, excitation_deg: float | None = None
@@ -272,7 +277,9 @@ class NMPC:
         )
         self.params = context.nominal_params
         self.identifier = (
-            self.identifier_type(context.fine_step, context.nominal_params)
+            self.identifier_type(
+                context.fine_step, context.nominal_params, **self.identifier_options
+            )
             if self.identifier_type is not None
             else None
         )
@@ -367,3 +374,19 @@ class NMPCLambdaLSSVM(NMPC):
     """``nmpc_lambda_lssvm``: NMPC with the model updated by λ-LS-SVM (Algorithm 2)."""
 
     identifier_type = LambdaLSSVM
+
+
+@register_controller("nmpc_wlssvm_svf", applies_to=("nomoto2",))
+class NMPCWeightedLSSVMSVF(NMPCWeightedLSSVM):
+    """``nmpc_wlssvm_svf``: ``nmpc_wlssvm`` with the outlier + state-variable-filter front end
+    (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019, issue 14)."""
+
+    identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}
+
+
+@register_controller("nmpc_lambda_lssvm_svf", applies_to=("nomoto2",))
+class NMPCLambdaLSSVMSVF(NMPCLambdaLSSVM):
+    """``nmpc_lambda_lssvm_svf``: ``nmpc_lambda_lssvm`` with the outlier + state-variable-filter
+    front end (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019)."""
+
+    identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}

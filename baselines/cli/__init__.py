@@ -9,7 +9,16 @@ import argparse
 import sys
 from collections.abc import Callable
 
-from baselines.cli import bench, leaderboard, manoeuvre, reproduce, scenarios, train
+from baselines.cli import (
+    bench,
+    leaderboard,
+    manoeuvre,
+    report,
+    reproduce,
+    run,
+    scenarios,
+    train,
+)
 from shipgym.errors import ShipgymError
 
 #: the subcommands' parser builders, in the order ``shipgym --help`` lists them
@@ -18,6 +27,8 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     reproduce.add_parser,
     train.add_parser,
     leaderboard.add_evaluate_parser,
+    run.add_parser,
+    report.add_parser,
     manoeuvre.add_parser,
     scenarios.add_parser,
     bench.add_parser,
@@ -42,13 +53,15 @@ def main(argv: list[str] | None = None) -> int:
     any other exception is a bug and keeps its traceback."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # a run's record keeps it
     try:
         return int(args.func(args))
     except ShipgymError as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        sys.stderr.write(f"shipgym {args.command}: interrupted\n")
+    except KeyboardInterrupt as exc:  # a run says what it kept (baselines.runs.RunInterrupted)
+        detail = f": {exc}" if str(exc) else ""
+        sys.stderr.write(f"shipgym {args.command}: interrupted{detail}\n")
         return EXIT_INTERRUPTED
 
 

@@ -8,6 +8,7 @@ from typing import Any
 
 from baselines import benchmarks
 from baselines.cli.options import add_json_option, emit
+from baselines.errors import check_count
 
 #: bench target -> the benchmark run with the parsed options (``--repeats``)
 BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
@@ -25,13 +26,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         choices=list(BENCHES),
         help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv)",
     )
-    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--repeats", type=int, default=5, help="timed repetitions (≥ 1)")
     add_json_option(p, "print the figures as a JSON object")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark, print its figures (nested keys joined by dots)."""
+    check_count(args.repeats, "--repeats")
     figures = BENCHES[args.target](args)
     emit(args, figures, "\n".join(flatten_lines(figures)))
     return 0

@@ -1,16 +1,33 @@
-"""``shipgym leaderboard`` (the suite's controllers) and ``shipgym evaluate`` (one policy)."""
+"""``shipgym leaderboard`` (the suite's controllers) and ``shipgym evaluate`` (one policy).
+
+Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
+:mod:`baselines.runs`); a folder that is not empty is refused before any work unless
+``--resume`` or ``--force``.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from baselines.cli.options import add_run_options, emit
+from baselines.cli.options import add_run_options, command_line, emit
+
+#: ``evaluate`` writes to ``EVALUATE_ROOT/<policy>`` unless given ``--out``
+EVALUATE_ROOT = Path("results/evaluate")
 
 
 def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("leaderboard", help="run every controller on a suite (SPEC §9)")
     add_run_options(p, out="results/leaderboard", progress_help="no progress bar on stderr")
+    p.add_argument(
+        "--controllers",
+        nargs="+",
+        default=None,
+        metavar="CONTROLLER",
+        help="run these instead of the suite's: names, specs module:Attr / file.py:Attr, "
+        "trained agents' folders or SB3 model zips",
+    )
     p.set_defaults(func=run)
 
 
@@ -18,26 +35,53 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "evaluate", help="evaluate a controller or trained agent on a suite (leaderboard rows)"
     )
-    p.add_argument("policy", help="controller name, shipped policy name or trained agent folder")
-    add_run_options(p, out="results/evaluate")
+    p.add_argument(
+        "policy",
+        help="controller name, spec module:Attr or file.py:Attr, shipped policy name, trained "
+        "agent folder or SB3 model zip",
+    )
+    add_run_options(
+        p,
+        out=None,
+        out_help=f"output directory (default {EVALUATE_ROOT}/<policy>; refused if not empty: "
+        "see --resume, --force)",
+    )
     p.set_defaults(func=run)
+
+
+def evaluate_folder(policy: str) -> Path:
+    """``evaluate``'s default folder for ``policy``: one per table name."""
+    from baselines.registry import controller_label
+
+    label = controller_label(policy)
+    return EVALUATE_ROOT / "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``), print the table or rows."""
-    from baselines.leaderboard import markdown_table, run_leaderboard
+    from baselines.runs import check_out_dir
 
     policy = getattr(args, "policy", None)
+    out, note = args.out, ""
+    if out is None:
+        out = evaluate_folder(policy)
+        note = f" (evaluate's folder for {policy!r}; give --out for another)"
+    check_out_dir(out, resume=args.resume, force=args.force, note=note)  # before any work
+    from baselines.leaderboard import markdown_table, run_leaderboard
+
     rows = run_leaderboard(
         suite=args.suite,
         seeds=args.seeds,
-        out_dir=args.out,
+        out_dir=out,
         backend=args.backend,
         workers=args.workers,
-        controllers=[policy] if policy else None,
+        controllers=[policy] if policy else getattr(args, "controllers", None),
         show_progress=not args.no_progress,
+        resume=args.resume,
+        force=args.force,
+        command=command_line(args),
     )
     emit(args, rows, markdown_table(rows))
     if not args.json:
-        sys.stderr.write(f"wrote {args.out}/leaderboard.md, .csv, .json and plots\n")
+        sys.stderr.write(f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes\n")
     return 0

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Callable
-from pathlib import Path
 
 from baselines.cli.options import add_json_option, emit
 from baselines.errors import RunError
@@ -17,8 +15,7 @@ Manoeuvre = Callable[[ShipModel, argparse.Namespace], tuple[ManoeuvreLog, dict[s
 
 def _turning(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
     """Turning circle at --rudder [deg] (default 35° or the ship's rudder limit)."""
-    default = min(35.0, math.degrees(model.rudder_limit))
-    return turning_circle(model, args.rudder if args.rudder is not None else default)
+    return turning_circle(model, args.rudder)
 
 
 def _zigzag(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
@@ -46,12 +43,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the manoeuvre, save its plot, print the figures."""
+    """Check the ship and ``--out`` (a writable folder; its plot of the same manoeuvre is
+    replaced), run the manoeuvre, save its plot, print the figures."""
+    from baselines.runs import check_out_dir
+
     if args.ship not in MODELS:
         raise RunError(f"unknown ship {args.ship!r}; valid: {', '.join(sorted(MODELS))}")
+    out = check_out_dir(args.out, force=True)
     model = MODELS[args.ship](variant=args.variant)
     log, figures = MANOEUVRES[args.kind](model, args)
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     plot = out / f"{args.ship}_{args.kind}.png"
     plot_manoeuvre(model, args.kind, log, figures, str(plot))

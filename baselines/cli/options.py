@@ -7,9 +7,7 @@ import sys
 from typing import Any
 
 from baselines.jsonout import dumps
-
-#: where leaderboard jobs and training runs execute (``--backend``)
-BACKENDS = ("local", "ray")
+from baselines.runs import BACKENDS
 
 
 def add_json_option(parser: argparse.ArgumentParser, help: str) -> None:
@@ -27,24 +25,50 @@ def add_backend_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--backend", choices=BACKENDS, default="local")
 
 
+def add_out_options(
+    parser: argparse.ArgumentParser,
+    out: str | None,
+    help: str = "output directory",
+    resume_help: str | None = "finish the run in --out: only the episodes missing from its "
+    "episodes.jsonl",
+) -> None:
+    """``--out`` (default ``out``) and, for a folder that is not empty, ``--resume`` (none
+    when ``resume_help`` is None) or ``--force`` (clear its earlier outputs)."""
+    parser.add_argument("--out", default=out, help=help)
+    group = parser.add_mutually_exclusive_group()
+    if resume_help is not None:
+        group.add_argument("--resume", action="store_true", help=resume_help)
+    group.add_argument(
+        "--force", action="store_true", help="clear the earlier outputs in --out, start afresh"
+    )
+
+
 def add_run_options(
-    parser: argparse.ArgumentParser, out: str, progress_help: str | None = None
+    parser: argparse.ArgumentParser,
+    out: str | None,
+    progress_help: str | None = None,
+    out_help: str = "output directory (refused if not empty: see --resume, --force)",
 ) -> None:
     """The options of a suite run (``leaderboard``, ``evaluate``): --suite, --seeds, --out
-    (default ``out``), --backend, --workers, --no-progress and --json."""
+    (default ``out``) with --resume / --force, --backend, --workers, --no-progress, --json."""
     parser.add_argument(
         "--suite", default="default", help="suite name in configs/suites or a YAML path"
     )
     parser.add_argument(
         "--seeds", type=int, default=None, help="seeds per scenario (default: suite's)"
     )
-    parser.add_argument("--out", default=out, help="output directory")
+    add_out_options(parser, out, out_help)
     add_backend_option(parser)
     parser.add_argument(
         "--workers", type=int, default=None, help="local processes (default: cores)"
     )
     add_progress_option(parser, progress_help)
     add_json_option(parser, "print the rows as JSON on stdout")
+
+
+def command_line(args: argparse.Namespace) -> list[str]:
+    """The command as typed (``shipgym …``), for a run's record."""
+    return ["shipgym", *getattr(args, "argv", sys.argv[1:])]
 
 
 def emit(args: argparse.Namespace, document: Any, text: str) -> None:

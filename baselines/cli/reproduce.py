@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from baselines.cli.options import add_json_option, add_progress_option, emit
+from baselines.errors import check_seeds
 from baselines.reproduce import PAPERS
 
 
@@ -20,13 +21,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the paper's cases, print its markdown table (or the rows with ``--json``)."""
+    """Check the options (before any work), run the paper's cases, print its markdown table
+    (or the rows with ``--json``).  The report's files in ``--out`` are replaced."""
     from tqdm import tqdm
 
+    from baselines.runs import check_out_dir
+
+    check_seeds(args.seeds, "--seeds")
+    out = args.out or f"results/reproduce/{args.paper}"
+    check_out_dir(out, force=True)  # usable (a writable folder); its earlier report replaced
     module = PAPERS[args.paper]
     bar = tqdm(desc=f"reproduce {args.paper}", file=sys.stderr, disable=args.no_progress)
     rows = module.run(
-        out_dir=args.out or f"results/reproduce/{args.paper}",
+        out_dir=out,
         seeds=args.seeds,
         progress=lambda: bar.update(1),
     )

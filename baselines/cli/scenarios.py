@@ -1,20 +1,39 @@
-"""``shipgym scenarios``: list the scenario catalogue."""
+"""``shipgym scenarios``: list the scenario catalogue, or check scenario files.
+
+``--validate FILE…`` loads and checks each file and names every problem it finds (key and
+YAML line): one ``ok FILE`` line per good file, one ``FILE:LINE: key 'K': message`` line per
+problem of a bad one; exit code 2 when any file is bad.  With ``--json``: a list of
+``{"file", "ok", "problems"}`` (``problems``: the lines without the file name).
+"""
 
 from __future__ import annotations
 
 import argparse
+import sys
 
 from baselines.cli.options import add_json_option, emit
 
+#: exit code when a validated file is bad (as a bad input elsewhere)
+EXIT_BAD_FILE = 2
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("scenarios", help="list the scenario catalogue")
-    add_json_option(p, "print the names as a JSON list")
+    p = sub.add_parser("scenarios", help="list the scenario catalogue, or check scenario files")
+    p.add_argument(
+        "--validate",
+        nargs="+",
+        metavar="FILE",
+        default=None,
+        help="load and check these scenario YAML files, naming every problem (exit 2 if any)",
+    )
+    add_json_option(p, "print the names (with --validate: one result per file) as JSON")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """One line per catalogue scenario: name, ship, description (``--json``: the names)."""
+    if args.validate is not None:
+        return validate(args)
     from shipgym.scenarios import list_scenarios, load_scenario
 
     names = list_scenarios()
@@ -23,4 +42,24 @@ def run(args: argparse.Namespace) -> int:
         sc = load_scenario(name)
         lines.append(f"{name:28s} {sc.model.name:10s} {sc.config.description.strip()}")
     emit(args, names, "\n".join(lines))
+    return 0
+
+
+def validate(args: argparse.Namespace) -> int:
+    """Check every ``--validate`` file; 0 when all are good, else :data:`EXIT_BAD_FILE`."""
+    from shipgym.scenarios.loader import check_scenario_file
+
+    results = []
+    lines = []
+    for file in args.validate:
+        problems = check_scenario_file(file)
+        results.append({"file": file, "ok": not problems, "problems": [p.text() for p in problems]})
+        if not problems:
+            lines.append(f"ok {file}")
+        lines += [p.text(file) for p in problems]
+    emit(args, results, "\n".join(lines))
+    bad = sum(not r["ok"] for r in results)
+    if bad:
+        sys.stderr.write(f"shipgym scenarios: {bad} of {len(results)} files have problems\n")
+        return EXIT_BAD_FILE
     return 0

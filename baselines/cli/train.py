@@ -5,8 +5,14 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from baselines.cli.options import add_backend_option, add_json_option, add_progress_option, emit
-from baselines.errors import RunError
+from baselines.cli.options import (
+    add_backend_option,
+    add_json_option,
+    add_out_options,
+    add_progress_option,
+    emit,
+)
+from baselines.errors import RunError, check_count
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -16,7 +22,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("agent", help="agent config name in configs/agents (ppo, sac, …) or 'all'")
     p.add_argument("--config", default=None, help="agent YAML (default configs/agents/AGENT.yaml)")
-    p.add_argument("--out", default=None, help="output directory (default results/agents/NAME)")
+    add_out_options(
+        p,
+        None,
+        help="output directory (default results/agents/NAME; refused if not empty: see "
+        "--resume, --force)",
+        resume_help="continue from the newest checkpoint",
+    )
     p.add_argument(
         "--seed",
         type=int,
@@ -27,7 +39,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=1, help="parallel training runs (local pool)")
     add_backend_option(p)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
-    p.add_argument("--resume", action="store_true", help="continue from the newest checkpoint")
     p.add_argument(
         "--ship", action="store_true", help="export the best model to baselines/learned/policies"
     )
@@ -39,7 +50,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
     """One job per (agent, seed) with its output directory (``train_sweep``'s input)."""
     from baselines.learned.agents import list_agent_configs, load_agent_config
+    from baselines.learned.train import check_agent_folder
 
+    if args.timesteps is not None:
+        check_count(args.timesteps, "--timesteps")
     if args.agent == "all":
         if args.config:
             raise RunError("train all: --config applies to one agent")
@@ -58,6 +72,8 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
                 out = f"{out}/{config.name}"
             if len(seeds) > 1:
                 out = f"{out}/seed_{seed}"
+            if not args.resume:  # before any run of the sweep starts
+                check_agent_folder(out, config.name, args.force)
             jobs.append(
                 {
                     "config": config,
@@ -65,6 +81,7 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
                     "seed": seed,
                     "n_timesteps": args.timesteps,
                     "resume": args.resume,
+                    "force": args.force,
                     "progress": not args.no_progress and len(names) * len(seeds) == 1,
                     "ship": args.ship,
                 }

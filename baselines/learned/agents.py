@@ -8,10 +8,13 @@ scenarios (never the ``heldout`` test set, which is kept for the leaderboard).
 
 from __future__ import annotations
 
+import difflib
+import inspect
 import os
 from typing import Any, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic_core import PydanticCustomError
 
 from baselines.errors import ConfigError
 from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
@@ -72,6 +75,59 @@ class AgentConfig(StrictModel):
     policy_kwargs: dict[str, Any] = Field(default_factory=dict)
     eval: EvalConfig = EvalConfig()
     checkpoint_freq: int = Field(50_000, ge=1)  # env steps between checkpoints
+
+    @field_validator("hyperparams")
+    @classmethod
+    def _constructor_arguments(cls, v: dict[str, Any], info: ValidationInfo) -> dict[str, Any]:
+        """Every hyperparameter is an argument of the algorithm's constructor (a misspelt one
+        is named with the valid ones), and none is one the trainer sets itself."""
+        algo = info.data.get("algo")
+        valid = hyperparameter_names(algo) if algo is not None else None
+        if valid is None:  # unknown algo (reported on its own) or SB3 not installed
+            return v
+        problems = []
+        for name in v:
+            if name in TRAINER_ARGUMENTS:
+                problems.append(f"{name!r} is set by the trainer ({TRAINER_ARGUMENTS[name]})")
+            elif name not in valid:
+                close = difflib.get_close_matches(name, valid, n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                problems.append(f"unknown hyperparameter {name!r} of {algo}{hint}")
+        if problems:
+            message = "; ".join(problems) + f"; valid for {algo}: {', '.join(valid)}"
+            raise PydanticCustomError("hyperparameter", "{message}", {"message": message})
+        return v
+
+
+#: constructor arguments the trainer passes itself -> where the config sets them
+TRAINER_ARGUMENTS = {
+    "policy": "the top-level 'policy' key",
+    "env": "the 'env' section",
+    "seed": "the top-level 'seed' key or --seed",
+    "policy_kwargs": "the top-level 'policy_kwargs' key",
+    "device": "always cpu",
+    "tensorboard_log": "under the output folder",
+    "verbose": "always 0",
+}
+
+
+def hyperparameter_names(algo: str) -> list[str] | None:
+    """The keyword arguments of the algorithm's SB3 constructor that ``hyperparams`` may set
+    (its signature, less :data:`TRAINER_ARGUMENTS` and private ones), sorted; None when the
+    algorithm is unknown or stable-baselines3 is not installed."""
+    try:
+        cls = algo_class(algo)
+    except (ImportError, ValueError):
+        return None
+    parameters = inspect.signature(cls.__init__).parameters.values()
+    return sorted(
+        p.name
+        for p in parameters
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+        and p.name != "self"
+        and not p.name.startswith("_")
+        and p.name not in TRAINER_ARGUMENTS
+    )
 
 
 def load_agent_config(name_or_path: str | os.PathLike) -> AgentConfig:

@@ -1,77 +1,365 @@
 """A trained SB3 agent behind the common policy interface (``kind = "learned"``).
 
-It sees exactly what the env's observation holds (measurements, no plant parameters, no
-schedule) and acts deterministically.  Recurrent agents (RecurrentPPO) keep their LSTM
-state within an episode and start afresh at every ``reset``.
+Any stable-baselines3 / sb3-contrib model zip is scored by its path, as ``model.save(path)``
+wrote it: the algorithm is read from the zip (:func:`detect_algorithm`), the action mode from
+its action space (shape (1,): rudder, (2,): guidance), and a ``vecnormalize.pkl`` beside it
+normalises the observation as in training.  A ``meta.json`` beside it (what ``shipgym
+train`` writes) is optional; its keys are checked (:class:`PolicyMeta`) and its training
+cost becomes leaderboard columns.  Every unreadable file is a
+:class:`~baselines.errors.ControllerError` naming the file (and the key).
+
+The policy sees exactly what the env's observation holds (measurements, no plant
+parameters, no schedule) and acts deterministically.  Recurrent agents (RecurrentPPO) keep
+their LSTM state within an episode and start afresh at every ``reset``.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import importlib
 import json
+import pickle
+import zipfile
+import zlib
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from baselines.errors import ControllerError
-from baselines.learned.agents import algo_class
 from baselines.policy import check_action_mode
+from shipgym.config import validate_model
 from shipgym.envs.context import ControllerContext
+from shipgym.envs.core import OBS_NAMES
 
 POLICY_DIR = Path(__file__).resolve().parent / "policies"
+
+#: algorithm id -> (module, class) of the SB3 / sb3-contrib algorithm that loads its zips
+ALGORITHMS: dict[str, tuple[str, str]] = {
+    "ppo": ("stable_baselines3", "PPO"),
+    "a2c": ("stable_baselines3", "A2C"),
+    "sac": ("stable_baselines3", "SAC"),
+    "td3": ("stable_baselines3", "TD3"),
+    "ddpg": ("stable_baselines3", "DDPG"),
+    "recurrent_ppo": ("sb3_contrib", "RecurrentPPO"),
+    "tqc": ("sb3_contrib", "TQC"),
+}
+#: algorithms whose policy carries a hidden state through the episode
+RECURRENT = frozenset({"recurrent_ppo"})
+
+#: the module of a zip's saved policy class -> the algorithm that saved it (for the two
+#: modules several algorithms share, :func:`detect_algorithm` reads the saved settings)
+_POLICY_MODULES = {
+    "stable_baselines3.common.policies": "ppo",  # or a2c
+    "stable_baselines3.sac.policies": "sac",
+    "stable_baselines3.td3.policies": "td3",  # or ddpg
+    "sb3_contrib.common.recurrent.policies": "recurrent_ppo",
+    "sb3_contrib.tqc.policies": "tqc",
+}
+
+#: the env's action sizes (``shipgym.envs.core``: one rudder command; guidance: two)
+ACTION_MODE_OF_SIZE = {1: "rudder", 2: "guidance"}
+
+#: the optional files beside a model zip
+META_FILE = "meta.json"
+VECNORMALIZE_FILE = "vecnormalize.pkl"
+
+#: saved training schedules a scoring run does not need (and that may not unpickle under
+#: another Python version): replaced on load, as rl-baselines3-zoo's ``enjoy`` does
+_INFERENCE_ONLY = {
+    "learning_rate": 0.0,
+    "lr_schedule": lambda _: 0.0,
+    "clip_range": lambda _: 0.0,
+}
 
 
 def shipped_policies() -> list[str]:
     """Names of the pre-trained policies shipped in ``baselines/learned/policies``."""
-    return sorted(p.name for p in POLICY_DIR.iterdir() if (p / "meta.json").is_file())
+    return sorted(p.name for p in POLICY_DIR.iterdir() if (p / META_FILE).is_file())
 
 
-def resolve_policy(name_or_path: str | Path) -> tuple[Path, Path]:
-    """A shipped policy name, a trained agent's directory or one of its ``.zip`` models
-    (``best_model.zip``, a checkpoint) → (model zip, meta.json).  A directory means its
-    ``model.zip`` (else ``best_model.zip``); ``meta.json`` is looked for beside the zip and
-    one folder up (checkpoints)."""
-    path = Path(name_or_path)
+class PolicyMeta(BaseModel):
+    """The keys of a ``meta.json`` this module reads (each optional; others are kept).
+
+    ``name``: the policy's name; ``algo``: one of :data:`ALGORITHMS` (must be the zip's);
+    ``action_mode``: must be the zip's; ``env_steps`` and ``wall_time_s`` [s]: the training
+    cost, both or neither.
+    """
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+
+    name: str | None = Field(None, min_length=1)
+    algo: Literal[tuple(ALGORITHMS)] | None = None  # type: ignore[valid-type]
+    action_mode: Literal[tuple(ACTION_MODE_OF_SIZE.values())] | None = None  # type: ignore[valid-type]
+    env_steps: int | None = Field(None, ge=0)
+    wall_time_s: float | None = Field(None, ge=0)
+
+    @model_validator(mode="after")
+    def _cost_complete(self) -> PolicyMeta:
+        if (self.env_steps is None) != (self.wall_time_s is None):
+            raise ValueError("give both 'env_steps' and 'wall_time_s' (training cost) or neither")
+        return self
+
+
+@dataclasses.dataclass(frozen=True)
+class SavedModel:
+    """What a model zip says about itself, read without torch: the algorithm that saved it
+    (None when the zip does not tell) and the action mode its action space drives."""
+
+    path: Path
+    algo: str | None
+    action_mode: str
+
+
+@dataclasses.dataclass(frozen=True)
+class PolicyFiles:
+    """A learned policy's files: the model, its checked ``meta.json`` (``meta``: as written,
+    empty without one) and the ``vecnormalize.pkl`` beside it, if any."""
+
+    model: SavedModel
+    algo: str
+    meta: dict[str, Any]
+    cost: PolicyMeta
+    vecnormalize: Path | None
+
+
+def model_zip(name_or_path: str | Path) -> Path:
+    """A shipped policy name, a trained agent's folder or a model zip → the model zip.
+
+    A folder means its ``model.zip``, else ``best_model.zip``, else its one ``.zip``."""
+    path = Path(name_or_path).expanduser()
     if not path.exists() and (POLICY_DIR / str(name_or_path)).is_dir():
         path = POLICY_DIR / str(name_or_path)
-    if path.is_dir():
-        zip_path = path / "model.zip"
-        if not zip_path.is_file():
-            zip_path = path / "best_model.zip"
-    else:
-        zip_path = path
-    meta = next(
-        (
-            d / "meta.json"
-            for d in (zip_path.parent, zip_path.parent.parent)
-            if (d / "meta.json").is_file()
-        ),
-        None,
-    )
-    if not zip_path.is_file() or meta is None:
+    if not path.exists():
         raise ControllerError(
-            f"{name_or_path!r} is not a trained policy (a model zip with a meta.json); "
-            f"shipped: {', '.join(shipped_policies())}; train one with `shipgym train AGENT`"
+            f"{name_or_path!r} is not a trained policy (a model zip, or a folder holding one); "
+            f"shipped: {', '.join(shipped_policies())}"
         )
-    return zip_path, meta
+    if not path.is_dir():
+        return path
+    for name in ("model.zip", "best_model.zip"):
+        if (path / name).is_file():
+            return path / name
+    zips = sorted(path.glob("*.zip"))
+    if len(zips) != 1:
+        found = f"it holds {', '.join(z.name for z in zips)}" if zips else "it holds none"
+        raise ControllerError(
+            f"{path}: a trained agent's folder holds model.zip, best_model.zip or one .zip "
+            f"model; {found}"
+        )
+    return zips[0]
+
+
+def policy_label(name_or_path: str | Path) -> str:
+    """The table name of a learned policy: a shipped policy's name; a folder's name; for a
+    zip the folder holding it, plus the zip's stem unless it is ``model``."""
+    path = Path(name_or_path).expanduser()
+    if path.suffix == ".zip":
+        stem = "" if path.stem == "model" else f"/{path.stem}"
+        return f"{path.resolve().parent.name}{stem}"
+    return path.resolve().name if path.exists() else str(name_or_path)
+
+
+def read_model(path: Path) -> SavedModel:
+    """The algorithm and action mode of a model zip, read from its ``data`` entry; a
+    truncated or corrupt zip, or one that is not an SB3 model of this env, is a clear error
+    naming the file."""
+    stat = path.stat()
+    return _read_model(path.resolve(), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=64)
+def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = archive.namelist()
+            broken = archive.testzip()
+            text = archive.read("data").decode() if "data" in names else None
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, UnicodeDecodeError) as exc:
+        raise ControllerError(
+            f"{path}: not a readable model zip (truncated or corrupt: {exc})"
+        ) from None
+    if broken is not None:
+        raise ControllerError(f"{path}: corrupt model zip: {broken!r} fails its CRC check")
+    if text is None or "policy.pth" not in names:
+        raise ControllerError(
+            f"{path}: truncated, or not a stable-baselines3 model zip (it has no 'data' and "
+            "'policy.pth' entries)"
+        )
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ControllerError(
+            f"{path}: corrupt model zip: its 'data' is not JSON ({exc})"
+        ) from None
+    observed = _box_shape(data.get("observation_space"))
+    if observed != (len(OBS_NAMES),):
+        raise ControllerError(
+            f"{path}: the model observes {_describe(data.get('observation_space'))}; the "
+            f"ShipPathFollow envs observe shape ({len(OBS_NAMES)},) ({', '.join(OBS_NAMES)})"
+        )
+    shape = _box_shape(data.get("action_space"))
+    mode = ACTION_MODE_OF_SIZE.get(shape[0]) if shape is not None and len(shape) == 1 else None
+    if mode is None:
+        raise ControllerError(
+            f"{path}: the model acts in {_describe(data.get('action_space'))}; the env takes "
+            "a Box of shape (1,) (action_mode rudder) or (2,) (guidance)"
+        )
+    return SavedModel(path=path, algo=detect_algorithm(data), action_mode=mode)
+
+
+def _box_shape(space: Any) -> tuple[int, ...] | None:
+    """The shape of a saved ``Box`` space (None for any other space)."""
+    if not isinstance(space, dict) or "Box" not in str(space.get(":type:", "")):
+        return None
+    shape = space.get("_shape")
+    return tuple(shape) if isinstance(shape, list) else None
+
+
+def _describe(space: Any) -> str:
+    if not isinstance(space, dict):
+        return "an unknown space"
+    kind = str(space.get(":type:", "?")).removeprefix("<class '").removesuffix("'>")
+    return f"{kind.rsplit('.', 1)[-1]} of shape {tuple(space.get('_shape') or ())}"
+
+
+def detect_algorithm(data: dict[str, Any]) -> str | None:
+    """The algorithm id that saved a model, from its zip's ``data`` (None: cannot tell).
+
+    The saved policy class's module names it; PPO and A2C share ``ActorCriticPolicy`` (A2C
+    saves no ``clip_range``), TD3 and DDPG ``TD3Policy`` (DDPG is TD3 without delayed
+    policy updates and without target smoothing: ``policy_delay`` 1, ``target_noise_clip``
+    0, SB3's DDPG settings)."""
+    policy_class = data.get("policy_class")
+    module = policy_class.get("__module__") if isinstance(policy_class, dict) else None
+    algo = _POLICY_MODULES.get(str(module))
+    if algo == "ppo" and "clip_range" not in data:
+        return "a2c"
+    if algo == "td3" and data.get("policy_delay") == 1 and data.get("target_noise_clip") == 0:
+        return "ddpg"
+    return algo
+
+
+def _meta_file(zip_path: Path) -> Path | None:
+    """``meta.json`` beside the zip, or one folder up for a training run's checkpoints."""
+    folders = [zip_path.parent]
+    if zip_path.parent.name == "checkpoints":
+        folders.append(zip_path.parent.parent)
+    return next((d / META_FILE for d in folders if (d / META_FILE).is_file()), None)
+
+
+def _read_meta(file: Path) -> tuple[dict[str, Any], PolicyMeta]:
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ControllerError(f"{file}: not JSON (not UTF-8 text: {exc.reason})") from None
+    except json.JSONDecodeError as exc:
+        raise ControllerError(
+            f"{file}: not JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})"
+        ) from None
+    return data, validate_model(data, PolicyMeta, str(file), ControllerError)
+
+
+def read_policy(name_or_path: str | Path) -> PolicyFiles:
+    """A learned policy's files, checked: the zip (:func:`read_model`), ``meta.json`` if
+    present (its ``algo`` and ``action_mode`` must be the zip's), ``vecnormalize.pkl``."""
+    saved = read_model(model_zip(name_or_path))
+    meta_file = _meta_file(saved.path)
+    meta, checked = _read_meta(meta_file) if meta_file else ({}, PolicyMeta())
+    algo = saved.algo
+    if checked.algo is not None:
+        if algo is not None and checked.algo != algo:
+            raise ControllerError(
+                f"{meta_file}: key 'algo' is {checked.algo!r}, but {saved.path.name} was "
+                f"saved by {algo!r}"
+            )
+        algo = checked.algo
+    if algo is None:
+        raise ControllerError(
+            f"{saved.path}: cannot tell which algorithm saved it (its policy class is not "
+            f"one of SB3's or sb3-contrib's); give a {META_FILE} beside it with \"algo\": one "
+            f"of {', '.join(ALGORITHMS)}"
+        )
+    if checked.action_mode is not None and checked.action_mode != saved.action_mode:
+        raise ControllerError(
+            f"{meta_file}: key 'action_mode' is {checked.action_mode!r}, but "
+            f"{saved.path.name} acts in {saved.action_mode!r} mode (its action space)"
+        )
+    vecnormalize = saved.path.parent / VECNORMALIZE_FILE
+    return PolicyFiles(
+        model=saved,
+        algo=algo,
+        meta=meta,
+        cost=checked,
+        vecnormalize=vecnormalize if vecnormalize.is_file() else None,
+    )
+
+
+def load_model(path: Path, algo: str) -> Any:
+    """The SB3 model of a zip, on the CPU; a zip that does not load is a clear error."""
+    module, name = ALGORITHMS[algo]
+    try:
+        algorithm = getattr(importlib.import_module(module), name)
+    except ImportError as exc:
+        package = module.replace("_", "-")
+        raise ControllerError(
+            f"{path}: a {name} model needs {package} (pip install {package}): {exc}"
+        ) from exc
+    try:
+        return algorithm.load(str(path), device="cpu", custom_objects=_INFERENCE_ONLY)
+    except (
+        zipfile.BadZipFile,
+        zlib.error,
+        EOFError,
+        pickle.UnpicklingError,
+        RuntimeError,
+        ValueError,
+        KeyError,
+    ) as exc:
+        raise ControllerError(f"{path}: cannot load it as a {name} model: {exc}") from exc
+
+
+def load_obs_normalizer(file: Path) -> Any:
+    """The ``VecNormalize`` statistics of ``file`` (no env attached: only
+    ``normalize_obs`` is used); an unreadable file is a clear error."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    try:
+        with open(file, "rb") as fh:
+            normalizer = pickle.load(fh)
+    except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, ValueError) as exc:
+        raise ControllerError(f"{file}: not a readable VecNormalize file: {exc}") from exc
+    if not isinstance(normalizer, VecNormalize):
+        raise ControllerError(f"{file}: holds a {type(normalizer).__name__}, not a VecNormalize")
+    normalizer.training = False
+    return normalizer
 
 
 class LearnedPolicy:
-    """A trained agent from a policy directory or model zip (see :func:`resolve_policy`)."""
+    """A trained agent from a policy folder or model zip (see :func:`read_policy`).
+
+    ``name``: its name (default: the meta's, else :func:`policy_label`)."""
 
     kind = "learned"
 
     def __init__(self, path: str | Path, name: str | None = None) -> None:
-        zip_path, meta = resolve_policy(path)
-        self.model_path = zip_path
-        self.meta: dict[str, Any] = json.loads(meta.read_text())
-        self.name = name or self.meta["name"]
-        self.action_mode: str = self.meta["action_mode"]
+        files = read_policy(path)
+        self.model_path = files.model.path
+        self.algo = files.algo
+        self.meta: dict[str, Any] = files.meta
+        self._cost = files.cost
+        self.name = name or files.cost.name or policy_label(path)
+        self.action_mode: str = files.model.action_mode
         import torch
 
         torch.set_num_threads(1)  # one small MLP per episode; leaderboard workers share cores
-        self.model = algo_class(self.meta["algo"]).load(str(zip_path), device="cpu")
-        self.recurrent = self.meta["algo"] == "recurrent_ppo"
+        self.model = load_model(self.model_path, self.algo)
+        self.obs_normalizer = (
+            load_obs_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
+        )
+        self.recurrent = self.algo in RECURRENT
         self._state: Any = None
         self._start = True
 
@@ -81,6 +369,8 @@ class LearnedPolicy:
         self._start = True
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        if self.obs_normalizer is not None:
+            obs = self.obs_normalizer.normalize_obs(obs)
         if self.recurrent:
             action, self._state = self.model.predict(
                 obs, state=self._state, episode_start=np.array([self._start]), deterministic=True
@@ -91,8 +381,11 @@ class LearnedPolicy:
         return action
 
     def episode_stats(self) -> dict[str, float]:
-        """Training cost, reported beside the metrics on the leaderboard."""
+        """Training cost, reported beside the metrics on the leaderboard (when the meta
+        gives it)."""
+        if self._cost.env_steps is None or self._cost.wall_time_s is None:
+            return {}
         return {
-            "train_env_steps": float(self.meta["env_steps"]),
-            "train_wall_s": float(self.meta["wall_time_s"]),
+            "train_env_steps": float(self._cost.env_steps),
+            "train_wall_s": float(self._cost.wall_time_s),
         }

@@ -8,7 +8,9 @@ Output directory (default ``results/agents/<name>``)::
     eval/evaluations.npz validation returns over training       tb/  TensorBoard logs
 
 ``resume=True`` continues from the newest checkpoint (model, replay buffer, reward
-normalisation and the wall-time counter) up to the config's ``n_timesteps``.
+normalisation and the wall-time counter) up to the config's ``n_timesteps``.  Otherwise an
+output directory that is not empty is refused, unless ``force=True`` (its earlier outputs,
+:data:`TRAINING_OUTPUTS`, are removed first).
 :func:`export_policy` copies the best model and its meta into a policy directory (the
 shipped ones live in ``baselines/learned/policies``).
 """
@@ -33,8 +35,11 @@ from baselines.learned.agents import (
     make_eval_env,
     make_training_env,
 )
+from baselines.runs import check_out_dir, clear_outputs
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
+#: what a training run writes into its directory (``force`` clears these, and only these)
+TRAINING_OUTPUTS = ("model.zip", "best_model.zip", "meta.json", "checkpoints", "eval", "tb")
 
 
 def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
@@ -137,8 +142,12 @@ def train(
     resume: bool = False,
     progress: bool = True,
     tensorboard: bool = True,
+    force: bool = False,
 ) -> dict[str, Any]:
-    """Train (or resume) an agent; returns the meta written to ``out_dir/meta.json``."""
+    """Train (or resume) an agent; returns the meta written to ``out_dir/meta.json``.
+
+    Without ``resume``, an ``out_dir`` that is not empty is refused (:class:`RunError`)
+    unless ``force`` (its earlier outputs are removed first)."""
     import stable_baselines3
     import torch
     from stable_baselines3.common.vec_env import VecNormalize
@@ -156,6 +165,10 @@ def train(
     if updates:
         config = config.model_copy(update=updates)
     out = Path(out_dir or f"results/agents/{config.name}")
+    if not resume:
+        check_agent_folder(out, config.name, force)
+        if force:
+            clear_outputs(out, TRAINING_OUTPUTS)
     out.mkdir(parents=True, exist_ok=True)
     cls = algo_class(config.algo)
     previous = latest_checkpoint(out) if resume else None
@@ -245,6 +258,12 @@ def train(
     return meta
 
 
+def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:
+    """A :class:`RunError` unless ``out`` can take a fresh training run of agent ``name``:
+    usable, and empty unless ``force``."""
+    check_out_dir(out, force=force, note=f" (agent folder of {name})")
+
+
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     """Copy the best model (else the final one) and meta.json into ``dest`` (a policy dir)."""
     src = Path(out_dir)
@@ -264,7 +283,8 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
     """One training run of a sweep (top-level: process pools and Ray pickle it).
 
     ``job``: ``config`` (name, path or AgentConfig), ``out_dir``, optional ``seed``,
-    ``n_timesteps``, ``resume``, ``progress``, ``ship`` (export to the shipped policies).
+    ``n_timesteps``, ``resume``, ``force``, ``progress``, ``ship`` (export to the shipped
+    policies).
     """
     from baselines.learned.policy import POLICY_DIR
 
@@ -279,6 +299,7 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
         resume=job.get("resume", False),
         progress=job.get("progress", False),
         tensorboard=job.get("tensorboard", True),
+        force=job.get("force", False),
     )
     if job.get("ship"):
         meta["shipped_to"] = str(export_policy(job["out_dir"], POLICY_DIR / config.name))

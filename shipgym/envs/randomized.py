@@ -4,8 +4,11 @@ Every ``reset`` draws a scenario from the distribution with the env's own seeded
 (train split: :func:`~shipgym.scenarios.sampling.train_scenario_seed`; test split: the
 named test scenarios in turn, or ``options={"index": i}``) and runs it in an ordinary
 :class:`~shipgym.envs.path_follow.ShipPathFollowEnv`: same observation, action, reward,
-``info`` and metrics.  The observation and action spaces do not depend on the scenario, so
-one policy serves the whole distribution.  ``reset(seed=s)`` is reproducible.
+``info`` and metrics, except that ``info`` has no ``samples`` (as the batched env): their
+number per step, Ts/h, differs between the ships of a distribution, which Gymnasium's
+vector envs cannot stack (online identification runs on the single env).  The observation
+and action spaces do not depend on the scenario, so one policy serves the whole
+distribution.  ``reset(seed=s)`` is reproducible.
 """
 
 from __future__ import annotations
@@ -86,7 +89,9 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         return self._env.reset(seed=episode_seed)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        return self._env.step(action)
+        obs, reward, terminated, truncated, info = self._env.step(action)
+        info.pop("samples", None)  # Ts/h samples: their number differs between ships
+        return obs, reward, terminated, truncated, info
 
     def __getattr__(self, name: str) -> Any:
         """The current scenario's env answers the rest (``scenario``, ``model``,

@@ -55,6 +55,7 @@ import dataclasses
 
 import numpy as np
 
+from shipgym.identification.errors import check_sampling_step
 from shipgym.identification.lssvm import lssvm_dual, lssvm_primal
 from shipgym.identification.nomoto import IdentificationError
 from shipgym.models.base import NUMPY, ShipModel
@@ -129,14 +130,13 @@ def fit_blanke(
     the servo, length and nominal speed of the identified model (default: the naval
     vessel's).  ``solver``: ``"primal"`` (fast) or ``"dual"`` (the paper's (N+1)² system).
     """
+    h = check_sampling_step(h)
     arrays = [np.asarray(a, dtype=float) for a in (u, v, r, delta)]
     n = arrays[0].shape[0]
     if any(a.ndim != 1 or a.shape[0] != n for a in arrays):
         raise IdentificationError("u, v, r and delta must be 1-D arrays of equal length")
     if n < 20:
         raise IdentificationError(f"too few samples for a Blanke fit: {n} < 20")
-    if not h > 0:
-        raise IdentificationError(f"the sampling time h must be > 0, got {h}")
     if rudder_regressors not in BlankeRegression.variants:
         raise IdentificationError(
             f"rudder_regressors must be one of {BlankeRegression.variants}, "

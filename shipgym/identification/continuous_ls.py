@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.identification.errors import IdentificationError, check_sampling_step
+
 
 class ContinuousLeastSquares:
     """Streaming estimator of (a [1/s], c [1/s²]) in ṙ = −a·r + c·δ.
@@ -30,8 +32,9 @@ class ContinuousLeastSquares:
     """
 
     def __init__(self, h: float, a0: float, c0: float, k0: float = 1e-4) -> None:
-        if h <= 0 or k0 <= 0:
-            raise ValueError(f"need h > 0 and k0 > 0, got h={h}, k0={k0}")
+        h = check_sampling_step(h)
+        if not k0 > 0:
+            raise IdentificationError(f"need k0 > 0, got k0={k0}")
         self.h = h
         self.theta = np.array([1.0 - a0, c0])
         self.K = k0 * np.eye(2)
@@ -58,19 +61,30 @@ class ContinuousLeastSquares:
         if r.shape != delta.shape:
             raise ValueError("r and delta must have the same length")
         h, decay, b0, b1 = self.h, self._decay, self._b0, self._b1
-        theta, K = self.theta, self.K
-        for rk, dk in zip(r, delta, strict=True):
+        # the 2×2 recursion on floats (≈ 10× faster than numpy per sample): K symmetric
+        k11, k12, k22 = float(self.K[0, 0]), float(self.K[0, 1]), float(self.K[1, 1])
+        t0, t1 = float(self.theta[0]), float(self.theta[1])
+        r_f, d_f = self.r_f, self.delta_f
+        prev = self._prev
+        for rk, dk in zip(r.tolist(), delta.tolist(), strict=True):
             if not (math.isfinite(rk) and math.isfinite(dk)):
                 continue  # a dropped sample: skip it, keep the estimate
-            if self._prev is None:  # first sample: filters start from zero
-                self._prev = (rk, dk)
+            if prev is None:  # first sample: filters start from zero
+                prev = (rk, dk)
                 continue
-            rp, dp = self._prev
-            self._prev = (rk, dk)
-            self.r_f = decay * self.r_f + b0 * rp + b1 * rk  # eq. (32), first-order hold
-            self.delta_f = decay * self.delta_f + b0 * dp + b1 * dk
-            phi = np.array([self.r_f, self.delta_f])
-            K += np.outer(phi, phi) * h  # eq. (14)
-            e = rk - phi @ theta  # x − Φᵀθ, eq. (33)-(34)
-            theta += h * np.linalg.solve(K, phi * e)  # eq. (15)
+            rp, dp = prev
+            prev = (rk, dk)
+            r_f = decay * r_f + b0 * rp + b1 * rk  # eq. (32), first-order hold
+            d_f = decay * d_f + b0 * dp + b1 * dk
+            k11 += r_f * r_f * h  # eq. (14): K += Φ Φᵀ h
+            k12 += r_f * d_f * h
+            k22 += d_f * d_f * h
+            e = rk - (r_f * t0 + d_f * t1)  # x − Φᵀθ, eq. (33)-(34)
+            det = k11 * k22 - k12 * k12
+            g0, g1 = r_f * e, d_f * e  # θ += h K⁻¹ Φ e, eq. (15), K⁻¹ in closed form
+            t0 += h * (k22 * g0 - k12 * g1) / det
+            t1 += h * (k11 * g1 - k12 * g0) / det
+        self.r_f, self.delta_f, self._prev = r_f, d_f, prev
+        self.K = np.array([[k11, k12], [k12, k22]])
+        self.theta = np.array([t0, t1])
         self.history.append((self.a, self.c))

@@ -20,6 +20,7 @@ import functools
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from shipgym.identification.errors import check_sampling_step
 from shipgym.manoeuvres import zigzag
 from shipgym.models.base import ShipModel
 
@@ -39,6 +40,7 @@ def fit_cubic_damping(
 
     K [1/s] and T [s] are held fixed (module doc).
     """
+    h = check_sampling_step(h)
     r = np.asarray(r, dtype=float)
     delta = np.asarray(delta, dtype=float)
     if r.shape != delta.shape or r.ndim != 1 or r.size < 3:

@@ -7,7 +7,11 @@ model (1) and the rudder servo (2) into two linear regressions y = θᵀx:
                   θ1 = [T1+T2, K, d0, 1, β, K·T3] / (T1·T2);
 * eq. (37):       y2 = (δc − δ)·h,  x2 = Δδ,  θ2 = Tc;
 
-and the parameters follow from θ1 by the algebra after eq. (42) (T1 > T2 root).
+and the parameters follow from θ1 by the algebra after eq. (42) (T1 > T2 root).  The rows
+are defined once (:func:`regression_rows`) on increments Δⁿψ ≈ hⁿψ⁽ⁿ⁾; where those come
+from is the *front end* (:mod:`shipgym.identification.front_end`): the paper's differences
+(default) or an outlier filter + state-variable filter (``front_end="svf"``, an extension
+beyond the paper for noisy headings).
 
 Forward-difference bias (h = 0.01 s).  Δⁿf(t)/hⁿ = f⁽ⁿ⁾(t + nh/2) + O(h²): the terms of
 (33) are evaluated at t + 1.5h, t + h, t + h/2 and t, so the regression is consistent only
@@ -25,28 +29,32 @@ import math
 
 import numpy as np
 
-from shipgym.errors import ShipgymError
+from shipgym.identification.errors import IdentificationError, check_sampling_step
+from shipgym.identification.front_end import (
+    PAPER_GAMMA,
+    FrontEndSettings,
+    RegressionSignals,
+    difference_signals,
+    forward_difference,
+)
 from shipgym.identification.lssvm import LSSVMSolution, lssvm_primal, weighted_lssvm
 from shipgym.models.nomoto2 import Nomoto2Params
 
+__all__ = [
+    "GAMMA",
+    "IdentificationError",
+    "NomotoRegression",
+    "fit_nomoto2",
+    "forward_difference",
+    "front_end_settings",
+    "nomoto_regressors",
+    "params_from_theta1",
+    "regression_rows",
+    "theta1_from_params",
+]
+
 #: γ of Liu et al. (2019) §4
-GAMMA = 1e15
-
-
-class IdentificationError(ShipgymError, ValueError):
-    """The data cannot identify the model (degenerate, too short, non-physical result)."""
-
-
-def forward_difference(f: np.ndarray, order: int) -> np.ndarray:
-    """Δⁿ_h[f](t_k) = Σ_i (−1)^i C(n, i) f(t_k + (n − i)h), eq. (32); length len(f) − n."""
-    f = np.asarray(f, dtype=float)
-    if order == 0:
-        return f.copy()
-    n = f.shape[0] - order
-    out = np.zeros(n)
-    for i in range(order + 1):
-        out += (-1) ** i * math.comb(order, i) * f[order - i : order - i + n]
-    return out
+GAMMA = PAPER_GAMMA
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,27 +67,44 @@ class NomotoRegression:
     x2: np.ndarray  # (n, 1) Δδ
 
 
-def nomoto_regressors(
-    psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray, h: float
-) -> NomotoRegression:
-    """Build eq. (35)–(37) from heading ψ [rad], rudder δ and command δc [rad] at spacing h [s]."""
+def regression_rows(signals: RegressionSignals, h: float) -> NomotoRegression:
+    """The rows of eq. (35)–(37) from a front end's signals at spacing h [s] (one definition
+    for every front end; with the differences these are the paper's rows bit for bit)."""
+    s = signals
+    n = len(s)
+    x1 = np.column_stack(
+        [
+            -h * s.psi2,
+            h**3 * s.delta,
+            np.full(n, h**3),
+            -(h**2) * s.psi1,
+            -(s.psi1**3),
+            h**2 * s.delta1,
+        ]
+    )
+    y2 = (s.servo_command - s.servo_delta) * h
+    return NomotoRegression(s.psi3, x1, y2, s.servo_delta1[:, None])
+
+
+def _check_log(psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray) -> tuple[np.ndarray, ...]:
     psi = np.asarray(psi, dtype=float)
     delta = np.asarray(delta, dtype=float)
     delta_c = np.asarray(delta_c, dtype=float)
     if not (psi.shape == delta.shape == delta_c.shape) or psi.ndim != 1:
         raise IdentificationError("psi, delta and delta_c must be 1-D arrays of equal length")
+    return psi, delta, delta_c
+
+
+def nomoto_regressors(
+    psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray, h: float
+) -> NomotoRegression:
+    """Build eq. (35)–(37) from heading ψ [rad], rudder δ and command δc [rad] at spacing h [s]
+    with the paper's forward differences."""
+    h = check_sampling_step(h)
+    psi, delta, delta_c = _check_log(psi, delta, delta_c)
     if psi.shape[0] < 4:
         raise IdentificationError(f"need at least 4 samples for Δ³ψ, got {psi.shape[0]}")
-    n = psi.shape[0] - 3
-    d1 = forward_difference(psi, 1)[:n]
-    d2 = forward_difference(psi, 2)[:n]
-    d3 = forward_difference(psi, 3)
-    dd = forward_difference(delta, 1)[:n]
-    x1 = np.column_stack(
-        [-h * d2, h**3 * delta[:n], np.full(n, h**3), -(h**2) * d1, -(d1**3), h**2 * dd]
-    )
-    y2 = (delta_c[:n] - delta[:n]) * h
-    return NomotoRegression(d3, x1, y2, dd[:, None])
+    return regression_rows(difference_signals(psi, delta, delta_c), h)
 
 
 def theta1_from_params(p: Nomoto2Params) -> np.ndarray:
@@ -163,19 +188,45 @@ def fit_nomoto2(
     delta_c: np.ndarray,
     h: float,
     *,
-    gamma: float = GAMMA,
+    gamma: float | None = None,
     weighted: bool = True,
     bias_penalty: bool = True,
     servo_model: str = "forward",
     base: Nomoto2Params | None = None,
+    front_end: str | FrontEndSettings = "differences",
+    svf_bandwidth: float | None = None,
+    outlier_filter: bool | None = None,
+    outlier_window: int | None = None,
+    outlier_threshold: float | None = None,
 ) -> Nomoto2Params:
     """Batch fit of the nomoto2 parameters from sampled ψ, δ, δc [rad] at spacing h [s].
 
     Liu et al. (2019) eq. (31)–(42): weighted (robust) bias-penalised LS-SVM with a linear
-    kernel, solved in its primal form.  Returns a :class:`Nomoto2Params` in SI units (u0, L,
-    Kc from ``base``).  Raises IdentificationError (naming the reason) on degenerate data.
+    kernel, solved in its primal form.  ``front_end``: ``"differences"`` (the paper's
+    eq. (32), default) or ``"svf"`` (Hampel outlier filter + state-variable filter of
+    bandwidth ``svf_bandwidth`` [rad/s], :mod:`shipgym.identification.front_end`), or a
+    :class:`FrontEndSettings`; ``gamma`` None: the front end's γ (the paper's 1e15 with the
+    differences, 1e20 with the SVF: ``FrontEndSettings.gamma``).  Returns a
+    :class:`Nomoto2Params` in SI units (u0, L, Kc from ``base``).  Raises
+    IdentificationError (naming the reason) on bad input or degenerate data.
     """
-    reg = nomoto_regressors(psi, delta, delta_c, h)
+    h = check_sampling_step(h)
+    settings = front_end_settings(
+        front_end, svf_bandwidth, outlier_filter, outlier_window, outlier_threshold
+    )
+    gamma = settings.gamma if gamma is None else gamma
+    if settings.front_end == "differences" and not settings.use_outlier_filter:
+        # the paper's rows, exactly as eq. (35)-(37)
+        reg = nomoto_regressors(psi, delta, delta_c, h)
+    else:
+        psi, delta, delta_c = _check_log(psi, delta, delta_c)
+        signals, _ = settings.make(h).push(psi, delta, delta_c)
+        if len(signals) < 10:
+            raise IdentificationError(
+                f"{psi.shape[0]} samples leave {len(signals)} rows after the {settings.front_end} "
+                "front end's start transient and delay: need a longer log"
+            )
+        reg = regression_rows(signals, h)
     problem = excitation_problem(reg.x1, reg.x2)
     if problem is not None:
         raise IdentificationError(problem)
@@ -188,3 +239,30 @@ def fit_nomoto2(
         return base.replace(**values)
     except ValueError as exc:
         raise IdentificationError(f"identified parameters are not physical: {exc}") from exc
+
+
+def front_end_settings(
+    front_end: str | FrontEndSettings = "differences",
+    svf_bandwidth: float | None = None,
+    outlier_filter: bool | None = None,
+    outlier_window: int | None = None,
+    outlier_threshold: float | None = None,
+) -> FrontEndSettings:
+    """The :class:`FrontEndSettings` of the keyword options (None: the default)."""
+    given = {
+        k: v
+        for k, v in (
+            ("svf_bandwidth", svf_bandwidth),
+            ("outlier_filter", outlier_filter),
+            ("outlier_window", outlier_window),
+            ("outlier_threshold", outlier_threshold),
+        )
+        if v is not None
+    }
+    if isinstance(front_end, FrontEndSettings):
+        return dataclasses.replace(front_end, **given) if given else front_end
+    if not isinstance(front_end, str):
+        raise IdentificationError(
+            f"front_end must be 'differences' or 'svf' (or FrontEndSettings), got {front_end!r}"
+        )
+    return FrontEndSettings(front_end, **given)

@@ -13,6 +13,12 @@ Liu et al. (2019) §3.2:
   a θ1 giving K < 0 or T1 < 0 (or no real T1, T2) is rejected and the previous one kept;
 * :class:`PersistentExcitation`: u_per = u_ori + N(0, σ²) (eq. (45)).
 
+Both identifiers take the front end of the regression as an option: ``front_end=
+"differences"`` (the paper's, default) or ``"svf"`` with ``svf_bandwidth`` [rad/s] and the
+outlier filter's ``outlier_filter`` / ``outlier_window`` / ``outlier_threshold``
+(:mod:`shipgym.identification.front_end`); its filter states are carried across ``update``
+calls and window slides, and its look-ahead (``delay`` samples) only delays the rows.
+
 Units of λ_c.  The paper's thresholds λ_c¹ = 1e-5 and λ_c² = 1e-2 only make sense with
 angles in degrees: with radians y2 = (δc − δ)·h never exceeds 0.52·0.01 = 5e-3, so λ_k²
 could never pass 1e-2.  λ_k is therefore evaluated on errors converted to degrees
@@ -28,13 +34,15 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.identification.errors import check_sample_keys, check_sampling_step
+from shipgym.identification.front_end import FrontEndSettings
 from shipgym.identification.lssvm import LSSVMSolution
 from shipgym.identification.nomoto import (
-    GAMMA,
     IdentificationError,
     excitation_problem,
-    nomoto_regressors,
+    front_end_settings,
     params_from_theta1,
+    regression_rows,
     solve_theta,
     tc_from_theta2,
     theta1_from_params,
@@ -42,6 +50,8 @@ from shipgym.identification.nomoto import (
 from shipgym.models.nomoto2 import Nomoto2Params
 
 RAD_TO_DEG = 180.0 / math.pi
+#: the keys of ``info["samples"]`` an identifier reads
+SAMPLE_KEYS = ("psi", "delta", "delta_c")
 
 
 class PersistentExcitation:
@@ -66,7 +76,12 @@ class _SubModel:
 
 
 class _SlidingWindowNomoto:
-    """Streaming regression rows of eq. (35)–(37) in a sliding window (§3.2.1)."""
+    """Streaming regression rows of eq. (35)–(37) in a sliding window (§3.2.1).
+
+    The rows come from a front end (``front_end="differences"``, the paper's, or ``"svf"``:
+    :mod:`shipgym.identification.front_end`), whose state is carried across ``update`` calls
+    and window slides.
+    """
 
     def __init__(
         self,
@@ -74,25 +89,35 @@ class _SlidingWindowNomoto:
         initial: Nomoto2Params | None = None,
         window: int = 1200,
         update_every: int = 50,
-        gamma: float = GAMMA,
+        gamma: float | None = None,
         servo_model: str = "forward",
         bias_penalty: bool = True,
+        *,
+        front_end: str | FrontEndSettings = "differences",
+        svf_bandwidth: float | None = None,
+        outlier_filter: bool | None = None,
+        outlier_window: int | None = None,
+        outlier_threshold: float | None = None,
     ) -> None:
-        if h <= 0 or window < 10 or update_every < 1:
-            raise ValueError(
-                f"need h > 0, window ≥ 10, update_every ≥ 1; got {h}, {window}, {update_every}"
+        h = check_sampling_step(h)
+        if window < 10 or update_every < 1:
+            raise IdentificationError(
+                f"need window ≥ 10 and update_every ≥ 1; got {window}, {update_every}"
             )
         self.h = h
         self.window = window
         self.update_every = update_every
-        self.gamma = gamma
         self.servo_model = servo_model
         self.bias_penalty = bias_penalty
+        self.front_end = front_end_settings(
+            front_end, svf_bandwidth, outlier_filter, outlier_window, outlier_threshold
+        )
+        self._source = self.front_end.make(h)
+        self.gamma = self.front_end.gamma if gamma is None else gamma
         self.params = initial if initial is not None else Nomoto2Params()
         self._base = self.params
         self.sub1 = _SubModel(theta1_from_params(self.params))
         self.sub2 = _SubModel(np.array([self._theta2_of(self.params.Tc)]))
-        self._tail = np.zeros((0, 3))  # last raw samples (ψ, δ, δc) not yet usable
         self._rows1 = np.zeros((0, 6))
         self._y1 = np.zeros(0)
         self._rows2 = np.zeros((0, 1))
@@ -104,6 +129,11 @@ class _SlidingWindowNomoto:
         self.history: list[dict[str, Any]] = []
         self.t = 0.0
 
+    @property
+    def delay(self) -> int:
+        """Samples between a sample's arrival and its row entering the window."""
+        return self._source.delay
+
     def _theta2_of(self, tc: float) -> float:
         if self.servo_model == "exact":
             return self.h / (1.0 - math.exp(-self.h / tc))
@@ -112,6 +142,7 @@ class _SlidingWindowNomoto:
     # -- feeding ----------------------------------------------------------------------
     def update(self, samples: Mapping[str, np.ndarray]) -> bool:
         """Feed ``info["samples"]`` (psi, delta, delta_c; t optional); True if re-identified."""
+        check_sample_keys(samples, SAMPLE_KEYS)
         if "t" in samples and len(samples["t"]):
             self.t = float(np.asarray(samples["t"])[-1]) + self.h  # end of the period
         return self.update_arrays(samples["psi"], samples["delta"], samples["delta_c"])
@@ -120,40 +151,17 @@ class _SlidingWindowNomoto:
         """Feed fine samples (rad); True if the model was re-identified.
 
         Rows enter the window in the paper's rhythm (N_w, then N_u at a time) however many
-        arrive per call.  A non-finite (dropped) sample breaks the difference chain: rows are
-        only built within unbroken runs of samples.
+        arrive per call.  With the differences a non-finite (dropped) sample breaks the
+        difference chain: rows are only built within unbroken runs of samples.
         """
-        new = np.column_stack(
-            [
-                np.asarray(psi, float).ravel(),
-                np.asarray(delta, float).ravel(),
-                np.asarray(delta_c, float).ravel(),
-            ]
-        )
-        finite = np.all(np.isfinite(new), axis=1)
-        updated = False
-        if not np.all(finite):
-            self.last_reason = "non-finite samples: difference chain restarted"
-        # unbroken runs of finite samples
-        breaks = np.flatnonzero(~finite)
-        start = 0
-        for stop in [*breaks.tolist(), new.shape[0]]:
-            if stop > start:
-                updated |= self._feed_run(new[start:stop])
-            if stop < new.shape[0]:
-                self._tail = np.zeros((0, 3))  # a gap: no difference across it
-            start = stop + 1
-        return updated
-
-    def _feed_run(self, new: np.ndarray) -> bool:
-        raw = np.vstack([self._tail, new])
-        if self._tail.shape[0]:  # keep heading continuous across calls
-            raw[:, 0] = np.unwrap(raw[:, 0])
-        if raw.shape[0] < 4:
-            self._tail = raw
+        signals, note = self._source.push(psi, delta, delta_c)
+        if note is not None:
+            self.last_reason = note
+        if not len(signals):
             return False
-        reg = nomoto_regressors(raw[:, 0], raw[:, 1], raw[:, 2], self.h)
-        self._tail = raw[-3:]
+        return self._feed_rows(regression_rows(signals, self.h))
+
+    def _feed_rows(self, reg: Any) -> bool:
         updated = False
         pos, n_new = 0, reg.y1.shape[0]
         while pos < n_new:
@@ -258,7 +266,9 @@ class LambdaLSSVM(_SlidingWindowNomoto):
 
     ``update(info["samples"])`` after every env step; ``params`` is the current
     :class:`Nomoto2Params` (SI).  ``history`` holds, per identification, the parameters,
-    λ_k¹, λ_k² and which sub-models were re-weighted or rejected.
+    λ_k¹, λ_k² and which sub-models were re-weighted or rejected.  ``front_end_options``:
+    ``front_end``, ``svf_bandwidth``, ``outlier_filter``, ``outlier_window``,
+    ``outlier_threshold`` (module doc).
     """
 
     def __init__(
@@ -267,7 +277,7 @@ class LambdaLSSVM(_SlidingWindowNomoto):
         initial: Nomoto2Params | None = None,
         window: int = 1200,
         update_every: int = 50,
-        gamma: float = GAMMA,
+        gamma: float | None = None,
         lambda_c1: float = 1e-5,
         lambda_c2: float = 1e-2,
         c3: float = 0.01,
@@ -275,10 +285,13 @@ class LambdaLSSVM(_SlidingWindowNomoto):
         index_unit: str = "deg",
         servo_model: str = "forward",
         bias_penalty: bool = True,
+        **front_end_options: Any,
     ) -> None:
-        super().__init__(h, initial, window, update_every, gamma, servo_model, bias_penalty)
+        super().__init__(
+            h, initial, window, update_every, gamma, servo_model, bias_penalty, **front_end_options
+        )
         if index_unit not in ("deg", "rad"):
-            raise ValueError(f"index_unit must be 'deg' or 'rad', got {index_unit!r}")
+            raise IdentificationError(f"index_unit must be 'deg' or 'rad', got {index_unit!r}")
         self.lambda_c = (lambda_c1, lambda_c2)
         self.c3, self.c4 = c3, c4
         self._index_scale = RAD_TO_DEG if index_unit == "deg" else 1.0

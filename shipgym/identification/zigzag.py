@@ -20,6 +20,7 @@ import functools
 
 import numpy as np
 
+from shipgym.identification.errors import check_sampling_step
 from shipgym.identification.lssvm import lssvm_primal
 from shipgym.identification.nomoto import IdentificationError, time_constants
 from shipgym.manoeuvres import ManoeuvreLog, zigzag
@@ -52,6 +53,7 @@ class NomotoFit:
 
 def fit_nomoto_zigzag(r: np.ndarray, delta: np.ndarray, h: float, C: float = C_ZIGZAG) -> NomotoFit:
     """Fit eq. (27) to yaw rate r [rad/s] and rudder angle δ [rad] sampled at h [s]."""
+    h = check_sampling_step(h)
     r = np.asarray(r, dtype=float)
     delta = np.asarray(delta, dtype=float)
     if r.shape != delta.shape or r.ndim != 1:

@@ -28,7 +28,15 @@ from shipgym.errors import ShipgymError
 
 
 class ParameterError(ShipgymError, ValueError):
-    """A model parameter is non-physical (e.g. a time constant ≤ 0)."""
+    """A model parameter is non-physical (e.g. a time constant ≤ 0).
+
+    ``problems`` holds one message per bad parameter (the error's text joins them), so that
+    a config check can name every one, not only the first.
+    """
+
+    def __init__(self, *problems: str) -> None:
+        super().__init__("; ".join(problems))
+        self.problems: tuple[str, ...] = problems
 
 
 def _np_stack(rows: Sequence[Any]) -> np.ndarray:
@@ -77,27 +85,78 @@ class ParameterRecord:
     """Base of the typed, validated parameter records (SI units, radians).
 
     Subclasses list their fields with units in comments and name the fields that must be
-    strictly positive in ``positive``.  Records convert to and from a flat vector (field
-    order) so that a CasADi solver can take them as parameters.
+    strictly positive in ``positive`` (and ≥ 0 in ``nonnegative``); further rules go in an
+    override of :meth:`problems`.  These hold for every record, an identifier's estimate
+    included.  ``plant_positive`` / ``plant_nonnegative`` name what a *real* plant needs on
+    top (e.g. nomoto2's gain K > 0, which a noisy estimate may violate): :meth:`check_plant`
+    enforces them where a ship is built from a config (a scenario's true parameters).
+    Records convert to and from a flat vector (field order) so that a CasADi solver can
+    take them as parameters.
     """
 
     positive: ClassVar[tuple[str, ...]] = ()
+    nonnegative: ClassVar[tuple[str, ...]] = ()
+    plant_positive: ClassVar[tuple[str, ...]] = ()
+    plant_nonnegative: ClassVar[tuple[str, ...]] = ()
 
     def __post_init__(self) -> None:
+        problems = self.problems()
+        if problems:
+            raise ParameterError(*problems)
+
+    def problems(self) -> list[str]:
+        """Every rule of a valid record this one breaks, one message each (empty: valid)."""
+        cls = type(self).__name__
+        out = []
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, int | float) or isinstance(value, bool):
-                raise ParameterError(
-                    f"{type(self).__name__}.{f.name} must be a number, got {value!r}"
-                )
-            if not math.isfinite(value):
-                raise ParameterError(f"{type(self).__name__}.{f.name} must be finite, got {value}")
-        for name in self.positive:
-            value = getattr(self, name)
-            if value <= 0:
-                raise ParameterError(
-                    f"{type(self).__name__}.{name} must be > 0 (physical), got {value}"
-                )
+                out.append(f"{cls}.{f.name} must be a number, got {value!r}")
+            elif not math.isfinite(value):
+                out.append(f"{cls}.{f.name} must be finite, got {value}")
+        if out:
+            return out
+        out += self._sign_problems(self.positive, self.nonnegative)
+        return out
+
+    def plant_problems(self) -> list[str]:
+        """:meth:`problems` and the rules of a real plant (``plant_positive``, …)."""
+        return self.problems() + self._sign_problems(self.plant_positive, self.plant_nonnegative)
+
+    def check_plant(self) -> None:
+        """Raise :class:`ParameterError` naming every parameter a real ship cannot have."""
+        problems = self.plant_problems()
+        if problems:
+            raise ParameterError(*problems)
+
+    def plant(self, **changes: float) -> ParameterRecord:
+        """This record with ``changes``, as a real plant: :class:`ParameterError` names
+        every rule it breaks, the record's and the plant's together (not only the first)."""
+        unknown = set(changes) - set(self.names())
+        if unknown:
+            return self.replace(**changes)  # raises, naming the unknown names
+        # the rules are methods of a record: apply them to an unvalidated instance first
+        unchecked = object.__new__(type(self))
+        for name in self.names():
+            object.__setattr__(unchecked, name, changes.get(name, getattr(self, name)))
+        problems = unchecked.plant_problems()
+        if problems:
+            raise ParameterError(*problems)
+        return self.replace(**changes)
+
+    def _sign_problems(self, positive: Sequence[str], nonnegative: Sequence[str]) -> list[str]:
+        cls = type(self).__name__
+        out = [
+            f"{cls}.{name} must be > 0 (physical), got {getattr(self, name)}"
+            for name in positive
+            if getattr(self, name) <= 0
+        ]
+        out += [
+            f"{cls}.{name} must be ≥ 0 (physical), got {getattr(self, name)}"
+            for name in nonnegative
+            if getattr(self, name) < 0
+        ]
+        return out
 
     @classmethod
     def names(cls) -> tuple[str, ...]:
@@ -203,8 +262,9 @@ class ShipModel(ABC):
     def from_config(
         cls, values: dict[str, float], unit_reading: str | None = None, variant: str | None = None
     ) -> ShipModel:
-        """The model with its default parameters overridden by ``values`` (config units)."""
-        return cls(cls.params_type().replace(**cls.config_to_si(values, unit_reading)), variant)
+        """The model with its default parameters overridden by ``values`` (config units):
+        a real plant, so :meth:`ParameterRecord.plant` checks them."""
+        return cls(cls.params_type().plant(**cls.config_to_si(values, unit_reading)), variant)
 
     # -- the one definition -------------------------------------------------------------
     @abstractmethod

@@ -175,6 +175,25 @@ class BlankeParams(ParameterRecord):
         "delta_dot_max",
     )
 
+    def problems(self) -> list[str]:
+        """The signs and the mass matrix a real vessel has, besides :attr:`positive`."""
+        out = super().problems()
+        if out:
+            return out
+        cls = type(self).__name__
+        if self.X_uau >= 0:  # the resistance that sets the thrust (thrust(p) > 0)
+            out.append(f"{cls}.X_uau must be < 0 (a resistance), got {self.X_uau}")
+        if self.m - self.X_udot <= 0:
+            out.append(f"{cls}: m − X_udot must be > 0 (surge mass), got {self.m - self.X_udot}")
+        m11, m12, m21, m22 = steering_mass_matrix(self)
+        if m11 <= 0 or m22 <= 0 or m11 * m22 - m12 * m21 <= 0:
+            out.append(
+                f"{cls}: the sway–yaw mass matrix [[m − Y_vdot, m·xG − Y_rdot], "
+                f"[m·xG − N_vdot, Iz − N_rdot]] = [[{m11:.4g}, {m12:.4g}], [{m21:.4g}, "
+                f"{m22:.4g}]] must have positive diagonal and determinant"
+            )
+        return out
+
 
 def surge_regressors(u: Any, v: Any, r: Any, delta: Any, ops: SimpleNamespace, scaled: bool):
     """Regressors of the speed equation [u|u|, v r, r², δ²] (u²δ² when ``scaled``)."""

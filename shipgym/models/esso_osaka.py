@@ -212,6 +212,7 @@ class EssoOsakaParams(ParameterRecord):
         "n0",
         "u0",
         "U_max",
+        "m",
         "m_Xudot",
         "m_Yvdot",
         "Iz_Nrdot",
@@ -224,29 +225,30 @@ class EssoOsakaParams(ParameterRecord):
         "Kp",
         "Ki",
     )
+    #: fields that must be ≥ 0: resistance coefficient, speed set-point
+    nonnegative: ClassVar[tuple[str, ...]] = ("C_R", "U_ref")
     #: fields that must be 0 or 1 / 1 or 2 (switches)
     switches: ClassVar[dict[str, tuple[float, ...]]] = {
         "speed_control": (0.0, 1.0),
         "slip_exp": (1.0, 2.0),
     }
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if out:
+            return out
+        cls = type(self).__name__
         for name, allowed in self.switches.items():
             if getattr(self, name) not in allowed:
-                raise ParameterError(
-                    f"{type(self).__name__}.{name} must be one of {allowed}, "
-                    f"got {getattr(self, name)}"
-                )
+                out.append(f"{cls}.{name} must be one of {allowed}, got {getattr(self, name)}")
         if not 0.0 <= self.wake < 1.0:
-            raise ParameterError(f"{type(self).__name__}.wake must be in [0, 1), got {self.wake}")
-        if self.U_ref < 0.0:
-            raise ParameterError(f"{type(self).__name__}.U_ref must be ≥ 0, got {self.U_ref}")
+            out.append(f"{cls}.wake must be in [0, 1), got {self.wake}")
         if math.pi * self.D**2 / 4.0 >= self.A_R:
-            raise ParameterError(
-                f"{type(self).__name__}.A_R must exceed the propeller disc area πD²/4 "
+            out.append(
+                f"{cls}.A_R must exceed the propeller disc area πD²/4 "
                 f"= {math.pi * self.D**2 / 4.0:.4g} m², got {self.A_R}"
             )
+        return out
 
 
 def _scaled(p: Any, ops: SimpleNamespace) -> SimpleNamespace:

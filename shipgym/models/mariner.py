@@ -105,19 +105,14 @@ class MarinerParams(ParameterRecord):
     #: fields that must be ≥ 0 (physical); S = 0 is a stopped engine
     nonnegative: ClassVar[tuple[str, ...]] = ("a2", "W", "S")
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        for name in self.nonnegative:
-            value = getattr(self, name)
-            if value < 0:
-                raise ParameterError(
-                    f"{type(self).__name__}.{name} must be ≥ 0 (physical), got {value}"
-                )
-        if self.a1 <= 0 and self.a2 == 0:
-            raise ParameterError(
+    def problems(self) -> list[str]:
+        out = super().problems()
+        if not out and self.a1 <= 0 and self.a2 == 0:
+            out.append(
                 f"{type(self).__name__}.a1 must be > 0 when a2 = 0 (no yaw damping), "
                 f"got a1 = {self.a1}"
             )
+        return out
 
 
 class Mariner(ShipModel):

@@ -47,6 +47,12 @@ class Nomoto2Params(ParameterRecord):
     L: float = 0.95  # ship length [m]
 
     positive: ClassVar[tuple[str, ...]] = ("T1", "T2", "Tc", "u0", "L")
+    #: a real plant also steers the documented way (K > 0: δ > 0 makes r > 0) and has a
+    #: servo that follows its command (Kc > 0); an identifier's estimate may break these
+    #: (the weighted LS-SVM keeps a K < 0, as in the paper's Figure 7), so only a ship built
+    #: from a config is held to them.  β < 0 (cubic anti-damping) stays allowed: it is the
+    #: documented way to make a test plant diverge.
+    plant_positive: ClassVar[tuple[str, ...]] = ("K", "Kc")
 
 
 class UnitReading(enum.StrEnum):

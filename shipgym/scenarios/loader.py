@@ -9,16 +9,20 @@ from collections.abc import Iterable, Mapping
 from importlib.resources.abc import Traversable
 from typing import Any
 
+import yaml
+from pydantic import ValidationError
+
 from shipgym.config import (
     ConfigError,
     catalogue,
     is_path,
     list_names,
     load_yaml_model,
+    read_yaml,
     resolve,
     validate_model,
 )
-from shipgym.models import MODELS, ParameterError, ShipModel
+from shipgym.models import MODELS, ParameterError, ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
 from shipgym.scenarios.schema import ScenarioConfig
@@ -27,7 +31,36 @@ DEG = math.pi / 180.0
 
 
 class ScenarioError(ConfigError):
-    """A scenario cannot be found or is malformed; the message names the file and key."""
+    """A scenario cannot be found or is malformed; the message names the file and key.
+
+    ``problems`` lists what :func:`build_scenario` found, one :class:`Problem` each (the
+    message has one line per problem).
+    """
+
+    def __init__(self, message: str, problems: Iterable[Problem] = ()) -> None:
+        super().__init__(message)
+        self.problems: tuple[Problem, ...] = tuple(problems)
+
+
+@dataclasses.dataclass(frozen=True)
+class Problem:
+    """One problem of a scenario: the dotted key at fault (``""``: the file as a whole),
+    what is wrong, and the 1-based line of the YAML file when known."""
+
+    key: str
+    message: str
+    line: int | None = None
+
+    def text(self, file: str | None = None) -> str:
+        """``line N: key 'K': message``, or with ``file`` ``FILE:N: key 'K': message`` (the
+        parts that are known)."""
+        line = "" if self.line is None else str(self.line)
+        if file is not None:
+            where = f"{file}:{line}: " if line else f"{file}: "
+        else:
+            where = f"line {line}: " if line else ""
+        key = f"key '{self.key}': " if self.key else ""
+        return f"{where}{key}{self.message}"
 
 
 def catalogue_dir() -> Traversable:
@@ -115,51 +148,60 @@ class Scenario:
 
 
 def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenario:
-    """SI objects from a validated config; errors name ``origin`` and the key."""
-    ship = config.ship
-    if ship.model not in MODELS:
-        raise ScenarioError(
-            f"{origin}: key 'ship.model': unknown model {ship.model!r}; valid: {sorted(MODELS)}"
-        )
+    """SI objects from a validated config; errors name ``origin`` and the key.
+
+    Checks every part (the ship's parameters against a real plant's, each event's result,
+    path, initial states, control period) and reports all problems at once, one line each.
+    """
+    ship = config.ship  # model, variant, unit reading and parameters checked by the schema
     model_cls = MODELS[ship.model]
-    if ship.variant is not None and ship.variant not in model_cls.variants:
-        valid = list(model_cls.variants) or "none (the model has one form)"
-        raise ScenarioError(
-            f"{origin}: key 'ship.variant': unknown variant {ship.variant!r} of {ship.model}; "
-            f"valid: {valid}"
-        )
-    try:
-        model = model_cls.from_config(ship.params, ship.unit_reading, ship.variant)
-    except ParameterError as exc:
-        raise ScenarioError(f"{origin}: key 'ship.params': {exc}") from exc
+    model = model_cls.from_config(ship.params, ship.unit_reading, ship.variant)
+    problems: list[Problem] = []
     events = []
+    current: ParameterRecord | None = model.params
     for i, ev in enumerate(config.events):
+        key = f"events.{i}.params"
         try:
             values = model_cls.config_to_si(ev.params, ship.unit_reading)
         except ParameterError as exc:
-            raise ScenarioError(f"{origin}: key 'events.{i}.params': {exc}") from exc
+            problems += [Problem(key, text) for text in exc.problems]
+            continue
         events.append(ParameterEvent(ev.time, values, ev.kind, ev.duration))
-    try:
-        schedule = ParameterSchedule(model.params, events)
-    except ParameterError as exc:
-        raise ScenarioError(f"{origin}: key 'events': {exc}") from exc
+        if current is None:
+            continue
+        try:  # the ship after the change must be a real plant too
+            current = current.plant(**values)
+        except ParameterError as exc:
+            problems += [Problem(key, f"after the event at {ev.time} s: {t}") for t in exc.problems]
+            current = None
+    schedule = None
+    if not problems:
+        try:
+            schedule = ParameterSchedule(model.params, events)
+        except ParameterError as exc:
+            problems.append(Problem("events", str(exc)))
+    path = None
     try:
         path_cls = WaypointPath if config.path.type == "waypoints" else PchipPath
         path = path_cls(config.path.waypoints)
     except ValueError as exc:
-        raise ScenarioError(f"{origin}: key 'path.waypoints': {exc}") from exc
+        problems.append(Problem("path.waypoints", str(exc)))
     try:
         model.initial_state(**config.initial_state.states)
     except KeyError as exc:
-        raise ScenarioError(f"{origin}: key 'initial_state.states': {exc.args[0]}") from None
+        problems.append(Problem("initial_state.states", str(exc.args[0])))
     fine = config.fine_step or model.fine_step
     period = config.control_period or model.control_period
     ratio = period / fine
     if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-        raise ScenarioError(
-            f"{origin}: key 'control_period': {period} s is not a whole multiple of the "
-            f"fine step {fine} s"
+        problems.append(
+            Problem(
+                "control_period",
+                f"{period} s is not a whole multiple of the fine step {fine} s",
+            )
         )
+    if problems:
+        raise ScenarioError("\n".join(p.text(origin) for p in problems), problems=problems)
     return Scenario(config, model, path, schedule, origin if origin != "<scenario>" else None)
 
 
@@ -172,6 +214,65 @@ def load_scenario_file(path: str | os.PathLike | Traversable) -> Scenario:
     """A scenario from a YAML file (:func:`shipgym.config.resolve` finds it)."""
     file = resolve("scenarios", path, error=ScenarioError)
     return build_scenario(load_yaml_model(file, ScenarioConfig, ScenarioError), str(file))
+
+
+def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
+    """Every problem of a scenario YAML file, each with its key and line (empty: valid).
+
+    Unlike :func:`load_scenario_file`, which stops at the first failing stage, this lists
+    all schema problems pydantic finds (types, ranges, unknown keys, non-finite numbers,
+    events after the time limit) and, when the schema passes, all problems of building
+    the scenario (non-physical parameters, a bad path, …)."""
+    try:
+        file = resolve("scenarios", path, error=ScenarioError)
+        text = file.read_text(encoding="utf-8")
+    except (ScenarioError, OSError) as exc:
+        return [Problem("", str(exc))]
+    try:
+        root = yaml.compose(text)  # the node tree: where each key is written
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]
+    except yaml.YAMLError as exc:
+        return [Problem("", f"malformed YAML: {exc}")]
+    try:
+        data = read_yaml(file, ScenarioError)
+    except ScenarioError as exc:
+        return [Problem("", str(exc))]
+    if not isinstance(data, Mapping):
+        return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
+    try:
+        build_scenario(ScenarioConfig.model_validate(data), str(file))
+    except ValidationError as exc:
+        found = [
+            Problem(".".join(str(part) for part in item["loc"]), item["msg"])
+            for item in exc.errors()
+        ]
+    except ScenarioError as exc:
+        found = list(exc.problems) or [Problem("", str(exc))]
+    else:
+        return []
+    return [dataclasses.replace(p, line=yaml_line(root, p.key)) for p in found]
+
+
+def yaml_line(root: yaml.Node | None, key: str) -> int | None:
+    """The 1-based line where the dotted ``key`` is written in a YAML node tree, or of its
+    deepest part that is (a missing key: its parent's line); None for the whole file.
+    Parts not in the tree are skipped (a union's tag, e.g. ``current.gauss_markov.mu``)."""
+    if root is None or not key:
+        return None
+    node, line = root, None
+    for part in key.split("."):
+        if isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                if isinstance(k, yaml.ScalarNode) and k.value == part:
+                    node, line = v, k.start_mark.line + 1
+                    break
+        elif isinstance(node, yaml.SequenceNode) and part.isdigit():
+            if int(part) < len(node.value):
+                node = node.value[int(part)]
+                line = node.start_mark.line + 1
+    return line
 
 
 def load_scenario(

@@ -5,14 +5,17 @@ with an error naming the file and the key.  Values are in the units of the confi
 metres, seconds, degrees where a key says ``_deg``; ship parameters in the units of the
 model's source paper (for nomoto2: Liu et al. 2019, d0 in °/s), converted to SI by the
 model under the scenario's ``unit_reading``.  The ``disturbances`` and ``sensors`` sections
-are the models of :mod:`shipgym.disturbance_config` (re-exported here).
+are the models of :mod:`shipgym.disturbance_config` (re-exported here).  Every number is
+finite (``.inf`` / ``.nan`` are rejected, :class:`shipgym.config.StrictModel`), and the checks
+that relate two keys (an event after the time limit) name the key at fault.
 """
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
+from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
 from shipgym.config import StrictModel
 from shipgym.disturbance_config import (
@@ -24,6 +27,10 @@ from shipgym.disturbance_config import (
     TwoPhaseCurrent,
     WaveConfig,
 )
+from shipgym.models import MODELS, ParameterError
+
+#: one problem found by a check across keys: (location, message, the input at fault)
+KeyProblem = tuple[tuple[str | int, ...], str, Any]
 
 __all__ = [
     "ConstantCurrent",
@@ -54,6 +61,34 @@ class ShipConfig(StrictModel):
     variant: str | None = Field(
         default=None, description="structural variant of the model's equations (esso_osaka: …)"
     )
+
+    @model_validator(mode="after")
+    def _a_real_ship(self) -> ShipConfig:
+        """A known model, variant and unit reading, and parameters a real plant can have
+        (:meth:`shipgym.models.ParameterRecord.plant`: every bad one named)."""
+        model_cls = MODELS.get(self.model)
+        if model_cls is None:
+            message = f"unknown model {self.model!r}; valid: {sorted(MODELS)}"
+            raise key_errors("ShipConfig", [(("model",), message, self.model)])
+        problems: list[KeyProblem] = []
+        if self.variant is not None and self.variant not in model_cls.variants:
+            valid = list(model_cls.variants) or "none (the model has one form)"
+            message = f"unknown variant {self.variant!r} of {self.model}; valid: {valid}"
+            problems.append((("variant",), message, self.variant))
+        if self.unit_reading is not None and self.unit_reading not in model_cls.unit_readings:
+            message = (
+                f"unknown unit_reading {self.unit_reading!r} of {self.model}; "
+                f"valid: {list(model_cls.unit_readings)}"
+            )
+            problems.append((("unit_reading",), message, self.unit_reading))
+        if not problems:
+            try:
+                model_cls.from_config(self.params, self.unit_reading, self.variant)
+            except ParameterError as exc:
+                problems += [(("params",), text, self.params) for text in exc.problems]
+        if problems:
+            raise key_errors("ShipConfig", problems)
+        return self
 
 
 class InitialState(StrictModel):
@@ -146,8 +181,45 @@ class ScenarioConfig(StrictModel):
     convergence_threshold: float | None = Field(None, gt=0)  # m; None: 0.05·L/0.95
 
     @model_validator(mode="after")
-    def _events_sorted(self) -> ScenarioConfig:
-        times = [e.time for e in self.events]
-        if times != sorted(times):
-            raise ValueError("events must be listed in time order")
+    def _times_within_the_episode(self) -> ScenarioConfig:
+        """Events in time order and before the time limit (each problem under its key)."""
+        problems: list[KeyProblem] = []
+        for i, event in enumerate(self.events):
+            if event.time >= self.time_limit:
+                problems.append(
+                    (
+                        ("events", i, "time"),
+                        f"event at {event.time} s is not before the time limit "
+                        f"(time_limit: {self.time_limit} s): it would never happen",
+                        event.time,
+                    )
+                )
+            if i and event.time < self.events[i - 1].time:
+                problems.append(
+                    (
+                        ("events", i, "time"),
+                        f"events must be listed in time order: {event.time} s comes after "
+                        f"{self.events[i - 1].time} s",
+                        event.time,
+                    )
+                )
+        if problems:
+            raise key_errors(type(self).__name__, problems)
         return self
+
+
+def key_errors(title: str, problems: list[KeyProblem]) -> ValidationError:
+    """A pydantic ValidationError with one error per (location, message, input), so that a
+    check relating several keys reports each problem under the key at fault (raised from a
+    model validator, the locations nest under the model's own)."""
+    return ValidationError.from_exception_data(
+        title,
+        [
+            InitErrorDetails(
+                type=PydanticCustomError("invalid", "{message}", {"message": message}),
+                loc=loc,
+                input=value,
+            )
+            for loc, message, value in problems
+        ],
+    )

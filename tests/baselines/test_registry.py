@@ -2,23 +2,24 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
 
 import baselines
-from baselines import registry
 from baselines.classical.pid import PIDLOS
 from baselines.classical.reference import ZeroRudder
+from baselines.errors import ControllerError
 from baselines.evaluation import run_episode
+from baselines.plugins import ControllerEntry
 from baselines.registry import (
     CONTROLLERS,
     applies_to,
     controller_kind,
     make_controller,
     register_controller,
+    resolve_controller,
 )
 from shipgym.envs.context import ControllerContext
 
@@ -35,18 +36,11 @@ BUILTINS = {
     "nmpc": ("rudder", ("nomoto2",)),
     "nmpc_wlssvm": ("rudder", ("nomoto2",)),
     "nmpc_lambda_lssvm": ("rudder", ("nomoto2",)),
+    "nmpc_wlssvm_svf": ("rudder", ("nomoto2",)),
+    "nmpc_lambda_lssvm_svf": ("rudder", ("nomoto2",)),
     "zero_rudder": ("rudder", None),
     "random": ("rudder", None),
 }
-
-
-@pytest.fixture
-def scratch_registry() -> Iterator[None]:
-    """Controllers registered inside a test are gone after it."""
-    saved = dict(registry._RECORDS)
-    yield
-    registry._RECORDS.clear()
-    registry._RECORDS.update(saved)
 
 
 def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
@@ -203,3 +197,25 @@ def test_learned_policies_resolve_by_name() -> None:
     policy, mode = make_controller("ppo")
     assert policy.kind == controller_kind("ppo") == "learned"
     assert mode == policy.action_mode == policy.meta["action_mode"]
+
+
+def test_the_long_form_renames_and_sets_a_registered_controller(scratch_registry: None) -> None:
+    """One controller, two table names, two settings; the alias keeps mode, ships, kind."""
+    stiff = ControllerEntry(
+        controller="pid_los", name="pid_stiff", settings={"natural_frequency": 2.0}
+    )
+    policy, mode = make_controller(stiff)
+    assert (policy.name, mode, type(policy)) == ("pid_stiff", "rudder", PIDLOS)
+    assert PIDLOS.name == "pid_los"  # the instance is renamed, not the class
+    mine = run_episode(policy, "nominal", seed=0)
+    theirs = run_episode(make_controller("pid_los")[0], "nominal", seed=0)
+    assert (mine.controller, theirs.controller) == ("pid_stiff", "pid_los")
+    assert mine.metrics["pid_kp"] > theirs.metrics["pid_kp"]
+    nmpc = resolve_controller(ControllerEntry(controller="nmpc", name="nmpc_2"))
+    assert nmpc.applies_to == ("nomoto2",) and controller_kind("nmpc_2") == "classical"
+    assert not applies_to("nmpc_2", "mariner")
+
+
+def test_unknown_settings_are_named_before_anything_is_made() -> None:
+    with pytest.raises(ControllerError, match=r"'pid_los'.*natural_frequncy"):
+        resolve_controller(ControllerEntry(controller="pid_los", settings={"natural_frequncy": 2}))

@@ -10,7 +10,7 @@ import pytest
 from scipy.optimize import brentq
 
 from baselines.cli import main
-from shipgym.manoeuvres import turning_circle, zigzag
+from shipgym.manoeuvres import ManoeuvreError, turning_circle, zigzag
 from shipgym.models import Nomoto2, Nomoto2Params
 
 
@@ -51,3 +51,16 @@ def test_cli_manoeuvre_json(tmp_path, capsys) -> None:
     assert {"overshoot_1", "overshoot_2"} <= set(json.loads(capsys.readouterr().out))
     assert main(["manoeuvre", "titanic", "zigzag"]) == 2
     assert "unknown ship" in capsys.readouterr().err
+
+
+def test_a_rudder_beyond_the_limit_is_an_error_not_clipped() -> None:
+    """nomoto2 steers ±30°: 35° would be a different manoeuvre than the figures claim."""
+    model = Nomoto2()
+    for run in (lambda d: turning_circle(model, d), lambda d: zigzag(model, d)):
+        with pytest.raises(ManoeuvreError, match=r"rudder -?35\.0° is beyond .* ±30°"):
+            run(35.0)
+        with pytest.raises(ManoeuvreError, match="beyond"):
+            run(-35.0)
+    _, at_limit = turning_circle(model, 30.0)
+    _, default = turning_circle(model)  # 35° or the ship's smaller limit
+    assert default == at_limit

@@ -31,6 +31,11 @@ from baselines.classical.adaptive.projection import projection
 PARAMETERS = ("rho", "sigma", "b")
 
 
+def _projection_constants(lower: float, upper: float, epsilon: float) -> tuple[float, float]:
+    """(c, w0²) of :func:`.projection.projection` for the bounds [lower, upper]."""
+    return 0.5 * (lower + upper), (0.5 * (upper - lower)) ** 2 / (1.0 + epsilon)
+
+
 class StatePredictor:
     """State predictor (eq. (20)) with projection adaptation (eq. (25)) — Xu et al. (2021).
 
@@ -113,38 +118,89 @@ class StatePredictor:
         """Integrate over the samples psi, r, delta [rad, rad/s, rad] at spacing step [s].
 
         The arrays hold n + 1 samples at t0, t0 + step, …, t0 + n·step; between samples the
-        measurements are linearly interpolated.  ψ is unwrapped onto ψ̂'s branch.
+        measurements are linearly interpolated.  ψ is unwrapped onto ψ̂'s branch.  The RK4
+        stages evaluate :meth:`_rhs` written out on local floats (the same operations in
+        the same order, so the same bits; ≈ 4× faster than calling it, tested).
         """
         psi = np.unwrap(np.asarray(psi, dtype=float))
         psi = psi + 2.0 * math.pi * round((self.psi_hat - psi[0]) / (2.0 * math.pi))
         n_sub = max(1, math.ceil(self.gamma2 * step / 0.5))
         dt = step / n_sub
+        half_dt, sixth_dt = 0.5 * dt, dt / 6.0
         decay = math.exp(-self.gamma1 * step)
         phi1 = (1.0 - decay) / self.gamma1  # ∫0^h e^{−Γ1(h−s)} ds
         phi2 = (step - phi1) / self.gamma1  # ∫0^h e^{−Γ1(h−s)} s ds
-        s = [self.r_hat, self.rho, self.sigma, self.b]
+        gamma1, gamma2 = self.gamma1, self.gamma2
+        K, T, a2 = self.model.K, self.model.T, self.model.a2
+        g_rho, g_sigma, g_b = self.gammas
+        eps = self.epsilon
+        # the projection's constants per estimate (projection.projection, precomputed)
+        (c_rho, w_rho), (c_sig, w_sig), (c_b, w_b) = (
+            _projection_constants(*self.bounds[name], eps) for name in PARAMETERS
+        )
+        ew_rho, ew_sig, ew_b = eps * w_rho, eps * w_sig, eps * w_b
+
+        def rhs(
+            r_hat: float, rho: float, sigma: float, b: float, r: float, delta: float
+        ) -> tuple[float, float, float, float]:
+            h_r = 1.0 + a2 * r * r  # NonlinearNomoto.damping
+            r_err = r_hat - r  # r̃, eq. (18)
+            d_r = -gamma2 * r_err + (rho * K * delta + b - sigma * h_r * r) / T  # eq. (20)
+            y = -r_err * K * delta  # eq. (25), each through projection()
+            off = rho - c_rho
+            f = (off * off - w_rho) / ew_rho
+            d_rho = g_rho * (y * (1.0 - f) if f > 0.0 and y * off > 0.0 else y)
+            y = r_err * h_r * r
+            off = sigma - c_sig
+            f = (off * off - w_sig) / ew_sig
+            d_sig = g_sigma * (y * (1.0 - f) if f > 0.0 and y * off > 0.0 else y)
+            y = -r_err
+            off = b - c_b
+            f = (off * off - w_b) / ew_b
+            d_b = g_b * (y * (1.0 - f) if f > 0.0 and y * off > 0.0 else y)
+            return d_r, d_rho, d_sig, d_b
+
+        x0, x1, x2, x3 = self.r_hat, self.rho, self.sigma, self.b
+        psi_hat = self.psi_hat
         psi_l = psi.tolist()
         r_l = np.asarray(r, dtype=float).tolist()
         d_l = np.asarray(delta, dtype=float).tolist()
         for j in range(len(psi_l) - 1):
             # ψ̂' = −Γ1·ψ̂ + (Γ1·ψ + r): exact for the affine interpolated forcing
-            u0 = self.gamma1 * psi_l[j] + r_l[j]
-            u1 = self.gamma1 * psi_l[j + 1] + r_l[j + 1]
-            self.psi_hat = decay * self.psi_hat + u0 * phi1 + (u1 - u0) / step * phi2
+            u0 = gamma1 * psi_l[j] + r_l[j]
+            u1 = gamma1 * psi_l[j + 1] + r_l[j + 1]
+            psi_hat = decay * psi_hat + u0 * phi1 + (u1 - u0) / step * phi2
             r0, dr = r_l[j], (r_l[j + 1] - r_l[j]) / n_sub
             e0, de = d_l[j], (d_l[j + 1] - d_l[j]) / n_sub
             for i in range(n_sub):
                 ra, da = r0 + i * dr, e0 + i * de
                 rm, dm = ra + 0.5 * dr, da + 0.5 * de
-                k1 = self._rhs(s, ra, da)
-                k2 = self._rhs([x + 0.5 * dt * k for x, k in zip(s, k1, strict=True)], rm, dm)
-                k3 = self._rhs([x + 0.5 * dt * k for x, k in zip(s, k2, strict=True)], rm, dm)
-                k4 = self._rhs([x + dt * k for x, k in zip(s, k3, strict=True)], ra + dr, da + de)
-                s = [
-                    x + dt / 6.0 * (a + 2.0 * b + 2.0 * c + d)
-                    for x, a, b, c, d in zip(s, k1, k2, k3, k4, strict=True)
-                ]
-        self.r_hat, self.rho, self.sigma, self.b = s
+                a0, a1, a2_, a3 = rhs(x0, x1, x2, x3, ra, da)
+                b0, b1, b2, b3 = rhs(
+                    x0 + half_dt * a0,
+                    x1 + half_dt * a1,
+                    x2 + half_dt * a2_,
+                    x3 + half_dt * a3,
+                    rm,
+                    dm,
+                )
+                c0, c1, c2, c3 = rhs(
+                    x0 + half_dt * b0,
+                    x1 + half_dt * b1,
+                    x2 + half_dt * b2,
+                    x3 + half_dt * b3,
+                    rm,
+                    dm,
+                )
+                d0, d1, d2, d3 = rhs(
+                    x0 + dt * c0, x1 + dt * c1, x2 + dt * c2, x3 + dt * c3, ra + dr, da + de
+                )
+                x0 = x0 + sixth_dt * (a0 + 2.0 * b0 + 2.0 * c0 + d0)
+                x1 = x1 + sixth_dt * (a1 + 2.0 * b1 + 2.0 * c1 + d1)
+                x2 = x2 + sixth_dt * (a2_ + 2.0 * b2 + 2.0 * c2 + d2)
+                x3 = x3 + sixth_dt * (a3 + 2.0 * b3 + 2.0 * c3 + d3)
+        self.psi_hat = psi_hat
+        self.r_hat, self.rho, self.sigma, self.b = x0, x1, x2, x3
 
     def lyapunov(self, psi: float, r: float, truth: tuple[float, float, float]) -> float:
         """V_pred of eq. (22) for true (ρ, σ, b) and measured ψ, r (γ = 0 terms omitted)."""

@@ -43,6 +43,8 @@ def plot_case(
         if history and policy.identifier is not None:
             t = [h["t"] for h in history]
             for key in changed:
+                if key == "beta":  # not identifiable at these yaw rates (README)
+                    continue
                 scale = truth_after.as_dict()[key] or 1.0
                 ax_p.plot(t, [h[key] / scale for h in history], lw=1, label=f"{name}: {key}")
         ident = policy.identifier
@@ -52,13 +54,13 @@ def plot_case(
                 [h["t"] for h in hist],
                 [max(h["lambda1"], 1e-12) for h in hist],
                 lw=1,
-                label="λ¹ (θ1)",
+                label=f"{name}: λ¹ (θ1)",
             )
             ax_l.semilogy(
                 [h["t"] for h in hist],
                 [max(h["lambda2"], 1e-12) for h in hist],
                 lw=1,
-                label="λ² (θ2)",
+                label=f"{name}: λ² (θ2)",
             )
             ax_l.axhline(ident.lambda_c[0], color="C0", ls=":", lw=1)
             ax_l.axhline(ident.lambda_c[1], color="C1", ls=":", lw=1)
@@ -66,7 +68,11 @@ def plot_case(
     for ax in (ax_e, ax_p, ax_l):
         ax.axvline(change, color="gray", ls=":", lw=1)
     ax_p.axhline(1.0, color="k", lw=0.8)
-    before = [truth_before.as_dict()[k] / (truth_after.as_dict()[k] or 1.0) for k in changed]
+    before = [
+        truth_before.as_dict()[k] / (truth_after.as_dict()[k] or 1.0)
+        for k in changed
+        if k != "beta"
+    ]
     for value in before:
         ax_p.axhline(value, color="gray", lw=0.5, ls="--")
     ax_track.set(xlabel="x [m]", ylabel="y [m]", title=f"{case} ({reading})")
@@ -75,7 +81,8 @@ def plot_case(
     ax_p.set(
         xlabel="t [s]",
         ylabel="identified / true (after change)",
-        title="identified parameters (1 = truth after the change)",
+        title="identified parameters (1 = truth after the change; β not shown)",
+        ylim=(-0.5, 2.5),
     )
     ax_l.set(xlabel="t [s]", ylabel="λ_k", title="λ-LS-SVM change index (dotted: λ_c)")
     for ax in axes.ravel():

@@ -238,3 +238,23 @@ def test_reproduction_rows_and_J_replay(tmp_path) -> None:  # type: ignore[no-un
     J_t = borkowski2018.cumulative_J(scenario, result.trajectory, scenario.control_period)
     assert J_t[-1] == pytest.approx(result.metrics["J"], rel=1e-9)
     assert J_t[-1] == pytest.approx(index[(case, "lqr", "J")], rel=1e-9)
+
+
+def test_fast_riccati_solution_equals_scipy_and_solves_the_care() -> None:
+    """solve_care (Hamiltonian eigenvectors) against scipy's ordered-QZ solver on the
+    track model of the four ships' (a, c, U) ranges."""
+    from scipy.linalg import solve_continuous_are
+
+    from baselines.classical.lqr import LQRWeights, solve_care, track_model
+
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        a, c, U = rng.uniform(0.005, 2.0), rng.uniform(1e-4, 2.0), rng.uniform(0.3, 9.0)
+        w = LQRWeights(rng.uniform(1e-5, 1.0), rng.uniform(0.1, 2.0), rng.uniform(1.0, 10.0))
+        A, B = track_model(a, c, U)
+        P = solve_care(A, B, w.Rx, w.Ru)
+        ref = solve_continuous_are(A, B, w.Rx, w.Ru)
+        np.testing.assert_allclose(P, ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+        residual = A.T @ P + P @ A - P @ B @ B.T @ P / w.lambda_delta + w.Rx
+        assert np.abs(residual).max() <= 1e-9 * np.abs(ref).max()
+        assert np.all(np.linalg.eigvalsh(P) > 0)

@@ -56,14 +56,18 @@ def test_train_and_test_splits_share_no_scenario() -> None:
 
 
 def test_heldout_contains_jumps_outside_the_training_ranges() -> None:
-    train = load_distribution("train").config
-    nominal = train.ships[0].params
-    tc_max = nominal["Tc"] * max(train.jumps.kinds["rudder_aging"].params["Tc"].range)
-    d0_min = nominal["d0"] + min(train.jumps.kinds["current_shift"].params["d0"].range)
+    """nomoto2's held-out jumps (the other ships': tests/shipgym/scenarios/test_sampling.py)."""
+    nomoto2 = load_distribution("train").config.ships[0]
+    assert nomoto2.model == "nomoto2"
+    nominal, kinds = nomoto2.params, nomoto2.jumps.kinds
+    tc_max = nominal["Tc"] * max(kinds["rudder_aging"].params["Tc"].range)
+    d0_min = nominal["d0"] + min(kinds["current_shift"].params["d0"].range)
     heldout = load_distribution("heldout")
     outside = 0
     for i in range(len(heldout)):
         sc = heldout.test_scenario(i)
+        if sc.ship.model != "nomoto2":
+            continue
         for event in sc.events:
             p = event.params
             if p.get("Tc", 0.0) > tc_max * 1.01 or p.get("d0", 0.0) < d0_min or "T2" in p:
@@ -110,6 +114,34 @@ def test_randomized_env_conforms_and_is_reproducible() -> None:
     np.testing.assert_array_equal(np.array(traj_a), np.array(traj_b))
     env.reset(seed=6)
     assert env.unwrapped.scenario_name != name_a
+
+
+def test_randomized_env_serves_every_ship_with_one_pair_of_spaces() -> None:
+    """The training distribution's resets reach all four ships; observations stay in the one
+    9-entry space and the actions are the same 1 (rudder) or 2 (guidance) entries."""
+    for mode, n_actions in (("rudder", 1), ("guidance", 2)):
+        env = gym.make(shipgym.RANDOMIZED_ENV_ID, action_mode=mode).unwrapped
+        assert env.observation_space.shape == (9,) and env.action_space.shape == (n_actions,)
+        ships = set()
+        for seed in range(80):
+            obs, _ = env.reset(seed=seed)
+            ships.add(env.scenario.model.name)
+            obs, *_ = env.step(env.action_space.sample())
+            assert env.observation_space.contains(obs)
+        assert ships == {"nomoto2", "esso_osaka", "mariner", "blanke"}
+
+
+def test_randomized_env_vectorises_across_ships_without_samples() -> None:
+    """Ships with different Ts/h in one Gymnasium vector env: ``info`` has every per-step key
+    but ``samples`` (whose length, Ts/h, differs between ships), so the infos stack."""
+    envs = gym.make_vec(shipgym.RANDOMIZED_ENV_ID, num_envs=4, vectorization_mode="sync")
+    envs.reset(seed=[3, 4, 8, 9])  # nomoto2 (Ts/h = 50), blanke (4), mariner (10), nomoto2
+    ships = [env.unwrapped.scenario.model.name for env in envs.unwrapped.envs]
+    assert ships == ["nomoto2", "blanke", "mariner", "nomoto2"]
+    _, _, _, _, info = envs.step(np.zeros((4, 1), dtype=np.float32))
+    assert "samples" not in info
+    assert {"t", "cross_track_error", "heading", "rudder_command", "position"} <= set(info)
+    envs.close()
 
 
 def _tiny_config(**env: object) -> AgentConfig:

@@ -97,3 +97,13 @@ def test_a_paper_report_of_known_rows() -> None:
     md = borkowski2018.report(rows)
     line = "| a0=0.02, c0=0.002 (paper) | 26512.1 | 21934.3 | 0.8273 | yes | 0.02755 | 0.0009795 |"
     assert line in md.splitlines()
+
+
+def test_borkowski_keeps_the_papers_1000_s_runs() -> None:
+    """mariner_track's time limit lets a controller finish the route; the reproduction still
+    cuts the episode at the paper's 1000 s (its J is over those)."""
+    from shipgym.scenarios import load_scenario
+
+    assert borkowski2018.build_scenario().config.time_limit == 1000.0
+    assert load_scenario("mariner_track").config.time_limit > 1000.0
+    assert borkowski2018.build_scenario(150.0).config.time_limit == 150.0

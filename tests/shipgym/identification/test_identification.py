@@ -26,9 +26,7 @@ from shipgym.identification import (
 )
 from shipgym.identification.lssvm import _quantiles
 from shipgym.models import Nomoto2, Nomoto2Params
-from shipgym.models.integrator import PeriodIntegrator
-
-H = 0.01
+from tests.shipgym.identification.logs import H, simulate
 
 
 # ----------------------------------------------------------------------------- LS-SVM core
@@ -122,27 +120,6 @@ def test_theta1_without_real_time_constants_is_an_error() -> None:
     theta[0] = 0.1  # (T1 + T2)² < 4 T1 T2
     with pytest.raises(IdentificationError, match="complex"):
         params_from_theta1(theta)
-
-
-def simulate(params: Nomoto2Params, h: float = H, duration: float = 60.0, seed: int = 0):
-    """Noise-free log of nomoto2 under a persistently exciting command (eq. (45) + a sine)."""
-    model = Nomoto2(params)
-    n = round(0.5 / h)
-    integ = PeriodIntegrator(model, h, n)
-    rng = np.random.default_rng(seed)
-    x = model.initial_state()
-    p = np.tile(params.to_vector(), (n, 1))
-    w = np.zeros((n, 3))
-    psi, delta, delta_c = [x[2]], [x[5]], []
-    for k in range(round(duration / 0.5)):
-        u = math.radians(10.0 * math.sin(0.15 * k) + 5.0 * rng.normal())
-        states = integ(x, u, w, p)[1:]  # drop the initial-state row
-        x = states[-1]
-        psi += list(states[:, 2])
-        delta += list(states[:, 5])
-        delta_c += [u] * n
-    delta_c.append(delta_c[-1])
-    return np.array(psi), np.array(delta), np.array(delta_c)
 
 
 def rel(est: Nomoto2Params, true: Nomoto2Params, key: str) -> float:
@@ -383,3 +360,31 @@ def test_degenerate_window_keeps_the_nu_rhythm() -> None:
         lam.update_arrays(np.linspace(0, 1, 2000)[n0 : n0 + 50], np.full(50, 0.1), np.full(50, 0.1))
     skipped = [e for e in lam.history if "skipped" in e]
     assert len(skipped) == 1 + (2000 - 3 - 1200) // 50
+
+
+# ----------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("h", [0.0, -0.01, math.nan, math.inf, "0.01"])
+def test_a_bad_sampling_step_is_refused_by_name_before_any_work(h) -> None:
+    """Issue 12 item 5: h = 0, h < 0 or non-finite → IdentificationError naming h, even with
+    data that would fail later for another reason (empty arrays)."""
+    empty = np.zeros(0)
+    with pytest.raises(IdentificationError, match="sampling step h"):
+        fit_nomoto2(empty, empty, empty, h)
+    for cls in (LambdaLSSVM, WeightedLSSVMOnline):
+        with pytest.raises(IdentificationError, match="sampling step h"):
+            cls(h)
+    with pytest.raises(IdentificationError, match="sampling step h"):
+        ContinuousLeastSquares(h, a0=0.02, c0=0.002)
+    with pytest.raises(IdentificationError, match="sampling step h"):
+        fit_nomoto_zigzag(empty, empty, h)
+
+
+@pytest.mark.parametrize("cls", [LambdaLSSVM, WeightedLSSVMOnline])
+def test_samples_without_a_key_are_refused_naming_it_and_the_keys_needed(cls) -> None:
+    """Issue 12 item 5: a dict lacking "delta_c" → IdentificationError naming the missing key
+    and the keys the identifier needs; nothing is fed."""
+    ident = cls(H)
+    samples = {"psi": np.zeros(50), "delta": np.zeros(50)}
+    with pytest.raises(IdentificationError, match=r"'delta_c'.*'psi', 'delta', 'delta_c'"):
+        ident.update(samples)
+    assert ident._y1.shape[0] == 0 and ident.updates == 0

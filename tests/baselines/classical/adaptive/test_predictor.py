@@ -165,3 +165,55 @@ def test_initial_estimates_outside_their_bounds_are_refused() -> None:
         StatePredictor(MODEL, 100, 10, 20, 20, 10, BOUNDS, 0.1, (20.0, 1.0, 0.0))
     with pytest.raises(ValueError, match="positive"):
         StatePredictor(MODEL, 100, 10, 20, 20, 10, {**BOUNDS, "rho": (-1.0, 2.0)})
+
+
+def _reference_advance(pred: StatePredictor, psi, r, delta, step: float) -> None:
+    """The predictor's integration written plainly on :meth:`StatePredictor._rhs` (RK4 with
+    list arithmetic): what ``advance`` computes, more slowly."""
+    psi = np.unwrap(np.asarray(psi, dtype=float))
+    psi = psi + 2.0 * math.pi * round((pred.psi_hat - psi[0]) / (2.0 * math.pi))
+    n_sub = max(1, math.ceil(pred.gamma2 * step / 0.5))
+    dt = step / n_sub
+    decay = math.exp(-pred.gamma1 * step)
+    phi1 = (1.0 - decay) / pred.gamma1
+    phi2 = (step - phi1) / pred.gamma1
+    s = [pred.r_hat, pred.rho, pred.sigma, pred.b]
+    for j in range(len(psi) - 1):
+        u0 = pred.gamma1 * psi[j] + r[j]
+        u1 = pred.gamma1 * psi[j + 1] + r[j + 1]
+        pred.psi_hat = decay * pred.psi_hat + u0 * phi1 + (u1 - u0) / step * phi2
+        r0, dr = r[j], (r[j + 1] - r[j]) / n_sub
+        e0, de = delta[j], (delta[j + 1] - delta[j]) / n_sub
+        for i in range(n_sub):
+            ra, da = r0 + i * dr, e0 + i * de
+            rm, dm = ra + 0.5 * dr, da + 0.5 * de
+            k1 = pred._rhs(s, ra, da)
+            k2 = pred._rhs([x + 0.5 * dt * k for x, k in zip(s, k1, strict=True)], rm, dm)
+            k3 = pred._rhs([x + 0.5 * dt * k for x, k in zip(s, k2, strict=True)], rm, dm)
+            k4 = pred._rhs([x + dt * k for x, k in zip(s, k3, strict=True)], ra + dr, da + de)
+            s = [
+                x + dt / 6.0 * (a + 2.0 * b + 2.0 * c + d)
+                for x, a, b, c, d in zip(s, k1, k2, k3, k4, strict=True)
+            ]
+    pred.r_hat, pred.rho, pred.sigma, pred.b = s
+
+
+def test_advance_equals_the_plain_rk4_of_the_rhs_bit_for_bit() -> None:
+    """The unrolled integration (speed) is the RK4 of eq. (20), (25) as written, including
+    active projections (a large disturbance pushes b̂ into its boundary layer)."""
+    t, psi, r, delta = _plant_samples(1.4, 0.7, 0.35, 40.0, h=0.05)  # b beyond its bound
+    fast, slow = _predictor((5.0, 5.0, 5.0)), _predictor((5.0, 5.0, 5.0))
+    fast.reset(psi[0], r[0])
+    slow.reset(psi[0], r[0])
+    for j in range(0, len(t) - 10, 10):  # periods of 10 samples, as the env's Ts/h
+        fast.advance(psi[j : j + 11], r[j : j + 11], delta[j : j + 11], 0.05)
+        _reference_advance(
+            slow, psi[j : j + 11].tolist(), r[j : j + 11].tolist(), delta[j : j + 11].tolist(), 0.05
+        )
+        assert (fast.psi_hat, *fast.estimates, fast.r_hat) == (
+            slow.psi_hat,
+            *slow.estimates,
+            slow.r_hat,
+        )
+    w0 = BOUNDS["b"][1] / math.sqrt(1.1)  # inner interval of the projection (ε = 0.1)
+    assert w0 < fast.b <= BOUNDS["b"][1]  # b̂ went into the boundary layer: projection active

@@ -1,0 +1,47 @@
+"""``shipgym report DIR [DIR …]``: tables and plots rebuilt from run folders (merged)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from baselines.cli.options import add_json_option, add_out_options, command_line, emit
+
+#: where ``report`` writes unless given ``--out``
+REPORT_OUT = "results/report"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "report",
+        help="rebuild the tables and plots from run folders (several: one merged table)",
+    )
+    p.add_argument("runs", nargs="+", metavar="DIR", help="leaderboard / evaluate output folders")
+    add_out_options(
+        p,
+        REPORT_OUT,
+        help=f"output directory (default {REPORT_OUT}; refused if not empty: see --force)",
+        resume_help=None,
+    )
+    add_json_option(p, "print the rows as JSON on stdout")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Merge the runs, write the report, print the table (or rows); say which runs were
+    incomplete."""
+    from baselines.report import write_report
+
+    rows, sources = write_report(args.runs, args.out, force=args.force, command=command_line(args))
+    from baselines.leaderboard import markdown_table
+
+    for source in sources:
+        if source["status"] != "complete":
+            sys.stderr.write(
+                f"note: {source['folder']} is {source['status']}: {source['episodes']} of "
+                f"{source['jobs']} episodes\n"
+            )
+    emit(args, rows, markdown_table(rows))
+    if not args.json:
+        sys.stderr.write(f"wrote {args.out}: leaderboard.md, .csv, .json, plots, report.json\n")
+    return 0

@@ -1,0 +1,100 @@
+"""``shipgym run SCENARIO CONTROLLER``: one episode, its metrics and a track plot.
+
+Writes ``metrics.json`` (the episode's row: scenario, controller, kind, seed and every
+metric, as ``--json`` prints it) and the leaderboard's figure of the episode (path and
+track, cross-track error, rudder angle) into ``--out``.  The default seed is the
+leaderboard's first evaluation seed, so the episode is that of the leaderboard's first
+seed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from baselines.cli.options import add_json_option, add_out_options, emit
+from baselines.errors import RunError
+from baselines.evaluation import EVAL_SEED_OFFSET
+
+#: the default ``--out`` is ``RUN_ROOT/<scenario>_<controller>_<seed>``
+RUN_ROOT = Path("results/run")
+METRICS_FILE = "metrics.json"
+#: what a run writes (``--force`` removes these and nothing else)
+OUTPUTS = (METRICS_FILE, "*.png")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "run", help="one episode of a controller on a scenario: its metrics and a track plot"
+    )
+    p.add_argument(
+        "scenario", help="catalogue name, held-out test scenario (heldout:3) or scenario YAML"
+    )
+    p.add_argument(
+        "controller", help="controller name, shipped policy name or trained agent folder / zip"
+    )
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=EVAL_SEED_OFFSET,
+        help=f"env seed (default {EVAL_SEED_OFFSET}, the leaderboard's first)",
+    )
+    add_out_options(
+        p,
+        None,
+        help=f"output directory (default {RUN_ROOT}/SCENARIO_CONTROLLER_SEED; refused if not "
+        "empty: see --force)",
+        resume_help=None,
+    )
+    add_json_option(p, "print the episode's metrics as one JSON object")
+    p.set_defaults(func=run)
+
+
+def default_out(scenario: str, controller: str, seed: int) -> Path:
+    """``RUN_ROOT/<scenario>_<controller>_<seed>``, each part reduced to a file name."""
+    parts = (scenario, controller, str(seed))
+    return RUN_ROOT / "_".join(_file_name(part) for part in parts)
+
+
+def _file_name(text: str) -> str:
+    return "".join(c if c.isalnum() or c in "-." else "_" for c in text).strip("._") or "_"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check the scenario, the controller and ``--out`` (in that order, before any work),
+    run the episode, write its files, print its metrics."""
+    from baselines.evaluation import evaluate
+    from baselines.jsonout import dumps
+    from baselines.leaderboard import check_controllers, plot_results
+    from baselines.registry import applies_to
+    from baselines.runs import check_out_dir, clear_outputs
+    from shipgym.config import is_path
+    from shipgym.scenarios import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    (label,) = check_controllers([args.controller])
+    ship = scenario.model.name
+    if not applies_to(label, ship):
+        raise RunError(
+            f"controller {label!r} does not apply to the {ship} ship of scenario {scenario.name!r}"
+        )
+    name = Path(args.scenario).stem if is_path(args.scenario) else args.scenario
+    out = check_out_dir(args.out or default_out(name, label, args.seed), force=args.force)
+    if args.force:
+        clear_outputs(out, OUTPUTS)
+    result = evaluate(args.controller, scenario, [args.seed])[0]
+    result.controller, result.scenario = label, args.scenario  # as the leaderboard names them
+    row = result.row()
+    out.mkdir(parents=True, exist_ok=True)
+    (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
+    plot_results([result], out, {args.scenario: scenario})
+    plots = sorted(p.name for p in out.glob("*.png"))
+    text = "\n".join(f"{k:24s} {_cell(v)}" for k, v in row.items())
+    emit(args, row, text)
+    sys.stderr.write(f"wrote {out}: {METRICS_FILE}, {', '.join(plots)}\n")
+    return 0
+
+
+def _cell(value: object) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)

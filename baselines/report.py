@@ -1,0 +1,137 @@
+"""``shipgym report``: the tables and plots rebuilt from one or more run folders.
+
+Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.jsonl``,
+:mod:`baselines.runs`); several merge into one table (separate ``evaluate`` runs of different
+policies on the same suite give the leaderboard of those policies).  Runs that give the same
+scenario name different settings, or hold the same (scenario, controller, seed) episode, are
+refused.  The output folder gets the leaderboard's tables and plots and ``report.json``
+(which runs, when, with what).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from baselines.errors import RunError
+from baselines.runs import (
+    check_out_dir,
+    clear_outputs,
+    differences,
+    episode_key,
+    episode_result,
+    git_commit,
+    now,
+    read_episodes,
+    read_run,
+    versions,
+    write_json,
+)
+
+if TYPE_CHECKING:
+    from baselines.evaluation import EpisodeResult
+
+REPORT_FILE = "report.json"
+
+
+def merge_runs(
+    folders: Sequence[str | os.PathLike],
+) -> tuple[dict[str, Any], list[EpisodeResult], list[dict[str, Any]]]:
+    """(suite, episodes, sources) of run folders merged: scenarios and controllers in order
+    of first appearance, seeds and "does not apply" pairs united; ``sources`` describes each
+    run (folder, command, status, times, episodes of jobs)."""
+    suite: dict[str, Any] = {
+        "name": None,
+        "seeds": [],
+        "controllers": [],
+        "scenarios": {},
+        "does_not_apply": [],
+    }
+    first_with: dict[str, str] = {}
+    episode_in: dict[tuple[str, str, int], str] = {}
+    results = []
+    sources = []
+    for folder in map(str, folders):
+        record = read_run(folder)
+        run_suite = record["suite"]
+        for name, settings in run_suite["scenarios"].items():
+            if name not in suite["scenarios"]:
+                suite["scenarios"][name] = settings
+                first_with[name] = folder
+                continue
+            changed = differences(suite["scenarios"][name], settings)
+            if changed:
+                raise RunError(
+                    f"scenario {name!r} has other settings in {folder} than in "
+                    f"{first_with[name]}: {'; '.join(changed[:3])}"
+                )
+        known = {c["name"] for c in suite["controllers"]}
+        suite["controllers"] += [c for c in run_suite["controllers"] if c["name"] not in known]
+        suite["does_not_apply"] += [
+            pair for pair in run_suite["does_not_apply"] if pair not in suite["does_not_apply"]
+        ]
+        suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
+        suite["name"] = suite["name"] or run_suite.get("name")
+        episodes = read_episodes(folder)
+        for episode in episodes:
+            key = episode_key(episode)
+            if key in episode_in:
+                raise RunError(
+                    f"episode (scenario, controller, seed) {key} is in {episode_in[key]} and "
+                    f"in {folder}: report one of them"
+                )
+            episode_in[key] = folder
+            results.append(episode_result(episode, folder))
+        sources.append(
+            {
+                "folder": folder,
+                "command": record.get("command"),
+                "status": record.get("status"),
+                "start_time": record.get("start_time"),
+                "end_time": record.get("end_time"),
+                "episodes": len(episodes),
+                "jobs": record.get("jobs"),
+            }
+        )
+    return suite, results, sources
+
+
+def write_report(
+    folders: Sequence[str | os.PathLike],
+    out: str | os.PathLike,
+    force: bool = False,
+    command: Sequence[str] = (),
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Merge ``folders`` and write the tables, plots and ``report.json`` into ``out`` (which
+    must be empty, or ``force``: its earlier outputs cleared, and none of ``folders``);
+    returns (rows, sources)."""
+    if not folders:
+        raise RunError("report: give at least one run folder")
+    target = check_out_dir(out, force=force)
+    for folder in folders:
+        if Path(folder).resolve() == target.resolve():
+            raise RunError(f"--out {target} is one of the runs read: choose another folder")
+    suite, results, sources = merge_runs(folders)
+    if force:
+        clear_outputs(target)
+    target.mkdir(parents=True, exist_ok=True)
+    from baselines.leaderboard import write_results
+
+    rows = write_results(target, suite, results)
+    write_json(
+        target / REPORT_FILE,
+        {
+            "command": list(command),
+            "time": now(),
+            "versions": versions(),
+            "git_commit": git_commit(),
+            "runs": sources,
+            "suite": suite,
+        },
+    )
+    return rows, sources
+
+
+__all__ = ["REPORT_FILE", "merge_runs", "write_report"]

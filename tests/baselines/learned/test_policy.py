@@ -1,0 +1,246 @@
+"""A plain stable-baselines3 zip is scored by its path (issue 12 items 2 and 5): algorithm
+from the zip, action mode from its action space, ``vecnormalize.pkl`` beside it used,
+``meta.json`` optional and checked, a truncated or corrupt zip a clear error."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import shipgym  # noqa: F401  (registers the envs)
+from baselines.cli import main
+from baselines.errors import ControllerError
+from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from baselines.learned.policy import ALGORITHMS, LearnedPolicy, read_model, read_policy
+from baselines.registry import controller_kind, make_controller, resolve_controller
+
+sb3 = pytest.importorskip("stable_baselines3")
+sb3_contrib = pytest.importorskip("sb3_contrib")
+
+ENV_ID = "ShipPathFollow-v0"
+
+
+def _env(action_mode: str = "rudder") -> gym.Env:
+    return gym.make(ENV_ID, action_mode=action_mode)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _one_torch_thread() -> None:
+    """Tiny networks: one thread (several contend for the shared cores, 20× slower)."""
+    import torch
+
+    torch.set_num_threads(1)
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """A tiny PPO and a tiny SAC trained on the env, saved with plain ``model.save``."""
+    folder = tmp_path_factory.mktemp("sb3")
+
+    def small() -> dict[str, Any]:  # fresh: SB3 adds keys to the policy_kwargs it is given
+        return {"policy_kwargs": {"net_arch": [16, 16]}, "device": "cpu", "seed": 0}
+
+    ppo = sb3.PPO("MlpPolicy", _env(), n_steps=128, batch_size=64, n_epochs=2, **small())
+    sac = sb3.SAC("MlpPolicy", _env(), learning_starts=100, buffer_size=1_000, **small())
+    paths = {}
+    for name, model in {"ppo": ppo, "sac": sac}.items():
+        model.learn(total_timesteps=256)
+        (folder / name).mkdir()
+        model.save(folder / name / "agent")  # → agent.zip, nothing else beside it
+        paths[name] = folder / name / "agent.zip"
+    return paths
+
+
+def _observations(n: int = 20) -> list[np.ndarray]:
+    env = _env()
+    obs, _ = env.reset(seed=3)
+    out = [obs]
+    for _ in range(n - 1):
+        obs, *_ = env.step(env.action_space.sample())
+        out.append(obs)
+    return out
+
+
+@pytest.mark.parametrize(("algo", "cls"), [("ppo", "PPO"), ("sac", "SAC")])
+def test_a_plain_sb3_zip_is_scored_by_its_path(
+    trained: dict[str, Path], algo: str, cls: str
+) -> None:
+    path = trained[algo]
+    policy, mode = make_controller(str(path))
+    assert isinstance(policy, LearnedPolicy) and (policy.algo, mode) == (algo, "rudder")
+    assert policy.name == f"{algo}/agent" and controller_kind(policy.name) == "learned"
+    model = getattr(sb3, cls).load(str(path), device="cpu")
+    for obs in _observations():  # the policy acts as the model does, deterministically
+        expected, _ = model.predict(obs, deterministic=True)
+        np.testing.assert_array_equal(policy.act(obs, {}), expected)
+    (result,) = evaluate(str(path), "nominal", [EVAL_SEED_OFFSET])
+    assert (result.controller, result.kind) == (f"{algo}/agent", "learned")
+    assert np.isfinite(result.metrics["return"])
+    assert "train_env_steps" not in result.metrics  # no meta.json: no training cost shown
+
+
+def test_the_policy_runs_torch_on_one_thread(trained: dict[str, Path]) -> None:
+    import torch
+
+    LearnedPolicy(trained["ppo"])
+    assert torch.get_num_threads() == 1
+
+
+class _Spaces(gym.Env):
+    """An env with the given spaces (for models the ship env cannot make)."""
+
+    def __init__(self, obs_shape: tuple[int, ...], action_shape: tuple[int, ...]) -> None:
+        self.observation_space = gym.spaces.Box(-1, 1, obs_shape, dtype=np.float32)
+        self.action_space = gym.spaces.Box(-1, 1, action_shape, dtype=np.float32)
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> tuple[Any, dict]:
+        return self.observation_space.sample(), {}
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
+        return self.observation_space.sample(), 0.0, False, False, {}
+
+
+def _saved(folder: Path, algo: str, env: gym.Env, name: str | None = None) -> Path:
+    module, cls = ALGORITHMS[algo]
+    algorithm = getattr(sb3 if module == "stable_baselines3" else sb3_contrib, cls)
+    policy = "MlpLstmPolicy" if algo == "recurrent_ppo" else "MlpPolicy"
+    model = algorithm(policy, env, device="cpu", policy_kwargs={"net_arch": [8]})
+    path = folder / f"{name or algo}.zip"
+    model.save(path)
+    return path
+
+
+@pytest.mark.parametrize("algo", list(ALGORITHMS))
+def test_the_algorithm_is_read_from_the_zip(tmp_path: Path, algo: str) -> None:
+    path = _saved(tmp_path, algo, _env())
+    assert read_model(path).algo == algo
+    assert read_policy(path).algo == algo
+
+
+def test_the_action_mode_comes_from_the_action_space(tmp_path: Path) -> None:
+    guidance = _saved(tmp_path, "ppo", _env("guidance"), "guidance")
+    policy, mode = make_controller(str(guidance))
+    assert mode == policy.action_mode == "guidance"
+    (result,) = evaluate(str(guidance), "nominal", [EVAL_SEED_OFFSET])
+    assert result.kind == "learned"
+    three = _saved(tmp_path, "ppo", _Spaces((9,), (3,)), "three")
+    with pytest.raises(ControllerError, match=r"three\.zip: the model acts in Box of shape \(3,\)"):
+        make_controller(str(three))
+    other_obs = _saved(tmp_path, "ppo", _Spaces((4,), (1,)), "obs4")
+    with pytest.raises(ControllerError, match=r"obs4\.zip: the model observes Box of shape \(4,\)"):
+        make_controller(str(other_obs))
+
+
+def test_vecnormalize_beside_the_zip_normalises_the_observation(tmp_path: Path) -> None:
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    venv = VecNormalize(DummyVecEnv([_env]), norm_obs=True, norm_reward=False)
+    model = sb3.PPO("MlpPolicy", venv, n_steps=64, batch_size=64, n_epochs=1, device="cpu")
+    model.learn(total_timesteps=64)  # the running mean and variance move away from 0, 1
+    model.save(tmp_path / "model")
+    venv.save(str(tmp_path / "vecnormalize.pkl"))
+    policy = LearnedPolicy(tmp_path)
+    assert policy.obs_normalizer is not None
+    for obs in _observations(5):
+        normalised, _ = model.predict(venv.normalize_obs(obs), deterministic=True)
+        np.testing.assert_array_equal(policy.act(obs, {}), normalised)
+    raw = np.array([model.predict(o, deterministic=True)[0] for o in _observations(5)])
+    acted = np.array([policy.act(o, {}) for o in _observations(5)])
+    assert not np.array_equal(raw, acted)  # the statistics were used
+    (tmp_path / "vecnormalize.pkl").write_bytes(b"not a pickle")
+    with pytest.raises(ControllerError, match=r"vecnormalize\.pkl: not a readable VecNormalize"):
+        LearnedPolicy(tmp_path)
+
+
+def _copy(trained: dict[str, Path], folder: Path) -> Path:
+    folder.mkdir()
+    return Path(shutil.copyfile(trained["ppo"], folder / "model.zip"))
+
+
+def test_a_truncated_or_corrupt_zip_is_a_clear_error_naming_it(
+    trained: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    data = trained["ppo"].read_bytes()
+    truncated = tmp_path / "truncated.zip"
+    truncated.write_bytes(data[: len(data) // 3])
+    flipped = bytearray(data)
+    flipped[len(data) // 2] ^= 0xFF
+    corrupt = tmp_path / "corrupt.zip"
+    corrupt.write_bytes(bytes(flipped))
+    empty = tmp_path / "empty.zip"
+    empty.write_bytes(b"")
+    for path in (truncated, corrupt, empty):
+        with pytest.raises(ControllerError, match=rf"{path}: .*(truncated|corrupt)"):
+            make_controller(str(path))
+    out = tmp_path / "out"
+    assert main(["evaluate", str(truncated), "--suite", "smoke", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(truncated) in err and "Traceback" not in err
+    assert not (out / "episodes.jsonl").exists()  # refused before any episode
+
+
+@pytest.mark.parametrize(
+    ("meta", "message"),
+    [
+        ("{not json", r"meta\.json: not JSON \(Expecting property name .* line 1, column 2\)"),
+        ('{"algo": "sac"}', r"meta\.json: key 'algo' is 'sac', but model\.zip was saved by 'ppo'"),
+        ('{"algo": "dqn"}', r"meta\.json: key 'algo': Input should be 'ppo', 'a2c'"),
+        ('{"action_mode": "guidance"}', r"meta\.json: key 'action_mode' is 'guidance', but"),
+        ('{"env_steps": "many", "wall_time_s": 1}', r"meta\.json: key 'env_steps': Input"),
+        ('{"env_steps": 256}', r"meta\.json: .*both 'env_steps' and 'wall_time_s'"),
+        ("[1, 2]", r"meta\.json: expected a mapping at the top level, got list"),
+    ],
+)
+def test_a_bad_meta_json_is_a_clear_error_naming_file_and_key(
+    trained: dict[str, Path], tmp_path: Path, meta: str, message: str
+) -> None:
+    model = _copy(trained, tmp_path / "agent")
+    (model.parent / "meta.json").write_text(meta)
+    with pytest.raises(ControllerError, match=message):
+        resolve_controller(str(model.parent))  # before any episode
+
+
+def test_a_meta_json_gives_name_and_training_cost(trained: dict[str, Path], tmp_path: Path) -> None:
+    model = _copy(trained, tmp_path / "agent")
+    meta = {"name": "mine", "algo": "ppo", "env_steps": 256, "wall_time_s": 1.5, "seed": 4}
+    (model.parent / "meta.json").write_text(json.dumps(meta))
+    assert LearnedPolicy(model.parent).name == "mine"
+    (result,) = evaluate(str(model.parent), "nominal", [EVAL_SEED_OFFSET])
+    assert result.controller == "agent"  # the table names a folder by its name
+    assert (result.metrics["train_env_steps"], result.metrics["train_wall_s"]) == (256.0, 1.5)
+
+
+def test_a_meta_json_names_the_algorithm_the_zip_does_not(
+    trained: dict[str, Path], tmp_path: Path
+) -> None:
+    """A zip whose policy class is the user's own (not one of SB3's) needs ``algo``."""
+    source = _copy(trained, tmp_path / "src")
+    custom = tmp_path / "agent" / "model.zip"
+    custom.parent.mkdir()
+    with zipfile.ZipFile(source) as src, zipfile.ZipFile(custom, "w") as dst:
+        for item in src.infolist():
+            content = src.read(item)
+            if item.filename == "data":
+                data = json.loads(content)
+                data["policy_class"]["__module__"] = "my_package.policies"
+                content = json.dumps(data).encode()
+            dst.writestr(item, content)
+    with pytest.raises(ControllerError, match=r"cannot tell which algorithm saved it"):
+        make_controller(str(custom))
+    (custom.parent / "meta.json").write_text('{"algo": "ppo"}')
+    policy, _ = make_controller(str(custom))
+    assert policy.algo == "ppo"
+
+
+def test_a_folder_without_one_model_zip_is_a_clear_error(tmp_path: Path) -> None:
+    (tmp_path / "a.zip").write_bytes(b"")
+    (tmp_path / "b.zip").write_bytes(b"")
+    with pytest.raises(ControllerError, match=r"holds model\.zip, .* it holds a\.zip, b\.zip"):
+        make_controller(str(tmp_path))

@@ -1,0 +1,227 @@
+"""Bad input on the command line: exit code 2, one stderr line naming the bad thing, no
+traceback, and nothing run or written before the check (issue 12, item 5)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from baselines.cli import main
+
+#: a scenario file's text with one ``{line}`` to fill in (nomoto2, 30 s)
+SCENARIO = """\
+name: bad_input
+ship: {{model: nomoto2, params: {{{params}}}}}
+initial_state: {{heading_deg: {heading}}}
+path: {{waypoints: [[1, 1], [15, 1], [15, 10]]}}
+disturbances: {{current: {{speed: 0.05, direction_deg: {direction}}}}}
+events: [{{time: {event}, params: {{Tc: 1.0}}}}]
+time_limit: {limit}
+"""
+GOOD = {"params": "Tc: 0.1", "heading": 0.0, "direction": 90.0, "event": 5.0, "limit": 30.0}
+
+
+def error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
+    """The one stderr line of a bad input (checked for its shape), without its prefix."""
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    prefix = f"shipgym {command}: error: "
+    assert err.startswith(prefix), err
+    return err.removeprefix(prefix).rstrip("\n")
+
+
+def scenario_file(tmp_path: Path, **bad: object) -> str:
+    file = tmp_path / "scenario.yaml"
+    file.write_text(SCENARIO.format(**{**GOOD, **bad}))
+    return str(file)
+
+
+def test_the_good_scenario_file_runs(tmp_path: Path) -> None:
+    """The template is valid: each test below breaks exactly one thing."""
+    out = tmp_path / "out"
+    assert main(["run", scenario_file(tmp_path), "zero_rudder", "--out", str(out)]) == 0
+    assert (out / "metrics.json").is_file()
+
+
+@pytest.mark.parametrize(
+    ("bad", "named"),
+    [
+        ({"event": 31.0}, ["events.0.time", "31.0 s", "time_limit: 30.0 s"]),
+        ({"params": "K: -0.5"}, ["ship.params", "K must be > 0", "-0.5"]),
+        ({"params": "K: 0"}, ["ship.params", "K must be > 0"]),
+        ({"params": "T1: 0"}, ["ship.params", "T1 must be > 0"]),
+        ({"limit": ".inf"}, ["time_limit", "finite"]),
+        ({"limit": ".nan"}, ["time_limit", "finite"]),
+        ({"direction": ".inf"}, ["direction_deg", "finite"]),
+        ({"heading": ".nan"}, ["initial_state.heading_deg", "finite"]),
+    ],
+    ids=[
+        "late_event",
+        "K<0",
+        "K=0",
+        "T1=0",
+        "inf_limit",
+        "nan_limit",
+        "inf_current",
+        "nan_heading",
+    ],
+)
+def test_a_bad_scenario_number_is_named_before_the_episode(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], bad: dict, named: list[str]
+) -> None:
+    file = scenario_file(tmp_path, **bad)
+    out = tmp_path / "out"
+    assert main(["run", file, "pid_los", "--out", str(out)]) == 2
+    message = error_line(capsys, "run")
+    assert file in message
+    for text in named:
+        assert text in message
+    assert not out.exists()
+
+
+def test_scenarios_validate_names_every_problem_and_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = scenario_file(tmp_path, heading=".nan", limit=".inf", params="K: -1")
+    assert main(["scenarios", "--validate", bad, "rudder_aging"]) == 2
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert f"{bad}:2: key 'ship.params': Nomoto2Params.K must be > 0 (physical), got -1.0" in lines
+    assert f"{bad}:3: key 'initial_state.heading_deg': Input should be a finite number" in lines
+    assert f"{bad}:7: key 'time_limit': Input should be a finite number" in lines
+    assert "ok rudder_aging" in lines and len(lines) == 4
+    assert "Traceback" not in captured.err
+
+
+def test_scenarios_validate_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    bad = scenario_file(tmp_path, event=40.0)
+    assert main(["scenarios", "--validate", "nominal", bad, "--json"]) == 2
+    results = json.loads(capsys.readouterr().out)
+    assert [(r["file"], r["ok"]) for r in results] == [("nominal", True), (bad, False)]
+    assert results[0]["problems"] == []
+    (problem,) = results[1]["problems"]
+    assert problem.startswith("line 6: key 'events.0.time': event at 40.0 s")
+    assert main(["scenarios", "--validate", "nominal", "--json"]) == 0
+
+
+def test_a_manoeuvre_rudder_beyond_the_limit_is_an_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = ["--out", str(tmp_path / "m")]
+    assert main(["manoeuvre", "nomoto2", "turning", "--rudder", "35", *out]) == 2
+    assert error_line(capsys, "manoeuvre") == "rudder 35.0° is beyond the nomoto2 rudder limit ±30°"
+    assert main(["manoeuvre", "mariner", "zigzag", "--rudder", "-40", *out]) == 2
+    assert "beyond the mariner rudder limit ±34.38°" in error_line(capsys, "manoeuvre")
+    assert not (tmp_path / "m").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "command", "message"),
+    [
+        (["reproduce", "liu2019", "--seeds", "0"], "reproduce", "--seeds must be ≥ 1, got 0"),
+        (["bench", "env", "--repeats", "0"], "bench", "--repeats must be ≥ 1, got 0"),
+        (["bench", "training", "--repeats", "-1"], "bench", "--repeats must be ≥ 1, got -1"),
+        (["train", "ppo", "--timesteps", "0"], "train", "--timesteps must be ≥ 1, got 0"),
+    ],
+)
+def test_counts_below_one_are_refused(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    argv: list[str],
+    command: str,
+    message: str,
+) -> None:
+    out = ["--out", str(tmp_path / "out")] if command != "bench" else []
+    assert main([*argv, *out, *(["--no-progress"] if command == "reproduce" else [])]) == 2
+    assert error_line(capsys, command) == message
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "rudder_aging", "pid_los"],
+        ["reproduce", "liu2019", "--no-progress"],
+        ["manoeuvre", "nomoto2", "turning"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_an_unusable_out_is_refused_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str]
+) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    assert main([*argv, "--out", str(blocker)]) == 2
+    assert error_line(capsys, argv[0]) == f"--out {blocker} is a file, not a folder"
+    assert main([*argv, "--out", str(blocker / "below")]) == 2
+    assert f"{blocker} is a file" in error_line(capsys, argv[0])
+
+
+def test_run_refuses_a_folder_that_is_not_empty(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    assert main(["run", "rudder_aging", "zero_rudder", "--out", str(out)]) == 2
+    assert f"--out {out} is not empty" in error_line(capsys, "run")
+    assert main(["run", "rudder_aging", "zero_rudder", "--out", str(out), "--force"]) == 2
+    assert "notes.txt" in error_line(capsys, "run")  # --force removes only a run's files
+    assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_a_misspelt_hyperparameter_is_named_with_the_valid_ones(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = yaml.safe_load(Path("configs/agents/ppo.yaml").read_text())
+    config["hyperparams"]["n_step"] = config["hyperparams"].pop("n_steps")
+    file = tmp_path / "agent.yaml"
+    file.write_text(yaml.safe_dump(config))
+    out = tmp_path / "out"
+    assert main(["train", "ppo", "--config", str(file), "--out", str(out)]) == 2
+    message = error_line(capsys, "train")
+    assert f"{file}: key 'hyperparams': unknown hyperparameter 'n_step' of ppo" in message
+    assert "(did you mean 'n_steps'?)" in message
+    valid = message.split("valid for ppo: ")[1].split(", ")
+    assert {"n_steps", "batch_size", "gae_lambda", "clip_range"} <= set(valid)
+    assert "seed" not in valid  # set by the trainer
+    assert not out.exists()
+
+
+def test_a_hyperparameter_the_trainer_sets_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = yaml.safe_load(Path("configs/agents/sac.yaml").read_text())
+    config["hyperparams"]["seed"] = 3
+    file = tmp_path / "agent.yaml"
+    file.write_text(yaml.safe_dump(config))
+    assert main(["train", "sac", "--config", str(file), "--out", str(tmp_path / "o")]) == 2
+    assert "'seed' is set by the trainer" in error_line(capsys, "train")
+
+
+@pytest.mark.parametrize(
+    ("text", "named"),
+    [
+        ("name: s\nscenarios: [rudder_aging\ncontrollers: [pid_los]\n", ["line 3", "malformed"]),
+        ("name: s\nscenarios: [rudder_aging]\ncontrollers: [pid_los]\nseedz: 3\n", ["'seedz'"]),
+        ("name: s\nscenarios: [rudder_aging]\n", ["'controllers'", "required"]),
+        ("name: s\nscenarios: [rudder_aging]\ncontrollers: []\n", ["'controllers'", "at least 1"]),
+    ],
+    ids=["malformed", "unknown_key", "no_controllers", "empty_controllers"],
+)
+def test_a_bad_suite_is_named_with_file_and_key(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, named: list[str]
+) -> None:
+    suite = tmp_path / "suite.yaml"
+    suite.write_text(text)
+    out = tmp_path / "out"
+    assert main(["leaderboard", "--suite", str(suite), "--out", str(out), "--no-progress"]) == 2
+    message = error_line(capsys, "leaderboard")
+    assert str(suite) in message
+    for part in named:
+        assert part in message
+    assert not out.exists()

@@ -1,0 +1,110 @@
+"""``shipgym run SCENARIO CONTROLLER``: one episode, its metrics (text and ``--json``), its
+``metrics.json`` and track plot in ``--out``, the same episode as the evaluation loop's."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from baselines.cli import main
+from baselines.cli.run import default_out
+from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+
+#: wall-clock figures differ between two runs of the same episode
+TIMING = ("compute_ms", "compute_ms_max")
+
+
+def run_json(capsys: pytest.CaptureFixture[str], *argv: str) -> dict:
+    assert main(["run", *argv, "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err
+    return json.loads(captured.out)
+
+
+def test_json_is_the_episode_of_the_evaluation_loop(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    doc = run_json(capsys, "rudder_aging", "pid_los", "--seed", "3", "--out", str(out))
+    assert (doc["scenario"], doc["controller"], doc["kind"], doc["seed"]) == (
+        "rudder_aging",
+        "pid_los",
+        "classical",
+        3,
+    )
+    (reference,) = evaluate("pid_los", "rudder_aging", [3])
+    for key, value in reference.metrics.items():
+        if key not in TIMING and isinstance(value, float | int | bool | str):
+            assert doc[key] == value, key
+    assert doc["termination_reason"] == reference.metrics["termination_reason"]
+    assert json.loads((out / "metrics.json").read_text()) == doc
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "rudder_aging.png"]
+    assert (out / "rudder_aging.png").stat().st_size > 10_000
+
+
+def test_text_output_and_the_default_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "nominal", "zero_rudder"]) == 0
+    captured = capsys.readouterr()
+    rows = dict(line.split(maxsplit=1) for line in captured.out.splitlines())
+    assert rows["scenario"] == "nominal" and rows["seed"] == str(EVAL_SEED_OFFSET)
+    assert {"ace", "t_c", "return", "success", "termination_reason"} <= set(rows)
+    folder = Path("results/run") / f"nominal_zero_rudder_{EVAL_SEED_OFFSET}"
+    assert default_out("nominal", "zero_rudder", EVAL_SEED_OFFSET) == folder
+    assert (folder / "metrics.json").is_file() and (folder / "nominal.png").is_file()
+    assert str(folder) in captured.err
+
+
+def test_a_second_run_into_the_same_folder_needs_force(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = str(tmp_path / "out")
+    first = run_json(capsys, "nominal", "zero_rudder", "--out", out)
+    assert main(["run", "nominal", "pid_los", "--out", out]) == 2
+    assert "is not empty" in capsys.readouterr().err
+    assert json.loads((tmp_path / "out" / "metrics.json").read_text()) == first
+    second = run_json(capsys, "nominal", "pid_los", "--out", out, "--force")
+    assert second["controller"] == "pid_los"
+    assert json.loads((tmp_path / "out" / "metrics.json").read_text()) == second
+
+
+def test_default_folder_parts_are_file_names() -> None:
+    assert default_out("heldout:3", "runs/ppo/model", 7) == Path(
+        "results/run/heldout_3_runs_ppo_model_7"
+    )
+
+
+def test_a_scenario_file_runs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    file = Path("configs/scenarios/nominal.yaml").resolve()
+    doc = run_json(capsys, str(file), "zero_rudder", "--out", str(tmp_path / "out"))
+    assert doc["scenario"] == str(file)
+    assert (tmp_path / "out" / "nominal.png").is_file()
+
+
+def test_a_controller_that_does_not_apply_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    assert main(["run", "mariner_track", "nmpc", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "shipgym run: error: controller 'nmpc' does not apply to the mariner ship of "
+        "scenario 'mariner_track'\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [(["nosuch", "pid_los"], "unknown scenario 'nosuch'"), (["nominal", "nosuch"], "'nosuch'")],
+)
+def test_unknown_names_are_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], named: str
+) -> None:
+    assert main(["run", *argv, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and named in err

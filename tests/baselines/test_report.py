@@ -1,0 +1,100 @@
+"""``shipgym report`` and ``evaluate``'s folders (issue 12): separate runs merge into one
+table, equal to the leaderboard of the same controllers."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from baselines.cli import main
+from baselines.errors import RunError
+from baselines.report import write_report
+from baselines.runs import read_run
+from tests.baselines.test_runs import untimed, write_suite
+
+
+@pytest.fixture(scope="module")
+def evaluated(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """``evaluate pid_los`` and ``evaluate zero_rudder`` in their own folders, and the
+    leaderboard of both, on the tiny suite."""
+    root = tmp_path_factory.mktemp("runs")
+    suite = write_suite(root)
+    folders = {name: root / name for name in ("pid_los", "zero_rudder", "both")}
+    for policy in ("pid_los", "zero_rudder"):
+        args = ["evaluate", policy, "--suite", suite, "--out", str(folders[policy])]
+        assert main([*args, "--workers", "1", "--no-progress", "--json"]) == 0
+    args = ["leaderboard", "--suite", suite, "--out", str(folders["both"]), "--workers", "1"]
+    assert main([*args, "--no-progress", "--json"]) == 0
+    return folders
+
+
+def test_report_merges_two_evaluate_runs_into_the_leaderboard_table(
+    evaluated: dict[str, Path], tmp_path: Path, capsys
+) -> None:
+    capsys.readouterr()
+    out = tmp_path / "report"
+    runs = [str(evaluated["pid_los"]), str(evaluated["zero_rudder"])]
+    assert main(["report", *runs, "--out", str(out), "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    board = json.loads((evaluated["both"] / "leaderboard.json").read_text())
+    assert untimed(rows) == untimed(board)
+    assert untimed(json.loads((out / "leaderboard.json").read_text())) == untimed(board)
+    for name in ("leaderboard.md", "leaderboard.csv", "generalisation.json", "nominal.png"):
+        assert (out / name).is_file(), name
+    report = json.loads((out / "report.json").read_text())
+    assert [r["folder"] for r in report["runs"]] == runs
+    assert [r["episodes"] for r in report["runs"]] == [4, 4]
+
+
+def test_report_of_one_run_rebuilds_its_tables(evaluated: dict[str, Path], tmp_path) -> None:
+    rows, _ = write_report([evaluated["both"]], tmp_path / "again")
+    board = json.loads((evaluated["both"] / "leaderboard.json").read_text())
+    assert untimed(rows) == untimed(board)
+    for name in ("leaderboard.md", "leaderboard.csv", "generalisation.json"):  # same episodes
+        assert (tmp_path / "again" / name).read_text() == (evaluated["both"] / name).read_text()
+
+
+def test_report_refuses_runs_that_disagree(evaluated: dict[str, Path], tmp_path: Path) -> None:
+    other = tmp_path / "other"
+    other.mkdir()
+    record = read_run(evaluated["pid_los"])
+    record["suite"]["scenarios"]["nominal"]["ship"]["params"]["K"] *= 2
+    (other / "run.json").write_text(json.dumps(record))
+    (other / "episodes.jsonl").write_text("")
+    with pytest.raises(RunError, match=r"scenario 'nominal' has other settings.*ship\.params\.K"):
+        write_report([evaluated["zero_rudder"], other], tmp_path / "out")
+    with pytest.raises(RunError, match=r"is in .* and in"):  # the same episodes twice
+        write_report([evaluated["pid_los"], evaluated["both"]], tmp_path / "out")
+    with pytest.raises(RunError, match="one of the runs read"):
+        write_report([evaluated["both"]], evaluated["both"], force=True)
+    with pytest.raises(RunError, match="not empty"):
+        write_report([evaluated["both"]], evaluated["pid_los"])
+    with pytest.raises(RunError, match="not a run folder"):
+        write_report([tmp_path], tmp_path / "out2")
+    assert not (tmp_path / "out").exists()
+
+
+def test_evaluate_writes_a_folder_per_policy(tmp_path: Path, monkeypatch, capsys) -> None:
+    monkeypatch.chdir(tmp_path)
+    suite = write_suite(tmp_path, scenarios=["nominal"], seeds=1)
+    for policy in ("pid_los", "zero_rudder"):
+        assert main(["evaluate", policy, "--suite", suite, "--no-progress", "--json"]) == 0
+        assert read_run(tmp_path / "results" / "evaluate" / policy)["status"] == "complete"
+    capsys.readouterr()
+    assert main(["evaluate", "pid_los", "--suite", suite, "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "results/evaluate/pid_los is not empty" in err and "evaluate's folder" in err
+
+
+def test_report_writes_results_report_by_default_and_never_over_it(
+    evaluated: dict[str, Path], tmp_path: Path, monkeypatch, capsys
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", str(evaluated["both"]), "--json"]) == 0
+    assert (tmp_path / "results" / "report" / "leaderboard.json").is_file()
+    capsys.readouterr()
+    assert main(["report", str(evaluated["both"])]) == 2
+    assert "results/report is not empty" in capsys.readouterr().err
+    assert main(["report", str(evaluated["both"]), "--force", "--json"]) == 0

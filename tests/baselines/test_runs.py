@@ -1,0 +1,335 @@
+"""Run records (issue 12): run.json, episodes.jsonl, refusal of a used --out, --force,
+--resume, Ctrl-C; the train refusal."""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+import baselines.leaderboard
+from baselines.cli import main
+from baselines.errors import RunError
+from baselines.jsonout import dumps
+from baselines.leaderboard import run_leaderboard
+from baselines.runs import (
+    RunInterrupted,
+    check_out_dir,
+    clear_outputs,
+    read_episodes,
+    read_run,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+#: 2 scenarios × 2 controllers × 2 seeds: 8 quick episodes
+TINY = {
+    "name": "tiny",
+    "scenarios": ["nominal", "rudder_aging"],
+    "controllers": ["pid_los", "zero_rudder"],
+    "seeds": 2,
+}
+TIMING = ("compute_ms", "compute_ms_std", "compute_ms_max")
+
+
+def write_suite(folder: Path, **changes: object) -> str:
+    file = folder / "tiny.yaml"
+    file.write_text(yaml.safe_dump({**TINY, **changes}))
+    return str(file)
+
+
+def untimed(rows: list[dict]) -> list[dict]:
+    """Rows as leaderboard.json holds them, wall-clock timings aside."""
+    return [
+        {k: v for k, v in r.items() if not k.startswith(TIMING)} for r in json.loads(dumps(rows))
+    ]
+
+
+@pytest.fixture(scope="module")
+def clean_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The tiny suite run once, uninterrupted."""
+    root = tmp_path_factory.mktemp("clean")
+    run_leaderboard(write_suite(root), out_dir=root / "out", workers=1, show_progress=False)
+    return root / "out"
+
+
+def test_run_json_records_command_suite_versions_times_and_status(clean_run: Path) -> None:
+    record = read_run(clean_run)
+    assert isinstance(record["command"], list) and record["command"]
+    suite = record["suite"]
+    assert suite["seeds"] == [10_000, 10_001]
+    assert [c["name"] for c in suite["controllers"]] == ["pid_los", "zero_rudder"]
+    assert list(suite["scenarios"]) == ["nominal", "rudder_aging"]
+    aging = suite["scenarios"]["rudder_aging"]  # the scenario's resolved settings
+    assert aging["ship"]["model"] == "nomoto2" and aging["events"]
+    versions = record["versions"]
+    assert {"python", "numpy", "scipy", "gymnasium", "casadi", "shipgym"} <= set(versions)
+    assert versions["stable-baselines3"] and versions["torch"]  # installed here
+    commit = record["git_commit"]
+    assert commit is None or (len(commit) == 40 and int(commit, 16) >= 0)
+    start = datetime.datetime.fromisoformat(record["start_time"])
+    end = datetime.datetime.fromisoformat(record["end_time"])
+    assert start.utcoffset() == datetime.timedelta(0) and start <= end
+    assert record["status"] == "complete"
+    assert record["jobs"] == record["episodes"] == 8
+
+
+def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) -> None:
+    lines = (clean_run / "episodes.jsonl").read_text().splitlines()
+    assert len(lines) == 8
+    records = [json.loads(line) for line in lines]  # strict JSON, one object per line
+    keys = {(r["scenario"], r["controller"], r["seed"]) for r in records}
+    assert len(keys) == 8
+    for r in records:
+        assert {"scenario", "controller", "kind", "seed", "training_seed"} <= set(r)
+        assert r["training_seed"] is None  # classical controllers are not trained
+        assert {"ace", "ace_L", "t_c", "return", "success", "compute_ms", "steps"} <= set(r)
+    # never converged: t_c = inf is kept as "inf" and reads back as inf
+    never = [r for r in read_episodes(clean_run) if r["controller"] == "zero_rudder"]
+    assert all(r["t_c"] == float("inf") for r in never)
+
+
+def test_a_learned_episode_records_its_training_seed(tmp_path: Path) -> None:
+    suite = write_suite(tmp_path, scenarios=["nominal"], controllers=["ppo"], seeds=1)
+    run_leaderboard(suite, out_dir=tmp_path / "out", workers=1, show_progress=False)
+    (record,) = read_episodes(tmp_path / "out")
+    meta = json.loads((ROOT / "baselines/learned/policies/ppo/meta.json").read_text())
+    assert record["training_seed"] == meta["seed"] and record["kind"] == "learned"
+
+
+def test_each_episode_is_on_disk_when_it_ends(tmp_path: Path) -> None:
+    seen: list[int] = []
+
+    def count_lines(result: object) -> None:
+        seen.append(len(read_episodes(tmp_path / "out")))
+
+    run_leaderboard(
+        write_suite(tmp_path),
+        out_dir=tmp_path / "out",
+        workers=2,
+        show_progress=False,
+        on_episode=count_lines,
+    )
+    assert seen == list(range(1, 9))
+
+
+def test_a_used_out_is_refused_before_any_episode(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    start = time.perf_counter()
+    with pytest.raises(RunError, match=r"not empty.*--resume.*--force"):
+        run_leaderboard(write_suite(tmp_path), out_dir=out, show_progress=False)
+    assert time.perf_counter() - start < 1.0
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    code = main(["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--out {out} is not empty" in err
+
+
+def test_an_unusable_out_is_refused_first(tmp_path: Path, capsys) -> None:
+    file = tmp_path / "file"
+    file.write_text("")
+    for out, problem in ((file, "is a file"), (file / "below", f"{file} is a file")):
+        # checked before the (unknown) suite is even read
+        assert main(["leaderboard", "--suite", "no_such_suite", "--out", str(out)]) == 2
+        assert problem in capsys.readouterr().err
+    if os.geteuid() != 0:  # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        with pytest.raises(RunError, match="not writable"):
+            check_out_dir(locked / "out")
+
+
+def test_force_clears_the_earlier_outputs(tmp_path: Path, clean_run: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("old_scenario.png", "leaderboard.md", "episodes.jsonl", "run.json"):
+        (out / name).write_text("stale")
+    (out / "trajectories").mkdir()
+    (out / "trajectories" / "000099.npz").write_text("stale")
+    suite = write_suite(tmp_path)
+    rows = run_leaderboard(suite, out_dir=out, workers=1, show_progress=False, force=True)
+    assert not (out / "old_scenario.png").exists()
+    assert not (out / "trajectories" / "000099.npz").exists()
+    assert len(read_episodes(out)) == 8 and read_run(out)["status"] == "complete"
+    assert untimed(rows) == untimed(json.loads((clean_run / "leaderboard.json").read_text()))
+    # a file no run writes is never deleted: --force refuses to touch it
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(RunError, match=r"notes\.txt"):
+        run_leaderboard(suite, out_dir=out, show_progress=False, force=True)
+    assert (out / "run.json").is_file()
+
+
+def test_an_interrupted_run_resumes_to_the_clean_table(tmp_path: Path, clean_run: Path) -> None:
+    suite, out = write_suite(tmp_path), tmp_path / "out"
+
+    def stop_after_three(result: object, seen: list[int] = []) -> None:  # noqa: B006
+        seen.append(1)
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(RunInterrupted) as interrupted:
+        run_leaderboard(
+            suite, out_dir=out, workers=2, show_progress=False, on_episode=stop_after_three
+        )
+    assert str(interrupted.value) == (
+        f"3 of 8 episodes kept in {out / 'episodes.jsonl'}; resume with --resume"
+    )
+    assert read_run(out)["status"] == "interrupted" and len(read_episodes(out)) == 3
+    assert not (out / "leaderboard.json").exists()
+    ran: list[object] = []
+    rows = run_leaderboard(
+        suite, out_dir=out, workers=1, show_progress=False, resume=True, on_episode=ran.append
+    )
+    assert len(ran) == 5  # only the missing jobs
+    record = read_run(out)
+    assert record["status"] == "complete" and record["episodes"] == 8
+    assert len(record["resumed"]) == 1
+    clean = json.loads((clean_run / "leaderboard.json").read_text())
+    assert untimed(json.loads((out / "leaderboard.json").read_text())) == untimed(clean)
+    assert untimed(rows) == untimed(clean)
+    assert sorted(p.name for p in out.glob("*.png")) == sorted(
+        p.name for p in clean_run.glob("*.png")
+    )
+
+
+def test_resume_with_a_changed_suite_is_refused(tmp_path: Path, clean_run: Path) -> None:
+    with pytest.raises(RunError, match=r"suite differs.*seeds: \[10000, 10001\] in the run"):
+        run_leaderboard(
+            write_suite(tmp_path), seeds=1, out_dir=clean_run, show_progress=False, resume=True
+        )
+    changed = write_suite(tmp_path, scenarios=["nominal", "current_shift"])
+    with pytest.raises(RunError, match=r"scenarios\.rudder_aging only in the run"):
+        run_leaderboard(changed, out_dir=clean_run, show_progress=False, resume=True)
+    with pytest.raises(RunError, match="no run to resume"):
+        run_leaderboard(changed, out_dir=tmp_path / "new", show_progress=False, resume=True)
+    assert read_run(clean_run)["status"] == "complete"
+
+
+def test_a_killed_run_keeps_its_episodes_and_resumes(tmp_path: Path, clean_run: Path) -> None:
+    """A line cut short by a kill is dropped on resume; the rest are kept."""
+    out = tmp_path / "out"
+    out.mkdir()
+    lines = (clean_run / "episodes.jsonl").read_text().splitlines(keepends=True)
+    (out / "episodes.jsonl").write_text("".join(lines[:4]) + lines[4][:30])
+    (out / "run.json").write_text((clean_run / "run.json").read_text())
+    assert len(read_episodes(out)) == 4
+    ran: list[object] = []
+    run_leaderboard(
+        write_suite(tmp_path),
+        out_dir=out,
+        workers=1,
+        show_progress=False,
+        resume=True,
+        on_episode=ran.append,
+    )
+    assert len(ran) == 4 and len(read_episodes(out)) == 8
+
+
+def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> None:
+    calls: list[object] = []
+    real = baselines.leaderboard.run_job
+
+    def third_is_interrupted(job: tuple) -> object:
+        calls.append(job)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(job)
+
+    monkeypatch.setattr(baselines.leaderboard, "run_job", third_is_interrupted)
+    out = tmp_path / "out"
+    args = ["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out), "--workers", "1"]
+    assert main([*args, "--no-progress"]) == 130
+    assert capsys.readouterr().err == (
+        f"shipgym leaderboard: interrupted: 2 of 8 episodes kept in {out / 'episodes.jsonl'}; "
+        "resume with --resume\n"
+    )
+    assert read_run(out)["command"] == ["shipgym", *args, "--no-progress"]
+
+
+def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
+    """A scenario given by its YAML path is plotted as ``<stem>.png`` inside --out, never
+    beside the scenario file."""
+    cases = tmp_path / "cases"
+    cases.mkdir()
+    (cases / "my_case.yaml").write_text((ROOT / "configs/scenarios/nominal.yaml").read_text())
+    suite = write_suite(tmp_path, scenarios=["cases/my_case.yaml"], controllers=["pid_los"])
+    out = tmp_path / "out"
+    run_leaderboard(suite, seeds=1, out_dir=out, workers=1, show_progress=False)
+    assert (out / "my_case.png").is_file()
+    assert sorted(p.name for p in cases.iterdir()) == ["my_case.yaml"]
+
+
+def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> None:
+    calls: list[object] = []
+    real = baselines.leaderboard.run_job
+
+    def second_fails(job: tuple) -> object:
+        calls.append(job)
+        if len(calls) == 2:
+            raise RuntimeError("a bug in a controller")
+        return real(job)
+
+    monkeypatch.setattr(baselines.leaderboard, "run_job", second_fails)
+    out = tmp_path / "out"
+    with pytest.raises(RuntimeError, match="a bug"):  # a bug keeps its traceback
+        run_leaderboard(write_suite(tmp_path), out_dir=out, workers=1, show_progress=False)
+    record = read_run(out)
+    assert record["status"] == "failed" and record["error"] == "RuntimeError: a bug in a controller"
+    assert record["episodes"] == len(read_episodes(out)) == 1
+
+
+def test_sigint_stops_the_workers_without_tracebacks(tmp_path: Path) -> None:
+    """A real Ctrl-C (SIGINT to the process group, as a terminal sends it) with 2 workers."""
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "baselines.cli", "leaderboard", "--suite", "smoke"]
+    command += ["--seeds", "1", "--out", str(out), "--workers", "2", "--no-progress"]
+    process = subprocess.Popen(
+        command,
+        cwd=ROOT,
+        stderr=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        text=True,
+        start_new_session=True,
+    )
+    deadline = time.monotonic() + 120
+    while not ((out / "run.json").is_file() and read_episodes(out)):  # an episode ended
+        assert process.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130
+    assert "Traceback" not in err and err.count("\n") == 1, err
+    assert err.startswith("shipgym leaderboard: interrupted: ") and "resume with --resume" in err
+    record = read_run(out)
+    assert record["status"] == "interrupted" and record["episodes"] == len(read_episodes(out))
+
+
+def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
+    from baselines.learned.train import TRAINING_OUTPUTS, train
+
+    out = tmp_path / "agent"
+    out.mkdir()
+    (out / "model.zip").write_text("an earlier run")
+    assert main(["train", "ppo", "--out", str(out), "--timesteps", "64", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"--out {out} is not empty" in err and "agent folder of ppo" in err
+    with pytest.raises(RunError, match="not empty"):
+        train("ppo", out_dir=out, n_timesteps=64, progress=False)
+    assert sorted(p.name for p in out.iterdir()) == ["model.zip"]
+    # --force clears only what training writes
+    (out / "checkpoints").mkdir()
+    clear_outputs(out, TRAINING_OUTPUTS)
+    assert not any(out.iterdir())
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(RunError, match=r"notes\.txt"):
+        train("ppo", out_dir=out, n_timesteps=64, progress=False, force=True)

@@ -1,0 +1,248 @@
+"""Scenario distributions: every ship in training, its own jumps and timing, the splits."""
+
+from __future__ import annotations
+
+import collections
+import itertools
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from baselines.evaluation import run_episode
+from baselines.registry import make_controller
+from shipgym.models import MODELS
+from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.sampling import (
+    DistributionConfig,
+    DistributionError,
+    ScenarioDistribution,
+    load_distribution,
+    train_rng,
+)
+
+SHIPS = ("nomoto2", "esso_osaka", "mariner", "blanke")
+DISTRIBUTIONS = Path(__file__).resolve().parents[3] / "configs/distributions"
+
+
+def _train_draws(n: int = 400) -> list[Any]:
+    train = load_distribution("train")
+    return [train.sample(train_rng(seed)) for seed in range(n)]
+
+
+def _legs(waypoints: list[tuple[float, float]]) -> float:
+    """Length of a polyline through the waypoints [m]."""
+    return sum(math.dist(a, b) for a, b in itertools.pairwise(waypoints))
+
+
+def _distribution(data: dict[str, Any]) -> ScenarioDistribution:
+    return ScenarioDistribution(DistributionConfig.model_validate(data))
+
+
+def _raw(name: str) -> dict[str, Any]:
+    return yaml.safe_load((DISTRIBUTIONS / f"{name}.yaml").read_text())
+
+
+def test_training_covers_every_ship_with_about_equal_env_steps() -> None:
+    """All four ships are drawn; the weights give each ≈ a quarter of the env steps (the
+    nominal steps of a route: its length / (U·Ts))."""
+    steps: collections.Counter[str] = collections.Counter()
+    for config in _train_draws():
+        sc = build_scenario(config, config.name)
+        route = _legs(config.path.waypoints)
+        steps[config.ship.model] += route / (sc.model.nominal_speed * sc.control_period)
+    assert set(steps) == set(SHIPS)
+    shares = {ship: steps[ship] / sum(steps.values()) for ship in SHIPS}
+    assert all(0.15 < share < 0.35 for share in shares.values()), shares
+
+
+def test_a_sampled_scenario_has_its_ships_timing_scale_and_jumps() -> None:
+    """Ts and h are the model's; waypoints scale with the ship length; each ship's jumps
+    change its own parameters (nomoto2 d0 shift; a current appearing on the others)."""
+    kinds: dict[str, set[str]] = collections.defaultdict(set)
+    for config in _train_draws():
+        sc = build_scenario(config, config.name)
+        model = MODELS[config.ship.model]
+        assert (sc.control_period, sc.fine_step) == (model.control_period, model.fine_step)
+        first = np.array(config.path.waypoints[0])
+        assert first[0] == pytest.approx(sc.model.length, rel=1e-3)  # 1 L ahead
+        assert abs(first[1]) <= 3.0 * sc.model.length + 1e-3
+        for event in config.events:
+            assert set(event.params) <= set(model.params_type.names())
+            kinds[config.ship.model].add(",".join(sorted(event.params)))
+        if config.disturbances.current.kind == "two_phase":
+            kinds[config.ship.model].add("current")
+    assert kinds["nomoto2"] == {"Tc", "d0", "K,T1"}
+    assert kinds["esso_osaka"] == {"T_servo", "Nd,Yd", "current"}
+    assert kinds["mariner"] == {"T_delta", "a3", "current"}
+    assert kinds["blanke"] == {"T_delta", "dCL", "current"}
+
+
+def test_a_current_shift_is_a_calm_then_appearing_current_within_the_time_limit() -> None:
+    shifts = [c for c in _train_draws() if c.disturbances.current.kind == "two_phase"]
+    assert shifts
+    for config in shifts:
+        current = config.disturbances.current
+        assert current.speed == 0.0 and current.sigma == 0.0
+        assert 0.0 < current.second_speed < 0.5 * MODELS[config.ship.model]().nominal_speed
+        assert current.switch_time < config.time_limit
+        assert config.events == []
+
+
+def test_time_limits_allow_for_the_current_against_the_route() -> None:
+    """time limit ≥ time_factor · route / (U − current speed): a current never makes the
+    route impossible in time."""
+    train = load_distribution("train").config
+    for config in _train_draws(200):
+        ship = next(s for s in train.ships if s.model == config.ship.model)
+        path = ship.path or train.path
+        current = config.disturbances.current
+        speed = max(current.speed, getattr(current, "second_speed", 0.0))
+        model = build_scenario(config, config.name).model
+        route = model.length + _legs(config.path.waypoints)  # + the 1 L approach
+        limit = path.time_factor * route / (model.nominal_speed - speed) + ship.time_margin
+        assert config.time_limit >= limit * (1 - 1e-4)
+
+
+def test_linked_jump_moves_both_rudder_derivatives_by_one_factor() -> None:
+    nominal = MODELS["esso_osaka"].params_type()
+    seen = 0
+    for config in _train_draws():
+        for event in config.events:
+            if "Yd" in event.params:
+                base = config.ship.params
+                assert event.params["Yd"] / base["Yd"] == pytest.approx(
+                    event.params["Nd"] / base["Nd"], rel=1e-12
+                )
+                seen += 1
+        if config.ship.model == "esso_osaka":
+            # factors on parameters not listed start from the model's defaults
+            assert 0.8 <= config.ship.params["Nr"] / nominal.Nr <= 1.25
+    assert seen
+
+
+def test_heldout_interleaves_the_ships_and_keeps_the_one_ship_scenarios() -> None:
+    """heldout:0-3 are one scenario per ship; adding ships to a test split leaves the first
+    ship's scenarios as they were (same seeds), only their names move."""
+    heldout = load_distribution("heldout")
+    assert len(heldout) == 21
+    assert [heldout.test_scenario(i).ship.model for i in range(4)] == list(SHIPS)
+    counts = collections.Counter(heldout.test_scenario(i).ship.model for i in range(21))
+    assert counts == {"nomoto2": 12, "esso_osaka": 3, "mariner": 3, "blanke": 3}
+    raw = _raw("heldout")
+    one_ship = {**raw, "ships": [{**raw["ships"][0], "count": 4}]}
+    alone = _distribution(one_ship)
+    for j, index in enumerate([0, 4, 8, 12]):  # nomoto2's j-th scenario in the mixed split
+        a, b = alone.test_scenario(j).model_dump(), heldout.test_scenario(index).model_dump()
+        a.pop("name"), b.pop("name")
+        if a["disturbances"]["current"]["speed"] == 0.0:
+            assert a == b
+        else:  # only the time limit may differ (U − current since the mixed split)
+            assert {k for k in a if a[k] != b[k]} <= {"time_limit"}
+
+
+def test_heldout_other_ships_have_one_scenario_of_each_outside_kind() -> None:
+    """order: cycle — the three held-out scenarios of each other ship cover its three jump
+    kinds, each outside the training range."""
+    heldout, train = load_distribution("heldout"), load_distribution("train").config
+    by_ship: dict[str, list[Any]] = collections.defaultdict(list)
+    for i in range(len(heldout)):
+        config = heldout.test_scenario(i)
+        by_ship[config.ship.model].append(config)
+    for ship in SHIPS[1:]:
+        trained = next(s for s in train.ships if s.model == ship).jumps.kinds
+        aging = next(iter(trained["rudder_aging"].params))
+        gain = next(iter(trained["gain_change"].params))
+        defaults = MODELS[ship].params_type().as_dict()
+        max_aging = max(trained["rudder_aging"].params[aging].range) * defaults[aging]
+        min_gain = min(trained["gain_change"].params[gain].range)
+        max_current = max(trained["current_shift"].current.speed)
+        outside = []
+        for config in by_ship[ship]:
+            if config.disturbances.current.kind == "two_phase":
+                outside.append(config.disturbances.current.second_speed > max_current)
+            else:
+                (event,) = config.events
+                if aging in event.params:
+                    outside.append(event.params[aging] > max_aging)
+                else:
+                    base = config.ship.params[gain]
+                    outside.append(event.params[gain] / base < min_gain)
+        assert outside == [True, True, True], ship
+
+
+def test_validation_is_the_training_ranges_in_the_test_seed_space() -> None:
+    validation, train = load_distribution("validation"), load_distribution("train")
+    assert validation.split == "test" and len(validation) == 8
+    assert validation.config.path == train.config.path
+    for v, t in zip(validation.config.ships, train.config.ships, strict=True):
+        assert v.count == 2
+        assert v.model_dump(exclude={"weight", "count"}) == t.model_dump(
+            exclude={"weight", "count"}
+        )
+    assert [validation.test_scenario(i).ship.model for i in range(4)] == list(SHIPS)
+
+
+def test_pid_los_finishes_every_validation_scenario() -> None:
+    """Feasibility: every ship's in-range scenarios can be finished in their time limits."""
+    validation = load_distribution("validation")
+    for name in validation.test_names():
+        policy, mode = make_controller("pid_los")
+        result = run_episode(policy, load_scenario(name), 0, mode)
+        assert result.metrics["termination_reason"] == "goal", name
+
+
+@pytest.mark.parametrize(
+    ("edit", "key"),
+    [
+        (lambda d: d["ships"][1]["current"].update(speed=[0.0, 0.5]), "ships.1.current.speed"),
+        (
+            lambda d: d["ships"][2]["jumps"]["kinds"]["gain_change"]["params"]["a3"].update(
+                range=[-1.0, 1.5]
+            ),
+            "ships.2.jumps.kinds.gain_change.params",
+        ),
+        (lambda d: d["ships"][0].update(count=3), "ships.0.count"),
+        (lambda d: d["ships"][3]["jumps"].update(time=[27.0, 300.0]), "ships.3.jumps.time"),
+        (lambda d: d["ships"][3]["jumps"].update(order="cycle"), "ships.3.jumps.order"),
+        (lambda d: d["ships"][1]["param_factors"].update(Nx=[0.9, 1.1]), "param_factors.Nx"),
+    ],
+)
+def test_bad_training_distribution_names_the_key(edit: Any, key: str, tmp_path: Path) -> None:
+    data = _raw("train")
+    edit(data)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    with pytest.raises(DistributionError, match=key.replace(".", r"\.")):
+        load_distribution(bad)
+
+
+def test_a_test_split_with_several_ships_needs_their_counts(tmp_path: Path) -> None:
+    data = _raw("heldout")
+    del data["ships"][2]["count"]
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    with pytest.raises(DistributionError, match=r"ships\.2\.count"):
+        load_distribution(bad)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("split: test\nranges_of: validation\ncount_per_ship: 1\n", "is not a train split"),
+        ("split: train\nranges_of: train\ncount_per_ship: 1\n", "only a test split"),
+        ("split: test\nranges_of: train\n", "count_per_ship"),
+        ("split: test\nranges_of: train\ncount_per_ship: 1\npath: {}\n", "path: comes from"),
+    ],
+)
+def test_ranges_of_takes_a_train_splits_ranges_only(
+    text: str, message: str, tmp_path: Path
+) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\n" + text)
+    with pytest.raises(DistributionError, match=message):
+        load_distribution(bad)
