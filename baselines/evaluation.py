@@ -1,16 +1,21 @@
-"""The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9)."""
+"""The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9).
+
+:func:`run_episode` runs one episode; :func:`evaluate_batch` runs several (a learned
+policy's in lockstep, one network forward per step for all, with the same bits).
+"""
 
 from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
+from baselines.errors import ControllerError
 from baselines.plugins import ControllerEntry, ControllerSpec
 from baselines.policy import Policy
 from baselines.registry import make_controller
@@ -43,6 +48,49 @@ class EpisodeResult:
         }
 
 
+class _Episode:
+    """One env's episode as the evaluation loop runs it: made and reset with ``seed``, then
+    stepped with the policy's actions and the time each took, then its result."""
+
+    def __init__(self, env_id: str, scenario: Any, seed: int, action_mode: str) -> None:
+        self.env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+        self.seed = seed
+        try:
+            self.obs, self.info = self.env.reset(seed=seed)
+        except BaseException:
+            self.env.close()
+            raise
+        self.base = self.env.unwrapped
+        self.rows: list[tuple[float, ...]] = [_traj_row(self.info)]
+        self.act_times: list[float] = []
+        self.done = False
+
+    def step(self, action: np.ndarray, act_time: float) -> None:
+        """Step with ``action``, which took the policy ``act_time`` [s]."""
+        self.act_times.append(act_time)
+        self.obs, _reward, terminated, truncated, self.info = self.env.step(action)
+        self.rows.append(_traj_row(self.info))
+        self.done = terminated or truncated
+
+    def result(self, policy: Policy) -> EpisodeResult:
+        metrics = dict(self.info["episode_metrics"])
+        metrics["termination_reason"] = self.info.get("termination_reason")
+        metrics.update(compute_time_metrics(self.act_times))
+        stats = getattr(policy, "episode_stats", None)
+        if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
+            metrics.update(stats())
+        traj = np.array(self.rows)
+        return EpisodeResult(
+            controller=policy.name,
+            kind=policy.kind,
+            scenario=self.base.scenario.name,
+            seed=self.seed,
+            metrics=metrics,
+            trajectory={k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)},
+            training_seed=training_seed(policy),
+        )
+
+
 def run_episode(
     policy: Policy,
     scenario: Any,
@@ -61,42 +109,98 @@ def run_episode(
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
-    env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+    episode = _Episode(env_id, scenario, seed, action_mode)
     try:
-        obs, info = env.reset(seed=seed)
-        base = env.unwrapped
-        policy.reset(base.controller_context, seed=seed)
-        act_times: list[float] = []
-        rows: list[tuple[float, ...]] = [_traj_row(info)]
-        while True:
+        policy.reset(episode.base.controller_context, seed=seed)
+        while not episode.done:
             start = time.perf_counter()
-            action = policy.act(obs, info)
-            act_times.append(time.perf_counter() - start)
-            obs, _reward, terminated, truncated, info = env.step(action)
-            rows.append(_traj_row(info))
-            if terminated or truncated:
-                break
-        metrics = dict(info["episode_metrics"])
-        metrics["termination_reason"] = info.get("termination_reason")
-        metrics.update(compute_time_metrics(act_times))
-        stats = getattr(policy, "episode_stats", None)
-        if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
-            metrics.update(stats())
+            action = policy.act(episode.obs, episode.info)
+            episode.step(action, time.perf_counter() - start)
+        result = episode.result(policy)
         if after_episode is not None:
-            after_episode(base)
-        traj = np.array(rows)
-        trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
-        return EpisodeResult(
-            controller=policy.name,
-            kind=policy.kind,
-            scenario=base.scenario.name,
-            seed=seed,
-            metrics=metrics,
-            trajectory=trajectory,
-            training_seed=training_seed(policy),
-        )
+            after_episode(episode.base)
+        return result
     finally:
-        env.close()
+        episode.env.close()
+
+
+@runtime_checkable
+class BatchPolicy(Policy, Protocol):
+    """A policy that acts for several episodes in lockstep (a learned policy: one network
+    forward for all), each action the one ``act`` would give in that episode alone."""
+
+    def reset_batch(self, contexts: Sequence[Any]) -> None: ...
+
+    def act_batch(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray: ...
+
+
+def evaluate_batch(
+    controller: ControllerSpec | Policy,
+    scenarios: Any,
+    seeds: Sequence[int],
+    training_seed: int | None = None,
+    action_mode: str | None = None,
+    env_id: str = ENV_ID,
+) -> list[EpisodeResult]:
+    """The episodes of ``seeds``, the i-th on ``scenarios[i]`` (a list, one scenario per
+    seed: e.g. each seed's trial variant) or all on one scenario; equal, bit for bit, to
+    :func:`run_episode` one by one (compute times aside).
+
+    ``controller``: a name, spec or long form (made with ``training_seed``, one of
+    :func:`~baselines.registry.training_seeds`; None: a learned policy's first) or a Policy
+    instance.  A :class:`BatchPolicy` (learned policies) runs all episodes in lockstep, one
+    ``act_batch`` for the live envs per step; its ``compute_ms`` / ``compute_ms_max`` [ms]
+    are the mean and maximum over an episode's steps of that call's time divided by the
+    number of envs it acted for.  Any other controller runs the episodes one by one (made
+    afresh per episode from a spec, as :func:`evaluate` does).
+    """
+    seeds = list(seeds)
+    per_seed = list(scenarios) if isinstance(scenarios, list | tuple) else [scenarios] * len(seeds)
+    if len(per_seed) != len(seeds):
+        raise ValueError(f"{len(per_seed)} scenarios for {len(seeds)} seeds: give one per seed")
+    made = isinstance(controller, str | ControllerEntry)
+    if made:
+        policy, mode = make_controller(controller, training_seed=training_seed)
+    elif training_seed is not None:
+        raise ControllerError(
+            f"training_seed={training_seed}: a Policy instance is one trained agent; give the "
+            "controller by name to choose its training seed"
+        )
+    else:
+        policy, mode = controller, None
+    mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
+    if isinstance(policy, BatchPolicy):
+        return _run_lockstep(policy, per_seed, seeds, mode, env_id)
+    results = []
+    for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
+        if made and i > 0:
+            policy, _ = make_controller(controller, training_seed=training_seed)
+        results.append(run_episode(policy, scenario, seed, mode, env_id))
+    return results
+
+
+def _run_lockstep(
+    policy: BatchPolicy, scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str
+) -> list[EpisodeResult]:
+    """:func:`evaluate_batch` for a :class:`BatchPolicy`: every env steps in lockstep."""
+    episodes: list[_Episode] = []
+    try:
+        for scenario, seed in zip(scenarios, seeds, strict=True):
+            episodes.append(_Episode(env_id, scenario, seed, action_mode))
+        policy.reset_batch([e.base.controller_context for e in episodes])
+        live = [i for i, e in enumerate(episodes) if not e.done]
+        while live:
+            obs = np.stack([episodes[i].obs for i in live])
+            start = time.perf_counter()
+            actions = policy.act_batch(obs, live)
+            share = (time.perf_counter() - start) / len(live)
+            for i, action in zip(live, actions, strict=True):
+                episodes[i].step(action, share)
+            live = [i for i in live if not episodes[i].done]
+        return [e.result(policy) for e in episodes]
+    finally:
+        for e in episodes:
+            e.env.close()
 
 
 def training_seed(policy: Policy) -> int | None:

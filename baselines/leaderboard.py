@@ -1,38 +1,60 @@
 """The leaderboard: every controller on every suite scenario × seeds, one table (SPEC §9).
 
-Jobs are independent (controller, scenario, seed) tasks.  ``local`` runs them in a process
-pool; ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+Each evaluation seed runs its own trial of a scenario: the suite's ``randomize`` ranges
+(:mod:`shipgym.scenarios.trials`) draw the start, the jump time and the current from the
+seed, and the sensor noise varies with it too.  A learned agent runs once per training seed
+(:func:`baselines.registry.training_seeds`), so its row aggregates training seeds ×
+evaluation seeds.
+
+The work is cut into jobs (:class:`Job`, names and seeds only: the worker builds each
+seed's trial): a classical controller's job is one (scenario, seed) episode; a learned
+agent's is one training seed on one scenario for all the evaluation seeds, evaluated
+batched (:func:`baselines.evaluation.evaluate_batch`: one network forward per step for all
+seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
+``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`baselines.runs`: ``run.json``,
-``episodes.jsonl``), and the tables are aggregated from that record.
+``episodes.jsonl``), and every table is aggregated from that record: the rows with
+``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`baselines.ranking`),
+``scenario_scores.json``, the figures.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import functools
 import math
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterable, Iterator, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from contextlib import closing
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from tqdm import tqdm
 
+from baselines import evaluation
 from baselines.errors import BackendError, RunError, check_seeds
-from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, evaluate
+from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
+from baselines.figures import median_ace_episode
 from baselines.jsonout import dumps
-from baselines.registry import applies_to, controller_kind, controller_label
+from baselines.plugins import ControllerSpec
+from baselines.ranking import SCORE_ONE, SCORE_ZERO, aggregate_ranking, row_intervals
+from baselines.ranking import scenario_scores as score_table
+from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
 from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
+from baselines.style import FIGURE_DPI, controller_style
 from baselines.suite import load_suite
 from shipgym.config import is_path
 from shipgym.metrics import aggregate
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 
-#: metric columns aggregated over seeds (mean and *_std)
+#: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
 COLUMNS = (
     "ace",
     "ace_L",
@@ -46,9 +68,12 @@ COLUMNS = (
     "max_abs_cross_track",
 )
 
-
-#: training-cost columns, present for learned agents only
+#: training-cost columns, present for learned agents only (mean and std over training seeds)
 TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
+
+AGGREGATE_FILE = "aggregate.json"
+PROB = f"prob_improvement_over_{SCORE_ONE}"
+SCENARIO_SCORES_FILE = "scenario_scores.json"
 
 
 def check_controllers(names: list[str]) -> list[str]:
@@ -69,13 +94,80 @@ def scenario_split(scenario: str) -> str:
     return "heldout" if scenario.startswith("heldout:") else "catalogue"
 
 
-def run_job(job: tuple[str, str, int]) -> EpisodeResult:
-    """One (controller, scenario, seed) episode; top-level so process pools can pickle it."""
-    controller, scenario, seed = job
-    result = evaluate(controller, scenario, [seed])[0]
-    result.controller = controller_label(controller)
-    result.scenario = scenario  # as the suite names it (a YAML path stays a path)
-    return result
+# --- jobs ------------------------------------------------------------------------------------
+
+
+class Job(NamedTuple):
+    """One unit of work: a controller (trained with ``training_seed``; None: not trained)
+    on the trials of scenario ``scenario`` (a name as the suite gives it) that ``seeds``
+    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials)."""
+
+    controller: ControllerSpec
+    scenario: str
+    seeds: tuple[int, ...]
+    training_seed: int | None = None
+    randomize: dict[str, Any] | None = None
+
+
+@functools.lru_cache(maxsize=128)
+def _cached_scenario(name: str, _stamp: tuple[int, int] | None) -> Scenario:
+    return load_scenario(name)
+
+
+def suite_scenario(name: str) -> Scenario:
+    """A suite's scenario, loaded once per process (a YAML file again when it changed)."""
+    stamp = None
+    if is_path(name):
+        stat = Path(name).stat()
+        stamp = (stat.st_mtime_ns, stat.st_size)
+    return _cached_scenario(name, stamp)
+
+
+def trials(job: Job) -> list[Scenario]:
+    """The job's scenario as each of its seeds draws it (the scenario itself without
+    randomisation)."""
+    base = suite_scenario(job.scenario)
+    randomization = None if job.randomize is None else TrialRandomization(**job.randomize)
+    return [trial_scenario(base, randomization, seed) for seed in job.seeds]
+
+
+def _named(results: list[EpisodeResult], job: Job) -> list[EpisodeResult]:
+    """``results`` under the table name and the suite's scenario name (a YAML path stays a
+    path), with the job's training seed."""
+    label = controller_label(job.controller)
+    for result in results:
+        result.controller = label
+        result.scenario = job.scenario
+        if job.training_seed is not None:
+            result.training_seed = job.training_seed
+    return results
+
+
+def run_job(job: tuple) -> EpisodeResult:
+    """One episode ``(controller, scenario, seed[, training_seed[, randomize]])`` (see
+    :class:`Job`); top-level so process pools can pickle it."""
+    one = Job(job[0], job[1], (int(job[2]),), *job[3:])
+    (trial,) = trials(one)
+    seeds = list(one.seeds)
+    result = evaluation.evaluate(one.controller, trial, seeds, training_seed=one.training_seed)
+    return _named(result, one)[0]
+
+
+def run_batch(job: Job) -> list[EpisodeResult]:
+    """The job's episodes, all seeds at once (:func:`baselines.evaluation.evaluate_batch`),
+    in the order of ``job.seeds``."""
+    results = evaluation.evaluate_batch(
+        job.controller, trials(job), list(job.seeds), training_seed=job.training_seed
+    )
+    return _named(list(results), job)
+
+
+def work(job: Job) -> list[EpisodeResult]:
+    """A job's episodes: a single seed through :func:`run_job`, several through
+    :func:`run_batch`."""
+    if len(job.seeds) == 1:
+        return [run_job((job.controller, job.scenario, job.seeds[0], *job[3:]))]
+    return run_batch(job)
 
 
 def _quiet_worker() -> None:
@@ -83,15 +175,15 @@ def _quiet_worker() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _iter_local(jobs: list, workers: int) -> Iterator[EpisodeResult]:
+def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
     """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes)."""
     if workers <= 1:
         for job in jobs:
-            yield run_job(job)
+            yield work(job)
         return
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker)
     try:
-        for fut in as_completed([pool.submit(run_job, j) for j in jobs]):
+        for fut in as_completed([pool.submit(work, j) for j in jobs]):
             yield fut.result()
     except BaseException:  # Ctrl-C, a failed job, or the consumer stopped: stop the workers
         workers_running = list((pool._processes or {}).values())  # shutdown forgets them
@@ -102,14 +194,14 @@ def _iter_local(jobs: list, workers: int) -> Iterator[EpisodeResult]:
     pool.shutdown()
 
 
-def _iter_ray(jobs: list) -> Iterator[EpisodeResult]:
+def _iter_ray(jobs: list[Job]) -> Iterator[list[EpisodeResult]]:
     try:
         import ray
     except ImportError as exc:
         raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
     if not ray.is_initialized():
         ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
-    remote = ray.remote(run_job)
+    remote = ray.remote(work)
     pending = [remote.remote(j) for j in jobs]
     try:
         while pending:
@@ -121,8 +213,9 @@ def _iter_ray(jobs: list) -> Iterator[EpisodeResult]:
         raise
 
 
-def iter_results(jobs: list, backend: str, workers: int) -> Iterator[EpisodeResult]:
-    """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), in completion order."""
+def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[EpisodeResult]]:
+    """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), job by job in completion
+    order."""
     if backend == "local":
         return _iter_local(jobs, workers)
     if backend == "ray":
@@ -130,29 +223,37 @@ def iter_results(jobs: list, backend: str, workers: int) -> Iterator[EpisodeResu
     raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
 
 
-def _job_key(job: tuple[str, str, int]) -> tuple[str, str, int]:
-    """(scenario, table name, seed): the key of the job's record in ``episodes.jsonl``."""
-    controller, scenario, seed = job
-    return (scenario, controller_label(controller), seed)
+def _result_key(result: EpisodeResult) -> tuple[str, str, int, int | None]:
+    """(scenario, table name, seed, training seed): the episode's key in ``episodes.jsonl``."""
+    return (result.scenario, result.controller, int(result.seed), result.training_seed)
 
 
 def suite_record(
-    spec: Any, names: list[str], scenarios: Mapping[str, Any], seed_list: list[int]
+    spec: Any,
+    names: list[ControllerSpec],
+    scenarios: Mapping[str, Scenario],
+    seed_list: list[int],
+    seeds_of: Mapping[str, list[int | None]],
 ) -> dict[str, Any]:
-    """The resolved suite as ``run.json`` keeps it: seeds, controllers (table name, how the
-    suite names it, kind), each scenario's settings and the pairs that do not apply."""
+    """The resolved suite as ``run.json`` keeps it: evaluation seeds, the trial
+    randomisation, controllers (table name, how the suite names it, kind, training seeds),
+    each scenario's settings and the pairs that do not apply."""
     ships = {s: sc.model.name for s, sc in scenarios.items()}
-    controllers = [
-        {
-            "name": controller_label(c),
-            "controller": c if isinstance(c, str) else c.model_dump(),  # the long form
-            "kind": controller_kind(controller_label(c)),
-        }
-        for c in names
-    ]
+    controllers = []
+    for c in names:
+        label = controller_label(c)
+        controllers.append(
+            {
+                "name": label,
+                "controller": c if isinstance(c, str) else c.model_dump(),  # the long form
+                "kind": controller_kind(label),
+                "training_seeds": list(seeds_of[label]),
+            }
+        )
     return {
         "name": spec.name,
         "seeds": seed_list,
+        "randomize": None if spec.randomize is None else spec.randomize.model_dump(mode="json"),
         "controllers": controllers,
         "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
         "does_not_apply": [
@@ -164,26 +265,62 @@ def suite_record(
     }
 
 
+def plan_jobs(
+    names: list[ControllerSpec],
+    scenarios: Iterable[str],
+    seed_list: list[int],
+    seeds_of: Mapping[str, list[int | None]],
+    randomize: dict[str, Any] | None,
+    skip: set[tuple[str, str]],
+) -> list[Job]:
+    """Every job of a run: per scenario and controller that applies, one job per seed for
+    a classical controller, one job of all seeds per training seed for a learned agent."""
+    jobs = []
+    for scenario in scenarios:
+        for c in names:
+            label = controller_label(c)
+            if (scenario, label) in skip:
+                continue
+            for k in seeds_of[label]:
+                if controller_kind(label) == "learned":
+                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize))
+                else:
+                    jobs += [Job(c, scenario, (seed,), k, randomize) for seed in seed_list]
+    return jobs
+
+
+def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
+    """The jobs with the seeds whose episodes ``done`` (episode keys) does not hold."""
+    todo = []
+    for job in jobs:
+        label = controller_label(job.controller)
+        seeds = [s for s in job.seeds if (job.scenario, label, s, job.training_seed) not in done]
+        if seeds:
+            todo.append(job._replace(seeds=tuple(seeds)))
+    return todo
+
+
 def run_leaderboard(
     suite: str = "default",
     seeds: int | None = None,
     out_dir: str | os.PathLike = "results/leaderboard",
     backend: str = "local",
     workers: int | None = None,
-    controllers: Iterable[str] | None = None,
+    controllers: Iterable[ControllerSpec] | None = None,
     show_progress: bool = True,
     resume: bool = False,
     force: bool = False,
     command: list[str] | None = None,
     on_episode: Callable[[EpisodeResult], None] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the suite, write leaderboard.{md,csv,json}, generalisation.json and plots; return
-    the aggregate rows.
+    """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
+    the rows.
 
-    ``out_dir`` must be empty unless ``resume`` (run only the jobs missing from its
-    ``episodes.jsonl``) or ``force`` (clear its earlier outputs); ``command``: the argv
-    recorded in ``run.json`` (default ``sys.argv``); ``on_episode``: called in this process
-    after each episode is recorded.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
+    ``out_dir`` must be empty unless ``resume`` (run only the episodes missing from its
+    ``episodes.jsonl``: a job whose episodes are partly there runs the missing seeds) or
+    ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
+    (default ``sys.argv``); ``on_episode``: called in this process after each episode is
+    recorded.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
     """
     check_out_dir(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
@@ -192,30 +329,27 @@ def run_leaderboard(
     n_seeds = int(seeds if seeds is not None else spec.seeds)
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
-    check_controllers(names)
+    labels = check_controllers(names)
+    seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
-    scenarios = {s: load_scenario(s) for s in spec.all_scenarios()}
-    record = suite_record(spec, names, scenarios, seed_list)
+    scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
+    record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
-    jobs = [
-        (c, s, seed)
-        for s in scenarios
-        for c in names
-        if (s, controller_label(c)) not in skip
-        for seed in seed_list
-    ]
+    jobs = plan_jobs(names, scenarios, seed_list, seeds_of, record["randomize"], skip)
+    n_episodes = sum(len(job.seeds) for job in jobs)
     log = RunLog.open(
         out_dir,
         command=sys.argv if command is None else command,
         suite=record,
-        jobs=len(jobs),
+        jobs=n_episodes,
         resume=resume,
         force=force,
     )
-    todo = [job for job in jobs if _job_key(job) not in log.done]
+    todo = missing(jobs, log.done)
+    rows = row_keys(jobs)
     bar = tqdm(
-        total=len(jobs),
-        initial=len(jobs) - len(todo),
+        total=n_episodes,
+        initial=n_episodes - sum(len(job.seeds) for job in todo),
         desc="leaderboard",
         file=sys.stderr,
         disable=not show_progress,
@@ -225,14 +359,43 @@ def run_leaderboard(
         closing(iter_results(todo, backend, workers or os.cpu_count() or 1)) as results,
     ):
         try:
-            for result in results:
-                log.append(result, keep_trajectory=result.seed == seed_list[0])
-                bar.update(1)
-                if on_episode is not None:
-                    on_episode(result)
+            for batch in results:
+                for result in batch:
+                    if _result_key(result) in log.done:
+                        continue  # recorded before (a resumed job)
+                    log.append(result, keep_trajectory=True)
+                    keep_drawn(log, rows, (result.scenario, result.controller))
+                    bar.update(1)
+                    if on_episode is not None:
+                        on_episode(result)
         finally:
             bar.close()
-        return write_results(log.folder, log.record["suite"], load_results(log.folder))
+        for row in rows:  # rows completed by a run that stopped before pruning them
+            keep_drawn(log, rows, row)
+        results = load_results(log.folder)
+        return write_results(log.folder, log.record["suite"], results, workers=workers)
+
+
+def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
+    """(scenario, table name) → the keys of the row's episodes (every training seed ×
+    evaluation seed)."""
+    rows: dict[tuple[str, str], set[tuple]] = defaultdict(set)
+    for job in jobs:
+        label = controller_label(job.controller)
+        for seed in job.seeds:
+            rows[(job.scenario, label)].add((job.scenario, label, seed, job.training_seed))
+    return rows
+
+
+def keep_drawn(log: RunLog, rows: Mapping[tuple[str, str], set[tuple]], row: tuple) -> None:
+    """Once every episode of ``row`` is recorded: keep the trajectory of the episode its
+    figure draws (:func:`baselines.figures.median_ace_episode`), remove the others'."""
+    keys = rows[row]
+    if not keys <= log.done:
+        return
+    scenario, controller = row
+    seed, training_seed = median_ace_episode([log.episodes[k] for k in keys], *row)
+    log.drop_trajectories(keys - {(scenario, controller, seed, training_seed)})
 
 
 def load_results(folder: str | os.PathLike) -> list[EpisodeResult]:
@@ -240,24 +403,132 @@ def load_results(folder: str | os.PathLike) -> list[EpisodeResult]:
     return [episode_result(r, folder) for r in read_episodes(folder)]
 
 
+# --- tables ----------------------------------------------------------------------------------
+
+
+def _order(result: EpisodeResult) -> tuple:
+    ts = result.training_seed
+    return (result.scenario, result.controller, ts is not None, ts or 0, result.seed)
+
+
+def episode_rows(results: Iterable[EpisodeResult]) -> list[dict[str, Any]]:
+    """The episodes as the ranking reads them: every metric, ``training_seed`` and keys."""
+    return [{**r.row(), "training_seed": r.training_seed} for r in results]
+
+
 def write_results(
-    out: str | os.PathLike, suite: Mapping[str, Any], results: list[EpisodeResult]
+    out: str | os.PathLike,
+    suite: Mapping[str, Any],
+    results: list[EpisodeResult],
+    workers: int | None = None,
 ) -> list[dict[str, Any]]:
-    """Tables and plots into ``out`` from episode results and a suite as ``run.json`` keeps
-    it (:func:`suite_record`); returns the rows."""
+    """Tables, ranking and figures into ``out`` from episode results and a suite as
+    ``run.json`` keeps it (:func:`suite_record`); returns the rows.
+
+    ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
+    controller × scenario scores, then the rows), ``generalisation.json``,
+    ``aggregate.json`` (:func:`ranking`), ``scenario_scores.json`` and the figures
+    (:mod:`baselines.figures`: per scenario the small multiples of each controller's
+    median-ACE episode, per split the ranking's interval estimates and performance
+    profiles) and ``leaderboard.html`` (:mod:`baselines.pages`: all of it on one page).  The
+    ranking of each split and each figure are independent tasks, run in a
+    pool of ``workers`` processes (default: the cores) when there are
+    :data:`POOLED_FIGURES` scenario figures or more.
+    """
+    from baselines import figures, pages
+
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
-    results = sorted(results, key=lambda r: (r.scenario, r.controller, r.seed))
+    results = sorted(results, key=_order)
+    out = Path(out)
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
-    rows = aggregate_results(
-        results,
-        list(suite["scenarios"]),
-        list(kinds),
-        kinds=kinds,
-        not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
-    )
-    write_tables(rows, Path(out))
-    plot_results(results, Path(out), suite["scenarios"])
+    episodes = episode_rows(results)
+    splits = {s: scenario_split(s) for s in suite["scenarios"]}
+    ranked = rankable(episodes)
+    drawn = figures.episodes_to_draw(results)
+    shown = sorted({scenario for scenario, _ in drawn})
+    with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
+        boards = [
+            pool.submit(ranking, ranked, {s: sp for s, sp in splits.items() if sp == split}, kinds)
+            for split in sorted(set(splits.values()))
+        ]
+        plots = {
+            scenario: pool.submit(
+                figures.plot_scenarios,
+                out,
+                {key: ep for key, ep in drawn.items() if key[0] == scenario},
+                suite["scenarios"],
+                kinds,
+            )
+            for scenario in shown
+        }
+        board = [row for future in boards for row in future.result()]
+        ranking_plots = [
+            pool.submit(
+                figures.plot_ranking,
+                out,
+                [r for r in board if r["split"] == split],
+                ranked,
+                splits,
+                kinds,
+            )
+            for split in dict.fromkeys(r["split"] for r in board)
+        ]
+        rows = aggregate_results(
+            results,
+            list(suite["scenarios"]),
+            list(kinds),
+            kinds=kinds,
+            not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
+        )
+        scores = score_table(ranked, splits) if board else []
+        (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
+        (out / SCENARIO_SCORES_FILE).write_text(dumps(scores, indent=2) + "\n")
+        left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
+        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out)
+        write_tables(rows, out, head=head)
+        files = [f for future in ranking_plots for f in future.result()]
+        files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
+    pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
     return rows
+
+
+def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:
+    """The page's line under its title: suite, seeds, trials, training seeds."""
+    trained = {r.training_seed for r in results if r.training_seed is not None}
+    parts = [
+        f"suite {suite.get('name') or '(merged)'}",
+        f"{len(suite['scenarios'])} scenarios",
+        f"{len(suite['controllers'])} controllers",
+        f"{len(suite['seeds'])} evaluation seeds"
+        + (" (randomised trials)" if suite.get("randomize") else ""),
+    ]
+    if trained:
+        parts.append(f"learned agents × {len(trained)} training seeds")
+    return " · ".join(parts)
+
+
+#: scenario figures from which :func:`write_results` draws in a process pool
+POOLED_FIGURES = 4
+
+
+class _Inline:
+    """An executor that runs each task as it is submitted (a small run needs no pool)."""
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+        future: Future = Future()
+        future.set_result(fn(*args))
+        return future
+
+
+@contextlib.contextmanager
+def _pool(workers: int, figures: int) -> Iterator[Executor | _Inline]:
+    """A process pool of ``workers`` for ``figures`` scenario figures and the ranking, or
+    :class:`_Inline` for a few or one worker."""
+    if workers <= 1 or figures < POOLED_FIGURES:
+        yield _Inline()
+        return
+    with ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
+        yield pool
 
 
 def aggregate_results(
@@ -267,44 +538,190 @@ def aggregate_results(
     kinds: Mapping[str, str] | None = None,
     not_applicable: set[tuple[str, str]] | None = None,
 ) -> list[dict[str, Any]]:
-    """One row per (scenario, controller): means and ``*_std`` over seeds, or "does not
-    apply".  ``kinds``: controller kinds (default: the registry's); ``not_applicable``: the
-    (scenario, controller) pairs that do not apply (None: every pair without episodes);
-    a pair without episodes that is not listed has no row (a partial or merged record)."""
+    """One row per (scenario, controller) over its episodes (training seeds × evaluation
+    seeds): means, ``*_std`` and 95 % ``*_ci95`` intervals ``[low, high]`` (bootstrap,
+    stratified over training seeds: :func:`baselines.ranking.row_intervals`; None where a
+    metric is not finite in every episode, e.g. t_c when a seed never converged), or "does
+    not apply".  ``seeds``: the evaluation seeds; ``training_seeds``: how many training
+    seeds (0 for a controller that is not trained), ``training_seed_list`` which;
+    ``episodes``: their product.  ``kinds``: controller kinds (default: the registry's);
+    ``not_applicable``: the (scenario, controller) pairs that do not apply (None: every pair
+    without episodes); a pair without episodes that is not listed has no row (a partial or
+    merged record)."""
+    groups: dict[tuple[str, str], list[EpisodeResult]] = defaultdict(list)
+    for r in results:
+        groups[(r.scenario, r.controller)].append(r)
     rows = []
     for scenario in scenarios:
         for controller in controllers:
-            group = [r for r in results if r.scenario == scenario and r.controller == controller]
+            group = groups.get((scenario, controller), [])
             listed = not_applicable is None or (scenario, controller) in not_applicable
             if not group and not listed:
                 continue  # not run (yet): no row
+            head = {
+                "scenario": scenario,
+                "split": scenario_split(scenario),
+                "controller": controller,
+                "kind": group[0].kind
+                if group
+                else (kinds or {}).get(controller) or controller_kind(controller),
+                "applies": bool(group),
+            }
             if not group:  # the controller does not apply to this scenario's ship: shown
-                rows.append(
-                    {
-                        "scenario": scenario,
-                        "split": scenario_split(scenario),
-                        "controller": controller,
-                        "kind": (kinds or {}).get(controller) or controller_kind(controller),
-                        "seeds": 0,
-                        "applies": False,
-                        **{k: None for key in COLUMNS for k in (key, f"{key}_std")},
-                    }
-                )
+                rows.append({**head, **_counts([]), **_metric_cells(COLUMNS, None, None)})
                 continue
             keys = COLUMNS + tuple(k for k in TRAINING_COLUMNS if k in group[0].metrics)
             agg = aggregate([r.metrics for r in group], keys)
-            rows.append(
-                {
-                    "scenario": scenario,
-                    "split": scenario_split(scenario),
-                    "controller": controller,
-                    "kind": group[0].kind,
-                    "applies": True,
-                    "seeds": len(group),
-                    **{k: v for k, v in agg.items() if k != "n"},
-                }
-            )
+            cis = row_intervals(episode_rows(group), COLUMNS)
+            rows.append({**head, **_counts(group), **_metric_cells(keys, agg, cis)})
     return rows
+
+
+def _counts(group: list[EpisodeResult]) -> dict[str, Any]:
+    trained = sorted({r.training_seed for r in group if r.training_seed is not None})
+    return {
+        "seeds": len({r.seed for r in group}),
+        "training_seeds": len(trained),
+        "training_seed_list": trained,
+        "episodes": len(group),
+    }
+
+
+def _metric_cells(
+    keys: Sequence[str], agg: Mapping[str, float] | None, cis: Mapping[str, Any] | None
+) -> dict[str, Any]:
+    """``key``, ``key_std`` and (for :data:`COLUMNS`) ``key_ci95`` of each metric."""
+    cells: dict[str, Any] = {}
+    for key in keys:
+        cells[key] = None if agg is None else agg[key]
+        cells[f"{key}_std"] = None if agg is None else agg[f"{key}_std"]
+        if key in COLUMNS:
+            cells[f"{key}_ci95"] = None if cis is None else cis[f"{key}_ci95"]
+    return cells
+
+
+# --- the ranking -----------------------------------------------------------------------------
+
+
+def rankable(episodes: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The episodes the ranking is computed from: those of the scenarios on which every
+    controller that ran there has all its runs (each of its training seeds × every
+    evaluation seed of the record).  A complete run keeps them all; an interrupted or
+    merged record leaves out the scenarios it holds only in part."""
+    seeds = {int(e["seed"]) for e in episodes}
+    trained: dict[str, set[Any]] = defaultdict(set)
+    cells: dict[tuple[str, str], set[tuple[Any, int]]] = defaultdict(set)
+    for e in episodes:
+        trained[e["controller"]].add(e["training_seed"])
+        cells[(e["scenario"], e["controller"])].add((e["training_seed"], int(e["seed"])))
+    partial = {
+        scenario
+        for (scenario, controller), runs in cells.items()
+        if len(runs) != len(trained[controller]) * len(seeds)
+    }
+    return [e for e in episodes if e["scenario"] not in partial]
+
+
+def ranking(
+    episodes: list[dict[str, Any]], splits: Mapping[str, str], kinds: Mapping[str, str]
+) -> list[dict[str, Any]]:
+    """The ``aggregate.json`` rows (:func:`baselines.ranking.aggregate_ranking`: per
+    controller and split, the normalised score's mean and IQM with intervals and the
+    probability of improvement over pid_los); empty without both references."""
+    present = {e["controller"] for e in episodes}
+    if not {SCORE_ZERO, SCORE_ONE} <= present:
+        return []
+    return aggregate_ranking(episodes, splits, kinds)
+
+
+def _interval(value: Any, ci: Any, digits: int = 2) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    text = f"{value:.{digits}f}"
+    if ci:
+        text += f" [{ci[0]:.{digits}f}, {ci[1]:.{digits}f}]"
+    return text
+
+
+def ranking_markdown(
+    board: list[dict[str, Any]],
+    scores: list[dict[str, Any]],
+    scenarios: list[str],
+    left_out: Sequence[str] = (),
+) -> str:
+    """The head of ``leaderboard.md``: the ranking per split and the controller × scenario
+    table of mean scores with 95 % intervals."""
+    lines = ["# Leaderboard", "", "## Ranking", ""]
+    if not board:
+        needs = f"No ranking: the normalised score needs {SCORE_ZERO} and {SCORE_ONE} on the "
+        return "\n".join([*lines, needs + "same scenarios and seeds.", ""])
+    lines += [
+        f"Normalised score of an episode, from its return: 0 = {SCORE_ZERO}, 1 = {SCORE_ONE} "
+        "on the same scenario and seed (trial). Per controller over the scenarios it applies "
+        "to: the mean and the interquartile mean (IQM) of its runs' scores (runs = training "
+        "seeds × evaluation seeds) and the probability that its score beats pid_los's on a "
+        "scenario and seed, each with a 95 % stratified-bootstrap interval (rliable; Agarwal "
+        "et al. 2021). Ranked by IQM.",
+        "",
+    ]
+    if left_out:
+        lines += [f"Left out (episodes missing): {', '.join(left_out)}.", ""]
+    for split in ("catalogue", "heldout"):
+        mine = [r for r in board if r["split"] == split]
+        if not mine:
+            continue
+        title = "Catalogue scenarios" if split == "catalogue" else "Held-out scenarios"
+        lines += [
+            f"### {title} ({len(mine[0]['scenarios'])})",
+            "",
+            "| rank | controller | kind | training seeds | scenarios | score mean [95 % CI] "
+            "| IQM [95 % CI] | P(improvement over pid_los) [95 % CI] |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        for rank, r in enumerate(mine, start=1):
+            cells = [
+                str(rank),
+                r["controller"],
+                r["kind"],
+                str(r["training_seeds"] or "–"),
+                str(len(r["scenarios"])),
+                _interval(r["score_mean"], r["score_mean_ci95"]),
+                _interval(r["score_iqm"], r["score_iqm_ci95"]),
+                _interval(
+                    r["prob_improvement_over_pid_los"], r["prob_improvement_over_pid_los_ci95"]
+                ),
+            ]
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
+    lines += scores_markdown(board, scores, scenarios)
+    return "\n".join(lines)
+
+
+def scores_markdown(
+    board: list[dict[str, Any]], scores: list[dict[str, Any]], scenarios: list[str]
+) -> list[str]:
+    """The controller × scenario table (mean score [95 % CI]; – where it does not apply)."""
+    cell = {(s["controller"], s["scenario"]): s for s in scores}
+    shown = [s for s in scenarios if any(key[1] == s for key in cell)]
+    controllers = list(dict.fromkeys(r["controller"] for r in board))
+    lines = [
+        "## Scores per scenario",
+        "",
+        "Mean normalised score over each row's episodes [95 % interval, stratified over "
+        "training seeds]; – where the controller does not apply.",
+        "",
+        "| controller | " + " | ".join(shown) + " |",
+        "|---|" + "---|" * len(shown),
+    ]
+    for controller in controllers:
+        row = [controller]
+        for s in shown:
+            found = cell.get((controller, s))
+            row.append(
+                _interval(*(found["score_mean"], found["score_ci95"]) if found else (None, None))
+            )
+        lines.append("| " + " | ".join(row) + " |")
+    return [*lines, ""]
 
 
 def _fmt(value: Any, std: Any = None) -> str:
@@ -320,14 +737,19 @@ def _fmt(value: Any, std: Any = None) -> str:
     return str(value)
 
 
-def write_tables(rows: list[dict[str, Any]], out: Path) -> None:
+def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
+    """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
+    before the rows (the ranking)."""
     (out / "leaderboard.json").write_text(dumps(rows, indent=2))
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")
         writer.writeheader()
         writer.writerows(rows)
-    (out / "leaderboard.md").write_text(markdown_table(rows) + generalisation_table(rows))
+    rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
+    (out / "leaderboard.md").write_text(
+        (head + "\n" if head else "") + rows_part + generalisation_table(rows)
+    )
     (out / "generalisation.json").write_text(dumps(generalisation(rows), indent=2))
 
 
@@ -382,39 +804,60 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
 
 
 def markdown_table(rows: list[dict[str, Any]]) -> str:
+    """The per-row table: mean ± std over each row's episodes, ACE and return with their
+    95 % intervals."""
     head = [
         "scenario",
         "controller",
         "kind",
+        "seeds",
         "ACE [m]",
+        "ACE 95 % CI",
         "ACE/L",
         "t_c [s]",
         "return",
+        "return 95 % CI",
         "rudder travel [rad]",
         "J",
         "success",
         "compute [ms]",
+        "training",
     ]
-    keys = ["ace", "ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
-    head.append("training")
+    keys = ["ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         cells = [r["scenario"], r["controller"], r["kind"]]
         if not r.get("applies", True):
-            lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * len(keys)) + " |")
+            lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * 11) + " |")
             continue
-        cells += [_fmt(r[k], r.get(f"{k}_std")) for k in keys]
+        seeds = str(r["seeds"])
+        if r.get("training_seeds"):
+            seeds += f" × {r['training_seeds']} trained"
+        values = {k: _fmt(r[k], r.get(f"{k}_std")) for k in ("ace", *keys)}
+        cells += [seeds, values["ace"], _ci(r.get("ace_ci95")), values["ace_L"], values["t_c"]]
+        cells += [values["return"], _ci(r.get("return_ci95"))]
+        cells += [values[k] for k in ("rudder_travel", "J", "success", "compute_ms")]
         cost = ""
         if "train_env_steps" in r:
             cost = f"{r['train_env_steps'] / 1e3:.0f} k steps, {r['train_wall_s'] / 60:.1f} min"
         cells.append(cost)
         lines.append("| " + " | ".join(cells) + " |")
     note = (
-        "\nMean ± std over seeds. t_c: moment (s of simulation time) from which |e| stays "
-        "below the threshold after the first parameter change; 'never' when it does not. "
-        "training: env steps and wall time of a learned agent's training run.\n"
+        "\nMean ± std over each row's episodes (evaluation seeds; × training seeds for a "
+        "learned agent), with the 95 % bootstrap interval of the mean (stratified over "
+        "training seeds; every metric's is in leaderboard.json as *_ci95). t_c: moment (s of "
+        "simulation time) from which |e| stays below the threshold after the first parameter "
+        "change; 'never' when it does not. training: env steps and wall time of a learned "
+        "agent's training run (mean over its training seeds).\n"
     )
     return "\n".join(lines) + "\n" + note
+
+
+def _ci(ci: Any) -> str:
+    return f"[{ci[0]:.3f}, {ci[1]:.3f}]" if ci else "–"
+
+
+# --- figures ---------------------------------------------------------------------------------
 
 
 def plot_file(scenario: str) -> str:
@@ -425,38 +868,45 @@ def plot_file(scenario: str) -> str:
 
 
 def plot_results(
-    results: list[EpisodeResult], out: Path, scenarios: Mapping[str, Any] | None = None
+    results: list[EpisodeResult],
+    out: Path,
+    scenarios: Mapping[str, Any] | None = None,
+    randomize: Mapping[str, Any] | None = None,
 ) -> None:
-    """Per scenario: tracks over the path, e(t) and δ(t) of the first seed of each controller
-    whose trajectory was kept.  ``scenarios``: name → settings (as ``run.json`` records
-    them; default: each scenario loaded by name)."""
+    """Per scenario: tracks over the path, e(t) and δ(t) of the first evaluation seed (of
+    the first training seed) of each controller whose trajectory was kept.  ``scenarios``:
+    name → settings (as ``run.json`` records them; default: each scenario loaded by name);
+    ``randomize``: the trial randomisation (the jump time drawn is that seed's)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    randomization = None if randomize is None else TrialRandomization(**randomize)
     for scenario in sorted({r.scenario for r in results if r.trajectory}):
-        sc = load_scenario(scenarios[scenario] if scenarios else scenario)
         first: dict[str, EpisodeResult] = {}
-        for r in sorted(results, key=lambda r: r.seed):
+        for r in sorted(results, key=_order):
             if r.scenario == scenario and r.trajectory:
                 first.setdefault(r.controller, r)
+        seed = min(r.seed for r in first.values())
+        sc = load_scenario(scenarios[scenario] if scenarios else scenario)
+        sc = trial_scenario(sc, randomization, seed)
         fig, axes = plt.subplots(1, 3, figsize=(15, 4))
         pts = sc.path.point(np.linspace(0, sc.path.length, 300))
         axes[0].plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="path")
         for name, r in first.items():
-            tr = r.trajectory
-            axes[0].plot(tr["x"], tr["y"], lw=1, label=name)
-            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=name)
-            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=name)
+            tr, look = r.trajectory, controller_style(name).kwargs()
+            axes[0].plot(tr["x"], tr["y"], lw=1, label=name, **look)
+            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=name, **look)
+            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=name, **look)
         if sc.change_time is not None:
             for ax in axes[1:]:
                 ax.axvline(sc.change_time, color="gray", ls=":", lw=1)
-        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=f"{scenario}: tracks")
+        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=f"{scenario}: tracks (seed {seed})")
         axes[0].set_aspect("equal", adjustable="datalim")
         axes[1].set(xlabel="t [s]", ylabel="e [m]", title="cross-track error")
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
         axes[0].legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(out / plot_file(scenario), dpi=90)
+        fig.savefig(out / plot_file(scenario), dpi=FIGURE_DPI)
         plt.close(fig)

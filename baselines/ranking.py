@@ -155,6 +155,54 @@ def score_matrix(
     return np.array([[cells[s][r] for s in scenarios] for r in runs], dtype=np.float64)
 
 
+def scenario_scores(
+    episodes: Sequence[Mapping[str, Any]], splits: Mapping[str, str], seed: int = 0
+) -> list[dict[str, Any]]:
+    """Per (controller, scenario): the mean normalised score over the row's episodes with its
+    95 % interval (stratified over training seeds), for the controller × scenario table."""
+    scored = normalised_scores(episodes)
+    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = defaultdict(list)
+    for ep in scored:
+        if ep.get("score") is not None:
+            groups[(ep["controller"], ep["scenario"])].append(ep)
+    out = []
+    for (controller, scenario), eps in sorted(groups.items()):
+        ci = row_intervals(eps, ["score"], seed=seed)["score_ci95"]
+        out.append(
+            {
+                "controller": controller,
+                "scenario": scenario,
+                "split": splits.get(scenario, "catalogue"),
+                "score_mean": float(np.mean([ep["score"] for ep in eps])),
+                "score_ci95": ci,
+                "episodes": len(eps),
+            }
+        )
+    return out
+
+
+def interquartile_mean(scores: np.ndarray) -> float:
+    """rliable's ``metrics.aggregate_iqm`` (scipy's 25 % ``trim_mean`` over all runs and
+    tasks), with the same bits: scipy's partition and mean without its per-call argument
+    checks (≈ 0.13 ms of each bootstrap sample)."""
+    a = np.asarray(scores, dtype=np.float64).ravel()
+    low = int(0.25 * a.size)
+    high = a.size - low
+    return np.mean(np.partition(a, (low, high - 1))[low:high])
+
+
+def probability_of_improvement(scores_x: np.ndarray, scores_y: np.ndarray) -> float:
+    """rliable's ``metrics.probability_of_improvement`` (the Mann-Whitney U statistic per
+    task, U / (m·n) = P(X > Y) + ½ P(X = Y), averaged over tasks), with the same bits,
+    vectorised: rliable calls scipy once per task and bootstrap sample (≈ 14 s per
+    controller for 14 tasks × 2000 samples; this: ≈ 0.1 s)."""
+    x, y = scores_x[:, None, :], scores_y[None, :, :]
+    u = (x > y).sum(axis=(0, 1)) + 0.5 * (x == y).sum(axis=(0, 1))
+    per_task = u / (scores_x.shape[0] * scores_y.shape[0])
+    same = [np.array_equal(scores_x[:, t], scores_y[:, t]) for t in range(scores_x.shape[1])]
+    return np.mean(np.where(same, 0.5, per_task))
+
+
 def _tasks(scored: Sequence[Mapping[str, Any]], controller: str, split_scenarios: set[str]):
     return sorted(
         {
@@ -197,13 +245,13 @@ def aggregate_ranking(
             with _quiet_arch():
                 point, interval = rly.get_interval_estimates(
                     {controller: x},
-                    lambda m: np.array([rmetrics.aggregate_mean(m), rmetrics.aggregate_iqm(m)]),
+                    lambda m: np.array([rmetrics.aggregate_mean(m), interquartile_mean(m)]),
                     reps=reps,
                     random_state=np.random.RandomState(seed),
                 )
                 p_point, p_interval = rly.get_interval_estimates(
                     {controller: [x, ref]},
-                    rmetrics.probability_of_improvement,
+                    probability_of_improvement,
                     reps=reps,
                     random_state=np.random.RandomState(seed),
                 )

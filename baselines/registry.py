@@ -72,7 +72,9 @@ class ControllerRecord:
 
     ``factory(**settings)`` makes a fresh :class:`~baselines.policy.Policy`;
     ``action_mode`` is the env mode it drives; ``applies_to`` the ship ids it runs on
-    (None: every ship); ``kind`` is ``"classical"`` unless the factory says otherwise.
+    (None: every ship); ``kind`` is ``"classical"`` unless the factory says otherwise;
+    ``training_seeds``: a learned policy's (the factory takes ``training_seed=k``), else
+    ``(None,)``.
     """
 
     name: str
@@ -80,6 +82,7 @@ class ControllerRecord:
     action_mode: str = "rudder"
     applies_to: tuple[str, ...] | None = None
     kind: str = "classical"
+    training_seeds: tuple[int | None, ...] = (None,)
 
 
 _RECORDS: dict[str, ControllerRecord] = {}
@@ -213,6 +216,9 @@ def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
         else base.factory,
     )
     _check_settings(base, entry)
+    if "training_seed" in entry.settings:  # a long form naming one training seed
+        seed = entry.settings["training_seed"]
+        record = dataclasses.replace(record, training_seeds=(_check_seed(base, seed),))
     registered = _RECORDS.get(record.name)
     if registered is None:
         _RESOLVED[record.name] = record
@@ -254,16 +260,24 @@ def _record_of(text: str) -> ControllerRecord:
 
 
 def _learned_record(name_or_path: str) -> ControllerRecord:
-    """A shipped policy, trained agent's folder or model zip, its files checked now."""
+    """A shipped policy, trained agent's folder or model zip, the files of every training
+    seed checked now (one action mode for all)."""
     from baselines.learned.policy import LearnedPolicy, policy_label, read_policy
+    from baselines.learned.policy import training_seeds as policy_seeds
 
-    files = read_policy(name_or_path)
+    seeds = policy_seeds(name_or_path)
+    files = [read_policy(name_or_path, seed) for seed in seeds]
+    modes = {f.model.action_mode: f.model.path for f in files}
+    if len(modes) > 1:
+        found = ", ".join(f"{path} acts in {mode!r} mode" for mode, path in modes.items())
+        raise ControllerError(f"{name_or_path!r}: its training seeds disagree: {found}")
     label = policy_label(name_or_path)
     return ControllerRecord(
         name=label,
         factory=functools.partial(LearnedPolicy, name_or_path, name=label),
-        action_mode=files.model.action_mode,
+        action_mode=files[0].model.action_mode,
         kind=LearnedPolicy.kind,
+        training_seeds=tuple(seeds),
     )
 
 
@@ -454,13 +468,42 @@ def unknown_controller(name: str) -> str:
     )
 
 
-def make_controller(name: ControllerSpec, **settings: Any) -> tuple[Policy, str]:
+def training_seeds(controller: ControllerSpec) -> list[int | None]:
+    """The training seeds ``controller`` has: a learned policy's (a shipped name or a
+    trained agent's folder with ``seed_<k>`` folders: every k, in order; one model: its
+    meta's seed), ``[None]`` for the rest (classical controllers, plug-ins, a model without
+    a seed).  Each is a ``training_seed`` for :func:`make_controller`."""
+    return list(resolve_controller(controller).training_seeds)
+
+
+def _check_seed(record: ControllerRecord, seed: Any) -> int | None:
+    """``seed`` if it is one of the training seeds of ``record``, else a clear error."""
+    if seed in record.training_seeds and not isinstance(seed, bool | float):
+        return seed
+    if record.training_seeds == (None,):
+        raise ControllerError(
+            f"controller {record.name!r} has no training seeds (it is not a trained agent, "
+            f"or its files name none): training_seed={seed!r}"
+        )
+    raise ControllerError(
+        f"controller {record.name!r} was trained with seeds "
+        f"{', '.join(map(str, record.training_seeds))}: no training seed {seed!r}"
+    )
+
+
+def make_controller(
+    name: ControllerSpec, training_seed: int | None = None, **settings: Any
+) -> tuple[Policy, str]:
     """A fresh controller and the action mode it needs; unknown names list the valid ones.
 
     ``name``: anything :func:`resolve_controller` accepts (made with ``settings``, after
     the long form's own); the policy carries the table name and the action mode.
+    ``training_seed``: one of :func:`training_seeds` (None: a learned policy's first); the
+    policy carries it as ``training_seed``.
     """
     record = resolve_controller(name)
+    if training_seed is not None:
+        settings["training_seed"] = _check_seed(record, training_seed)
     policy = record.factory(**settings)
     for attr in ("name", "action_mode"):  # a factory function's policy learns them here
         if getattr(policy, attr, None) != getattr(record, attr):

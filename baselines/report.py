@@ -3,8 +3,9 @@
 Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.jsonl``,
 :mod:`baselines.runs`); several merge into one table (separate ``evaluate`` runs of different
 policies on the same suite give the leaderboard of those policies).  Runs that give the same
-scenario name different settings, or hold the same (scenario, controller, seed) episode, are
-refused.  The output folder gets the leaderboard's tables and plots and ``report.json``
+scenario name different settings, draw their trials differently (``randomize``), or hold the
+same (scenario, controller, seed, training_seed) episode, are refused.  The output folder
+gets the leaderboard's tables, ranking (``aggregate.json``) and figures, and ``report.json``
 (which runs, when, with what).
 """
 
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from baselines.errors import RunError
 from baselines.runs import (
+    Key,
     check_out_dir,
     clear_outputs,
     differences,
@@ -45,17 +47,26 @@ def merge_runs(
     suite: dict[str, Any] = {
         "name": None,
         "seeds": [],
+        "randomize": None,
         "controllers": [],
         "scenarios": {},
         "does_not_apply": [],
     }
     first_with: dict[str, str] = {}
-    episode_in: dict[tuple[str, str, int], str] = {}
+    episode_in: dict[Key, str] = {}
     results = []
     sources = []
     for folder in map(str, folders):
         record = read_run(folder)
         run_suite = record["suite"]
+        randomize = run_suite.get("randomize")
+        if sources and randomize != suite["randomize"]:
+            raise RunError(
+                f"{folder} draws its trials with randomize {randomize} but "
+                f"{sources[0]['folder']} with {suite['randomize']}: their seeds are other "
+                "trials; report runs of one randomisation"
+            )
+        suite["randomize"] = randomize
         for name, settings in run_suite["scenarios"].items():
             if name not in suite["scenarios"]:
                 suite["scenarios"][name] = settings
@@ -79,7 +90,8 @@ def merge_runs(
             key = episode_key(episode)
             if key in episode_in:
                 raise RunError(
-                    f"episode (scenario, controller, seed) {key} is in {episode_in[key]} and "
+                    f"episode (scenario, controller, seed, training_seed) {key} is in "
+                    f"{episode_in[key]} and "
                     f"in {folder}: report one of them"
                 )
             episode_in[key] = folder
@@ -104,9 +116,9 @@ def write_report(
     force: bool = False,
     command: Sequence[str] = (),
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Merge ``folders`` and write the tables, plots and ``report.json`` into ``out`` (which
-    must be empty, or ``force``: its earlier outputs cleared, and none of ``folders``);
-    returns (rows, sources)."""
+    """Merge ``folders`` and write the tables, ranking, figures and ``report.json`` into
+    ``out`` (which must be empty, or ``force``: its earlier outputs cleared, and none of
+    ``folders``); returns (rows, sources)."""
     if not folders:
         raise RunError("report: give at least one run folder")
     target = check_out_dir(out, force=force)

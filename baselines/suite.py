@@ -12,6 +12,7 @@ from pydantic import Discriminator, Field, Tag, model_validator
 from baselines.errors import ConfigError
 from baselines.plugins import ControllerEntry, ControllerSpec, anchored
 from shipgym.config import ConfigFile, StrictModel, is_path, list_names, load_yaml_model, resolve
+from shipgym.scenarios.trials import TrialRandomization
 
 
 def _controller_form(value: Any) -> str:
@@ -36,7 +37,11 @@ class SuiteConfig(StrictModel):
     zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
     {keyword: value}}`` (:class:`~baselines.plugins.ControllerEntry`); a relative file path
     among them is read against the suite file's folder.  ``seeds``: evaluation seeds per
-    (controller, scenario).
+    (controller, scenario, training seed).  ``randomize``: what each evaluation seed draws
+    for its trial of a scenario (:class:`~shipgym.scenarios.trials.TrialRandomization`:
+    start offset and heading error, jump-time jitter, current speed and direction; the
+    sensor noise varies with the seed anyway); absent: every seed runs the scenario as
+    written.
     """
 
     name: str
@@ -45,6 +50,7 @@ class SuiteConfig(StrictModel):
     heldout_scenarios: int = Field(0, ge=0)
     controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1)
+    randomize: TrialRandomization | None = None
 
     @model_validator(mode="after")
     def _scenarios_given_once(self) -> SuiteConfig:

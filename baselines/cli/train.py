@@ -1,4 +1,10 @@
-"""``shipgym train AGENT``: train SB3 agents (configs/agents), one run or a sweep."""
+"""``shipgym train AGENT``: train SB3 agents (configs/agents), one run or a sweep.
+
+``shipgym train all --seeds 0 1 2 --ship`` trains every agent with three seeds (runs in
+``results/agents/<name>/seed_<k>``) and ships each into
+``baselines/learned/policies/<name>/seed_<k>``; with ``--resume`` a finished run is not
+trained again, so the same command on finished runs only exports them.
+"""
 
 from __future__ import annotations
 
@@ -30,17 +36,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         resume_help="continue from the newest checkpoint",
     )
     p.add_argument(
+        "--seeds",
         "--seed",
+        dest="seeds",
         type=int,
         nargs="+",
         default=None,
-        help="override the config's seed; several: a sweep",
+        metavar="SEED",
+        help="training seed(s), overriding the config's; several: a sweep, each run in OUT/seed_K",
     )
     p.add_argument("--workers", type=int, default=1, help="parallel training runs (local pool)")
     add_backend_option(p)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
     p.add_argument(
-        "--ship", action="store_true", help="export the best model to baselines/learned/policies"
+        "--ship",
+        action="store_true",
+        help="export each run's best model to baselines/learned/policies/NAME/seed_K "
+        "(with --resume, finished runs are not trained again: only exported)",
     )
     add_progress_option(p)
     add_json_option(p, "print the training meta as JSON")
@@ -60,9 +72,7 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
         names = list_agent_configs()
     else:
         names = [args.agent]
-    seeds = args.seed or [None]
-    if args.ship and len(seeds) > 1:
-        raise RunError("--ship exports one policy per agent: give at most one --seed")
+    seeds = args.seeds or [None]
     jobs = []
     for name in names:
         config = load_agent_config(args.config or name)
@@ -97,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
     text = "\n".join(
         f"{m['name']} (seed {m['seed']}): {m['env_steps']} env steps in "
         f"{m['wall_time_s']:.0f} s -> {m['out_dir']}"
+        + (f", shipped to {m['shipped_to']}" if "shipped_to" in m else "")
         for m in metas
     )
     emit(args, metas if len(metas) > 1 else metas[0], text)

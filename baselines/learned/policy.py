@@ -8,9 +8,23 @@ train`` writes) is optional; its keys are checked (:class:`PolicyMeta`) and its 
 cost becomes leaderboard columns.  Every unreadable file is a
 :class:`~baselines.errors.ControllerError` naming the file (and the key).
 
+A policy trained with several seeds is a folder of ``seed_<k>/`` folders, each a policy
+folder as above (``policies/<name>/seed_<k>/model.zip``; a ``shipgym train --seeds …`` run
+folder ``results/agents/<name>/seed_<k>/`` alike): its name means all of them
+(:func:`training_seeds`), and ``training_seed=k`` picks one.  A folder holding one model is
+one training seed, the ``seed`` of its ``meta.json`` (None without one).
+
 The policy sees exactly what the env's observation holds (measurements, no plant
 parameters, no schedule) and acts deterministically.  Recurrent agents (RecurrentPPO) keep
 their LSTM state within an episode and start afresh at every ``reset``.
+
+**Batched and one-by-one actions are the same bits.**  The network always runs on a batch
+of :data:`BATCH_ROWS` rows (one env's observation padded with zero rows, several envs'
+observations in chunks of :data:`BATCH_ROWS`): torch's float32 GEMM gives a row the same bits
+whatever the other rows and the row's position, for a fixed batch size, but not across batch
+sizes (1 row and 64 rows differ by an ulp).  So :meth:`LearnedPolicy.act` (one env) and
+:meth:`LearnedPolicy.act_batch` (several envs in lockstep, each with its own LSTM state and
+episode start) give equal actions, and equal episodes.
 """
 
 from __future__ import annotations
@@ -20,8 +34,10 @@ import functools
 import importlib
 import json
 import pickle
+import re
 import zipfile
 import zlib
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -65,6 +81,12 @@ ACTION_MODE_OF_SIZE = {1: "rudder", 2: "guidance"}
 #: the optional files beside a model zip
 META_FILE = "meta.json"
 VECNORMALIZE_FILE = "vecnormalize.pkl"
+#: the model zips a policy folder is read from, in this order (else its one ``.zip``)
+MODEL_FILES = ("model.zip", "best_model.zip")
+#: the folder of one training seed inside a policy folder: ``seed_<k>``
+SEED_FOLDER = re.compile(r"seed_(\d+)")
+#: rows of every network forward (one env's observation is padded to it, more are chunked)
+BATCH_ROWS = 16
 
 #: saved training schedules a scoring run does not need (and that may not unpickle under
 #: another Python version): replaced on load, as rl-baselines3-zoo's ``enjoy`` does
@@ -76,8 +98,26 @@ _INFERENCE_ONLY = {
 
 
 def shipped_policies() -> list[str]:
-    """Names of the pre-trained policies shipped in ``baselines/learned/policies``."""
-    return sorted(p.name for p in POLICY_DIR.iterdir() if (p / META_FILE).is_file())
+    """Names of the pre-trained policies shipped in ``baselines/learned/policies`` (one
+    model, or ``seed_<k>/`` folders of one each)."""
+    return sorted(
+        p.name
+        for p in POLICY_DIR.iterdir()
+        if (p / META_FILE).is_file() or any((s / META_FILE).is_file() for s in _seeds(p).values())
+    )
+
+
+def _seeds(folder: Path) -> dict[int, Path]:
+    """Training seed -> its ``seed_<k>`` folder in ``folder`` (those holding a model zip),
+    in seed order; empty for a folder of one model and for a file."""
+    if not folder.is_dir():
+        return {}
+    found = {
+        int(match.group(1)): sub
+        for sub in folder.iterdir()
+        if (match := SEED_FOLDER.fullmatch(sub.name)) and sub.is_dir() and any(sub.glob("*.zip"))
+    }
+    return dict(sorted(found.items()))
 
 
 class PolicyMeta(BaseModel):
@@ -85,7 +125,7 @@ class PolicyMeta(BaseModel):
 
     ``name``: the policy's name; ``algo``: one of :data:`ALGORITHMS` (must be the zip's);
     ``action_mode``: must be the zip's; ``env_steps`` and ``wall_time_s`` [s]: the training
-    cost, both or neither.
+    cost, both or neither; ``seed``: the training seed.
     """
 
     model_config = ConfigDict(extra="allow", frozen=True)
@@ -95,6 +135,7 @@ class PolicyMeta(BaseModel):
     action_mode: Literal[tuple(ACTION_MODE_OF_SIZE.values())] | None = None  # type: ignore[valid-type]
     env_steps: int | None = Field(None, ge=0)
     wall_time_s: float | None = Field(None, ge=0)
+    seed: int | None = Field(None, ge=0)
 
     @model_validator(mode="after")
     def _cost_complete(self) -> PolicyMeta:
@@ -116,19 +157,19 @@ class SavedModel:
 @dataclasses.dataclass(frozen=True)
 class PolicyFiles:
     """A learned policy's files: the model, its checked ``meta.json`` (``meta``: as written,
-    empty without one) and the ``vecnormalize.pkl`` beside it, if any."""
+    empty without one), the ``vecnormalize.pkl`` beside it, if any, and the training seed
+    (its ``seed_<k>`` folder's, else the meta's; None when neither says)."""
 
     model: SavedModel
     algo: str
     meta: dict[str, Any]
     cost: PolicyMeta
     vecnormalize: Path | None
+    training_seed: int | None = None
 
 
-def model_zip(name_or_path: str | Path) -> Path:
-    """A shipped policy name, a trained agent's folder or a model zip → the model zip.
-
-    A folder means its ``model.zip``, else ``best_model.zip``, else its one ``.zip``."""
+def _source(name_or_path: str | Path) -> Path:
+    """A shipped policy name, a folder or a zip → its path (a clear error if none)."""
     path = Path(name_or_path).expanduser()
     if not path.exists() and (POLICY_DIR / str(name_or_path)).is_dir():
         path = POLICY_DIR / str(name_or_path)
@@ -137,9 +178,51 @@ def model_zip(name_or_path: str | Path) -> Path:
             f"{name_or_path!r} is not a trained policy (a model zip, or a folder holding one); "
             f"shipped: {', '.join(shipped_policies())}"
         )
+    return path
+
+
+def _seed_folder(path: Path, training_seed: int | None) -> tuple[Path, int | None]:
+    """The folder of ``training_seed`` (None: the first) when ``path`` holds ``seed_<k>``
+    folders, with that seed; else ``path`` itself and None."""
+    seeds = _seeds(path)
+    if not seeds:
+        return path, None
+    tops = sorted(z.name for z in path.glob("*.zip"))
+    if tops:
+        raise ControllerError(
+            f"{path}: holds both a model ({', '.join(tops)}) and training-seed folders "
+            f"({', '.join(p.name for p in seeds.values())}): name the one to use"
+        )
+    if training_seed is None:
+        training_seed = next(iter(seeds))
+    if training_seed not in seeds:
+        raise ControllerError(
+            f"{path}: no training seed {training_seed}; it holds "
+            f"{', '.join(p.name for p in seeds.values())}"
+        )
+    return seeds[training_seed], training_seed
+
+
+def training_seeds(name_or_path: str | Path) -> list[int | None]:
+    """The training seeds of a learned policy: its ``seed_<k>`` folders' k, in order; for a
+    single model, the ``seed`` of its ``meta.json`` ([None] when it gives none)."""
+    seeds = _seeds(_source(name_or_path))
+    return list(seeds) if seeds else [read_policy(name_or_path).training_seed]
+
+
+def model_zip(name_or_path: str | Path, training_seed: int | None = None) -> Path:
+    """A shipped policy name, a trained agent's folder or a model zip → the model zip.
+
+    A folder means its ``model.zip``, else ``best_model.zip``, else its one ``.zip``; a
+    folder of ``seed_<k>`` folders means that of ``training_seed`` (None: the first)."""
+    path, _ = _seed_folder(_source(name_or_path), training_seed)
+    return _folder_model(path)
+
+
+def _folder_model(path: Path) -> Path:
     if not path.is_dir():
         return path
-    for name in ("model.zip", "best_model.zip"):
+    for name in MODEL_FILES:
         if (path / name).is_file():
             return path / name
     zips = sorted(path.glob("*.zip"))
@@ -153,13 +236,17 @@ def model_zip(name_or_path: str | Path) -> Path:
 
 
 def policy_label(name_or_path: str | Path) -> str:
-    """The table name of a learned policy: a shipped policy's name; a folder's name; for a
-    zip the folder holding it, plus the zip's stem unless it is ``model``."""
+    """The table name of a learned policy: a shipped policy's name; a folder's name (a
+    ``seed_<k>`` folder with its parent's: ``ppo/seed_1``); for a zip the folder holding it,
+    plus the zip's stem unless it is ``model``."""
     path = Path(name_or_path).expanduser()
     if path.suffix == ".zip":
         stem = "" if path.stem == "model" else f"/{path.stem}"
         return f"{path.resolve().parent.name}{stem}"
-    return path.resolve().name if path.exists() else str(name_or_path)
+    if not path.exists():
+        return str(name_or_path)
+    path = path.resolve()
+    return f"{path.parent.name}/{path.name}" if SEED_FOLDER.fullmatch(path.name) else path.name
 
 
 def read_model(path: Path) -> SavedModel:
@@ -262,12 +349,24 @@ def _read_meta(file: Path) -> tuple[dict[str, Any], PolicyMeta]:
     return data, validate_model(data, PolicyMeta, str(file), ControllerError)
 
 
-def read_policy(name_or_path: str | Path) -> PolicyFiles:
+def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> PolicyFiles:
     """A learned policy's files, checked: the zip (:func:`read_model`), ``meta.json`` if
-    present (its ``algo`` and ``action_mode`` must be the zip's), ``vecnormalize.pkl``."""
-    saved = read_model(model_zip(name_or_path))
+    present (its ``algo`` and ``action_mode`` must be the zip's, its ``seed`` the
+    ``seed_<k>`` folder's), ``vecnormalize.pkl``.  ``training_seed``: which seed's files
+    (None: the first; a single model's must be its meta's seed)."""
+    folder, seed = _seed_folder(_source(name_or_path), training_seed)
+    saved = read_model(_folder_model(folder))
     meta_file = _meta_file(saved.path)
     meta, checked = _read_meta(meta_file) if meta_file else ({}, PolicyMeta())
+    if seed is None:
+        seed = checked.seed
+        if training_seed is not None and training_seed != seed:
+            said = f"its {META_FILE} says seed {seed}" if seed is not None else "it names none"
+            raise ControllerError(f"{saved.path}: no training seed {training_seed}: {said}")
+    elif checked.seed is not None and checked.seed != seed:
+        raise ControllerError(
+            f"{meta_file}: key 'seed' is {checked.seed}, but the folder is {folder.name}"
+        )
     algo = saved.algo
     if checked.algo is not None:
         if algo is not None and checked.algo != algo:
@@ -294,6 +393,7 @@ def read_policy(name_or_path: str | Path) -> PolicyFiles:
         meta=meta,
         cost=checked,
         vecnormalize=vecnormalize if vecnormalize.is_file() else None,
+        training_seed=seed,
     )
 
 
@@ -337,19 +437,34 @@ def load_obs_normalizer(file: Path) -> Any:
     return normalizer
 
 
+@dataclasses.dataclass
+class _Memory:
+    """What a policy carries from one step of an episode to the next: the LSTM state
+    ``(h, c)`` (each of shape (layers, hidden); None before the first step) and whether
+    the next step starts the episode."""
+
+    state: tuple[np.ndarray, np.ndarray] | None = None
+    start: bool = True
+
+
 class LearnedPolicy:
     """A trained agent from a policy folder or model zip (see :func:`read_policy`).
 
-    ``name``: its name (default: the meta's, else :func:`policy_label`)."""
+    ``name``: its name (default: the meta's, else :func:`policy_label`);
+    ``training_seed``: which of a multi-seed policy's seeds (None: the first), kept as the
+    attribute ``training_seed`` (a single model's: its meta's seed)."""
 
     kind = "learned"
 
-    def __init__(self, path: str | Path, name: str | None = None) -> None:
-        files = read_policy(path)
+    def __init__(
+        self, path: str | Path, name: str | None = None, training_seed: int | None = None
+    ) -> None:
+        files = read_policy(path, training_seed)
         self.model_path = files.model.path
         self.algo = files.algo
         self.meta: dict[str, Any] = files.meta
         self._cost = files.cost
+        self.training_seed = files.training_seed
         self.name = name or files.cost.name or policy_label(path)
         self.action_mode: str = files.model.action_mode
         import torch
@@ -360,25 +475,60 @@ class LearnedPolicy:
             load_obs_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
         )
         self.recurrent = self.algo in RECURRENT
-        self._state: Any = None
-        self._start = True
+        self._memory = _Memory()
+        self._batch: list[_Memory] = []
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
-        self._state = None
-        self._start = True
+        self._memory = _Memory()
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        return self._act_rows(np.asarray(obs)[None], [self._memory])[0]
+
+    def reset_batch(self, contexts: Sequence[ControllerContext]) -> None:
+        """Start one episode per context (envs in lockstep, :meth:`act_batch`)."""
+        for context in contexts:
+            check_action_mode(self, context)
+        self._batch = [_Memory() for _ in contexts]
+
+    def act_batch(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
+        """The actions (one row each) for the observations ``obs`` (one row each) of the
+        episodes ``episodes`` (indices into :meth:`reset_batch`'s contexts); each is the
+        action :meth:`act` would give in that episode alone, bit for bit."""
+        return self._act_rows(np.asarray(obs), [self._batch[i] for i in episodes])
+
+    def _act_rows(self, obs: np.ndarray, memories: list[_Memory]) -> np.ndarray:
         if self.obs_normalizer is not None:
-            obs = self.obs_normalizer.normalize_obs(obs)
-        if self.recurrent:
-            action, self._state = self.model.predict(
-                obs, state=self._state, episode_start=np.array([self._start]), deterministic=True
-            )
-            self._start = False
-            return action
-        action, _ = self.model.predict(obs, deterministic=True)
-        return action
+            obs = self.obs_normalizer.normalize_obs(obs)  # elementwise: batch-independent
+        chunks = range(0, len(obs), BATCH_ROWS)
+        return np.concatenate(
+            [self._forward(obs[i : i + BATCH_ROWS], memories[i : i + BATCH_ROWS]) for i in chunks]
+        )
+
+    def _forward(self, obs: np.ndarray, memories: list[_Memory]) -> np.ndarray:
+        """One network forward on ``obs`` (at most :data:`BATCH_ROWS` rows) padded with zero
+        rows to :data:`BATCH_ROWS` (padding rows start an episode with a zero state)."""
+        n = len(obs)
+        padded = np.zeros((BATCH_ROWS, *obs.shape[1:]), dtype=obs.dtype)
+        padded[:n] = obs
+        if not self.recurrent:
+            actions, _ = self.model.predict(padded, deterministic=True)
+            return actions[:n]
+        layers, _, hidden = self.model.policy.lstm_hidden_state_shape
+        h = np.zeros((layers, BATCH_ROWS, hidden), dtype=np.float32)
+        c = np.zeros_like(h)
+        starts = np.ones(BATCH_ROWS, dtype=bool)
+        for i, memory in enumerate(memories):
+            if memory.state is not None:
+                h[:, i], c[:, i] = memory.state
+            starts[i] = memory.start
+        actions, (h, c) = self.model.predict(
+            padded, state=(h, c), episode_start=starts, deterministic=True
+        )
+        for i, memory in enumerate(memories):
+            memory.state = (h[:, i].copy(), c[:, i].copy())
+            memory.start = False
+        return actions[:n]
 
     def episode_stats(self) -> dict[str, float]:
         """Training cost, reported beside the metrics on the leaderboard (when the meta

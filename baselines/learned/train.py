@@ -8,11 +8,16 @@ Output directory (default ``results/agents/<name>``)::
     eval/evaluations.npz validation returns over training       tb/  TensorBoard logs
 
 ``resume=True`` continues from the newest checkpoint (model, replay buffer, reward
-normalisation and the wall-time counter) up to the config's ``n_timesteps``.  Otherwise an
-output directory that is not empty is refused, unless ``force=True`` (its earlier outputs,
-:data:`TRAINING_OUTPUTS`, are removed first).
-:func:`export_policy` copies the best model and its meta into a policy directory (the
-shipped ones live in ``baselines/learned/policies``).
+normalisation and the wall-time counter) up to the config's ``n_timesteps``; a finished run
+(its ``meta.json`` has the ``n_timesteps``) is left as it is and its meta returned.
+Otherwise an output directory that is not empty is refused, unless ``force=True`` (its
+earlier outputs, :data:`TRAINING_OUTPUTS`, are removed first).
+
+:func:`export_policy` copies what :class:`~baselines.learned.policy.LearnedPolicy` needs (the
+best model, its meta, ``vecnormalize.pkl`` if the run has one; no checkpoints, replay buffers
+or logs) into a policy directory; :func:`ship_policy` into the shipped layout
+``baselines/learned/policies/<name>/seed_<k>/``.  So ``shipgym train all --seeds 0 1 2
+--ship --resume`` on finished runs only exports them.
 """
 
 from __future__ import annotations
@@ -165,6 +170,8 @@ def train(
     if updates:
         config = config.model_copy(update=updates)
     out = Path(out_dir or f"results/agents/{config.name}")
+    if resume and (finished := finished_run(out, config.n_timesteps)) is not None:
+        return finished
     if not resume:
         check_agent_folder(out, config.name, force)
         if force:
@@ -258,14 +265,29 @@ def train(
     return meta
 
 
+def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
+    """The meta of the run in ``out`` if it is finished (its ``model.zip`` saved and its
+    ``meta.json`` counting at least ``n_timesteps`` env steps), else None."""
+    meta_file = Path(out) / "meta.json"
+    if not (meta_file.is_file() and (Path(out) / "model.zip").is_file()):
+        return None
+    meta = json.loads(meta_file.read_text())
+    return meta if int(meta.get("env_steps", 0)) >= n_timesteps else None
+
+
 def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:
     """A :class:`RunError` unless ``out`` can take a fresh training run of agent ``name``:
     usable, and empty unless ``force``."""
     check_out_dir(out, force=force, note=f" (agent folder of {name})")
 
 
+#: the files of a policy folder (what LearnedPolicy reads), written by export_policy
+POLICY_FILES = ("model.zip", "meta.json", "vecnormalize.pkl")
+
+
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
-    """Copy the best model (else the final one) and meta.json into ``dest`` (a policy dir)."""
+    """Copy the best model (else the final one) as ``model.zip``, ``meta.json`` and the
+    run's ``vecnormalize.pkl`` (if any) into ``dest`` (a policy dir); nothing else."""
     src = Path(out_dir)
     model = src / "best_model.zip"
     if not model.is_file():
@@ -276,6 +298,31 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     target.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(model, target / "model.zip")
     shutil.copyfile(src / "meta.json", target / "meta.json")
+    normalizer = src / "vecnormalize.pkl"
+    if normalizer.is_file():
+        shutil.copyfile(normalizer, target / "vecnormalize.pkl")
+    else:
+        (target / "vecnormalize.pkl").unlink(missing_ok=True)  # not a stale one
+    return target
+
+
+def ship_policy(out_dir: str | Path, root: str | Path | None = None) -> Path:
+    """Export the run in ``out_dir`` into the shipped layout ``root/<name>/seed_<k>/``
+    (name and seed from its ``meta.json``; ``root``: default ``baselines/learned/policies``).
+    A single-model policy folder of that name (the layout before training seeds) has its
+    files removed: the agent is its ``seed_<k>`` folders from now on."""
+    from baselines.learned.policy import POLICY_DIR
+
+    meta_file = Path(out_dir) / "meta.json"
+    if not meta_file.is_file():
+        raise RunError(f"{out_dir}: no trained model (model.zip / meta.json) to export")
+    meta = json.loads(meta_file.read_text())
+    if not isinstance(meta.get("name"), str) or not isinstance(meta.get("seed"), int):
+        raise RunError(f"{meta_file}: a shipped policy needs its 'name' and its 'seed'")
+    agent = Path(root if root is not None else POLICY_DIR) / meta["name"]
+    target = export_policy(out_dir, agent / f"seed_{meta['seed']}")
+    for name in POLICY_FILES:
+        (agent / name).unlink(missing_ok=True)
     return target
 
 
@@ -284,10 +331,8 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
 
     ``job``: ``config`` (name, path or AgentConfig), ``out_dir``, optional ``seed``,
     ``n_timesteps``, ``resume``, ``force``, ``progress``, ``ship`` (export to the shipped
-    policies).
+    policies, :func:`ship_policy`).
     """
-    from baselines.learned.policy import POLICY_DIR
-
     config = job["config"]
     if not isinstance(config, AgentConfig):
         config = load_agent_config(config)
@@ -302,7 +347,7 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
         force=job.get("force", False),
     )
     if job.get("ship"):
-        meta["shipped_to"] = str(export_policy(job["out_dir"], POLICY_DIR / config.name))
+        meta["shipped_to"] = str(ship_policy(job["out_dir"]))
     meta["out_dir"] = str(job["out_dir"])
     return meta
 

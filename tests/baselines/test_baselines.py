@@ -79,7 +79,7 @@ def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
     ppo = next(r for r in on_disk if r["controller"] == "ppo")
     assert ppo["kind"] == "learned" and ppo["train_env_steps"] > 0
     assert {r["split"] for r in on_disk} == {"catalogue", "heldout"}
-    assert (tmp_path / "rudder_aging.png").is_file()
+    assert (tmp_path / "scenario_rudder_aging.png").is_file()
     assert_equals_golden(on_disk, GOLDEN / "smoke_leaderboard.json")
 
 

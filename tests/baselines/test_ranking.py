@@ -147,3 +147,31 @@ def test_performance_profile_is_the_fraction_of_runs_above_tau() -> None:
     np.testing.assert_allclose(profiles["half"], [1.0, 0.0])
     np.testing.assert_allclose(profiles["pid_los"], [1.0, 1.0])
     assert intervals["half"].shape == (2, 2)
+
+
+def test_scenario_scores_give_each_cell_its_mean_and_interval() -> None:
+    from baselines.ranking import scenario_scores
+
+    eps = _episodes({"zero_rudder": [-100.0] * 4, "pid_los": [-20.0] * 4, "half": [-60.0] * 4})
+    cells = {(c["controller"], c["scenario"]): c for c in scenario_scores(eps, {"a": "catalogue"})}
+    assert cells[("half", "a")]["score_mean"] == pytest.approx(0.5)
+    assert cells[("half", "a")]["score_ci95"] == pytest.approx([0.5, 0.5])
+    assert cells[("pid_los", "b")]["split"] == "catalogue"  # unknown scenarios: catalogue
+    assert cells[("zero_rudder", "a")]["episodes"] == 4
+
+
+def test_the_fast_metrics_give_rliables_bits() -> None:
+    """interquartile_mean and probability_of_improvement (vectorised) equal rliable's
+    aggregate_iqm and probability_of_improvement exactly, ties and equal columns included."""
+    from rliable import metrics as rmetrics
+
+    from baselines.ranking import interquartile_mean, probability_of_improvement
+
+    rng = np.random.default_rng(3)
+    for trial in range(200):
+        m, n, tasks = rng.integers(1, 12, 3)
+        digits = int(rng.integers(0, 3))  # coarse rounding makes ties
+        x = np.round(rng.normal(1.0, 0.3, (m, tasks)), digits)
+        y = x.copy() if trial % 7 == 0 else np.round(rng.normal(1.0, 0.3, (n, tasks)), digits)
+        assert interquartile_mean(x) == rmetrics.aggregate_iqm(x)
+        assert probability_of_improvement(x, y) == rmetrics.probability_of_improvement(x, y)

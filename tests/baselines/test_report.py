@@ -41,8 +41,13 @@ def test_report_merges_two_evaluate_runs_into_the_leaderboard_table(
     board = json.loads((evaluated["both"] / "leaderboard.json").read_text())
     assert untimed(rows) == untimed(board)
     assert untimed(json.loads((out / "leaderboard.json").read_text())) == untimed(board)
-    for name in ("leaderboard.md", "leaderboard.csv", "generalisation.json", "nominal.png"):
+    for name in ("leaderboard.md", "leaderboard.csv", "generalisation.json", "aggregate.json"):
         assert (out / name).is_file(), name
+    assert (out / "scenario_nominal.png").is_file()
+    # the ranking of the merged runs is the leaderboard's
+    aggregate = (out / "aggregate.json").read_text()
+    assert aggregate == (evaluated["both"] / "aggregate.json").read_text()
+    assert [r["controller"] for r in json.loads(aggregate)] == ["pid_los", "zero_rudder"]
     report = json.loads((out / "report.json").read_text())
     assert [r["folder"] for r in report["runs"]] == runs
     assert [r["episodes"] for r in report["runs"]] == [4, 4]
@@ -64,6 +69,11 @@ def test_report_refuses_runs_that_disagree(evaluated: dict[str, Path], tmp_path:
     (other / "run.json").write_text(json.dumps(record))
     (other / "episodes.jsonl").write_text("")
     with pytest.raises(RunError, match=r"scenario 'nominal' has other settings.*ship\.params\.K"):
+        write_report([evaluated["zero_rudder"], other], tmp_path / "out")
+    record["suite"]["scenarios"]["nominal"]["ship"]["params"]["K"] /= 2
+    record["suite"]["randomize"] = {"heading_error_deg": [-5.0, 5.0]}  # other trials
+    (other / "run.json").write_text(json.dumps(record))
+    with pytest.raises(RunError, match=r"draws its trials with randomize .*heading_error_deg"):
         write_report([evaluated["zero_rudder"], other], tmp_path / "out")
     with pytest.raises(RunError, match=r"is in .* and in"):  # the same episodes twice
         write_report([evaluated["pid_los"], evaluated["both"]], tmp_path / "out")

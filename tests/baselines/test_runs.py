@@ -97,11 +97,18 @@ def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) ->
 
 
 def test_a_learned_episode_records_its_training_seed(tmp_path: Path) -> None:
+    """One episode per shipped training seed, each with its own (its meta's) seed."""
+    from baselines.learned.policy import model_zip
+    from baselines.registry import training_seeds
+
     suite = write_suite(tmp_path, scenarios=["nominal"], controllers=["ppo"], seeds=1)
     run_leaderboard(suite, out_dir=tmp_path / "out", workers=1, show_progress=False)
-    (record,) = read_episodes(tmp_path / "out")
-    meta = json.loads((ROOT / "baselines/learned/policies/ppo/meta.json").read_text())
-    assert record["training_seed"] == meta["seed"] and record["kind"] == "learned"
+    records = read_episodes(tmp_path / "out")
+    seeds = training_seeds("ppo")
+    assert [r["training_seed"] for r in records] == seeds and len(seeds) >= 3
+    for record, seed in zip(records, seeds, strict=True):
+        meta = json.loads((model_zip("ppo", seed).parent / "meta.json").read_text())
+        assert record["training_seed"] == meta["seed"] and record["kind"] == "learned"
 
 
 def test_each_episode_is_on_disk_when_it_ends(tmp_path: Path) -> None:
@@ -257,15 +264,15 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
 
 
 def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
-    """A scenario given by its YAML path is plotted as ``<stem>.png`` inside --out, never
-    beside the scenario file."""
+    """A scenario given by its YAML path is plotted as ``scenario_<stem>.png`` inside --out,
+    never beside the scenario file."""
     cases = tmp_path / "cases"
     cases.mkdir()
     (cases / "my_case.yaml").write_text((ROOT / "configs/scenarios/nominal.yaml").read_text())
     suite = write_suite(tmp_path, scenarios=["cases/my_case.yaml"], controllers=["pid_los"])
     out = tmp_path / "out"
     run_leaderboard(suite, seeds=1, out_dir=out, workers=1, show_progress=False)
-    assert (out / "my_case.png").is_file()
+    assert (out / "scenario_my_case.png").is_file()
     assert sorted(p.name for p in cases.iterdir()) == ["my_case.yaml"]
 
 

@@ -28,7 +28,9 @@ def test_packaged_suites_load() -> None:
         heldout_scenarios=1,
         controllers=["nmpc_lambda_lssvm", "pid_los", "ppo", "zero_rudder"],
         seeds=2,
+        randomize=smoke.randomize,
     )
+    assert smoke.randomize is not None and smoke.randomize.heading_error_deg is not None
     assert smoke.all_scenarios() == ["rudder_aging", "mariner_track", "heldout:0"]
 
 

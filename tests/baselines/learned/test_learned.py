@@ -263,9 +263,11 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
         _policy_params(tmp_path / "ray"), _policy_params(tmp_path / "here"), strict=True
     ):
         np.testing.assert_array_equal(x, y)
-    timing = ("compute_ms", "compute_ms_std")
-    strip = [{k: v for k, v in r.items() if k not in timing} for r in local]
-    assert strip == [{k: v for k, v in r.items() if k not in timing} for r in remote]
+
+    def strip(rows: list[dict]) -> list[dict]:  # wall-clock timings aside
+        return [{k: v for k, v in r.items() if not k.startswith("compute_ms")} for r in rows]
+
+    assert strip(local) == strip(remote)
 
 
 def test_training_sweep_gives_the_same_runs_in_a_process_pool(tmp_path: Path) -> None:
@@ -297,3 +299,50 @@ def test_training_sweep_gives_the_same_runs_in_a_process_pool(tmp_path: Path) ->
             np.testing.assert_array_equal(x, y)
     with pytest.raises(ValueError, match="unknown backend"):
         train_sweep(jobs(tmp_path / "x"), backend="slurm")
+
+
+def test_train_seeds_ship_lays_out_a_folder_per_training_seed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``train --seeds 1 2`` trains a run per seed; ``--ship --resume`` on the finished runs
+    exports them (without training again) into ``policies/<name>/seed_<k>`` — what
+    LearnedPolicy reads, nothing else — and the agent's single-model files are removed."""
+    from baselines.cli import main
+    from baselines.registry import training_seeds
+
+    policies = tmp_path / "policies"
+    monkeypatch.setattr("baselines.learned.policy.POLICY_DIR", policies)
+    (policies / "ppo_tiny").mkdir(parents=True)
+    for old in ("model.zip", "meta.json"):  # the layout before training seeds
+        (policies / "ppo_tiny" / old).write_text("old")
+    config = tmp_path / "tiny.yaml"
+    config.write_text(yaml.safe_dump(_tiny_config().model_dump()))
+    out = tmp_path / "agents"
+    args = ["train", "ppo", "--config", str(config), "--out", str(out), "--no-progress"]
+    args += ["--seeds", "1", "2", "--timesteps", "128", "--json"]
+    assert main(args) == 0
+    trained = json.loads(capsys.readouterr().out)
+    assert [(m["seed"], m["env_steps"]) for m in trained] == [(1, 128), (2, 128)]
+    models = {s: out / f"seed_{s}" / "model.zip" for s in (1, 2)}
+    written = {s: path.stat().st_mtime_ns for s, path in models.items()}
+    assert main([*args, "--ship", "--resume"]) == 0
+    shipped = json.loads(capsys.readouterr().out)
+    assert [m["wall_time_s"] for m in shipped] == [m["wall_time_s"] for m in trained]
+    assert {s: path.stat().st_mtime_ns for s, path in models.items()} == written  # not retrained
+    agent = policies / "ppo_tiny"
+    assert [m["shipped_to"] for m in shipped] == [str(agent / "seed_1"), str(agent / "seed_2")]
+    assert sorted(p.name for p in agent.iterdir()) == ["seed_1", "seed_2"]
+    for s in (1, 2):
+        assert sorted(p.name for p in (agent / f"seed_{s}").iterdir()) == ["meta.json", "model.zip"]
+    assert training_seeds("ppo_tiny") == [1, 2]
+    assert training_seeds(str(out)) == [1, 2]  # the run folder resolves the same way
+    policy = LearnedPolicy("ppo_tiny", training_seed=2)
+    assert (policy.name, policy.training_seed) == ("ppo_tiny", 2)
+
+
+def test_train_takes_seed_as_an_alias_of_seeds() -> None:
+    from baselines.cli import build_parser
+
+    parser = build_parser()
+    assert parser.parse_args(["train", "ppo", "--seed", "3"]).seeds == [3]
+    assert parser.parse_args(["train", "all", "--seeds", "0", "1", "2"]).seeds == [0, 1, 2]

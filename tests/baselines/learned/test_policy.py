@@ -1,6 +1,7 @@
 """A plain stable-baselines3 zip is scored by its path (issue 12 items 2 and 5): algorithm
 from the zip, action mode from its action space, ``vecnormalize.pkl`` beside it used,
-``meta.json`` optional and checked, a truncated or corrupt zip a clear error."""
+``meta.json`` optional and checked, a truncated or corrupt zip a clear error.  An agent
+trained with several seeds is a folder of ``seed_<k>`` folders (issue 13 item 2)."""
 
 from __future__ import annotations
 
@@ -17,9 +18,23 @@ import pytest
 import shipgym  # noqa: F401  (registers the envs)
 from baselines.cli import main
 from baselines.errors import ControllerError
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from baselines.learned.policy import ALGORITHMS, LearnedPolicy, read_model, read_policy
-from baselines.registry import controller_kind, make_controller, resolve_controller
+from baselines.evaluation import EVAL_SEED_OFFSET, evaluate, evaluate_batch
+from baselines.learned.policy import (
+    ALGORITHMS,
+    BATCH_ROWS,
+    LearnedPolicy,
+    read_model,
+    read_policy,
+    shipped_policies,
+)
+from baselines.plugins import ControllerEntry
+from baselines.registry import (
+    controller_kind,
+    controller_label,
+    make_controller,
+    resolve_controller,
+    training_seeds,
+)
 
 sb3 = pytest.importorskip("stable_baselines3")
 sb3_contrib = pytest.importorskip("sb3_contrib")
@@ -58,6 +73,16 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return paths
 
 
+def _predict(model: Any, obs: np.ndarray) -> np.ndarray:
+    """The model's deterministic action for ``obs`` in a batch of ``BATCH_ROWS`` rows, as the
+    policy runs it (torch's GEMM gives a row the same bits whatever the other rows, for a
+    fixed batch size, but not across batch sizes)."""
+    batch = np.zeros((BATCH_ROWS, *obs.shape), dtype=obs.dtype)
+    batch[3] = obs  # any row: the bits do not depend on the position
+    actions, _ = model.predict(batch, deterministic=True)
+    return actions[3]
+
+
 def _observations(n: int = 20) -> list[np.ndarray]:
     env = _env()
     obs, _ = env.reset(seed=3)
@@ -78,8 +103,7 @@ def test_a_plain_sb3_zip_is_scored_by_its_path(
     assert policy.name == f"{algo}/agent" and controller_kind(policy.name) == "learned"
     model = getattr(sb3, cls).load(str(path), device="cpu")
     for obs in _observations():  # the policy acts as the model does, deterministically
-        expected, _ = model.predict(obs, deterministic=True)
-        np.testing.assert_array_equal(policy.act(obs, {}), expected)
+        np.testing.assert_array_equal(policy.act(obs, {}), _predict(model, obs))
     (result,) = evaluate(str(path), "nominal", [EVAL_SEED_OFFSET])
     assert (result.controller, result.kind) == (f"{algo}/agent", "learned")
     assert np.isfinite(result.metrics["return"])
@@ -149,9 +173,8 @@ def test_vecnormalize_beside_the_zip_normalises_the_observation(tmp_path: Path) 
     policy = LearnedPolicy(tmp_path)
     assert policy.obs_normalizer is not None
     for obs in _observations(5):
-        normalised, _ = model.predict(venv.normalize_obs(obs), deterministic=True)
-        np.testing.assert_array_equal(policy.act(obs, {}), normalised)
-    raw = np.array([model.predict(o, deterministic=True)[0] for o in _observations(5)])
+        np.testing.assert_array_equal(policy.act(obs, {}), _predict(model, venv.normalize_obs(obs)))
+    raw = np.array([_predict(model, o) for o in _observations(5)])
     acted = np.array([policy.act(o, {}) for o in _observations(5)])
     assert not np.array_equal(raw, acted)  # the statistics were used
     (tmp_path / "vecnormalize.pkl").write_bytes(b"not a pickle")
@@ -244,3 +267,95 @@ def test_a_folder_without_one_model_zip_is_a_clear_error(tmp_path: Path) -> None
     (tmp_path / "b.zip").write_bytes(b"")
     with pytest.raises(ControllerError, match=r"holds model\.zip, .* it holds a\.zip, b\.zip"):
         make_controller(str(tmp_path))
+
+
+# --------------------------------------------------------------------- training seeds
+
+
+def _seeded_agent(trained: dict[str, Path], folder: Path) -> Path:
+    """An agent folder of two training seeds as ``shipgym train --seeds 0 1 --ship`` lays
+    it out: ``seed_0`` (the tiny PPO) and ``seed_1`` (the tiny SAC, to tell them apart),
+    each with its meta (its seed and training cost)."""
+    for seed, algo in enumerate(("ppo", "sac")):
+        (folder / f"seed_{seed}").mkdir(parents=True)
+        shutil.copyfile(trained[algo], folder / f"seed_{seed}" / "model.zip")
+        meta = {"seed": seed, "env_steps": 100 * (seed + 1), "wall_time_s": 1.0 + seed}
+        (folder / f"seed_{seed}" / "meta.json").write_text(json.dumps(meta))
+    return folder
+
+
+def test_a_folder_of_seed_folders_is_one_agent_with_its_training_seeds(
+    trained: dict[str, Path], tmp_path: Path
+) -> None:
+    agent = str(_seeded_agent(trained, tmp_path / "agent"))
+    (tmp_path / "agent" / "seed_2" / "checkpoints").mkdir(parents=True)  # a run not done yet
+    assert training_seeds(agent) == [0, 1]
+    assert controller_label(agent) == "agent" and controller_kind("agent") == "learned"
+    policy, mode = make_controller(agent, training_seed=1)
+    assert (policy.algo, policy.training_seed, policy.name, mode) == ("sac", 1, "agent", "rudder")
+    first, _ = make_controller(agent)  # without a training seed: the first
+    assert (first.algo, first.training_seed) == ("ppo", 0)
+    (result,) = evaluate_batch(agent, "nominal", [EVAL_SEED_OFFSET], training_seed=1)
+    assert (result.controller, result.training_seed) == ("agent", 1)
+    assert (result.metrics["train_env_steps"], result.metrics["train_wall_s"]) == (200.0, 2.0)
+    with pytest.raises(ControllerError, match=r"'agent' was trained with seeds 0, 1: no .* 5"):
+        make_controller(agent, training_seed=5)
+    with pytest.raises(ControllerError, match=r"no training seed 5; it holds seed_0, seed_1"):
+        LearnedPolicy(agent, training_seed=5)
+    assert LearnedPolicy(tmp_path / "agent" / "seed_1").name == "agent/seed_1"
+
+
+def test_a_single_model_is_one_training_seed_its_meta_names(
+    trained: dict[str, Path], tmp_path: Path
+) -> None:
+    """The layout before training seeds (``policies/<name>/model.zip``) is one training seed,
+    its meta's; a zip without one has [None], as classical controllers do."""
+    model = _copy(trained, tmp_path / "flat")
+    (model.parent / "meta.json").write_text(json.dumps({"seed": 3}))
+    assert training_seeds(str(model.parent)) == [3]
+    policy, _ = make_controller(str(model.parent), training_seed=3)
+    assert policy.training_seed == 3
+    with pytest.raises(ControllerError, match=r"no training seed 4: its meta\.json says seed 3"):
+        LearnedPolicy(model.parent, training_seed=4)
+    assert training_seeds(str(trained["ppo"])) == [None]
+    assert training_seeds("pid_los") == [None]
+    with pytest.raises(ControllerError, match=r"'pid_los' has no training seeds"):
+        make_controller("pid_los", training_seed=0)
+
+
+def test_a_suite_long_form_can_name_one_training_seed(
+    trained: dict[str, Path], tmp_path: Path, scratch_registry: None
+) -> None:
+    agent = str(_seeded_agent(trained, tmp_path / "agent"))
+    entry = ControllerEntry(controller=agent, name="agent_s1", settings={"training_seed": 1})
+    assert training_seeds(entry) == [1]
+    assert make_controller(entry)[0].algo == "sac"
+    with pytest.raises(ControllerError, match=r"no training seed 7"):
+        training_seeds(ControllerEntry(controller=agent, settings={"training_seed": 7}))
+
+
+def test_seed_folders_that_contradict_themselves_are_clear_errors(
+    trained: dict[str, Path], tmp_path: Path
+) -> None:
+    both = _seeded_agent(trained, tmp_path / "both")
+    shutil.copyfile(trained["ppo"], both / "model.zip")
+    with pytest.raises(ControllerError, match=r"holds both a model \(model\.zip\) and training"):
+        make_controller(str(both))
+    mislabelled = _seeded_agent(trained, tmp_path / "mislabelled")
+    (mislabelled / "seed_1" / "meta.json").write_text('{"seed": 0}')
+    with pytest.raises(ControllerError, match=r"seed_1/meta\.json: key 'seed' is 0, but the"):
+        make_controller(str(mislabelled))
+    modes = _seeded_agent(trained, tmp_path / "modes")
+    _saved(modes / "seed_1", "ppo", _env("guidance"), "model")
+    with pytest.raises(ControllerError, match=r"its training seeds disagree: .* 'guidance' mode"):
+        make_controller(str(modes))
+
+
+def test_every_shipped_agent_loads_each_of_its_training_seeds() -> None:
+    for name in shipped_policies():
+        seeds = training_seeds(name)
+        assert seeds and all(isinstance(seed, int) for seed in seeds), name
+        for seed in seeds:
+            policy, _ = make_controller(name, training_seed=seed)
+            assert (policy.name, policy.training_seed) == (name, seed)
+            assert policy.episode_stats()["train_env_steps"] > 0

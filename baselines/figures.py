@@ -1,0 +1,640 @@
+"""The leaderboard's figures (issue 13): per-scenario small multiples and the rliable ranking.
+
+Every figure uses :func:`baselines.style.controller_style` (one colour and line style per
+controller, the same in every figure), labels its axes with units, keeps legends outside the
+data and is written twice: a PNG at :data:`~baselines.style.FIGURE_DPI` (200 dpi) and an SVG
+copy beside it (:func:`save_figure`).  Matplotlib runs on the Agg backend.
+
+What a run hands in:
+
+* ``drawn``: (scenario, controller) → :class:`DrawnEpisode` (or a plain ``(seed,
+  trajectory)`` / ``(seed, trajectory, training_seed)`` tuple) — the episode to draw, its
+  trajectory as :attr:`baselines.evaluation.EpisodeResult.trajectory` keeps it (arrays ``t``
+  [s], ``x``, ``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad], …).
+  :func:`median_ace_episode` names the episode to keep (the median-ACE seed, and its training
+  seed), :func:`episodes_to_draw` picks them from episode results.
+* ``aggregate``: the ``aggregate.json`` rows (:func:`baselines.ranking.aggregate_ranking`);
+  ``episodes``: the ``episodes.jsonl`` records; ``splits``: scenario → split.
+
+Functions (each returns the written files, PNG then SVG):
+
+* :func:`plot_scenario` ``(out_dir, scenario, drawn, change_time, path_xy=None,
+  ship_length=None, kinds=None, chosen_by="median-ACE")`` — one scenario: a grid with one
+  column per controller family (at most :data:`PANEL_CONTROLLERS` controllers a column) and
+  three rows with the same axes in every column: track x–y over the path, e(t), δ(t); the
+  parameter-change time as a labelled vertical line ("change at t = … s") and each ship's
+  position at that time; the title and legends say which episode is drawn.  File
+  ``scenario_<name>``.
+* :func:`plot_scenarios` ``(out_dir, drawn, scenarios=None, kinds=None,
+  chosen_by="median-ACE")`` — every scenario of ``drawn``; change time, path and ship
+  length read from the scenario (:func:`shipgym.scenarios.load_scenario` of
+  ``scenarios[name]``, else of the name).
+* :func:`plot_ranking` ``(out_dir, aggregate, episodes, splits, kinds=None)`` — per split: rliable's
+  interval estimates (mean and IQM of the normalised score and P(improvement over pid_los),
+  95 % intervals; file ``ranking_<split>``) and performance profiles (one panel per family,
+  file ``profile_<split>``).
+
+18 scenarios and the ranking of 20 controllers take about half a minute on one core.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from baselines.style import FIGURE_DPI, controller_style
+
+#: most controllers drawn in one panel; a bigger family is split over several columns
+PANEL_CONTROLLERS = 5
+#: most points of a drawn line (longer trajectories are thinned by a stride, last point kept)
+MAX_POINTS = 2000
+#: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
+#: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)
+PROFILE_REPS = 200
+#: controller families, the order of the columns
+FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
+REFERENCES = ("zero_rudder", "random")
+_LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3")
+_CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
+
+
+class DrawnEpisode(NamedTuple):
+    """The episode drawn for one (scenario, controller): evaluation seed, trajectory arrays
+    (``t`` [s], ``x``/``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad]) and the
+    training seed of a learned agent (None for the rest)."""
+
+    seed: int
+    trajectory: Mapping[str, Any]
+    training_seed: int | None = None
+
+
+def pyplot() -> Any:
+    """``matplotlib.pyplot`` on the non-interactive Agg backend."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def figure_stem(name: str) -> str:
+    """A file-name stem for a scenario or split: ``heldout:0`` → ``heldout_0``, a YAML path →
+    its stem."""
+    if name.endswith((".yaml", ".yml")) or "/" in name:
+        name = Path(name).stem
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+
+
+def save_figure(fig: Any, out_dir: str | Path, stem: str, tight: bool = False) -> list[Path]:
+    """Write ``fig`` as ``<stem>.png`` (200 dpi) and ``<stem>.svg`` into ``out_dir`` (made if
+    missing), close it and return both paths.  ``tight``: crop to what is drawn (for a
+    figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
+    layout is computed once (the PNG) and kept for the SVG."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    bbox = "tight" if tight else None
+    with pyplot().rc_context({"svg.fonttype": "none", "svg.hashsalt": "shipgym"}):
+        fig.savefig(paths[0], dpi=FIGURE_DPI, bbox_inches=bbox)
+        fig.set_layout_engine("none")
+        fig.savefig(paths[1], bbox_inches=bbox, metadata={"Date": None})
+    pyplot().close(fig)
+    return paths
+
+
+# ------------------------------------------------------------------ which episode to draw
+def _ace(record: Mapping[str, Any]) -> float:
+    value = record.get("ace")
+    if value is None or not math.isfinite(float(value)):
+        return math.inf  # an undefined ACE sorts last
+    return float(value)
+
+
+def median_ace_episode(
+    records: Iterable[Mapping[str, Any]], scenario: str, controller: str
+) -> tuple[int, int | None] | None:
+    """(seed, training seed) of the median-ACE episode of one (scenario, controller) among
+    ``records`` (``episodes.jsonl`` objects or result rows with ``ace``, ``seed`` and, for
+    learned agents, ``training_seed``); with an even count the lower median, ties broken by
+    (training seed, seed).  None if the pair has no episode."""
+    mine = [
+        r for r in records if r.get("scenario") == scenario and r.get("controller") == controller
+    ]
+    if not mine:
+        return None
+    mine.sort(key=lambda r: (_ace(r), _seed_key(r.get("training_seed")), int(r["seed"])))
+    pick = mine[(len(mine) - 1) // 2]
+    return int(pick["seed"]), pick.get("training_seed")
+
+
+def _seed_key(seed: int | None) -> tuple[bool, int]:
+    return (seed is None, seed if seed is not None else 0)
+
+
+def episodes_to_draw(results: Iterable[Any]) -> dict[tuple[str, str], DrawnEpisode]:
+    """The median-ACE episode of each (scenario, controller) of ``results``
+    (:class:`~baselines.evaluation.EpisodeResult`), for :func:`plot_scenarios`; a pair whose
+    median episode has no kept trajectory is left out."""
+    results = list(results)
+    records = [
+        {
+            "scenario": r.scenario,
+            "controller": r.controller,
+            "seed": r.seed,
+            "training_seed": r.training_seed,
+            "ace": r.metrics.get("ace"),
+        }
+        for r in results
+    ]
+    kept = {(r.scenario, r.controller, r.seed, r.training_seed): r for r in results if r.trajectory}
+    drawn = {}
+    for scenario, controller in dict.fromkeys((r.scenario, r.controller) for r in results):
+        pick = median_ace_episode(records, scenario, controller)
+        if pick is not None and (scenario, controller, *pick) in kept:
+            r = kept[(scenario, controller, *pick)]
+            drawn[(scenario, controller)] = DrawnEpisode(r.seed, r.trajectory, r.training_seed)
+    return drawn
+
+
+def _as_drawn(value: Any) -> DrawnEpisode:
+    return value if isinstance(value, DrawnEpisode) else DrawnEpisode(*value)
+
+
+# ---------------------------------------------------------------------------- families
+def controller_family(name: str, kind: str | None = None) -> str:
+    """The controller's family (one of :data:`FAMILIES`): the column it is drawn in."""
+    if name in REFERENCES:
+        return "references"
+    if kind == "learned" or name in _LEARNED:
+        return "learned"
+    if name.startswith("pid"):
+        return "PID"
+    if name.endswith("lqr"):
+        return "LQR"
+    if name.startswith("nmpc"):
+        return "NMPC"
+    if "backstepping" in name:
+        return "backstepping"
+    return "other"
+
+
+def family_panels(
+    controllers: Iterable[str], kinds: Mapping[str, str] | None = None
+) -> list[tuple[str, list[str]]]:
+    """(title, controllers) of each panel column: families in :data:`FAMILIES` order, each
+    split into chunks of at most :data:`PANEL_CONTROLLERS`, controllers in given order."""
+    groups: dict[str, list[str]] = defaultdict(list)
+    for name in controllers:
+        groups[controller_family(name, (kinds or {}).get(name))].append(name)
+    panels = []
+    for family in FAMILIES:
+        members = groups.get(family, [])
+        chunks = [
+            members[i : i + PANEL_CONTROLLERS] for i in range(0, len(members), PANEL_CONTROLLERS)
+        ]
+        for k, chunk in enumerate(chunks):
+            title = family if len(chunks) == 1 else f"{family} ({k + 1}/{len(chunks)})"
+            panels.append((title, chunk))
+    return panels
+
+
+# ------------------------------------------------------------------------ one scenario
+def _thin(values: Any, step: int) -> np.ndarray:
+    a = np.asarray(values, dtype=np.float64)
+    if step <= 1:
+        return a
+    return np.concatenate([a[::step], a[-1:]]) if (a.size - 1) % step else a[::step]
+
+
+def _episode_label(name: str, ep: DrawnEpisode) -> str:
+    if ep.training_seed is None:
+        return f"{name} (seed {ep.seed})"
+    return f"{name} (seed {ep.seed}, training seed {ep.training_seed})"
+
+
+def _which_episode(episodes: Mapping[str, DrawnEpisode], chosen_by: str) -> str:
+    """The title's account of the drawn episodes (classical controllers have no training
+    seed)."""
+    seeds = {ep.seed for ep in episodes.values()}
+    trained = {ep.training_seed for ep in episodes.values()} - {None}
+    if len(seeds) > 1:
+        return f"each controller's {chosen_by} episode (seed in the legend)"
+    text = f"{chosen_by} seed {next(iter(seeds))}"
+    if len(trained) == 1:
+        return text + f" (training seed {next(iter(trained))})"
+    return text + (" (training seeds in the legend)" if trained else "")
+
+
+def _limits(arrays: Sequence[np.ndarray], pad: float) -> tuple[float, float]:
+    """(low, high) of the finite values of ``arrays``, widened by 4 % and at least ``pad``."""
+    finite = [a[np.isfinite(a)] for a in arrays]
+    values = np.concatenate(finite) if finite else np.zeros(0)
+    if values.size == 0:
+        values = np.zeros(1)
+    low, high = float(values.min()), float(values.max())
+    margin = max(pad, 0.04 * (high - low))
+    return low - margin, high + margin
+
+
+def _equal_aspect(
+    xlim: tuple[float, float], ylim: tuple[float, float], width: float, height: float
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """``xlim``, ``ylim`` [m] widened about their centres so that a panel of ``width`` ×
+    ``height`` [in] shows x and y at the same scale."""
+    dx, dy = xlim[1] - xlim[0], ylim[1] - ylim[0]
+    if dy * width < dx * height:
+        c, half = 0.5 * (ylim[0] + ylim[1]), 0.5 * dx * height / width
+        return xlim, (c - half, c + half)
+    c, half = 0.5 * (xlim[0] + xlim[1]), 0.5 * dy * width / height
+    return (c - half, c + half), ylim
+
+
+def _change_line(ax: Any, change_time: float | None) -> None:
+    """The parameter-change time [s] as a labelled vertical line (call after the limits are
+    set: the label goes to the line's roomier side)."""
+    if change_time is None:
+        return
+    ax.axvline(change_time, **_CHANGE_STYLE)
+    low, high = ax.get_xlim()
+    right = change_time < low + 0.6 * (high - low)
+    ax.text(
+        change_time,
+        0.98,
+        f" change at t = {change_time:g} s ",
+        transform=ax.get_xaxis_transform(),
+        fontsize=6.5,
+        va="top",
+        ha="left" if right else "right",
+        bbox={
+            "boxstyle": "square,pad=0.1",
+            "facecolor": "white",
+            "edgecolor": "none",
+            "alpha": 0.75,
+        },
+    )
+
+
+#: layout of a scenario figure [in]: panel width, row heights (track, e, δ), margins, the gap
+#: between columns, between rows, the legends' room and the extra room of an own-scale column
+_PANEL_W, _ROWS_H = 2.4, (2.1, 1.6, 1.6)
+_LEFT, _RIGHT, _TOP, _GAP, _ROW_GAP, _OWN_GAP = 0.8, 0.15, 0.65, 0.2, 0.5, 0.55
+_LEGEND_LINE = 0.14  # [in] a legend entry
+_TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
+
+
+def _scales(
+    lines: Mapping[str, Mapping[str, np.ndarray]],
+    names: Sequence[str],
+    path: np.ndarray,
+    pad: float,
+) -> dict[str, tuple[float, float]]:
+    """Axis limits of the panels drawing ``names``: track x/y (equal scale), t, e, δ."""
+    traces = [lines[n] for n in names]
+    xy = _equal_aspect(
+        _limits([path[:, 0]] + [tr["x"] for tr in traces], pad),
+        _limits([path[:, 1]] + [tr["y"] for tr in traces], pad),
+        _PANEL_W,
+        _ROWS_H[0],
+    )
+    return {
+        "x": xy[0],
+        "y": xy[1],
+        "t": _limits([tr["t"] for tr in traces], 0.0),
+        "e": _limits([tr["cross_track_error"] for tr in traces], 0.1),
+        "d": _limits([np.degrees(tr["rudder_angle"]) for tr in traces], 0.5),
+    }
+
+
+def _column_axes(
+    fig: Any, rows_h: Sequence[float], own_scale: Sequence[bool], legend_lines: int
+) -> list[list[Any]]:
+    """One axes per row (heights ``rows_h`` [in]) in each of ``len(own_scale)`` columns, at
+    fixed positions (no layout engine: fast, the same in every figure, and room for the
+    legends below, :func:`_legend_below`); a column with its own scale gets room for its
+    tick labels."""
+    n = len(own_scale)
+    width = _LEFT + n * _PANEL_W + (n - 1) * _GAP + _OWN_GAP * sum(own_scale[1:]) + _RIGHT
+    height = _TOP + sum(rows_h) + len(rows_h) * _ROW_GAP + legend_lines * _LEGEND_LINE + 0.15
+    fig.set_size_inches(width, height)
+    columns, left = [], _LEFT
+    for col in range(n):
+        if col and own_scale[col]:
+            left += _OWN_GAP
+        top, axes = height - _TOP, []
+        for h in rows_h:
+            top -= h
+            axes.append(fig.add_axes((left / width, top / height, _PANEL_W / width, h / height)))
+            top -= _ROW_GAP
+        columns.append(axes)
+        left += _PANEL_W + _GAP
+    return columns
+
+
+def _legend_below(ax: Any, handles: Sequence[Any] | None = None) -> None:
+    """The legend of a column under its bottom axes ``ax``, outside the data (in the room
+    :func:`_column_axes` leaves)."""
+    height = ax.get_position().height * ax.figure.get_figheight()
+    ax.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -_ROW_GAP / height - 0.02),
+        fontsize=6.5,
+        frameon=False,
+        borderaxespad=0.0,
+    )
+
+
+def plot_scenario(
+    out_dir: str | Path,
+    scenario: str,
+    drawn: Mapping[str, DrawnEpisode | tuple],
+    change_time: float | None,
+    path_xy: np.ndarray | None = None,
+    ship_length: float | None = None,
+    kinds: Mapping[str, str] | None = None,
+    chosen_by: str = "median-ACE",
+) -> list[Path]:
+    """Small multiples of one scenario (module doc) from ``drawn``: controller → episode;
+    ``change_time`` [s] (None: no parameter change), ``path_xy`` (N, 2) points of the path
+    [m], ``ship_length`` [m] (in the title), ``kinds``: controller → kind (learned agents
+    outside the shipped names), ``chosen_by``: how the episodes were picked, for the title
+    (:func:`median_ace_episode`'s "median-ACE", or e.g. "first").  Every column has the same
+    axes, except the references' (zero_rudder, random: their own scale, so a drifting
+    reference does not flatten the rest).  Returns the PNG and SVG paths."""
+    plt = pyplot()
+    episodes = {name: _as_drawn(ep) for name, ep in drawn.items()}
+    panels = family_panels(episodes, kinds) or [("no episode kept", [])]
+    longest = max((len(ep.trajectory["t"]) for ep in episodes.values()), default=1)
+    step = max(1, math.ceil(longest / MAX_POINTS))
+    lines = {
+        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in episodes.items()
+    }
+    path = np.asarray(path_xy, dtype=np.float64) if path_xy is not None else np.empty((0, 2))
+    pad = ship_length or 1.0
+    controlled = [n for n in episodes if controller_family(n, (kinds or {}).get(n)) != "references"]
+    shared = _scales(lines, controlled or list(episodes), path, pad)
+    own_scale = [bool(controlled) and title.startswith("references") for title, _ in panels]
+    fig = plt.figure()
+    most = max(len(members) for _, members in panels)
+    columns = _column_axes(fig, _ROWS_H, own_scale, legend_lines=max(most, 1))
+    for col, ((title, members), (ax_track, ax_e, ax_d)) in enumerate(
+        zip(panels, columns, strict=True)
+    ):
+        lim = _scales(lines, members, path, pad) if own_scale[col] else shared
+        handles: list[Any] = []
+        if path.size:
+            ax_track.plot(path[:, 0], path[:, 1], color="0.55", lw=2.2, alpha=0.5, zorder=1)
+        for name in members:
+            tr, style = lines[name], controller_style(name)
+            label = _episode_label(name, episodes[name])
+            handles += ax_track.plot(
+                tr["x"], tr["y"], lw=1.0, label=label, gid=f"{name}/track", **style.kwargs()
+            )
+            if change_time is not None and tr["t"].size and tr["t"][-1] >= change_time:
+                k = int(np.searchsorted(tr["t"], change_time))  # where the ship is at the change
+                ax_track.plot(
+                    tr["x"][k], tr["y"][k], marker=style.marker, ms=5, color=style.color, lw=0
+                )
+            ax_e.plot(tr["t"], tr["cross_track_error"], lw=0.9, gid=f"{name}/e", **style.kwargs())
+            ax_d.plot(
+                tr["t"],
+                np.degrees(tr["rudder_angle"]),
+                lw=0.9,
+                gid=f"{name}/rudder",
+                **style.kwargs(),
+            )
+        ax_track.set(xlim=lim["x"], ylim=lim["y"], xlabel="x [m]")
+        ax_track.set_title(title + (" (own scale)" if own_scale[col] else ""), fontsize=9)
+        ax_e.set(xlim=lim["t"], ylim=lim["e"], xlabel="t [s]")
+        ax_d.set(xlim=lim["t"], ylim=lim["d"], xlabel="t [s]")
+        for ax in (ax_e, ax_d):
+            ax.axhline(0.0, color="0.7", lw=0.6, zorder=0)
+            _change_line(ax, change_time)
+        for ax, ylabel in zip(
+            (ax_track, ax_e, ax_d),
+            ("y [m]", "cross-track error e [m]", "rudder angle δ [deg]"),
+            strict=True,
+        ):
+            ax.tick_params(labelsize=7)
+            ax.xaxis.label.set_size(8)
+            ax.grid(True, alpha=0.25)
+            if col == 0 or own_scale[col]:
+                ax.set_ylabel(ylabel if col == 0 else "", fontsize=8)
+            else:
+                ax.tick_params(labelleft=False)  # the same scale as the column to its left
+        if handles:
+            _legend_below(ax_d, handles)
+    fig.suptitle(
+        _scenario_title(scenario, episodes, change_time, ship_length, chosen_by),
+        fontsize=10,
+        y=1.0 - 0.15 / fig.get_figheight(),
+        va="top",
+    )
+    return save_figure(fig, out_dir, "scenario_" + figure_stem(scenario))
+
+
+def _scenario_title(
+    scenario: str,
+    episodes: Mapping[str, DrawnEpisode],
+    change_time: float | None,
+    ship_length: float | None,
+    chosen_by: str,
+) -> str:
+    change = (
+        "no parameter change"
+        if change_time is None
+        else f"parameter change at t = {change_time:g} s"
+    )
+    ship = f"ship length L = {ship_length:g} m; " if ship_length else ""
+    which = _which_episode(episodes, chosen_by) if episodes else "no episode kept"
+    return f"{scenario} — {ship}{change}; drawn: {which}"
+
+
+def scenario_geometry(scenario: Any, points: int = 400) -> dict[str, Any]:
+    """``change_time`` [s], ``path_xy`` (``points`` × 2) [m] and ``ship_length`` [m] of a
+    :class:`~shipgym.scenarios.Scenario`: the keyword arguments of :func:`plot_scenario`."""
+    path = scenario.path
+    return {
+        "change_time": scenario.change_time,
+        "path_xy": np.asarray(path.point(np.linspace(0.0, path.length, points))),
+        "ship_length": scenario.ship_length,
+    }
+
+
+def plot_scenarios(
+    out_dir: str | Path,
+    drawn: Mapping[tuple[str, str], DrawnEpisode | tuple],
+    scenarios: Mapping[str, Any] | None = None,
+    kinds: Mapping[str, str] | None = None,
+    chosen_by: str = "median-ACE",
+) -> list[Path]:
+    """:func:`plot_scenario` for every scenario of ``drawn`` ((scenario, controller) →
+    episode), in sorted order; ``scenarios``: name → what
+    :func:`shipgym.scenarios.load_scenario` takes (``run.json``'s settings; default: the
+    name).  Returns every written file."""
+    from shipgym.scenarios import load_scenario
+
+    by_scenario: dict[str, dict[str, DrawnEpisode | tuple]] = defaultdict(dict)
+    for (scenario, controller), episode in drawn.items():
+        by_scenario[scenario][controller] = episode
+    files: list[Path] = []
+    for name in sorted(by_scenario):
+        spec = load_scenario((scenarios or {}).get(name, name))
+        files += plot_scenario(
+            out_dir,
+            name,
+            by_scenario[name],
+            kinds=kinds,
+            chosen_by=chosen_by,
+            **scenario_geometry(spec),
+        )
+    return files
+
+
+# ----------------------------------------------------------------------------- ranking
+SPLIT_TITLES = {"catalogue": "catalogue scenarios", "heldout": "held-out scenarios"}
+_SCORE_LABEL = "normalised score (0 = zero_rudder, 1 = pid_los)"
+
+
+def _interval(row: Mapping[str, Any], key: str) -> list[float]:
+    ci = row.get(f"{key}_ci95") or [math.nan, math.nan]
+    return [float(ci[0]), float(ci[1])]
+
+
+def plot_ranking(
+    out_dir: str | Path,
+    aggregate: Sequence[Mapping[str, Any]],
+    episodes: Sequence[Mapping[str, Any]],
+    splits: Mapping[str, str],
+    kinds: Mapping[str, str] | None = None,
+) -> list[Path]:
+    """Per split of ``aggregate``: ``ranking_<split>`` (rliable's interval estimates) and
+    ``profile_<split>`` (performance profiles from ``episodes``, one panel per family); see
+    the module doc.  Returns every written file."""
+    files: list[Path] = []
+    for split in dict.fromkeys(r["split"] for r in aggregate):
+        rows = [r for r in aggregate if r["split"] == split]
+        files += _plot_intervals(out_dir, split, rows)
+        files += _plot_profiles(out_dir, split, episodes, splits, kinds)
+    return files
+
+
+def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]]) -> list:
+    from rliable import plot_utils
+
+    plt = pyplot()
+    rows = sorted(rows, key=lambda r: (r["score_iqm"], r["controller"]))  # best on top
+    keys = ("score_mean", "score_iqm", "prob_improvement_over_pid_los")
+    names = [r["controller"] for r in rows]
+    point = {r["controller"]: np.array([float(r[k]) for k in keys]) for r in rows}
+    interval = {r["controller"]: np.array([_interval(r, k) for k in keys]).T for r in rows}
+    with plt.rc_context({"font.size": 8}):
+        fig, axes = plot_utils.plot_interval_estimates(
+            point,
+            interval,
+            metric_names=["mean score", "IQM score", "P(score > pid_los)"],
+            algorithms=names,
+            colors={n: controller_style(n).color for n in names},
+            subfigure_width=3.6,
+            row_height=0.3,
+            xlabel="",
+        )
+    for ax, label, ref in zip(
+        axes,
+        (_SCORE_LABEL, _SCORE_LABEL, "probability [–]"),
+        ((0.0, 1.0), (0.0, 1.0), (0.5,)),
+        strict=True,
+    ):
+        ax.set_xlabel(label, fontsize=9)
+        ax.title.set_fontsize(11)
+        ax.tick_params(labelsize=8)
+        for x in ref:
+            ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
+    axes[0].set_yticklabels(names, fontsize=9)
+    for i, ax in enumerate(axes):
+        for bars in ax.containers:  # rliable labels each interval bar with its controller
+            for bar in bars:
+                bar.set_gid(f"{bars.get_label()}/interval/{keys[i]}")
+    fig.suptitle(
+        f"Aggregate over {SPLIT_TITLES.get(split, split)}: point estimate (black) and 95 % "
+        "stratified-bootstrap interval (bar), rliable",
+        fontsize=10,
+        y=1.02,
+    )
+    return save_figure(fig, out_dir, "ranking_" + figure_stem(split), tight=True)
+
+
+def _taus(scores: np.ndarray) -> np.ndarray:
+    """Thresholds of the performance profile [score]: 0 … 1.25 widened to the 1st and 99th
+    percentiles of the scores."""
+    low, high = np.quantile(scores, [0.01, 0.99]) if scores.size else (0.0, 1.0)
+    return np.linspace(min(0.0, float(low)), max(1.25, float(high)), 121)
+
+
+def _plot_profiles(
+    out_dir: str | Path,
+    split: str,
+    episodes: Sequence[Mapping[str, Any]],
+    splits: Mapping[str, str],
+    kinds: Mapping[str, str] | None,
+) -> list[Path]:
+    from rliable import plot_utils
+
+    from baselines.ranking import normalised_scores, performance_profiles
+
+    plt = pyplot()
+    in_split = {s for s, sp in splits.items() if sp == split}
+    scores = np.array(
+        [
+            ep["score"]
+            for ep in normalised_scores(episodes)
+            if ep["scenario"] in in_split and ep["score"] is not None
+        ]
+    )
+    taus = _taus(scores)
+    profiles, cis = performance_profiles(episodes, splits, split, taus, reps=PROFILE_REPS)
+    panels = family_panels(profiles, kinds)
+    if not panels:
+        return []
+    fig = plt.figure()
+    most = max(len(members) for _, members in panels)
+    columns = _column_axes(fig, (2.2,), [False] * len(panels), legend_lines=most)
+    for col, ((title, members), (ax,)) in enumerate(zip(panels, columns, strict=True)):
+        plot_utils.plot_performance_profiles(
+            {m: profiles[m] for m in members},
+            taus,
+            performance_profile_cis={m: cis[m] for m in members},
+            ax=ax,
+            colors={m: controller_style(m).color for m in members},
+            linestyles={m: controller_style(m).linestyle for m in members},
+            xlabel="score τ [–]",
+            ylabel="" if col else "fraction of runs with score > τ",
+            labelsize=8,
+            ticklabelsize=7,
+            wrect=4,
+            hrect=4,
+        )
+        if col:
+            ax.tick_params(labelleft=False)  # the same scale as the column to its left
+        for line in ax.get_lines():  # rliable applies a linewidth keyword to its first line only
+            line.set_linewidth(1.3)
+            line.set_gid(f"{line.get_label()}/profile")
+        for x in (0.0, 1.0):
+            ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlim(taus[0], taus[-1])
+        _legend_below(ax)
+    fig.suptitle(
+        f"Performance profiles, {SPLIT_TITLES.get(split, split)} (95 % intervals shaded; "
+        "dashed: zero_rudder = 0, pid_los = 1)",
+        fontsize=10,
+        y=1.0 - 0.15 / fig.get_figheight(),
+        va="top",
+    )
+    return save_figure(fig, out_dir, "profile_" + figure_stem(split))

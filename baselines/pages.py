@@ -1,0 +1,448 @@
+"""``leaderboard.html``: the leaderboard as one self-contained page (issue 13).
+
+No network: the style sheet and the script are inline and every figure is embedded as a
+data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
+
+1. the **ranking** per split (``aggregate.json`` rows: mean and IQM of the normalised score
+   and the probability of improvement over ``pid_los``, 95 % intervals) and its figures
+   (``ranking_*`` / ``profile_*`` of :mod:`baselines.figures`);
+2. the **controller × scenario table** of mean scores with their intervals
+   (:func:`baselines.ranking.scenario_scores`), shaded from 0 (``zero_rudder``) to ≥ 1
+   (``pid_los``);
+3. the **scenario figures** (``scenario_*``), one per scenario;
+4. the **long per-row table** (``leaderboard.json`` rows), collapsed.
+
+Every table sorts on a click on its header (numbers best-first, i.e. descending, text
+ascending; a second click reverses; empty cells stay last).  The page sorts its
+controller × scenario table on load from the address's hash: ``#sort=<column>`` (the first
+click's order) or ``#sort=<column>:asc`` / ``:desc``, where a column is ``controller``,
+``kind``, ``iqm:<split>`` or a scenario's name.  Every text from the data (controller
+names are user input: plug-ins) is HTML-escaped.
+
+:func:`write_html` ``(out_dir, rows, aggregate, scores, figures, title=…, subtitle=None)``
+writes the page and returns its path.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from baselines.figures import figure_stem
+from baselines.style import controller_style
+
+PAGE_FILE = "leaderboard.html"
+SPLIT_TITLES = {"catalogue": "Catalogue scenarios", "heldout": "Held-out scenarios"}
+#: the long table's metric columns: key → header (with units)
+ROW_METRICS = {
+    "ace": "ACE [m]",
+    "ace_L": "ACE/L [–]",
+    "t_c": "t_c [s]",
+    "return": "return [–]",
+    "rudder_travel": "rudder travel [rad]",
+    "J": "J [–]",
+    "success": "success [–]",
+    "compute_ms": "compute [ms]",
+}
+
+_CSS = """
+body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:24px;
+color:#1b1f24;background:#fff}
+h1{font-size:24px;margin:0 0 4px}h2{font-size:19px;margin:28px 0 8px;border-bottom:1px solid
+#d0d7de;padding-bottom:4px}h3{font-size:16px;margin:18px 0 6px}
+p.note{color:#57606a;margin:4px 0 10px;max-width:75em}
+.scroll{overflow-x:auto;max-width:100%;border:1px solid #d0d7de;border-radius:4px}
+table{border-collapse:collapse;font-variant-numeric:tabular-nums}
+th,td{padding:3px 8px;border-bottom:1px solid #eaeef2;text-align:right;white-space:nowrap}
+th{background:#f6f8fa;position:sticky;top:0;cursor:pointer;user-select:none;z-index:1}
+th[aria-sort=ascending]::after{content:" \\25B2"}th[aria-sort=descending]::after{content:" \\25BC"}
+td.name,th.name{text-align:left;position:sticky;left:0;background:#fff;z-index:2}
+th.name{background:#f6f8fa;z-index:3}
+td.text,th.text{text-align:left}
+small.ci{color:#57606a;display:block;font-size:11px}
+table.compact small.ci{display:inline;margin-left:6px}
+.splits{display:flex;flex-wrap:wrap;gap:8px 24px;align-items:flex-start}
+td.na{color:#8c959f;font-style:italic}
+span.swatch{display:inline-block;width:22px;height:0;border-top-width:3px;margin-right:6px;
+vertical-align:middle}
+figure{margin:10px 0 22px}figure img{max-width:100%;height:auto;border:1px solid #eaeef2}
+figcaption{color:#57606a;font-size:12px}
+details>summary{cursor:pointer;font-weight:600;margin:8px 0}
+"""
+
+_JS = """
+(function () {
+  function key(row, col, numeric) {
+    var v = row.cells[col].getAttribute("data-sort");
+    if (v === null || v === "") return null;
+    if (!numeric) return v.toLowerCase();
+    var x = parseFloat(v);
+    return isNaN(x) ? null : x;
+  }
+  function sortTable(table, col, dir) {
+    var head = table.tHead.rows[0].cells, body = table.tBodies[0];
+    var numeric = head[col].getAttribute("data-type") === "number";
+    var rows = Array.prototype.slice.call(body.rows);
+    rows.sort(function (a, b) {
+      var x = key(a, col, numeric), y = key(b, col, numeric);
+      if (x === null || y === null) return (x === null) - (y === null);
+      var r = numeric ? x - y : (x < y ? -1 : x > y ? 1 : 0);
+      return dir === "descending" ? -r : r;
+    });
+    rows.forEach(function (r) { body.appendChild(r); });
+    for (var i = 0; i < head.length; i++) head[i].removeAttribute("aria-sort");
+    head[col].setAttribute("aria-sort", dir);
+  }
+  function firstOrder(th) {
+    return th.getAttribute("data-type") === "number" ? "descending" : "ascending";
+  }
+  document.querySelectorAll("table.sortable").forEach(function (table) {
+    var head = table.tHead.rows[0].cells;
+    Array.prototype.forEach.call(head, function (th, col) {
+      th.title = "click to sort (again to reverse)";
+      th.addEventListener("click", function (ev) {
+        if (ev.target.closest && ev.target.closest("a")) return;  // a link, not a sort
+        var first = firstOrder(th), now = th.getAttribute("aria-sort");
+        sortTable(table, col, now === first ? (first === "ascending" ? "descending"
+                                                                   : "ascending") : first);
+      });
+    });
+  });
+  var m = /^#sort=(.+)$/.exec(window.location.hash);
+  var table = document.getElementById("scores");
+  if (m && table) {
+    var want = decodeURIComponent(m[1]), dir = null, tail = /:(asc|desc)$/.exec(want);
+    if (tail) { dir = tail[1] === "asc" ? "ascending" : "descending";
+                want = want.slice(0, -tail[0].length); }
+    Array.prototype.forEach.call(table.tHead.rows[0].cells, function (th) {
+      if (th.getAttribute("data-key") !== want) return;
+      th.click();
+      if (dir && th.getAttribute("aria-sort") !== dir) th.click();
+    });
+  }
+})();
+"""
+
+
+def _e(text: Any) -> str:
+    """HTML-escaped text (quotes too: safe in attributes)."""
+    return html.escape(str(text), quote=True)
+
+
+def _finite(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
+def _number(value: Any) -> str:
+    """A number for a cell: 3 significant decimals, ∞ as "never" (t_c), none as "–"."""
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        if math.isinf(value):
+            return "never" if value > 0 else "−∞"
+        if math.isnan(value):
+            return "–"
+        return f"{value:.3f}" if isinstance(value, float) else str(value)
+    return "–" if value is None else str(value)
+
+
+def _interval(ci: Any) -> str:
+    if isinstance(ci, Sequence) and len(ci) == 2 and all(_finite(v) is not None for v in ci):
+        return f"[{ci[0]:.3f}, {ci[1]:.3f}]"
+    return ""
+
+
+def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> str:
+    """A numeric cell: the value, its interval (or ± std) below, the value as sort key."""
+    sort = _finite(value)
+    extra = _interval(ci) or (f"± {std:.3f}" if _finite(std) is not None else "")
+    style = f' style="background:{_shade(sort)}"' if shade and sort is not None else ""
+    small = f'<small class="ci">{_e(extra)}</small>' if extra else ""
+    return (
+        f'<td data-sort="{"" if sort is None else repr(sort)}"{style}>'
+        f"{_e(_number(value))}{small}</td>"
+    )
+
+
+def _shade(score: float) -> str:
+    """Background of a score cell: red (0 = zero_rudder) → yellow → green (≥ 1.2)."""
+    t = min(max(score / 1.2, 0.0), 1.0)
+    return f"hsl({120 * t:.0f},65%,88%)"
+
+
+def _text_cell(text: Any) -> str:
+    return f'<td class="text" data-sort="{_e(text)}">{_e(text)}</td>'
+
+
+def _name_cell(name: str) -> str:
+    style = controller_style(name)
+    border = {"-": "solid", "--": "dashed", "-.": "dashed", ":": "dotted"}.get(
+        style.linestyle, "solid"
+    )
+    swatch = (
+        f'<span class="swatch" style="border-top-style:{border};'
+        f'border-top-color:{_e(style.color)}"></span>'
+    )
+    return f'<td class="name" data-sort="{_e(name)}">{swatch}{_e(name)}</td>'
+
+
+def _head(columns: Iterable[tuple[str, str, str]]) -> str:
+    """``<thead>`` of (key, header text, "number" | "text") columns; the first is the name."""
+    cells = []
+    for i, (key, text, kind) in enumerate(columns):
+        cls = "name" if i == 0 else ("text" if kind == "text" else "")
+        cells.append(
+            f'<th data-key="{_e(key)}" data-type="{kind}"'
+            + (f' class="{cls}"' if cls else "")
+            + f">{text}</th>"
+        )
+    return "<thead><tr>" + "".join(cells) + "</tr></thead>"
+
+
+def _table(table_id: str, head: str, body: Iterable[str], compact: bool = False) -> str:
+    """A sortable table; ``compact``: intervals beside the values, not below."""
+    rows = "".join(f"<tr>{r}</tr>" for r in body)
+    cls = "sortable compact" if compact else "sortable"
+    return (
+        f'<div class="scroll"><table class="{cls}" id="{_e(table_id)}">{head}'
+        f"<tbody>{rows}</tbody></table></div>"
+    )
+
+
+# ----------------------------------------------------------------------------- sections
+def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
+    """One table per split of the ``aggregate.json`` rows, in their order (ranked by IQM)."""
+    head = _head(
+        [
+            ("controller", "controller", "text"),
+            ("rank", "rank", "number"),
+            ("kind", "kind", "text"),
+            ("scenarios", "scenarios", "number"),
+            ("runs", "runs", "number"),
+            ("training_seeds", "training seeds", "number"),
+            ("score_mean", "mean score", "number"),
+            ("score_iqm", "IQM score", "number"),
+            ("prob", "P(score &gt; pid_los)", "number"),
+        ]
+    )
+    parts = []
+    for split in dict.fromkeys(r["split"] for r in aggregate):
+        rows = [r for r in aggregate if r["split"] == split]
+        body = []
+        for rank, r in enumerate(rows, start=1):
+            scenarios = r.get("scenarios")
+            n = len(scenarios) if isinstance(scenarios, Sequence) else scenarios
+            body.append(
+                _name_cell(r["controller"])
+                + f'<td data-sort="{-rank}">{rank}</td>'  # best-first on the first click
+                + _text_cell(r.get("kind", ""))
+                + _cell(n)
+                + _cell(r.get("runs"))
+                + _cell(r.get("training_seeds"))
+                + _cell(r.get("score_mean"), r.get("score_mean_ci95"))
+                + _cell(r.get("score_iqm"), r.get("score_iqm_ci95"))
+                + _cell(
+                    r.get("prob_improvement_over_pid_los"),
+                    r.get("prob_improvement_over_pid_los_ci95"),
+                )
+            )
+        title = SPLIT_TITLES.get(split, split)
+        table = _table(f"ranking-{split}", head, body, compact=True)
+        parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
+    return '<div class="splits">' + "".join(parts) + "</div>"
+
+
+def _controller_order(
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    scores: Sequence[Mapping[str, Any]],
+) -> list[str]:
+    """Controllers by the first split's ranking, then any other in the order they appear."""
+    names = [r["controller"] for r in aggregate if r["split"] == aggregate[0]["split"]]
+    names += [r["controller"] for r in aggregate]
+    names += [r["controller"] for r in rows] + [s["controller"] for s in scores]
+    return list(dict.fromkeys(names))
+
+
+def score_table(
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    scores: Sequence[Mapping[str, Any]],
+) -> str:
+    """The sortable controller × scenario table (``id="scores"``): each controller's IQM per
+    split, then its mean score with interval per scenario; "n/a" where it does not apply."""
+    scenarios = list(dict.fromkeys([r["scenario"] for r in rows] + [s["scenario"] for s in scores]))
+    split_of = {r["scenario"]: r.get("split", "") for r in rows}
+    split_of.update({s["scenario"]: s.get("split", "") for s in scores})
+    splits = list(dict.fromkeys(r["split"] for r in aggregate))
+    cell = {(s["controller"], s["scenario"]): s for s in scores}
+    iqm = {(r["controller"], r["split"]): r for r in aggregate}
+    kinds = {r["controller"]: r.get("kind", "") for r in [*rows, *aggregate]}
+    not_applicable = {
+        (r["controller"], r["scenario"]) for r in rows if r.get("applies", True) is False
+    }
+    columns = [("controller", "controller", "text"), ("kind", "kind", "text")]
+    columns += [(f"iqm:{sp}", f"IQM<br>{_e(sp)}", "number") for sp in splits]
+    columns += [
+        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}</small>',
+         "number")
+        for s in scenarios
+    ]  # fmt: skip
+    body = []
+    for name in _controller_order(rows, aggregate, scores):
+        tds = [_name_cell(name), _text_cell(kinds.get(name, ""))]
+        for sp in splits:
+            agg = iqm.get((name, sp), {})
+            tds.append(_cell(agg.get("score_iqm"), agg.get("score_iqm_ci95")))
+        for s in scenarios:
+            if (name, s) in not_applicable:
+                tds.append('<td class="na" data-sort="" title="does not apply">n/a</td>')
+            else:
+                sc = cell.get((name, s), {})
+                tds.append(_cell(sc.get("score_mean"), sc.get("score_ci95"), shade=True))
+        body.append("".join(tds))
+    return _table("scores", _head(columns), body)
+
+
+def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """The long table: one row per (scenario, controller), every metric with its interval
+    (``*_ci95``, else ± std)."""
+    metrics = [k for k in ROW_METRICS if any(k in r for r in rows)]
+    columns = [
+        ("controller", "controller", "text"),
+        ("scenario", "scenario", "text"),
+        ("split", "split", "text"),
+        ("kind", "kind", "text"),
+        ("seeds", "seeds", "number"),
+        ("training_seeds", "training seeds", "number"),
+    ] + [(k, _e(ROW_METRICS[k]), "number") for k in metrics]
+    body = []
+    for r in rows:
+        tds = [_name_cell(r["controller"])] + [
+            _text_cell(r.get(k, "")) for k in ("scenario", "split", "kind")
+        ]
+        tds += [_cell(r.get("seeds")), _cell(r.get("training_seeds"))]
+        if r.get("applies", True) is False:
+            tds.append(
+                f'<td class="na" colspan="{len(metrics)}" data-sort="" '
+                'style="text-align:left">does not apply</td>'
+            )
+        else:
+            tds += [_cell(r.get(k), r.get(f"{k}_ci95"), r.get(f"{k}_std")) for k in metrics]
+        body.append("".join(tds))
+    return _table("rows", _head(columns), body)
+
+
+# ------------------------------------------------------------------------------ figures
+def _anchor(name: str) -> str:
+    """The id of a scenario's figure (the stem :func:`baselines.figures.plot_scenario` gives
+    its files)."""
+    return "scenario_" + figure_stem(name)
+
+
+def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
+    """stem → (data URI, file name) of each figure, the SVG where a stem has one, else the
+    PNG; in the order of ``figures``."""
+    by_stem: dict[str, Path] = {}
+    for f in map(Path, figures):
+        if f.suffix.lower() not in (".svg", ".png"):
+            continue
+        if f.stem not in by_stem or f.suffix.lower() == ".svg":
+            by_stem[f.stem] = f
+    out = {}
+    for stem, f in by_stem.items():
+        mime = "image/svg+xml" if f.suffix.lower() == ".svg" else "image/png"
+        data = base64.b64encode(f.read_bytes()).decode("ascii")
+        out[stem] = (f"data:{mime};base64,{data}", f.name)
+    return out
+
+
+def _figure(stem: str, uri: str, name: str, caption: str) -> str:
+    return (
+        f'<figure id="fig-{_e(stem)}"><img src="{uri}" alt="{_e(caption)}" loading="lazy">'
+        f"<figcaption>{_e(caption)} — <code>{_e(name)}</code></figcaption></figure>"
+    )
+
+
+def figure_sections(
+    figures: Iterable[str | Path], scenarios: Iterable[str] = ()
+) -> tuple[str, str]:
+    """(ranking figures, scenario figures) as HTML: per split its interval estimates, then
+    its performance profiles; the scenario figures in the order of ``figures``, captioned
+    with the scenario's name where ``scenarios`` has it."""
+    names = {_anchor(s): s for s in scenarios}
+    ranking: list[tuple[str, int, str]] = []
+    drawn = []
+    for stem, (uri, file) in embedded_figures(figures).items():
+        kind, _, split = stem.partition("_")
+        if kind in ("ranking", "profile"):
+            what = "interval estimates" if kind == "ranking" else "performance profiles"
+            html_ = _figure(stem, uri, file, f"{what}, {split}")
+            ranking.append((split, kind == "profile", html_))
+        else:
+            label = names.get(stem, stem.removeprefix("scenario_"))
+            drawn.append(_figure(stem, uri, file, f"scenario {label}"))
+    return "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2])), "".join(drawn)
+
+
+# --------------------------------------------------------------------------------- page
+def page(
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    scores: Sequence[Mapping[str, Any]],
+    figures: Iterable[str | Path] = (),
+    title: str = "shipgym leaderboard",
+    subtitle: str | None = None,
+) -> str:
+    """The page's HTML (module doc)."""
+    ranking_figs, scenario_figs = figure_sections(figures, (r["scenario"] for r in rows))
+    sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
+    return (
+        "<!DOCTYPE html>\n"
+        '<html lang="en"><head><meta charset="utf-8">'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
+        f"<h1>{_e(title)}</h1>{sub}"
+        '<h2 id="ranking">Ranking</h2><p class="note">Normalised score per episode from the '
+        "return: 0 = <code>zero_rudder</code>, 1 = <code>pid_los</code> on the same scenario "
+        "and seed. Mean and interquartile mean (IQM) over the scenarios a controller applies "
+        "to, and the probability that its score beats <code>pid_los</code>'s, with 95 % "
+        "stratified-bootstrap intervals (rliable; runs = training seeds × evaluation seeds). "
+        "Click a column header to sort.</p>"
+        f"{ranking_tables(aggregate)}"
+        '<h2 id="scores-per-scenario">Scores per scenario</h2><p class="note">Mean normalised '
+        "score of each controller on each scenario, 95 % interval below; n/a: the controller "
+        "does not apply to the scenario's ship. Click a header to sort; a scenario's name "
+        "links to its figure.</p>"
+        f"{score_table(rows, aggregate, scores)}"
+        f'<h2 id="ranking-figures">Ranking figures</h2>{ranking_figs or "<p>No figures.</p>"}'
+        f'<h2 id="figures">Scenarios</h2>{scenario_figs or "<p>No figures.</p>"}'
+        '<h2 id="all-rows">All rows</h2><details><summary>One row per scenario and controller '
+        f"({len(rows)} rows): means with 95 % intervals</summary>{row_table(rows)}</details>"
+        f"<script>{_JS}</script></body></html>\n"
+    )
+
+
+def write_html(
+    out_dir: str | Path,
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    scores: Sequence[Mapping[str, Any]],
+    figures: Iterable[str | Path] = (),
+    title: str = "shipgym leaderboard",
+    subtitle: str | None = None,
+) -> Path:
+    """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
+    ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
+    :func:`baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
+    :mod:`baselines.figures`; ``subtitle``: a line under the title (e.g. the suite and seeds).
+    Returns the page's path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / PAGE_FILE
+    path.write_text(page(rows, aggregate, scores, figures, title, subtitle), encoding="utf-8")
+    return path

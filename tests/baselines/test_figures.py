@@ -1,0 +1,152 @@
+"""The leaderboard's figures: 200 dpi PNG + SVG, one look per controller, what is drawn."""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from baselines import figures
+from baselines.figures import (
+    DrawnEpisode,
+    episodes_to_draw,
+    family_panels,
+    median_ace_episode,
+    plot_ranking,
+    plot_scenario,
+)
+from baselines.ranking import aggregate_ranking
+from baselines.style import FIGURE_DPI, controller_style
+
+SVG = "{http://www.w3.org/2000/svg}"
+
+
+def trajectory(offset: float, n: int = 120) -> dict[str, np.ndarray]:
+    """A ship running along y = 0 with a decaying cross-track error of ``offset`` [m]."""
+    t = np.linspace(0.0, 120.0, n)
+    e = offset * np.exp(-t / 30.0)
+    return {
+        "t": t,
+        "x": 2.0 * t,
+        "y": e,
+        "cross_track_error": e,
+        "heading": np.zeros(n),
+        "rudder_angle": -0.01 * e,
+        "rudder_command": -0.01 * e,
+    }
+
+
+def stroke(svg: Path, gid: str) -> str:
+    """The colour (stroke, else fill) of the first drawn path in the SVG group ``gid``."""
+    group = next(g for g in ET.parse(svg).iter(f"{SVG}g") if g.get("id") == gid)
+    style = next(p.get("style") for p in group.iter(f"{SVG}path") if p.get("style"))
+    props = dict(part.split(":", 1) for part in style.replace(" ", "").split(";") if part)
+    colour = props["stroke"] if props.get("stroke", "none") != "none" else props["fill"]
+    return colour.lower()
+
+
+def svg_text(svg: Path) -> str:
+    return " ".join(t.text or "" for t in ET.parse(svg).iter(f"{SVG}text"))
+
+
+@pytest.fixture(scope="module")
+def scenario_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    drawn = {
+        "pid_los": DrawnEpisode(10003, trajectory(5.0), None),
+        "lqr": (10003, trajectory(3.0)),
+        "ppo": DrawnEpisode(10003, trajectory(4.0), 1),
+        "zero_rudder": DrawnEpisode(10003, trajectory(20.0), None),
+    }
+    path = np.array([[0.0, 0.0], [240.0, 0.0]])
+    out = tmp_path_factory.mktemp("figures")
+    return plot_scenario(out, "heldout:0", drawn, change_time=60.0, path_xy=path, ship_length=3.25)
+
+
+def test_a_scenario_figure_is_a_200_dpi_png_and_an_svg(scenario_files: list[Path]) -> None:
+    png, svg = scenario_files
+    assert (png.name, svg.name) == ("scenario_heldout_0.png", "scenario_heldout_0.svg")
+    with Image.open(png) as image:
+        assert image.info["dpi"] == pytest.approx((FIGURE_DPI, FIGURE_DPI), abs=0.01)
+        assert min(image.size) > 1000  # inches × 200, not a thumbnail
+    assert ET.parse(svg).getroot().tag == f"{SVG}svg"
+
+
+def test_the_figure_says_what_is_drawn_with_units(scenario_files: list[Path]) -> None:
+    text = svg_text(scenario_files[1])
+    assert "change at t = 60 s" in text
+    assert "median-ACE seed 10003" in text
+    assert "ppo (seed 10003, training seed 1)" in text  # the legend names each episode
+    for unit in ("x [m]", "y [m]", "t [s]", "cross-track error e [m]", "rudder angle δ [deg]"):
+        assert unit in text
+
+
+def test_a_controller_has_its_colour_in_every_figure(
+    scenario_files: list[Path], tmp_path: Path
+) -> None:
+    episodes = [
+        {"scenario": s, "controller": c, "kind": "classical", "seed": seed, "return": r + seed % 3}
+        for s in ("a", "b")
+        for seed in (10000, 10001, 10002)
+        for c, r in (("zero_rudder", -50.0), ("pid_los", -10.0), ("lqr", -12.0))
+    ]
+    splits = {"a": "catalogue", "b": "catalogue"}
+    aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
+    files = plot_ranking(tmp_path, aggregate, episodes, splits)
+    assert [f.name for f in files] == [
+        "ranking_catalogue.png",
+        "ranking_catalogue.svg",
+        "profile_catalogue.png",
+        "profile_catalogue.svg",
+    ]
+    for name in ("pid_los", "lqr"):
+        colour = controller_style(name).color.lower()
+        assert stroke(scenario_files[1], f"{name}/track") == colour
+        assert stroke(scenario_files[1], f"{name}/e") == colour
+        assert stroke(files[1], f"{name}/interval/score_iqm") == colour
+        assert stroke(files[3], f"{name}/profile") == colour
+    with Image.open(files[0]) as image:
+        assert image.info["dpi"] == pytest.approx((FIGURE_DPI, FIGURE_DPI), abs=0.01)
+
+
+def test_the_median_ace_episode_is_an_episode_of_the_pair() -> None:
+    records = [
+        {"scenario": "s", "controller": "ppo", "seed": 1, "training_seed": 0, "ace": 3.0},
+        {"scenario": "s", "controller": "ppo", "seed": 2, "training_seed": 0, "ace": 1.0},
+        {"scenario": "s", "controller": "ppo", "seed": 1, "training_seed": 1, "ace": 2.0},
+        {"scenario": "s", "controller": "ppo", "seed": 2, "training_seed": 1, "ace": math.nan},
+        {"scenario": "s", "controller": "lqr", "seed": 1, "training_seed": None, "ace": 0.5},
+    ]
+    # ACEs 1, 2, 3, nan (last): the lower median is 2, seed 1 of training seed 1
+    assert median_ace_episode(records, "s", "ppo") == (1, 1)
+    assert median_ace_episode(records, "s", "lqr") == (1, None)
+    assert median_ace_episode(records, "s", "pid_los") is None
+
+
+def test_episodes_to_draw_keeps_the_median_episode_with_its_trajectory() -> None:
+    class Result:
+        def __init__(self, seed: int, ace: float, kept: bool) -> None:
+            self.scenario, self.controller, self.seed, self.training_seed = "s", "lqr", seed, None
+            self.metrics = {"ace": ace}
+            self.trajectory = trajectory(ace) if kept else {}
+
+    drawn = episodes_to_draw([Result(1, 5.0, True), Result(2, 1.0, True), Result(3, 2.0, True)])
+    assert drawn[("s", "lqr")].seed == 3
+    assert episodes_to_draw([Result(1, 5.0, True), Result(3, 2.0, False)]) == {}
+
+
+def test_a_big_family_is_split_over_panels() -> None:
+    names = [f"pid_{i}" for i in range(7)] + ["lqr", "zero_rudder", "my_plugin"]
+    panels = family_panels(names, {"my_plugin": "learned"})
+    assert [title for title, _ in panels] == [
+        "PID (1/2)",
+        "PID (2/2)",
+        "LQR",
+        "learned",
+        "references",
+    ]
+    assert all(len(members) <= figures.PANEL_CONTROLLERS for _, members in panels)
+    assert sorted(n for _, members in panels for n in members) == sorted(names)

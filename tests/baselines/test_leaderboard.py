@@ -1,0 +1,249 @@
+"""The leaderboard's trials, training seeds, row intervals and ranking (issue 13)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from baselines.errors import RunError
+from baselines.leaderboard import COLUMNS, Job, plan_jobs, run_batch, run_job, run_leaderboard
+from baselines.learned.policy import model_zip
+from baselines.runs import read_episodes, read_run
+from tests.baselines.test_runs import TIMING, untimed, write_suite
+
+RANDOMIZE = {
+    "cross_track_offset_L": [-1.0, 1.0],
+    "heading_error_deg": [-10.0, 10.0],
+    "jump_time_jitter_s": [-5.0, 5.0],
+}
+#: aggregate.json's fields (issue 13)
+AGGREGATE_KEYS = {
+    "controller",
+    "kind",
+    "split",
+    "scenarios",
+    "runs",
+    "training_seeds",
+    "score_mean",
+    "score_mean_ci95",
+    "score_iqm",
+    "score_iqm_ci95",
+    "prob_improvement_over_pid_los",
+    "prob_improvement_over_pid_los_ci95",
+}
+
+
+def run(suite: str, out: Path, **kwargs: object) -> list[dict]:
+    return run_leaderboard(suite, out_dir=out, workers=1, show_progress=False, **kwargs)
+
+
+def untimed_episodes(folder: Path) -> list[dict]:
+    return [{k: v for k, v in e.items() if not k.startswith(TIMING)} for e in read_episodes(folder)]
+
+
+@pytest.fixture(scope="module")
+def randomised(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """pid_los and zero_rudder on two nomoto2 scenarios, 3 randomised trials each."""
+    root = tmp_path_factory.mktemp("randomised")
+    run(write_suite(root, seeds=3, randomize=RANDOMIZE), root / "out")
+    return root / "out"
+
+
+@pytest.fixture(scope="module")
+def agent(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A trained agent's folder with two training seeds (``seed_0``, ``seed_1``: copies of
+    the shipped ppo's first, the meta's seed set to the folder's)."""
+    folder = tmp_path_factory.mktemp("agents") / "agent"
+    for k in (0, 1):
+        shutil.copytree(model_zip("ppo").parent, folder / f"seed_{k}")
+        meta = folder / f"seed_{k}" / "meta.json"
+        meta.write_text(json.dumps({**json.loads(meta.read_text()), "seed": k}))
+    return folder
+
+
+def test_rows_carry_an_interval_for_every_metric(randomised: Path) -> None:
+    rows = json.loads((randomised / "leaderboard.json").read_text())
+    episodes = read_episodes(randomised)
+    assert len(rows) == 4
+    for row in rows:
+        assert row["seeds"] == row["episodes"] == 3
+        assert row["training_seeds"] == 0 and row["training_seed_list"] == []
+        mine = [
+            e
+            for e in episodes
+            if (e["scenario"], e["controller"]) == (row["scenario"], row["controller"])
+        ]
+        for metric in COLUMNS:
+            assert f"{metric}_std" in row and f"{metric}_ci95" in row
+        for metric in ("ace", "return", "rudder_travel", "J", "mean_abs_cross_track"):
+            low, high = row[f"{metric}_ci95"]
+            values = [float(e[metric]) for e in mine]
+            assert min(values) <= low <= row[metric] <= high <= max(values), (row, metric)
+        for metric in ("ace", "return"):  # three different trials: a spread
+            assert row[f"{metric}_ci95"][0] < row[metric] < row[f"{metric}_ci95"][1]
+        low, high = row["success_ci95"]
+        assert 0.0 <= low <= row["success"] <= high <= 1.0
+    pair = ("zero_rudder", "rudder_aging")
+    (never,) = [r for r in rows if (r["controller"], r["scenario"]) == pair]
+    assert never["t_c"] is None and never["t_c_ci95"] is None  # never converged
+
+
+def test_aggregate_json_scores_pid_los_one_and_zero_rudder_zero(randomised: Path) -> None:
+    board = json.loads((randomised / "aggregate.json").read_text())
+    assert [(r["split"], r["controller"]) for r in board] == [
+        ("catalogue", "pid_los"),
+        ("catalogue", "zero_rudder"),
+    ]
+    for row in board:
+        assert set(row) >= AGGREGATE_KEYS
+        assert row["scenarios"] == ["nominal", "rudder_aging"]
+        assert row["runs"] == 3 and row["training_seeds"] == 0 and row["kind"] == "classical"
+    pid, zero = board
+    for key in ("score_mean", "score_iqm"):
+        assert pid[key] == 1.0 and pid[f"{key}_ci95"] == [1.0, 1.0]
+        assert zero[key] == 0.0 and zero[f"{key}_ci95"] == [0.0, 0.0]
+    assert pid["prob_improvement_over_pid_los"] == 0.5  # against itself
+    assert zero["prob_improvement_over_pid_los"] == 0.0
+    scores = json.loads((randomised / "scenario_scores.json").read_text())
+    assert {(s["controller"], s["scenario"], s["score_mean"]) for s in scores} == {
+        ("pid_los", "nominal", 1.0),
+        ("pid_los", "rudder_aging", 1.0),
+        ("zero_rudder", "nominal", 0.0),
+        ("zero_rudder", "rudder_aging", 0.0),
+    }
+    for name in ("ranking_catalogue.png", "profile_catalogue.png", "ranking_catalogue.svg"):
+        assert (randomised / name).is_file(), name
+
+
+def test_the_markdown_opens_with_the_ranking(randomised: Path) -> None:
+    text = (randomised / "leaderboard.md").read_text()
+    assert text.startswith("# Leaderboard\n\n## Ranking\n")
+    ranking, rest = text.split("## Scores per scenario", 1)
+    assert "| rank | controller | kind | training seeds |" in ranking
+    first = next(line for line in ranking.splitlines() if line.startswith("| 1 |"))
+    assert first.startswith("| 1 | pid_los | classical | – | 2 | 1.00 [1.00, 1.00] |")
+    scores, rows = rest.split("## All rows", 1)
+    assert "| controller | nominal | rudder_aging |" in scores
+    assert "| zero_rudder | 0.00 [0.00, 0.00] | 0.00 [0.00, 0.00] |" in scores
+    assert "| rudder_aging | zero_rudder | classical | 3 |" in rows
+
+
+def test_trials_are_reproducible_per_seed_and_differ_across_seeds(
+    randomised: Path, tmp_path: Path
+) -> None:
+    run(write_suite(tmp_path, seeds=3, randomize=RANDOMIZE), tmp_path / "again")
+    assert untimed_episodes(tmp_path / "again") == untimed_episodes(randomised)
+    pid = [e for e in read_episodes(randomised) if e["controller"] == "pid_los"]
+    assert len({e["ace"] for e in pid}) == len(pid) == 6  # every trial its own episode
+    starts = {}
+    for seed in (10_000, 10_001, 10_002, 10_000):
+        result = run_job(("pid_los", "nominal", seed, None, RANDOMIZE))
+        start = (result.trajectory["x"][0], result.trajectory["y"][0])
+        assert starts.setdefault(seed, start) == start  # the same seed: the same start
+    assert len(set(starts.values())) == 3
+    # without randomisation every seed of the deterministic scenario is the same episode
+    fixed = [run_job(("pid_los", "nominal", seed)) for seed in (10_000, 10_001)]
+    assert fixed[0].metrics["ace"] == fixed[1].metrics["ace"]
+    assert (fixed[0].trajectory["x"][0], fixed[0].trajectory["y"][0]) == (0.0, 0.0)
+
+
+def test_run_json_keeps_the_randomisation_and_resume_refuses_another(
+    randomised: Path, tmp_path: Path
+) -> None:
+    suite = read_run(randomised)["suite"]
+    assert suite["randomize"] == {
+        **RANDOMIZE,
+        "current_speed_factor": None,
+        "current_direction_deg": None,
+    }
+    assert [c["training_seeds"] for c in suite["controllers"]] == [[None], [None]]
+    other = write_suite(tmp_path, seeds=3, randomize={**RANDOMIZE, "heading_error_deg": [0, 5]})
+    with pytest.raises(RunError, match=r"suite differs.*randomize\.heading_error_deg"):
+        run(other, randomised, resume=True)
+    with pytest.raises(RunError, match=r"randomize: \{.* in the run, null now"):
+        run(write_suite(tmp_path, seeds=3), randomised, resume=True)
+
+
+def test_a_learned_job_is_one_training_seed_on_all_seeds(agent: Path) -> None:
+    seeds_of = {"agent": [0, 1], "pid_los": [None]}
+    jobs = plan_jobs([str(agent), "pid_los"], ["nominal"], [7, 8], seeds_of, None, set())
+    assert [(j.seeds, j.training_seed) for j in jobs] == [
+        ((7, 8), 0),
+        ((7, 8), 1),
+        ((7,), None),
+        ((8,), None),
+    ]
+    # batched through evaluate_batch: the episodes run_job gives one by one, trial by trial
+    batch = run_batch(Job(str(agent), "rudder_aging", (10_000, 10_001), 1, RANDOMIZE))
+    for result in batch:
+        alone = run_job((str(agent), "rudder_aging", result.seed, 1, RANDOMIZE))
+        assert result.training_seed == alone.training_seed == 1
+        assert untimed([result.row()]) == untimed([alone.row()])
+
+
+@pytest.fixture(scope="module")
+def with_agent(tmp_path_factory: pytest.TempPathFactory, agent: Path) -> tuple[str, Path]:
+    """(suite, clean run) of the agent with its two training seeds beside the references."""
+    root = tmp_path_factory.mktemp("with_agent")
+    suite = write_suite(
+        root,
+        scenarios=["rudder_aging"],
+        controllers=[str(agent), "pid_los", "zero_rudder"],
+        seeds=2,
+        randomize=RANDOMIZE,
+    )
+    run(suite, root / "clean")
+    return suite, root / "clean"
+
+
+def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
+    with_agent: tuple[str, Path],
+) -> None:
+    _, clean = with_agent
+    learned = [e for e in read_episodes(clean) if e["controller"] == "agent"]
+    assert sorted((e["training_seed"], e["seed"]) for e in learned) == [
+        (0, 10_000),
+        (0, 10_001),
+        (1, 10_000),
+        (1, 10_001),
+    ]
+    rows = json.loads((clean / "leaderboard.json").read_text())
+    (row,) = [r for r in rows if r["kind"] == "learned"]
+    assert (row["seeds"], row["training_seeds"], row["training_seed_list"]) == (2, 2, [0, 1])
+    assert row["episodes"] == 4 and len(row["ace_ci95"]) == len(row["return_ci95"]) == 2
+    board = {r["controller"]: r for r in json.loads((clean / "aggregate.json").read_text())}
+    assert (board["agent"]["training_seeds"], board["agent"]["runs"]) == (2, 4)
+    controllers = read_run(clean)["suite"]["controllers"]
+    assert [c["training_seeds"] for c in controllers] == [[0, 1], [None], [None]]
+    # one kept trajectory per row: the episode its figure draws
+    assert len(list((clean / "trajectories").iterdir())) == 3
+
+
+def test_resume_with_training_seeds_equals_a_clean_run(
+    with_agent: tuple[str, Path], tmp_path: Path
+) -> None:
+    suite, clean = with_agent
+    out = tmp_path / "out"
+
+    def stop_after_three(result: object, seen: list[int] = []) -> None:  # noqa: B006
+        seen.append(1)
+        if len(seen) == 3:  # inside the agent's second training seed's job
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(suite, out, on_episode=stop_after_three)
+    assert len(read_episodes(out)) == 3
+    ran: list[object] = []
+    rows = run(suite, out, resume=True, on_episode=ran.append)
+    assert [(r.controller, r.training_seed) for r in ran[:1]] == [("agent", 1)]
+    assert len(ran) == 5 and len(read_episodes(out)) == 8
+    board = json.loads((clean / "leaderboard.json").read_text())
+    assert untimed(rows) == untimed(board)
+    for name in ("aggregate.json", "scenario_scores.json"):
+        assert (out / name).read_text() == (clean / name).read_text(), name
+    assert sorted(p.name for p in (out / "trajectories").iterdir()) == sorted(
+        p.name for p in (clean / "trajectories").iterdir()
+    )

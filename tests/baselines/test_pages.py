@@ -1,0 +1,224 @@
+"""``leaderboard.html``: self-contained, escaped, and rendered by a real headless browser."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from html.parser import HTMLParser
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from baselines.figures import DrawnEpisode, plot_scenario
+from baselines.pages import PAGE_FILE, page, write_html
+
+CONTROLLERS = [
+    "pid_los",
+    "pid_lookahead_los",
+    "pid_vf",
+    "pid_tvvf",
+    "lqr",
+    "adaptive_lqr",
+    "nmpc",
+    "nmpc_wlssvm",
+    "nmpc_lambda_lssvm",
+    "l1_backstepping",
+    "adaptive_backstepping",
+    "ppo",
+    "ppo_guidance",
+    "recurrent_ppo",
+    "sac",
+    "td3",
+    "zero_rudder",
+    "my <plugin> & co",  # a plug-in's name is user input: escaped, still listed
+]
+SCENARIOS = {"nominal": "catalogue", "rudder_aging": "catalogue", "heldout:0": "heldout"}
+LEARNED = {"ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3"}
+
+
+def _score(i: int, j: int) -> float:
+    """A distinct synthetic score of controller i on scenario j."""
+    return round(1.2 - 0.06 * i + 0.013 * ((i * 7 + j * 5) % 11), 4)
+
+
+def synthetic_tables() -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
+    """(rows, aggregate, scores) shaped as leaderboard.json, aggregate.json and
+    ranking.scenario_scores give them."""
+    rows, scores, aggregate = [], [], []
+    for j, (scenario, split) in enumerate(SCENARIOS.items()):
+        for i, name in enumerate(CONTROLLERS):
+            kind = "learned" if name in LEARNED else "classical"
+            applies = not (name == "nmpc" and scenario == "heldout:0")
+            row: dict[str, Any] = {"scenario": scenario, "split": split, "controller": name}
+            row |= {"kind": kind, "applies": applies, "seeds": 10 if applies else 0}
+            if applies:
+                row |= {"ace": 1.0 + 0.1 * i, "ace_ci95": [0.9 + 0.1 * i, 1.1 + 0.1 * i]}
+                row |= {"return": -10.0 - i, "return_ci95": [-11.0 - i, -9.0 - i]}
+                row |= {"t_c": float("inf") if i % 5 == 0 else 30.0 + i, "success": 1.0}
+                if kind == "learned":
+                    row["training_seeds"] = 3
+                s = _score(i, j)
+                scores.append(
+                    {"controller": name, "scenario": scenario, "split": split}
+                    | {"score_mean": s, "score_ci95": [s - 0.02, s + 0.02], "episodes": 10}
+                )
+            rows.append(row)
+    for split in ("catalogue", "heldout"):
+        for i, name in enumerate(CONTROLLERS):
+            mine = [s for s in scores if s["controller"] == name and s["split"] == split]
+            if not mine:
+                continue
+            m = float(np.mean([s["score_mean"] for s in mine]))
+            aggregate.append(
+                {"controller": name, "kind": rows[i]["kind"], "split": split}
+                | {"scenarios": [s["scenario"] for s in mine], "runs": 10, "training_seeds": 0}
+                | {"score_mean": m, "score_mean_ci95": [m - 0.03, m + 0.03]}
+                | {"score_iqm": m, "score_iqm_ci95": [m - 0.04, m + 0.04]}
+                | {"prob_improvement_over_pid_los": 0.5}
+                | {"prob_improvement_over_pid_los_ci95": [0.4, 0.6]}
+            )
+    aggregate.sort(key=lambda r: (r["split"], -r["score_iqm"]))
+    return rows, aggregate, scores
+
+
+class _ScoreRows(HTMLParser):
+    """The first cell's text of every body row of ``<table id="scores">``, and its headers'
+    ``aria-sort``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.names: list[str] = []
+        self.sorted: dict[str, str] = {}
+        self._in_table = self._in_body = self._first = False
+        self._cell = 0
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if tag == "table":
+            self._in_table = a.get("id") == "scores"
+        elif self._in_table and tag == "th" and a.get("aria-sort"):
+            self.sorted[a["data-key"] or ""] = a["aria-sort"] or ""
+        elif self._in_table and tag == "tbody":
+            self._in_body = True
+        elif self._in_body and tag == "tr":
+            self._cell = 0
+        elif self._in_body and tag == "td":
+            self._cell += 1
+            self._first = self._cell == 1
+            if self._first:
+                self.names.append("")
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "td":
+            self._first = False
+        elif tag == "table":
+            self._in_table = self._in_body = False
+
+    def handle_data(self, data: str) -> None:
+        if self._first:
+            self.names[-1] += data
+
+
+def score_rows(dom: str) -> _ScoreRows:
+    parser = _ScoreRows()
+    parser.feed(dom)
+    return parser
+
+
+def test_the_page_is_self_contained_and_escaped() -> None:
+    rows, aggregate, scores = synthetic_tables()
+    text = page(rows, aggregate, scores)
+    assert "<plugin>" not in text and "my &lt;plugin&gt; &amp; co" in text
+    # no address outside the page: every src / href is a data URI or an anchor
+    assert not re.findall(r'(?:src|href)="(?!data:|#)', text)
+    assert "<link" not in text and "@import" not in text
+
+
+def test_a_cell_shows_the_interval_and_n_a_where_a_controller_does_not_apply() -> None:
+    rows, aggregate, scores = synthetic_tables()
+    text = page(rows, aggregate, scores)
+    cell = next(s for s in scores if (s["controller"], s["scenario"]) == ("lqr", "nominal"))
+    lo, hi = cell["score_ci95"]
+    assert f"[{lo:.3f}, {hi:.3f}]" in text
+    assert 'title="does not apply">n/a</td>' in text
+    assert ">never<" in text  # t_c = inf in the long table
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--disable-dev-shm-usage",
+)
+
+
+def chromium(url: str, tmp: Path, *args: str) -> str:
+    """Run headless chromium on ``url``; its standard output."""
+    assert CHROMIUM is not None
+    done = subprocess.run(
+        [CHROMIUM, *FLAGS, f"--user-data-dir={tmp / 'profile'}", *args, url],
+        capture_output=True,
+        text=True,
+        timeout=180,
+        check=True,
+    )
+    return done.stdout
+
+
+@pytest.fixture(scope="module")
+def built_page(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("page")
+    t = np.linspace(0.0, 60.0, 60)
+    traj = {"t": t, "x": 2.0 * t, "y": np.exp(-t / 20), "cross_track_error": np.exp(-t / 20)}
+    traj["rudder_angle"] = -0.1 * np.exp(-t / 20)
+    drawn = {"pid_los": DrawnEpisode(10000, traj), "lqr": DrawnEpisode(10000, traj)}
+    figs = plot_scenario(out / "fig", "nominal", drawn, 30.0, np.array([[0, 0], [120, 0]]))
+    rows, aggregate, scores = synthetic_tables()
+    return write_html(out, rows, aggregate, scores, figs, subtitle="synthetic: 18 controllers")
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
+def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page: Path) -> None:
+    assert built_page.name == PAGE_FILE
+    tmp = built_page.parent
+    shot = tmp / "screenshot.png"
+    chromium(built_page.as_uri(), tmp, f"--screenshot={shot}", "--window-size=1400,2000")
+    with Image.open(shot) as image:
+        assert image.size == (1400, 2000)
+        rgb = np.asarray(image.convert("RGB"))
+    colours = np.unique(rgb.reshape(-1, 3), axis=0)
+    assert len(colours) > 50  # text, swatches, shaded cells: not a blank page
+    assert (rgb < 200).any(axis=2).mean() > 0.01  # ink on at least 1 % of the pixels
+
+    dom = chromium(built_page.as_uri(), tmp, "--dump-dom")  # the DOM after the script ran
+    assert sorted(score_rows(dom).names) == sorted(CONTROLLERS)
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
+@pytest.mark.parametrize(
+    ("fragment", "order"),
+    [("#sort=rudder_aging", "descending"), ("#sort=iqm:heldout:asc", "ascending")],
+)
+def test_the_table_sorts_by_a_clicked_header(built_page: Path, fragment: str, order: str) -> None:
+    # the page clicks the header named in its address's hash (twice for the other order)
+    dom = chromium(built_page.as_uri() + fragment, built_page.parent, "--dump-dom")
+    shown = score_rows(dom)
+    key = fragment.removeprefix("#sort=").removesuffix(":asc")
+    assert shown.sorted == {key: order}
+    _, aggregate, scores = synthetic_tables()
+    if key == "rudder_aging":
+        value = {s["controller"]: s["score_mean"] for s in scores if s["scenario"] == key}
+    else:
+        value = {r["controller"]: r["score_iqm"] for r in aggregate if r["split"] == "heldout"}
+    ranked = sorted(value, key=value.__getitem__, reverse=order == "descending")
+    missing = [n for n in CONTROLLERS if n not in value]  # n/a: last in either order
+    assert shown.names == ranked + missing
