@@ -449,7 +449,7 @@ def _scenario_title(
     change = (
         "no parameter change"
         if change_time is None
-        else f"parameter change at t = {change_time:g} s"
+        else f"parameter change at t = {change_time:g} s (trials may jitter it)"
     )
     ship = f"ship length L = {ship_length:g} m; " if ship_length else ""
     which = _which_episode(episodes, chosen_by) if episodes else "no episode kept"
