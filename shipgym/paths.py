@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import PchipInterpolator
 
 from shipgym.angles import wrap_angle
+from shipgym.numerics import SCALAR
 
 __all__ = [
     "LegFrame",
@@ -446,8 +447,6 @@ class PchipPath:
         with the signed cross-track e = −(x − x_c) sin ψ_c + (y − y_c) cos ψ_c relative to the
         tangent angle ψ_c at the closest point (x_c, y_c) — positive left of the path.
         """
-        from shipgym.numerics import SCALAR
-
         local = s_hint is not None and window is not None
         if local and window < 0.0:
             raise ValueError(f"window must be >= 0, got {window}")
