@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, Literal
 
 import numpy as np
@@ -37,10 +38,12 @@ from shipgym.numerics import SCALAR
 
 __all__ = [
     "LegFrame",
+    "LegTable",
     "PchipPath",
     "WaypointPath",
     "acceptance_circle_reached",
     "advance_leg",
+    "advance_legs",
     "along_track",
     "along_track_reached",
     "cross_track",
@@ -168,6 +171,11 @@ class WaypointPath:
 
     def __repr__(self) -> str:
         return f"WaypointPath(n_legs={self.n_legs}, length={self.length:.6g})"
+
+    @cached_property
+    def legs(self) -> LegTable:
+        """The per-leg constants of the step core (:class:`LegTable`)."""
+        return LegTable.of(self)
 
     # -- per-leg frame --------------------------------------------------------------------
     def leg_frame(self, x: float, y: float, leg: int) -> LegFrame:
@@ -627,21 +635,78 @@ def _velocity(cell: tuple[Any, ...], t: Any) -> tuple[Any, Any]:
 # --------------------------------------------------------------------------------------------
 # Waypoint switching
 # --------------------------------------------------------------------------------------------
-def acceptance_circle_reached(
-    x: float, y: float, waypoint: tuple[float, float], radius: float
-) -> bool:
+def acceptance_circle_reached(x: Any, y: Any, waypoint: tuple[Any, Any], radius: float) -> Any:
     """Liu et al. (2019) eq. (13): (x − x_{n+1})² + (y − y_{n+1})² ≤ R0² (all in m).
 
     The caller chooses R0; the paper uses R0 = 2L and requires R_LOS ≥ R0.
     """
-    dx = x - float(waypoint[0])
-    dy = y - float(waypoint[1])
+    dx = x - waypoint[0]  # floats, or arrays over ships (the step core)
+    dy = y - waypoint[1]
     return dx * dx + dy * dy <= radius * radius
 
 
 def along_track_reached(frame: LegFrame, radius: float) -> bool:
     """Borkowski (2018) eq. (27): |P_i P_{i+1}| − x_r < R [m] (remaining along-track distance)."""
     return frame.leg_length - frame.along_track < radius
+
+
+@dataclass(frozen=True)
+class LegTable:
+    """Per-leg constants of a polyline: start/end points, unit direction (c, s) = (cos ψp,
+    sin ψp), length, angle and the angle change to the next leg; each a list (one ship) and
+    an array (N ships: gathered by the leg index array)."""
+
+    lists: dict[str, list[float]]
+    arrays: dict[str, np.ndarray]
+    last_leg: int
+    goal: tuple[float, float]
+
+    @classmethod
+    def of(cls, path: WaypointPath) -> LegTable:
+        wp = [(float(p[0]), float(p[1])) for p in path.waypoints]
+        legs = range(len(wp) - 1)
+        # math.hypot / math.atan2: exactly the numbers of shipgym.paths.segment_frame
+        length = [math.hypot(wp[i + 1][0] - wp[i][0], wp[i + 1][1] - wp[i][1]) for i in legs]
+        lists = {
+            "x0": [wp[i][0] for i in legs],
+            "y0": [wp[i][1] for i in legs],
+            "x1": [wp[i + 1][0] for i in legs],
+            "y1": [wp[i + 1][1] for i in legs],
+            "c": [(wp[i + 1][0] - wp[i][0]) / length[i] for i in legs],
+            "s": [(wp[i + 1][1] - wp[i][1]) / length[i] for i in legs],
+            "length": length,
+            "angle": [math.atan2(wp[i + 1][1] - wp[i][1], wp[i + 1][0] - wp[i][0]) for i in legs],
+            "change": [path.next_leg_angle_change(i) for i in legs],
+        }
+        arrays = {k: np.array(v) for k, v in lists.items()}
+        return cls(lists, arrays, len(wp) - 2, wp[-1])
+
+
+def advance_legs(
+    x: Any, y: Any, leg: Any, table: LegTable, radius: float, switching: str, xp: Any
+) -> Any:
+    """Active leg(s) after the switching rule at position(s) (x, y) [m].
+
+    Leg i ends at waypoint i + 1; while that waypoint counts as reached (``"circle"``: Liu et
+    al. 2019 eq. (13), (x − x_{i+1})² + (y − y_{i+1})² ≤ R0²; ``"along_track"``: Borkowski
+    2018 eq. (27), |P_i P_{i+1}| − x_r < R) the next leg becomes active, so several legs can
+    be skipped in one call; the last leg is never left.
+    """
+    tab = table.arrays if xp.batched else table.lists
+    last = table.last_leg
+    for _ in range(last):
+        if switching == "circle":
+            reached = acceptance_circle_reached(x, y, (tab["x1"][leg], tab["y1"][leg]), radius)
+        else:
+            along = along_track(
+                x - tab["x0"][leg], y - tab["y0"][leg], tab["c"][leg], tab["s"][leg]
+            )
+            reached = tab["length"][leg] - along < radius
+        step = reached & (leg < last)
+        if not xp.any(step):
+            break
+        leg = leg + step
+    return leg
 
 
 def advance_leg(
@@ -652,26 +717,11 @@ def advance_leg(
     radius: float,
     rule: Literal["circle", "along_track"] = "circle",
 ) -> int:
-    """Active leg index after applying the waypoint switching rule at ship position (x, y) [m].
-
-    Leg i ends at waypoint i + 1; while that waypoint counts as reached (``"circle"``: Liu et al.
-    2019 eq. (13) with R0 = `radius`; ``"along_track"``: Borkowski 2018 eq. (27) with R =
-    `radius`) the next leg becomes active, so several legs can be skipped in one call.  The
-    last leg is never left.
-    """
+    """Active leg index after applying the waypoint switching rule at ship position (x, y) [m]
+    (:func:`advance_legs` for one ship, with its arguments checked)."""
     if rule not in ("circle", "along_track"):
         raise ValueError(f"unknown switching rule {rule!r}; use 'circle' or 'along_track'")
     last = path.n_legs - 1
     if not 0 <= leg <= last:
         raise IndexError(f"leg {leg} out of range [0, {last}]")
-    wp = path.waypoints
-    while leg < last:
-        if rule == "circle":
-            nxt = wp[leg + 1]
-            reached = acceptance_circle_reached(x, y, (float(nxt[0]), float(nxt[1])), radius)
-        else:
-            reached = along_track_reached(path.leg_frame(x, y, leg), radius)
-        if not reached:
-            break
-        leg += 1
-    return leg
+    return advance_legs(float(x), float(y), int(leg), path.legs, radius, rule, SCALAR)

@@ -2,8 +2,8 @@
 
 One tracker for both path types and for one ship or N: the single env, the batched env and
 the controllers that keep their own bookkeeping from measured positions all use
-:class:`PathTracker`.  Its pure functions (:func:`advance_legs`, :func:`polyline_frame`,
-:func:`curve_frame`) are written once for floats and arrays (``xp`` of
+:class:`PathTracker`.  Its pure functions (:func:`shipgym.paths.advance_legs`,
+:func:`polyline_frame`, :func:`curve_frame`) are written once for floats and arrays (``xp`` of
 :mod:`shipgym.numerics`), so one ship and the matching ship of a batch get the same bits.
 """
 
@@ -17,7 +17,15 @@ import numpy as np
 
 from shipgym.angles import wrap_angle
 from shipgym.numerics import ARRAY, SCALAR
-from shipgym.paths import CurvePoint, PchipPath, WaypointPath, along_track, cross_track
+from shipgym.paths import (
+    CurvePoint,
+    LegTable,
+    PchipPath,
+    WaypointPath,
+    advance_legs,
+    along_track,
+    cross_track,
+)
 
 SWITCHING_RULES = ("circle", "along_track")
 
@@ -33,67 +41,6 @@ class TrackFrame:
     angle_change_next: Any  # path-angle change to the next leg [rad]
     distance_to_next: Any  # distance to the next waypoint [m]
     at_goal: Any  # final waypoint reached
-
-
-@dataclasses.dataclass(frozen=True)
-class LegTable:
-    """Per-leg constants of a polyline: start/end points, unit direction (c, s) = (cos ψp,
-    sin ψp), length, angle and the angle change to the next leg; each a list (one ship) and
-    an array (N ships: gathered by the leg index array)."""
-
-    lists: dict[str, list[float]]
-    arrays: dict[str, np.ndarray]
-    last_leg: int
-    goal: tuple[float, float]
-
-    @classmethod
-    def of(cls, path: WaypointPath) -> LegTable:
-        wp = [(float(p[0]), float(p[1])) for p in path.waypoints]
-        legs = range(len(wp) - 1)
-        # math.hypot / math.atan2: exactly the numbers of shipgym.paths.segment_frame
-        length = [math.hypot(wp[i + 1][0] - wp[i][0], wp[i + 1][1] - wp[i][1]) for i in legs]
-        lists = {
-            "x0": [wp[i][0] for i in legs],
-            "y0": [wp[i][1] for i in legs],
-            "x1": [wp[i + 1][0] for i in legs],
-            "y1": [wp[i + 1][1] for i in legs],
-            "c": [(wp[i + 1][0] - wp[i][0]) / length[i] for i in legs],
-            "s": [(wp[i + 1][1] - wp[i][1]) / length[i] for i in legs],
-            "length": length,
-            "angle": [math.atan2(wp[i + 1][1] - wp[i][1], wp[i + 1][0] - wp[i][0]) for i in legs],
-            "change": [path.next_leg_angle_change(i) for i in legs],
-        }
-        arrays = {k: np.array(v) for k, v in lists.items()}
-        return cls(lists, arrays, len(wp) - 2, wp[-1])
-
-
-def advance_legs(
-    x: Any, y: Any, leg: Any, table: LegTable, radius: float, switching: str, xp: Any
-) -> Any:
-    """Active leg(s) after the switching rule at position(s) (x, y) [m].
-
-    Leg i ends at waypoint i + 1; while that waypoint counts as reached (``"circle"``: Liu et
-    al. 2019 eq. (13), (x − x_{i+1})² + (y − y_{i+1})² ≤ R0²; ``"along_track"``: Borkowski
-    2018 eq. (27), |P_i P_{i+1}| − x_r < R) the next leg becomes active, so several legs can
-    be skipped in one call; the last leg is never left.
-    """
-    tab = table.arrays if xp.batched else table.lists
-    last = table.last_leg
-    for _ in range(last):
-        if switching == "circle":
-            dx = x - tab["x1"][leg]
-            dy = y - tab["y1"][leg]
-            reached = dx * dx + dy * dy <= radius * radius
-        else:
-            along = along_track(
-                x - tab["x0"][leg], y - tab["y0"][leg], tab["c"][leg], tab["s"][leg]
-            )
-            reached = tab["length"][leg] - along < radius
-        step = reached & (leg < last)
-        if not xp.any(step):
-            break
-        leg = leg + step
-    return leg
 
 
 def polyline_frame(x: Any, y: Any, leg: Any, table: LegTable, radius: float, xp: Any) -> TrackFrame:
@@ -187,7 +134,7 @@ class PathTracker:
             self._window = 4.0 * self.radius  # arc length searched around the last point [m]
             self.point: CurvePoint | None = None
         else:
-            self._legs = LegTable.of(path)
+            self._legs = path.legs
         self.leg = zero
         self.frame: TrackFrame | None = None
 
