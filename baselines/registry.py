@@ -62,8 +62,9 @@ BUILTIN_MODULES = (
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])
 
-#: what a controller is (SPEC §9b)
-KINDS = ("classical", "learned")
+#: what a controller is (SPEC §9b); a "reference" (zero_rudder, random, oracle) is shown on
+#: every scenario but never ranked as a competitor
+KINDS = ("classical", "learned", "reference")
 
 
 @dataclasses.dataclass(frozen=True)

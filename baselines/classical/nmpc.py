@@ -41,6 +41,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
+from baselines.classical.box_qp import BoxQP
 from baselines.policy import check_action_mode
 from baselines.registry import register_controller
 from shipgym.codegen import compiled
@@ -134,38 +135,11 @@ class NMPCSolver:
         self.lb = np.full(s.control_horizon, -rudder_limit)
         self.ub = np.full(s.control_horizon, rudder_limit)
         # the Gauss–Newton QP: min ½Δᵀ(JᵀJ)Δ + (Jᵀρ)ᵀΔ, lb − u ≤ Δ ≤ ub − u (CasADi qrqp)
-        n = s.control_horizon
-        qp = ca.conic(
-            "gn_qp",
-            "qrqp",
-            {"h": ca.Sparsity.dense(n, n), "a": ca.Sparsity(0, n)},
-            {
-                "print_iter": False,
-                "print_header": False,
-                "print_info": False,
-                "error_on_fail": False,
-            },
-        )
-        self._qp_in = {
-            name: np.zeros(qp.sparsity_in(i).nnz()) for i, name in enumerate(qp.name_in())
-        }
-        self._qp_out = [np.zeros(qp.sparsity_out(i).nnz()) for i in range(qp.n_out())]
-        buffer, self._qp_eval = qp.buffer()
-        for i, name in enumerate(qp.name_in()):
-            buffer.set_arg(i, memoryview(self._qp_in[name]))
-        for i, out in enumerate(self._qp_out):
-            buffer.set_res(i, memoryview(out))
-        self._qp = (qp, buffer)
+        self._qp = BoxQP(s.control_horizon)
 
     def _gauss_newton_step(self, u: np.ndarray, rho: np.ndarray, jac: np.ndarray) -> np.ndarray:
         """Box-constrained Gauss–Newton step Δ (the SQP's QP), solved by qrqp."""
-        q = self._qp_in
-        q["h"][:] = (jac.T @ jac).ravel()
-        q["g"][:] = jac.T @ rho
-        q["lbx"][:] = self.lb - u
-        q["ubx"][:] = self.ub - u
-        self._qp_eval()
-        return self._qp_out[0].copy()
+        return self._qp.solve(jac.T @ jac, jac.T @ rho, self.lb - u, self.ub - u)
 
     def _bind(self, function: ca.Function, outputs: list[np.ndarray]):
         buffer, evaluate = function.buffer()

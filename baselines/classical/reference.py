@@ -14,7 +14,7 @@ from shipgym.envs.context import ControllerContext
 class ZeroRudder:
     """Always commands zero (rudder mode) / the default guidance action."""
 
-    kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
+    kind = "reference"  # shown on every scenario, never ranked as a competitor
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self._dim = 1 if context.action_mode == "rudder" else 2
@@ -27,7 +27,7 @@ class ZeroRudder:
 class RandomRudder:
     """Uniform random action in [-1, 1], seeded per episode."""
 
-    kind = "classical"  # a non-learned reference row (SPEC §9b kinds)
+    kind = "reference"  # shown on every scenario, never ranked as a competitor
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self._dim = 1 if context.action_mode == "rudder" else 2
