@@ -18,6 +18,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from baselines.errors import ControllerError
 from baselines.plugins import ControllerEntry, ControllerSpec
 from baselines.policy import Policy
+from baselines.privileged import grants_truth, reset_with_truth
 from baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"
@@ -98,6 +99,7 @@ def run_episode(
     action_mode: str | None = None,
     env_id: str = ENV_ID,
     after_episode: Callable[[Any], None] | None = None,
+    privileged: bool = False,
 ) -> EpisodeResult:
     """Run one episode; the policy sees only obs, info and the controller context.
 
@@ -106,12 +108,17 @@ def run_episode(
     closed, to read the env's own episode logs (e.g. ``episode_disturbances()``).
     Controller compute time is measured here, around each ``act`` call, never by the env:
     ``compute_ms`` [ms] is its mean per step and ``compute_ms_max`` [ms] its maximum.
+    ``privileged``: set by :func:`evaluate` / :func:`evaluate_batch` for the built-in
+    ``oracle`` only (:mod:`baselines.privileged`): it then reads the true plant.
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
     episode = _Episode(env_id, scenario, seed, action_mode)
     try:
-        policy.reset(episode.base.controller_context, seed=seed)
+        if privileged:
+            reset_with_truth(policy, episode.base.controller_context, episode.base, seed)
+        else:
+            policy.reset(episode.base.controller_context, seed=seed)
         while not episode.done:
             start = time.perf_counter()
             action = policy.act(episode.obs, episode.info)
@@ -172,10 +179,11 @@ def evaluate_batch(
     if isinstance(policy, BatchPolicy):
         return _run_lockstep(policy, per_seed, seeds, mode, env_id)
     results = []
+    privileged = made and grants_truth(controller)
     for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
         if made and i > 0:
             policy, _ = make_controller(controller, training_seed=training_seed)
-        results.append(run_episode(policy, scenario, seed, mode, env_id))
+        results.append(run_episode(policy, scenario, seed, mode, env_id, privileged=privileged))
     return results
 
 
@@ -248,9 +256,11 @@ def evaluate(
     """
     results = []
     for seed in seeds:
+        privileged = False
         if isinstance(controller, str | ControllerEntry):
             policy, mode = make_controller(controller, **settings)
+            privileged = not settings and grants_truth(controller)
         else:
             policy, mode = controller, settings.get("action_mode")
-        results.append(run_episode(policy, scenario, seed, mode))
+        results.append(run_episode(policy, scenario, seed, mode, privileged=privileged))
     return results

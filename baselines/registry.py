@@ -58,6 +58,7 @@ BUILTIN_MODULES = (
     "baselines.classical.l1_backstepping",
     "baselines.classical.nmpc",
     "baselines.classical.reference",
+    "baselines.classical.oracle",
 )
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])

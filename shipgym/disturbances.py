@@ -325,6 +325,20 @@ class Disturbances:
             row[self._cols["yaw_disturbance"]] = self._k_bias * self._cur.speed
         return row
 
+    def mean_rows(self, times: np.ndarray) -> np.ndarray:
+        """(k, n_w) deterministic disturbances at ``times`` [s]: the mean current (with a
+        two-phase switch or ramp), its direction and the yaw bias that follows its speed;
+        no fluctuation, no waves.  At any t before a switch this is :meth:`constant_row`."""
+        t = np.asarray(times, dtype=float)
+        rows = np.zeros((t.size, self._n_w))
+        speed = np.broadcast_to(np.asarray(self._mean_speed(t), dtype=float), t.shape)
+        if "current_x" in self._cols:
+            rows[:, self._cols["current_x"]] = speed * self._cos0
+            rows[:, self._cols["current_y"]] = speed * self._sin0
+        if self._k_bias:
+            rows[:, self._cols["yaw_disturbance"]] = self._k_bias * speed
+        return rows
+
     # ------------------------------------------------------------------ random part
     def reset(self, i: int, rng: np.random.Generator) -> None:
         """Ship i's processes from their stationary law (the sample at t = −h)."""

@@ -36,6 +36,9 @@ class ControllerContext:
     #: the scenario's guidance settings (law, R_LOS = los_radius_L·L, look-ahead, VF/TVVF
     #: parameters): a scenario's ``guidance:`` block
     guidance: Any
+    #: the scenario's reward weights (``reward:`` block: w_ψ, w_δ, w_Δ, goal bonus): the task's
+    #: objective, public like the path
+    reward: Any
 
     @classmethod
     def of(cls, scenario: Scenario, action_mode: str) -> ControllerContext:
@@ -55,6 +58,7 @@ class ControllerContext:
             switching=sc.config.path.switching,
             action_mode=action_mode,
             guidance=sc.config.guidance,
+            reward=sc.config.reward,
         )
 
     @property

@@ -43,6 +43,11 @@ from shipgym.tracking import PathTracker, TrackFrame
 
 ACTION_MODES = ("rudder", "guidance")
 
+#: revision of the step core's numbers (dynamics, reward, termination): reference data
+#: computed with the env (the oracle's costs, ``baselines.references``) is valid for one
+#: revision; bump it whenever a change moves an episode's numbers
+ENV_REVISION = 1
+
 OBS_NAMES = (
     "cross_track",
     "sin_heading_error",

@@ -42,6 +42,7 @@ from shipgym.angles import wrap_angle
 from shipgym.disturbances import SensorModel
 from shipgym.envs import core
 from shipgym.envs.context import ControllerContext
+from shipgym.envs.truth import PlantTruth
 from shipgym.envs.core import GUIDANCE_OFFSET_MAX, LOG_FIELDS, OBS_HIGH, OBS_LOW, OBS_NAMES
 from shipgym.metrics import EpisodeLog, compute_metrics
 from shipgym.numerics import SCALAR
@@ -288,6 +289,25 @@ class ShipPathFollowEnv(gym.Env):
         for j, name in enumerate(self.model.disturbance_names):
             out[name] = blocks[:, j].copy()
         return out
+
+    def plant_truth(self) -> PlantTruth:
+        """The true plant now (:mod:`shipgym.envs.truth`): privileged.  Never in ``info`` or
+        the controller context; the evaluation loop passes it to the built-in ``oracle``
+        reference only."""
+        if self._state is None:
+            raise RuntimeError("call reset() before plant_truth()")
+        sc = self.scenario
+        if self._disturbances.time_varying and self._step_count > 0:
+            now = self._w_block[-1].copy()  # the last substep's disturbances
+        else:
+            now = self._disturbances.mean_rows(np.array([self._t]))[0]
+        return PlantTruth(
+            t=self._t,
+            state=self._state.copy(),
+            params=sc.schedule.record_at(self._t),
+            disturbance_now=now,
+            mean_disturbance=self._disturbances.mean_rows,
+        )
 
     @property
     def pose(self) -> tuple[float, float, float]:
