@@ -424,7 +424,7 @@ def resolution_lines(board: Sequence[Mapping[str, Any]]) -> list[str]:
         lines.append(
             f"Resolution, {res['split']}: median width of the cost-ratio IQM intervals "
             f"{res['median_ci_width']:.3f}, range of the IQM over the {res['controllers']} "
-            f"competing controllers {res['iqm_range']:.3f} (target width < range / 5: "
+            f"competing controller(s) {res['iqm_range']:.3f} (target width < range / 5: "
             f"{verdict})."
         )
     return [*lines, ""] if lines else []
