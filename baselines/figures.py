@@ -65,7 +65,7 @@ REFERENCES = ("zero_rudder", "random", ORACLE)
 _LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3")
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
 #: the oracle's episode, drawn in every column as the reference
-_ORACLE_STYLE = {"color": "black", "linestyle": "-", "alpha": 0.4, "zorder": 1.5}
+_ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}
 
 
 class DrawnEpisode(NamedTuple):
@@ -401,9 +401,9 @@ def plot_scenario(
             tr = lines[name]
             label = _episode_label(name, everything[name]) + ", the reference"
             handles += ax_track.plot(
-                tr["x"], tr["y"], lw=1.6, label=label, gid=f"{name}/track", **_ORACLE_STYLE
+                tr["x"], tr["y"], lw=1.2, label=label, gid=f"{name}/track", **_ORACLE_STYLE
             )
-            ax_e.plot(tr["t"], tr["cross_track_error"], lw=1.4, gid=f"{name}/e", **_ORACLE_STYLE)
+            ax_e.plot(tr["t"], tr["cross_track_error"], lw=1.1, gid=f"{name}/e", **_ORACLE_STYLE)
             ax_d.plot(
                 tr["t"],
                 np.degrees(tr["rudder_angle"]),
@@ -606,7 +606,7 @@ def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str,
         f"Aggregate over {SPLIT_TITLES.get(split, split)}: point estimate (black) and 95 % "
         "stratified-bootstrap interval (bar), rliable; 1 = the oracle's cost, lower is better",
         fontsize=10,
-        y=1.02,
+        y=1.0 + 0.5 / fig.get_figheight(),  # above the panels' titles, however few rows
     )
     return save_figure(fig, out_dir, "ranking_" + figure_stem(split), tight=True)
 

@@ -298,8 +298,8 @@ def score_table(
     scores: Sequence[Mapping[str, Any]],
 ) -> str:
     """The sortable controller × scenario table (``id="scores"``): each controller's IQM cost
-    ratio per split, then its geometric-mean cost ratio with interval per scenario (the
-    oracle's row: its mean cost); "n/a" where it does not apply."""
+    ratio per split, then its geometric-mean cost ratio with interval per scenario (whose
+    header gives the oracle's mean cost); "n/a" where it does not apply."""
     scenarios = list(dict.fromkeys([r["scenario"] for r in rows] + [s["scenario"] for s in scores]))
     split_of = {r["scenario"]: r.get("split", "") for r in rows}
     split_of.update({s["scenario"]: s.get("split", "") for s in scores})
@@ -315,8 +315,8 @@ def score_table(
     columns = [("controller", "controller", "text"), ("kind", "kind", "text")]
     columns += [(f"iqm:{sp}", f"IQM<br>{_e(sp)}", "lower") for sp in splits]
     columns += [
-        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}</small>',
-         "lower")
+        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}'
+         f"{_oracle_cost(oracle.get(s))}</small>", "lower")
         for s in scenarios
     ]  # fmt: skip
     body = []
@@ -336,14 +336,14 @@ def score_table(
                     _cell(sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True)
                 )
         body.append("".join(tds))
-    if oracle:  # the reference: its cost, the denominator of every ratio in its column
-        tds = [_name_cell(ORACLE), _text_cell("reference: mean cost")]
-        tds += ['<td data-sort=""></td>'] * len(splits)
-        for s in scenarios:
-            found = oracle.get(s, {})
-            tds.append(_cell(found.get("oracle_cost"), found.get("oracle_cost_ci95")))
-        body.append("".join(tds))
     return _table("scores", _head(columns), body)
+
+
+def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
+    """A scenario header's line on the oracle's mean cost (the ratios' denominator)."""
+    if not entry:
+        return ""
+    return f"<br>{_e(ORACLE)} cost {_e(_number(entry.get('oracle_cost')))}"
 
 
 def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
@@ -450,8 +450,9 @@ def page(
         f"{ranking_tables(aggregate) if aggregate else _no_ranking()}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
         "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
-        "interval below (green: the oracle's cost, red: 4× or more); the last row: the "
-        "oracle's mean cost. n/a: the controller does not apply to the scenario's ship. "
+        "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
+        "name the oracle's mean cost. n/a: the controller does not apply to the scenario's "
+        "ship. "
         "Click a header to sort; a scenario's name links to its figure.</p>"
         f"{score_table(rows, aggregate, scores)}"
         f'<h2 id="ranking-figures">Ranking figures</h2>{ranking_figs or "<p>No figures.</p>"}'
