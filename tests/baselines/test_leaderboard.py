@@ -313,3 +313,18 @@ def test_resume_with_training_seeds_equals_a_clean_run(
     assert sorted(p.name for p in (out / "trajectories").iterdir()) == sorted(
         p.name for p in (clean / "trajectories").iterdir()
     )
+
+
+def test_the_terminal_ends_with_the_ranking_and_the_page(
+    ranked: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``report`` (like ``leaderboard``) prints the ranking and where the page is, not the
+    long rows."""
+    from baselines.cli import main
+
+    out = tmp_path / "again"
+    assert main(["report", str(ranked.parent / "record"), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert text.rstrip().endswith(f"leaderboard: {out / 'leaderboard.html'}")
+    assert "| 1 | pid_los | classical |" in text and "Resolution, catalogue" in text
+    assert "| scenario | controller |" not in text
