@@ -489,7 +489,7 @@ def write_results(
                 splits,
                 kinds,
             )
-            for split in dict.fromkeys(r["split"] for r in board if not is_partial(r["split"]))
+            for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
         ]
         rows = aggregate_results(
             results,

@@ -54,6 +54,7 @@ ROW_METRICS = {
     "ace_L": "ACE/L [–]",
     "t_c": "t_c [s]",
     "return": "return [–]",
+    "cost": "cost [–]",
     "rudder_travel": "rudder travel [rad]",
     "J": "J [–]",
     "success": "success [–]",
