@@ -22,6 +22,7 @@ Functions (each returns the written files, PNG then SVG):
   ship_length=None, kinds=None, chosen_by="median-ACE")`` — one scenario: a grid with one
   column per controller family (at most :data:`PANEL_CONTROLLERS` controllers a column) and
   three rows with the same axes in every column: track x–y over the path, e(t), δ(t); the
+  oracle's episode (controller ``oracle``) drawn in every column as the reference; the
   parameter-change time as a labelled vertical line ("change at t = … s") and each ship's
   position at that time; the title and legends say which episode is drawn.  File
   ``scenario_<name>``.
@@ -30,8 +31,9 @@ Functions (each returns the written files, PNG then SVG):
   length read from the scenario (:func:`shipgym.scenarios.load_scenario` of
   ``scenarios[name]``, else of the name).
 * :func:`plot_ranking` ``(out_dir, aggregate, episodes, splits, kinds=None)`` — per split: rliable's
-  interval estimates (mean and IQM of the normalised score and P(improvement over pid_los),
-  95 % intervals; file ``ranking_<split>``) and performance profiles (one panel per family,
+  interval estimates (IQM and geometric mean of the cost ratio C / C_oracle on a log axis,
+  P(improvement over pid_los) and the failure rate, 95 % intervals; file
+  ``ranking_<split>``) and performance profiles of the cost ratio (one panel per family,
   file ``profile_<split>``).
 
 18 scenarios and the ranking of 20 controllers take about half a minute on one core.
@@ -47,6 +49,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from baselines.ranking import ORACLE
 from baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
@@ -58,9 +61,11 @@ MAX_POINTS = 2000
 PROFILE_REPS = 200
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
-REFERENCES = ("zero_rudder", "random")
+REFERENCES = ("zero_rudder", "random", ORACLE)
 _LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3")
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
+#: the oracle's episode, drawn in every column as the reference
+_ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}
 
 
 class DrawnEpisode(NamedTuple):
@@ -368,28 +373,44 @@ def plot_scenario(
     axes, except the references' (zero_rudder, random: their own scale, so a drifting
     reference does not flatten the rest).  Returns the PNG and SVG paths."""
     plt = pyplot()
-    episodes = {name: _as_drawn(ep) for name, ep in drawn.items()}
+    everything = {name: _as_drawn(ep) for name, ep in drawn.items()}
+    episodes = {name: ep for name, ep in everything.items() if name != ORACLE}
+    oracle = [ORACLE] if ORACLE in everything else []
     panels = family_panels(episodes, kinds) or [("no episode kept", [])]
-    longest = max((len(ep.trajectory["t"]) for ep in episodes.values()), default=1)
+    longest = max((len(ep.trajectory["t"]) for ep in everything.values()), default=1)
     step = max(1, math.ceil(longest / MAX_POINTS))
     lines = {
-        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in episodes.items()
+        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in everything.items()
     }
     path = np.asarray(path_xy, dtype=np.float64) if path_xy is not None else np.empty((0, 2))
     pad = ship_length or 1.0
     controlled = [n for n in episodes if controller_family(n, (kinds or {}).get(n)) != "references"]
-    shared = _scales(lines, controlled or list(episodes), path, pad)
+    shared = _scales(lines, (controlled or list(episodes)) + oracle, path, pad)
     own_scale = [bool(controlled) and title.startswith("references") for title, _ in panels]
     fig = plt.figure()
-    most = max(len(members) for _, members in panels)
+    most = max(len(members) for _, members in panels) + len(oracle)
     columns = _column_axes(fig, _ROWS_H, own_scale, legend_lines=max(most, 1))
     for col, ((title, members), (ax_track, ax_e, ax_d)) in enumerate(
         zip(panels, columns, strict=True)
     ):
-        lim = _scales(lines, members, path, pad) if own_scale[col] else shared
+        lim = _scales(lines, members + oracle, path, pad) if own_scale[col] else shared
         handles: list[Any] = []
         if path.size:
             ax_track.plot(path[:, 0], path[:, 1], color="0.55", lw=2.2, alpha=0.5, zorder=1)
+        for name in oracle:  # the reference in every column
+            tr = lines[name]
+            label = _episode_label(name, everything[name]) + ", the reference"
+            handles += ax_track.plot(
+                tr["x"], tr["y"], lw=1.2, label=label, gid=f"{name}/track", **_ORACLE_STYLE
+            )
+            ax_e.plot(tr["t"], tr["cross_track_error"], lw=1.1, gid=f"{name}/e", **_ORACLE_STYLE)
+            ax_d.plot(
+                tr["t"],
+                np.degrees(tr["rudder_angle"]),
+                lw=1.4,
+                gid=f"{name}/rudder",
+                **_ORACLE_STYLE,
+            )
         for name in members:
             tr, style = lines[name], controller_style(name)
             label = _episode_label(name, episodes[name])
@@ -431,7 +452,7 @@ def plot_scenario(
         if handles:
             _legend_below(ax_d, handles)
     fig.suptitle(
-        _scenario_title(scenario, episodes, change_time, ship_length, chosen_by),
+        _scenario_title(scenario, everything, change_time, ship_length, chosen_by),
         fontsize=10,
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
@@ -499,12 +520,24 @@ def plot_scenarios(
 
 # ----------------------------------------------------------------------------- ranking
 SPLIT_TITLES = {"catalogue": "catalogue scenarios", "heldout": "held-out scenarios"}
-_SCORE_LABEL = "normalised score (0 = zero_rudder, 1 = pid_los)"
+_RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"
+#: the intervals drawn per controller: key, panel title, axis label, reference lines
+_INTERVAL_PANELS = (
+    ("cost_ratio_iqm", "IQM cost ratio", _RATIO_LABEL, (1.0,)),
+    ("cost_ratio_gmean", "geometric-mean cost ratio", _RATIO_LABEL, (1.0,)),
+    ("prob_improvement_over_pid_los", "P(ratio < pid_los's)", "probability [–]", (0.5,)),
+    ("failure_rate", "failure rate", "fraction of episodes [–]", ()),
+)
 
 
 def _interval(row: Mapping[str, Any], key: str) -> list[float]:
     ci = row.get(f"{key}_ci95") or [math.nan, math.nan]
     return [float(ci[0]), float(ci[1])]
+
+
+def _value(row: Mapping[str, Any], key: str) -> float:
+    value = row.get(key)
+    return math.nan if value is None else float(value)
 
 
 def plot_ranking(
@@ -514,67 +547,92 @@ def plot_ranking(
     splits: Mapping[str, str],
     kinds: Mapping[str, str] | None = None,
 ) -> list[Path]:
-    """Per split of ``aggregate``: ``ranking_<split>`` (rliable's interval estimates) and
-    ``profile_<split>`` (performance profiles from ``episodes``, one panel per family); see
-    the module doc.  Returns every written file."""
+    """Per split of ``aggregate``: ``ranking_<split>`` (rliable's interval estimates, the
+    cost ratios on a log axis; a row of the split's partial table is drawn too, its label
+    saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
+    ratio from ``episodes``, one panel per family); see the module doc.  Returns every
+    written file."""
+    from baselines.ranking import PARTIAL
+
     files: list[Path] = []
-    for split in dict.fromkeys(r["split"] for r in aggregate):
-        rows = [r for r in aggregate if r["split"] == split]
+    for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in aggregate):
+        rows = [r for r in aggregate if r["split"].removesuffix(PARTIAL) == split]
         files += _plot_intervals(out_dir, split, rows)
         files += _plot_profiles(out_dir, split, episodes, splits, kinds)
     return files
+
+
+def _ranking_label(row: Mapping[str, Any], common: int) -> str:
+    """A controller's name, with its scenario count when it is ranked on fewer."""
+    n = len(row["scenarios"])
+    return row["controller"] if n == common else f"{row['controller']} ({n} of {common} scen.)"
 
 
 def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]]) -> list:
     from rliable import plot_utils
 
     plt = pyplot()
-    rows = sorted(rows, key=lambda r: (r["score_iqm"], r["controller"]))  # best on top
-    keys = ("score_mean", "score_iqm", "prob_improvement_over_pid_los")
+    rows = sorted(rows, key=lambda r: (-r["cost_ratio_iqm"], r["controller"]))  # best on top
+    common = max(len(r["scenarios"]) for r in rows)
+    keys = [panel[0] for panel in _INTERVAL_PANELS]
     names = [r["controller"] for r in rows]
-    point = {r["controller"]: np.array([float(r[k]) for k in keys]) for r in rows}
+    point = {r["controller"]: np.array([_value(r, k) for k in keys]) for r in rows}
     interval = {r["controller"]: np.array([_interval(r, k) for k in keys]).T for r in rows}
     with plt.rc_context({"font.size": 8}):
         fig, axes = plot_utils.plot_interval_estimates(
             point,
             interval,
-            metric_names=["mean score", "IQM score", "P(score > pid_los)"],
+            metric_names=[panel[1] for panel in _INTERVAL_PANELS],
             algorithms=names,
             colors={n: controller_style(n).color for n in names},
-            subfigure_width=3.6,
+            subfigure_width=3.4,
             row_height=0.3,
             xlabel="",
         )
-    for ax, label, ref in zip(
-        axes,
-        (_SCORE_LABEL, _SCORE_LABEL, "probability [–]"),
-        ((0.0, 1.0), (0.0, 1.0), (0.5,)),
-        strict=True,
-    ):
+    for ax, (key, _, label, refs) in zip(axes, _INTERVAL_PANELS, strict=True):
+        if key.startswith("cost_ratio"):
+            _log_ratio_axis(ax, [v for r in rows for v in (*_interval(r, key), _value(r, key))])
         ax.set_xlabel(label, fontsize=9)
         ax.title.set_fontsize(11)
         ax.tick_params(labelsize=8)
-        for x in ref:
+        for x in refs:
             ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
-    axes[0].set_yticklabels(names, fontsize=9)
+    axes[0].set_yticklabels([_ranking_label(r, common) for r in rows], fontsize=9)
     for i, ax in enumerate(axes):
         for bars in ax.containers:  # rliable labels each interval bar with its controller
             for bar in bars:
                 bar.set_gid(f"{bars.get_label()}/interval/{keys[i]}")
     fig.suptitle(
         f"Aggregate over {SPLIT_TITLES.get(split, split)}: point estimate (black) and 95 % "
-        "stratified-bootstrap interval (bar), rliable",
+        "stratified-bootstrap interval (bar), rliable; 1 = the oracle's cost, lower is better",
         fontsize=10,
-        y=1.02,
+        y=1.0 + 0.5 / fig.get_figheight(),  # above the panels' titles, however few rows
     )
     return save_figure(fig, out_dir, "ranking_" + figure_stem(split), tight=True)
 
 
-def _taus(scores: np.ndarray) -> np.ndarray:
-    """Thresholds of the performance profile [score]: 0 … 1.25 widened to the 1st and 99th
-    percentiles of the scores."""
-    low, high = np.quantile(scores, [0.01, 0.99]) if scores.size else (0.0, 1.0)
-    return np.linspace(min(0.0, float(low)), max(1.25, float(high)), 121)
+def _log_ratio_axis(ax: Any, values: Iterable[float]) -> None:
+    """A log x axis over the finite positive ``values`` and 1 (the oracle), with plain
+    number labels."""
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+
+    finite = [v for v in values if math.isfinite(v) and v > 0] + [1.0]
+    low, high = min(finite), max(finite)
+    ax.set_xscale("log")
+    ax.set_xlim(low / 1.15, high * 1.15)
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    formatter = ScalarFormatter()
+    formatter.set_scientific(False)
+    ax.xaxis.set_major_formatter(formatter)
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def _taus(ratios: np.ndarray) -> np.ndarray:
+    """Thresholds of the performance profile [cost ratio]: log-spaced from the lowest ratio
+    (at most 1, the oracle) to the 99th percentile (at least 2)."""
+    finite = ratios[np.isfinite(ratios) & (ratios > 0)] if ratios.size else ratios
+    low, high = np.quantile(finite, [0.0, 0.99]) if finite.size else (1.0, 2.0)
+    return np.geomspace(min(1.0, float(low)), max(2.0, float(high)), 121)
 
 
 def _plot_profiles(
@@ -586,18 +644,18 @@ def _plot_profiles(
 ) -> list[Path]:
     from rliable import plot_utils
 
-    from baselines.ranking import normalised_scores, performance_profiles
+    from baselines.ranking import performance_profiles, scored_episodes
 
     plt = pyplot()
     in_split = {s for s, sp in splits.items() if sp == split}
-    scores = np.array(
+    ratios = np.array(
         [
-            ep["score"]
-            for ep in normalised_scores(episodes)
-            if ep["scenario"] in in_split and ep["score"] is not None
+            ep["cost_ratio"]
+            for ep in scored_episodes(episodes)
+            if ep["scenario"] in in_split and ep["cost_ratio"] is not None
         ]
     )
-    taus = _taus(scores)
+    taus = _taus(ratios)
     profiles, cis = performance_profiles(episodes, splits, split, taus, reps=PROFILE_REPS)
     panels = family_panels(profiles, kinds)
     if not panels:
@@ -613,8 +671,8 @@ def _plot_profiles(
             ax=ax,
             colors={m: controller_style(m).color for m in members},
             linestyles={m: controller_style(m).linestyle for m in members},
-            xlabel="score τ [–]",
-            ylabel="" if col else "fraction of runs with score > τ",
+            xlabel="cost ratio τ [–] (log)",
+            ylabel="" if col else "fraction of runs with ratio > τ",
             labelsize=8,
             ticklabelsize=7,
             wrect=4,
@@ -625,14 +683,14 @@ def _plot_profiles(
         for line in ax.get_lines():  # rliable applies a linewidth keyword to its first line only
             line.set_linewidth(1.3)
             line.set_gid(f"{line.get_label()}/profile")
-        for x in (0.0, 1.0):
-            ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
+        ax.axvline(1.0, color="0.45", lw=0.8, ls="--", zorder=0)
         ax.set_title(title, fontsize=9)
+        _log_ratio_axis(ax, [taus[0], taus[-1]])
         ax.set_xlim(taus[0], taus[-1])
         _legend_below(ax)
     fig.suptitle(
-        f"Performance profiles, {SPLIT_TITLES.get(split, split)} (95 % intervals shaded; "
-        "dashed: zero_rudder = 0, pid_los = 1)",
+        f"Performance profiles of the cost ratio, {SPLIT_TITLES.get(split, split)} (95 % "
+        "intervals shaded; dashed: the oracle = 1; lower curves are better)",
         fontsize=10,
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",

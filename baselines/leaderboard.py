@@ -14,8 +14,8 @@ seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process 
 ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
-``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`baselines.ranking`),
-``scenario_scores.json``, the figures.
+``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`baselines.ranking`: cost over
+the oracle's), ``scenario_scores.json``, the figures.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import functools
+import json
 import math
 import os
 import signal
@@ -43,7 +44,17 @@ from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from baselines.figures import median_ace_episode
 from baselines.jsonout import dumps
 from baselines.plugins import ControllerSpec
-from baselines.ranking import SCORE_ONE, SCORE_ZERO, aggregate_ranking, row_intervals
+from baselines.ranking import (
+    BASELINE,
+    NO_RANKING,
+    ORACLE,
+    PARTIAL,
+    SCORE_EXPLAINED,
+    aggregate_ranking,
+    is_partial,
+    resolution_lines,
+    row_intervals,
+)
 from baselines.ranking import scenario_scores as score_table
 from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
 from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
@@ -60,6 +71,7 @@ COLUMNS = (
     "ace_L",
     "t_c",
     "return",
+    "cost",
     "rudder_travel",
     "J",
     "success",
@@ -72,7 +84,7 @@ COLUMNS = (
 TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
 
 AGGREGATE_FILE = "aggregate.json"
-PROB = f"prob_improvement_over_{SCORE_ONE}"
+PROB = f"prob_improvement_over_{BASELINE}"
 SCENARIO_SCORES_FILE = "scenario_scores.json"
 
 
@@ -426,8 +438,9 @@ def write_results(
     ``run.json`` keeps it (:func:`suite_record`); returns the rows.
 
     ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
-    controller × scenario scores, then the rows), ``generalisation.json``,
-    ``aggregate.json`` (:func:`ranking`), ``scenario_scores.json`` and the figures
+    controller × scenario cost ratios, then the rows), ``generalisation.json``,
+    ``aggregate.json`` (:func:`baselines.ranking.aggregate_ranking`),
+    ``scenario_scores.json`` and the figures
     (:mod:`baselines.figures`: per scenario the small multiples of each controller's
     median-ACE episode, per split the ranking's interval estimates and performance
     profiles) and ``leaderboard.html`` (:mod:`baselines.pages`: all of it on one page).  The
@@ -448,7 +461,9 @@ def write_results(
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
         boards = [
-            pool.submit(ranking, ranked, {s: sp for s, sp in splits.items() if sp == split}, kinds)
+            pool.submit(
+                aggregate_ranking, ranked, {s: sp for s, sp in splits.items() if sp == split}, kinds
+            )
             for split in sorted(set(splits.values()))
         ]
         plots = {
@@ -461,17 +476,20 @@ def write_results(
             )
             for scenario in shown
         }
-        board = [row for future in boards for row in future.result()]
+        board = sorted(
+            (row for future in boards for row in future.result()),
+            key=lambda r: (r["split"], r["cost_ratio_iqm"], r["controller"]),
+        )
         ranking_plots = [
             pool.submit(
                 figures.plot_ranking,
                 out,
-                [r for r in board if r["split"] == split],
+                [r for r in board if r["split"].removesuffix(PARTIAL) == split],
                 ranked,
                 splits,
                 kinds,
             )
-            for split in dict.fromkeys(r["split"] for r in board)
+            for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
         ]
         rows = aggregate_results(
             results,
@@ -480,11 +498,11 @@ def write_results(
             kinds=kinds,
             not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
         )
-        scores = score_table(ranked, splits) if board else []
+        scores = score_table(ranked, splits, kinds)
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
         (out / SCENARIO_SCORES_FILE).write_text(dumps(scores, indent=2) + "\n")
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
-        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out)
+        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked)
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
@@ -622,18 +640,6 @@ def rankable(episodes: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return [e for e in episodes if e["scenario"] not in partial]
 
 
-def ranking(
-    episodes: list[dict[str, Any]], splits: Mapping[str, str], kinds: Mapping[str, str]
-) -> list[dict[str, Any]]:
-    """The ``aggregate.json`` rows (:func:`baselines.ranking.aggregate_ranking`: per
-    controller and split, the normalised score's mean and IQM with intervals and the
-    probability of improvement over pid_los); empty without both references."""
-    present = {e["controller"] for e in episodes}
-    if not {SCORE_ZERO, SCORE_ONE} <= present:
-        return []
-    return aggregate_ranking(episodes, splits, kinds)
-
-
 def _interval(value: Any, ci: Any, digits: int = 2) -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
@@ -643,40 +649,31 @@ def _interval(value: Any, ci: Any, digits: int = 2) -> str:
     return text
 
 
-def ranking_markdown(
-    board: list[dict[str, Any]],
-    scores: list[dict[str, Any]],
-    scenarios: list[str],
-    left_out: Sequence[str] = (),
-) -> str:
-    """The head of ``leaderboard.md``: the ranking per split and the controller × scenario
-    table of mean scores with 95 % intervals."""
-    lines = ["# Leaderboard", "", "## Ranking", ""]
-    if not board:
-        needs = f"No ranking: the normalised score needs {SCORE_ZERO} and {SCORE_ONE} on the "
-        return "\n".join([*lines, needs + "same scenarios and seeds.", ""])
-    lines += [
-        f"Normalised score of an episode, from its return: 0 = {SCORE_ZERO}, 1 = {SCORE_ONE} "
-        "on the same scenario and seed (trial). Per controller over the scenarios it applies "
-        "to: the mean and the interquartile mean (IQM) of its runs' scores (runs = training "
-        "seeds × evaluation seeds) and the probability that its score beats pid_los's on a "
-        "scenario and seed, each with a 95 % stratified-bootstrap interval (rliable; Agarwal "
-        "et al. 2021). Ranked by IQM.",
-        "",
-    ]
-    if left_out:
-        lines += [f"Left out (episodes missing): {', '.join(left_out)}.", ""]
-    for split in ("catalogue", "heldout"):
+def _table_title(split: str, rows: Sequence[Mapping[str, Any]]) -> str:
+    """A ranking table's heading: the split, and its scenarios (every controller's in a
+    main table; a partial table's controllers have their own)."""
+    base = split.removesuffix(PARTIAL)
+    name = "Catalogue scenarios" if base == "catalogue" else "Held-out scenarios"
+    if is_partial(split):
+        return (
+            f"{name}: controllers that do not apply to every scenario (each ranked on the "
+            "scenarios it applies to; not comparable with the table above)"
+        )
+    return f"{name} ({len(rows[0]['scenarios'])}, the same for every controller)"
+
+
+def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The ranking as markdown: one table per split, each followed by its partial table."""
+    lines: list[str] = []
+    for split in dict.fromkeys(r["split"] for r in board):
         mine = [r for r in board if r["split"] == split]
-        if not mine:
-            continue
-        title = "Catalogue scenarios" if split == "catalogue" else "Held-out scenarios"
         lines += [
-            f"### {title} ({len(mine[0]['scenarios'])})",
+            f"### {_table_title(split, mine)}",
             "",
-            "| rank | controller | kind | training seeds | scenarios | score mean [95 % CI] "
-            "| IQM [95 % CI] | P(improvement over pid_los) [95 % CI] |",
-            "|---|---|---|---|---|---|---|---|",
+            "| rank | controller | kind | training seeds | scenarios | cost ratio IQM [95 % CI] "
+            f"| geometric mean [95 % CI] | P(improvement over {BASELINE}) [95 % CI] "
+            "| failure rate [95 % CI] |",
+            "|---|---|---|---|---|---|---|---|---|",
         ]
         for rank, r in enumerate(mine, start=1):
             cells = [
@@ -685,14 +682,37 @@ def ranking_markdown(
                 r["kind"],
                 str(r["training_seeds"] or "–"),
                 str(len(r["scenarios"])),
-                _interval(r["score_mean"], r["score_mean_ci95"]),
-                _interval(r["score_iqm"], r["score_iqm_ci95"]),
-                _interval(
-                    r["prob_improvement_over_pid_los"], r["prob_improvement_over_pid_los_ci95"]
-                ),
+                _interval(r["cost_ratio_iqm"], r["cost_ratio_iqm_ci95"], 3),
+                _interval(r["cost_ratio_gmean"], r["cost_ratio_gmean_ci95"], 3),
+                _interval(r[PROB], r[f"{PROB}_ci95"]),
+                _interval(r["failure_rate"], r["failure_rate_ci95"]),
             ]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
+    return lines
+
+
+def ranking_markdown(
+    board: list[dict[str, Any]],
+    scores: list[dict[str, Any]],
+    scenarios: list[str],
+    left_out: Sequence[str] = (),
+    episodes: Sequence[Mapping[str, Any]] = (),
+) -> str:
+    """The head of ``leaderboard.md``: the score in two sentences, the ranking per split
+    (and its partial tables), the resolution and the controller × scenario table of cost
+    ratios; ``episodes``: the ranked ones (to name the scenarios without the oracle's)."""
+    lines = ["# Leaderboard", "", "## Ranking", ""]
+    if not board:
+        return "\n".join([*lines, NO_RANKING, ""])
+    lines += [SCORE_EXPLAINED, ""]
+    if left_out:
+        lines += [f"Left out (episodes missing): {', '.join(left_out)}.", ""]
+    with_oracle = {e["scenario"] for e in episodes if e["controller"] == ORACLE}
+    unranked = sorted({e["scenario"] for e in episodes} - with_oracle)
+    if unranked:
+        lines += [f"Not ranked (no episodes of {ORACLE}): {', '.join(unranked)}.", ""]
+    lines += ranking_tables(board) + resolution_lines(board)
     lines += scores_markdown(board, scores, scenarios)
     return "\n".join(lines)
 
@@ -700,28 +720,52 @@ def ranking_markdown(
 def scores_markdown(
     board: list[dict[str, Any]], scores: list[dict[str, Any]], scenarios: list[str]
 ) -> list[str]:
-    """The controller × scenario table (mean score [95 % CI]; – where it does not apply)."""
-    cell = {(s["controller"], s["scenario"]): s for s in scores}
-    shown = [s for s in scenarios if any(key[1] == s for key in cell)]
+    """The controller × scenario table: the oracle's mean cost, then each controller's
+    geometric-mean cost ratio [95 % CI] (– where it does not apply)."""
+    by_scenario = {s["scenario"]: s for s in scores}
+    shown = [s for s in scenarios if s in by_scenario]
+    cell = {(c["controller"], s["scenario"]): c for s in scores for c in s["controllers"]}
     controllers = list(dict.fromkeys(r["controller"] for r in board))
+    controllers += sorted({c for c, _ in cell} - set(controllers))  # the references
     lines = [
-        "## Scores per scenario",
+        "## Cost ratio per scenario",
         "",
-        "Mean normalised score over each row's episodes [95 % interval, stratified over "
-        "training seeds]; – where the controller does not apply.",
+        f"First row: the mean cost of {ORACLE} on each scenario [95 % interval]. Then each "
+        "controller's geometric mean of C / C_oracle over the row's episodes [95 % interval, "
+        "stratified over training seeds]; – where the controller does not apply.",
         "",
         "| controller | " + " | ".join(shown) + " |",
         "|---|" + "---|" * len(shown),
+        f"| {ORACLE} (cost) | "
+        + " | ".join(
+            _interval(by_scenario[s]["oracle_cost"], by_scenario[s]["oracle_cost_ci95"], 1)
+            for s in shown
+        )
+        + " |",
     ]
     for controller in controllers:
         row = [controller]
         for s in shown:
             found = cell.get((controller, s))
             row.append(
-                _interval(*(found["score_mean"], found["score_ci95"]) if found else (None, None))
+                _interval(found["cost_ratio_gmean"], found["cost_ratio_gmean_ci95"], 3)
+                if found
+                else "–"
             )
         lines.append("| " + " | ".join(row) + " |")
     return [*lines, ""]
+
+
+def terminal_summary(folder: str | os.PathLike) -> str:
+    """What ``leaderboard``, ``evaluate`` and ``report`` print: the ranking of the run
+    folder's ``aggregate.json`` (or why there is none), its resolution, and the path of
+    ``leaderboard.html``."""
+    from baselines.pages import PAGE_FILE
+
+    board = json.loads((Path(folder) / AGGREGATE_FILE).read_text())
+    lines = ["## Ranking (cost over the oracle's; lower is better)", ""]
+    lines += ranking_tables(board) + resolution_lines(board) if board else [NO_RANKING, ""]
+    return "\n".join([*lines, f"leaderboard: {Path(folder) / PAGE_FILE}"])
 
 
 def _fmt(value: Any, std: Any = None) -> str:

@@ -3,17 +3,20 @@
 No network: the style sheet and the script are inline and every figure is embedded as a
 data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
 
-1. the **ranking** per split (``aggregate.json`` rows: mean and IQM of the normalised score
-   and the probability of improvement over ``pid_los``, 95 % intervals) and its figures
-   (``ranking_*`` / ``profile_*`` of :mod:`baselines.figures`);
-2. the **controller × scenario table** of mean scores with their intervals
-   (:func:`baselines.ranking.scenario_scores`), shaded from 0 (``zero_rudder``) to ≥ 1
-   (``pid_los``);
+1. the **ranking** per split (``aggregate.json`` rows: IQM and geometric mean of the cost
+   ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
+   rate, 95 % intervals; a split's partial table below it), the resolution of each split
+   and the figures (``ranking_*`` / ``profile_*`` of :mod:`baselines.figures`);
+2. the **controller × scenario table**: the oracle's mean cost, then each controller's
+   geometric-mean cost ratio with its interval (``scenario_scores.json``,
+   :func:`baselines.ranking.scenario_scores`), shaded from 1 (the oracle, green) to ≥ 4
+   (red);
 3. the **scenario figures** (``scenario_*``), one per scenario;
 4. the **long per-row table** (``leaderboard.json`` rows), collapsed.
 
-Every table sorts on a click on its header (numbers best-first, i.e. descending, text
-ascending; a second click reverses; empty cells stay last).  The page sorts its
+Every table sorts on a click on its header (numbers best-first: cost ratios and failure
+rates ascending, others descending; text ascending; a second click reverses; empty cells
+stay last).  The page sorts its
 controller × scenario table on load from the address's hash: ``#sort=<column>`` (the first
 click's order) or ``#sort=<column>:asc`` / ``:desc``, where a column is ``controller``,
 ``kind``, ``iqm:<split>`` or a scenario's name.  Every text from the data (controller
@@ -33,6 +36,14 @@ from pathlib import Path
 from typing import Any
 
 from baselines.figures import figure_stem
+from baselines.ranking import (
+    NO_RANKING,
+    ORACLE,
+    PARTIAL,
+    SCORE_EXPLAINED,
+    is_partial,
+    resolution_lines,
+)
 from baselines.style import controller_style
 
 PAGE_FILE = "leaderboard.html"
@@ -43,6 +54,7 @@ ROW_METRICS = {
     "ace_L": "ACE/L [–]",
     "t_c": "t_c [s]",
     "return": "return [–]",
+    "cost": "cost [–]",
     "rudder_travel": "rudder travel [rad]",
     "J": "J [–]",
     "success": "success [–]",
@@ -98,6 +110,7 @@ _JS = """
     head[col].setAttribute("aria-sort", dir);
   }
   function firstOrder(th) {
+    if (th.getAttribute("data-first")) return th.getAttribute("data-first");
     return th.getAttribute("data-type") === "number" ? "descending" : "ascending";
   }
   document.querySelectorAll("table.sortable").forEach(function (table) {
@@ -168,10 +181,11 @@ def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> s
     )
 
 
-def _shade(score: float) -> str:
-    """Background of a score cell: red (0 = zero_rudder) → yellow → green (≥ 1.2)."""
-    t = min(max(score / 1.2, 0.0), 1.0)
-    return f"hsl({120 * t:.0f},65%,88%)"
+def _shade(ratio: float) -> str:
+    """Background of a cost-ratio cell: green (≤ 1, the oracle) → yellow → red (≥ 4), on a
+    log scale."""
+    t = min(max(math.log(ratio) / math.log(4.0), 0.0), 1.0) if ratio > 0 else 0.0
+    return f"hsl({120 * (1.0 - t):.0f},65%,88%)"
 
 
 def _text_cell(text: Any) -> str:
@@ -191,12 +205,16 @@ def _name_cell(name: str) -> str:
 
 
 def _head(columns: Iterable[tuple[str, str, str]]) -> str:
-    """``<thead>`` of (key, header text, "number" | "text") columns; the first is the name."""
+    """``<thead>`` of (key, header text, "number" | "lower" | "text") columns (``lower``: a
+    number that is better lower, sorted ascending on the first click); the first is the
+    name."""
     cells = []
     for i, (key, text, kind) in enumerate(columns):
         cls = "name" if i == 0 else ("text" if kind == "text" else "")
+        first = ' data-first="ascending"' if kind == "lower" else ""
         cells.append(
-            f'<th data-key="{_e(key)}" data-type="{kind}"'
+            f'<th data-key="{_e(key)}" data-type="{"number" if kind == "lower" else kind}"'
+            + first
             + (f' class="{cls}"' if cls else "")
             + f">{text}</th>"
         )
@@ -215,7 +233,8 @@ def _table(table_id: str, head: str, body: Iterable[str], compact: bool = False)
 
 # ----------------------------------------------------------------------------- sections
 def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
-    """One table per split of the ``aggregate.json`` rows, in their order (ranked by IQM)."""
+    """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
+    cost ratio's IQM, lowest first); a split's partial table is titled as such."""
     head = _head(
         [
             ("controller", "controller", "text"),
@@ -224,9 +243,10 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("scenarios", "scenarios", "number"),
             ("runs", "runs", "number"),
             ("training_seeds", "training seeds", "number"),
-            ("score_mean", "mean score", "number"),
-            ("score_iqm", "IQM score", "number"),
-            ("prob", "P(score &gt; pid_los)", "number"),
+            ("cost_ratio_iqm", "IQM cost ratio", "lower"),
+            ("cost_ratio_gmean", "geometric mean", "lower"),
+            ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
+            ("failure_rate", "failure rate", "lower"),
         ]
     )
     parts = []
@@ -243,28 +263,33 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
                 + _cell(n)
                 + _cell(r.get("runs"))
                 + _cell(r.get("training_seeds"))
-                + _cell(r.get("score_mean"), r.get("score_mean_ci95"))
-                + _cell(r.get("score_iqm"), r.get("score_iqm_ci95"))
+                + _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95"))
+                + _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95"))
                 + _cell(
                     r.get("prob_improvement_over_pid_los"),
                     r.get("prob_improvement_over_pid_los_ci95"),
                 )
+                + _cell(r.get("failure_rate"), r.get("failure_rate_ci95"))
             )
-        title = SPLIT_TITLES.get(split, split)
+        base = split.removesuffix(PARTIAL)
+        title = SPLIT_TITLES.get(base, base)
+        if is_partial(split):
+            title += ": controllers that do not apply to every scenario (each on its own)"
         table = _table(f"ranking-{split}", head, body, compact=True)
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
-    return '<div class="splits">' + "".join(parts) + "</div>"
+    notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
+    return '<div class="splits">' + "".join(parts) + "</div>" + notes
 
 
 def _controller_order(
     rows: Sequence[Mapping[str, Any]],
     aggregate: Sequence[Mapping[str, Any]],
-    scores: Sequence[Mapping[str, Any]],
+    cells: Mapping[tuple[str, str], Mapping[str, Any]],
 ) -> list[str]:
     """Controllers by the first split's ranking, then any other in the order they appear."""
     names = [r["controller"] for r in aggregate if r["split"] == aggregate[0]["split"]]
     names += [r["controller"] for r in aggregate]
-    names += [r["controller"] for r in rows] + [s["controller"] for s in scores]
+    names += [r["controller"] for r in rows] + [c for c, _ in cells]
     return list(dict.fromkeys(names))
 
 
@@ -273,39 +298,53 @@ def score_table(
     aggregate: Sequence[Mapping[str, Any]],
     scores: Sequence[Mapping[str, Any]],
 ) -> str:
-    """The sortable controller × scenario table (``id="scores"``): each controller's IQM per
-    split, then its mean score with interval per scenario; "n/a" where it does not apply."""
+    """The sortable controller × scenario table (``id="scores"``): each controller's IQM cost
+    ratio per split, then its geometric-mean cost ratio with interval per scenario (whose
+    header gives the oracle's mean cost); "n/a" where it does not apply."""
     scenarios = list(dict.fromkeys([r["scenario"] for r in rows] + [s["scenario"] for s in scores]))
     split_of = {r["scenario"]: r.get("split", "") for r in rows}
     split_of.update({s["scenario"]: s.get("split", "") for s in scores})
     splits = list(dict.fromkeys(r["split"] for r in aggregate))
-    cell = {(s["controller"], s["scenario"]): s for s in scores}
+    cell = {(c["controller"], s["scenario"]): c for s in scores for c in s["controllers"]}
+    oracle = {s["scenario"]: s for s in scores}
     iqm = {(r["controller"], r["split"]): r for r in aggregate}
     kinds = {r["controller"]: r.get("kind", "") for r in [*rows, *aggregate]}
+    kinds.update({c: v.get("kind", "") for (c, _), v in cell.items()})
     not_applicable = {
         (r["controller"], r["scenario"]) for r in rows if r.get("applies", True) is False
     }
     columns = [("controller", "controller", "text"), ("kind", "kind", "text")]
-    columns += [(f"iqm:{sp}", f"IQM<br>{_e(sp)}", "number") for sp in splits]
+    columns += [(f"iqm:{sp}", f"IQM<br>{_e(sp)}", "lower") for sp in splits]
     columns += [
-        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}</small>',
-         "number")
+        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}'
+         f"{_oracle_cost(oracle.get(s))}</small>", "lower")
         for s in scenarios
     ]  # fmt: skip
     body = []
-    for name in _controller_order(rows, aggregate, scores):
+    for name in _controller_order(rows, aggregate, cell):
+        if name == ORACLE:
+            continue
         tds = [_name_cell(name), _text_cell(kinds.get(name, ""))]
         for sp in splits:
             agg = iqm.get((name, sp), {})
-            tds.append(_cell(agg.get("score_iqm"), agg.get("score_iqm_ci95")))
+            tds.append(_cell(agg.get("cost_ratio_iqm"), agg.get("cost_ratio_iqm_ci95")))
         for s in scenarios:
             if (name, s) in not_applicable:
                 tds.append('<td class="na" data-sort="" title="does not apply">n/a</td>')
             else:
                 sc = cell.get((name, s), {})
-                tds.append(_cell(sc.get("score_mean"), sc.get("score_ci95"), shade=True))
+                tds.append(
+                    _cell(sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True)
+                )
         body.append("".join(tds))
     return _table("scores", _head(columns), body)
+
+
+def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
+    """A scenario header's line on the oracle's mean cost (the ratios' denominator)."""
+    if not entry:
+        return ""
+    return f"<br>{_e(ORACLE)} cost {_e(_number(entry.get('oracle_cost')))}"
 
 
 def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
@@ -407,17 +446,15 @@ def page(
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
         f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
         f"<h1>{_e(title)}</h1>{sub}"
-        '<h2 id="ranking">Ranking</h2><p class="note">Normalised score per episode from the '
-        "return: 0 = <code>zero_rudder</code>, 1 = <code>pid_los</code> on the same scenario "
-        "and seed. Mean and interquartile mean (IQM) over the scenarios a controller applies "
-        "to, and the probability that its score beats <code>pid_los</code>'s, with 95 % "
-        "stratified-bootstrap intervals (rliable; runs = training seeds × evaluation seeds). "
-        "Click a column header to sort.</p>"
-        f"{ranking_tables(aggregate)}"
-        '<h2 id="scores-per-scenario">Scores per scenario</h2><p class="note">Mean normalised '
-        "score of each controller on each scenario, 95 % interval below; n/a: the controller "
-        "does not apply to the scenario's ship. Click a header to sort; a scenario's name "
-        "links to its figure.</p>"
+        '<h2 id="ranking">Ranking</h2><p class="note">'
+        f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
+        f"{ranking_tables(aggregate) if aggregate else _no_ranking()}"
+        '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
+        "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
+        "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
+        "name the oracle's mean cost. n/a: the controller does not apply to the scenario's "
+        "ship. "
+        "Click a header to sort; a scenario's name links to its figure.</p>"
         f"{score_table(rows, aggregate, scores)}"
         f'<h2 id="ranking-figures">Ranking figures</h2>{ranking_figs or "<p>No figures.</p>"}'
         f'<h2 id="figures">Scenarios</h2>{scenario_figs or "<p>No figures.</p>"}'
@@ -425,6 +462,10 @@ def page(
         f"({len(rows)} rows): means with 95 % intervals</summary>{row_table(rows)}</details>"
         f"<script>{_JS}</script></body></html>\n"
     )
+
+
+def _no_ranking() -> str:
+    return f'<p class="note">{_e(NO_RANKING.replace("`", ""))}</p>'
 
 
 def write_html(

@@ -1,4 +1,4 @@
-"""Interval estimates and the aggregate ranking of the leaderboard (issue 13).
+"""Interval estimates and the aggregate ranking of the leaderboard (issues 13 and 17).
 
 After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" (the
 ``rliable`` library):
@@ -8,45 +8,105 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   training seeds for learned agents (each bootstrap sample redraws the evaluation episodes
   within each training seed, so every training run stays represented):
   :func:`row_intervals`, vectorised numpy (one row costs ≈ 1 ms).
-* **Normalised score** per episode, from the return (the same reward for every
-  controller): 0 = ``zero_rudder``, 1 = ``pid_los`` on the same scenario and seed,
-  score = (R − R_zero) / (R_pid − R_zero) (:func:`normalised_scores`).
+* **Cost ratio** per episode: the episode's cost C (the metric ``cost``: the step costs and
+  any corridor penalty, the return without the goal bonus) over the cost of the reference
+  controller ``oracle`` (a privileged NMPC on the true plant) on the same scenario and trial
+  (evaluation seed): C / C_oracle, 1 = as good as the oracle, lower is better
+  (:func:`scored_episodes`).  An episode *fails* when it ends outside the corridor or with a
+  non-finite state (``termination_reason``), or its cost is not finite.
 * **Aggregate ranking** per controller and split (catalogue / held-out), over the scenarios
-  the controller applies to: mean and interquartile mean (IQM) of the scores with 95 %
-  stratified-bootstrap intervals, and the probability of improvement over ``pid_los``
-  P(score > pid_los's on the same scenario and seed) with its interval, computed with
-  ``rliable`` (:func:`aggregate_ranking`; runs = training seeds × evaluation seeds, tasks =
-  scenarios).  The performance profile (fraction of runs with score > τ) comes from
-  ``rliable`` too (:func:`performance_profiles`).
+  of the split that have the oracle's episodes: the interquartile mean (IQM) and the
+  geometric mean of the cost ratios, the probability of improvement over ``pid_los``
+  P(ratio < pid_los's ratio on a scenario) + ½ P(equal) (rliable's probability of
+  improvement of the negated ratios: lower cost is the improvement) and the failure rate,
+  each with a 95 % stratified-bootstrap interval (runs = training seeds × evaluation seeds,
+  tasks = scenarios; :func:`aggregate_ranking`), ranked by the IQM, ascending.  References
+  (kind ``reference``: ``oracle``, ``zero_rudder``, ``random``) are not ranked.  Every
+  competitor of the main table of a split is ranked on the same scenarios; one that lacks
+  some (it does not apply to a ship) is ranked on its own scenarios in the separate table
+  ``split`` = ``"<split>:partial"``.  The performance profile (fraction of runs with ratio
+  > τ) comes from ``rliable`` too (:func:`performance_profiles`).
+
+**Reproducible**: rliable 1.2's bootstraps draw from numpy's *global* generator (its
+``update_indices`` calls ``np.random.choice``; the ``random_state`` it hands to arch is
+never used), so every rliable call here runs inside :func:`seeded_global_rng`: the global
+state seeded, and restored afterwards.  The same episodes give the same numbers in any
+process and order.
 """
 
 from __future__ import annotations
 
 import contextlib
 import math
-import warnings
 from collections import defaultdict
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-#: the two reference controllers of the normalised score
-SCORE_ZERO = "zero_rudder"
-SCORE_ONE = "pid_los"
+#: the reference of the cost ratio (its cost is the denominator)
+ORACLE = "oracle"
+#: the controller of the probability of improvement
+BASELINE = "pid_los"
+#: the kind of the controllers shown on every scenario but never ranked
+REFERENCE_KIND = "reference"
+#: the ``termination_reason`` values of a failed episode
+FAILURE_REASONS = ("corridor", "non_finite_state")
+#: the split label's suffix of the table of controllers ranked on fewer scenarios
+PARTIAL = ":partial"
 #: 95 % intervals
 CONFIDENCE = 0.95
 #: bootstrap replications of row intervals (numpy) and of the aggregate (rliable)
 ROW_REPS = 4000
 AGGREGATE_REPS = 2000
+#: the fields of an ``aggregate.json`` object, in order
+AGGREGATE_FIELDS = (
+    "controller",
+    "kind",
+    "split",
+    "scenarios",
+    "runs",
+    "training_seeds",
+    "cost_ratio_iqm",
+    "cost_ratio_iqm_ci95",
+    "cost_ratio_gmean",
+    "cost_ratio_gmean_ci95",
+    f"prob_improvement_over_{BASELINE}",
+    f"prob_improvement_over_{BASELINE}_ci95",
+    "failure_rate",
+    "failure_rate_ci95",
+)
+
+
+#: leaderboard.md's two sentences on the score
+SCORE_EXPLAINED = (
+    "An episode's cost is the sum of its step costs and any corridor penalty (its return "
+    f"without the goal bonus), and its cost ratio divides it by the cost of `{ORACLE}` (an "
+    "NMPC that knows the true plant, a reference) on the same scenario and trial, so 1 is "
+    "the oracle's cost and lower is better. Per controller and split: the interquartile "
+    "mean (IQM) and the geometric mean of the ratios over runs (training seeds × "
+    f"evaluation seeds) and scenarios, P(its ratio is below {BASELINE}'s on a scenario) and "
+    "the rate of episodes ending outside the corridor or non-finite, each with a 95 % "
+    "stratified-bootstrap interval (rliable; Agarwal et al. 2021), ranked by IQM, lowest "
+    "first."
+)
+#: what leaderboard.md and the terminal say without the oracle's episodes
+NO_RANKING = (
+    f"No ranking: the cost ratio needs the episodes of the reference `{ORACLE}` on the same "
+    "scenarios and trials, and this record has none."
+)
 
 
 @contextlib.contextmanager
-def _quiet_arch() -> Iterator[None]:
-    """rliable passes ``random_state`` to arch's bootstrap, which arch 7 deprecates."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", "random_state is deprecated", FutureWarning)
+def seeded_global_rng(seed: int) -> Iterator[None]:
+    """numpy's global generator seeded with ``seed`` inside, restored afterwards (rliable
+    draws its bootstrap indices from it: module doc)."""
+    state = np.random.get_state()  # noqa: NPY002
+    np.random.seed(seed)  # noqa: NPY002
+    try:
         yield
+    finally:
+        np.random.set_state(state)  # noqa: NPY002
 
 
 def _rng(seed: int) -> np.random.Generator:
@@ -106,46 +166,50 @@ def _number(value: Any) -> float:
 
 
 # ---------------------------------------------------------------------------------- scores
-def normalised_scores(
-    episodes: Sequence[Mapping[str, Any]],
-    zero: str = SCORE_ZERO,
-    one: str = SCORE_ONE,
+def is_failure(episode: Mapping[str, Any]) -> bool:
+    """The episode ended outside the corridor or non-finite (or its cost is not finite)."""
+    return episode.get("termination_reason") in FAILURE_REASONS or not math.isfinite(
+        _number(episode.get("cost"))
+    )
+
+
+def scored_episodes(
+    episodes: Sequence[Mapping[str, Any]], oracle: str = ORACLE
 ) -> list[dict[str, Any]]:
-    """Each episode's score (R − R_zero) / (R_one − R_zero), the references on the same
-    scenario and seed; episodes whose references are missing, or whose references tie
-    (R_one = R_zero), get ``score`` None.  Returns copies of the episodes with ``score``."""
-    ref: dict[tuple[str, str, int], float] = {}
+    """Copies of the episodes with ``cost_ratio`` = C / C_oracle (the oracle's episode of the
+    same scenario and seed; exactly 1 for the oracle's own) and ``failure`` (0 or 1,
+    :func:`is_failure`).  ``cost_ratio`` is None where the oracle has no episode, or where
+    either cost is not finite or the oracle's is not positive."""
+    ref: dict[tuple[str, int], float] = {}
     for ep in episodes:
-        if ep["controller"] in (zero, one) and ep.get("return") is not None:
-            ref[(ep["controller"], ep["scenario"], int(ep["seed"]))] = float(ep["return"])
+        if ep["controller"] == oracle:
+            ref[(ep["scenario"], int(ep["seed"]))] = _number(ep.get("cost"))
     out = []
     for ep in episodes:
-        key = (ep["scenario"], int(ep["seed"]))
-        low, high = ref.get((zero, *key)), ref.get((one, *key))
-        score = None
-        if low is not None and high is not None and high != low and ep.get("return") is not None:
-            if ep["controller"] == one:
-                score = 1.0  # exactly, by definition
-            elif ep["controller"] == zero:
-                score = 0.0
-            else:
-                score = (float(ep["return"]) - low) / (high - low)
-        out.append({**ep, "score": score})
+        c_ref = ref.get((ep["scenario"], int(ep["seed"])), math.nan)
+        cost = _number(ep.get("cost"))
+        ratio = None
+        if math.isfinite(c_ref) and c_ref > 0.0 and math.isfinite(cost):
+            ratio = 1.0 if ep["controller"] == oracle else cost / c_ref
+        out.append({**ep, "cost_ratio": ratio, "failure": float(is_failure(ep))})
     return out
 
 
-def score_matrix(
-    scored: Sequence[Mapping[str, Any]], controller: str, scenarios: Sequence[str]
+def run_matrix(
+    scored: Sequence[Mapping[str, Any]],
+    controller: str,
+    scenarios: Sequence[str],
+    key: str = "cost_ratio",
 ) -> np.ndarray:
-    """(runs, tasks) scores of one controller: a run is a (training seed, evaluation seed)
-    pair, a task a scenario (rliable's layout).  Raises ValueError if a scenario lacks a
-    run the others have (unequal seeds)."""
+    """(runs, tasks) values ``key`` of one controller's episodes that have a cost ratio: a
+    run is a (training seed, evaluation seed) pair, a task a scenario (rliable's layout).
+    Raises ValueError if a scenario lacks a run the others have (unequal seeds)."""
     cells: dict[str, dict[tuple[Any, int], float]] = {s: {} for s in scenarios}
     for ep in scored:
         if ep["controller"] == controller and ep["scenario"] in cells:
-            if ep.get("score") is not None:
-                cells[ep["scenario"]][(ep.get("training_seed"), int(ep["seed"]))] = ep["score"]
-    runs = sorted(cells[scenarios[0]], key=lambda r: (r[0] is None, r[0], r[1]))
+            if ep.get("cost_ratio") is not None:
+                cells[ep["scenario"]][(ep.get("training_seed"), int(ep["seed"]))] = ep[key]
+    runs = sorted(cells[scenarios[0]], key=lambda r: (r[0] is None, r[0] or 0, r[1]))
     for s in scenarios:
         if set(cells[s]) != set(runs):
             raise ValueError(
@@ -153,32 +217,6 @@ def score_matrix(
                 f"{scenarios[0]!r} has {runs}: every scenario needs the same seeds"
             )
     return np.array([[cells[s][r] for s in scenarios] for r in runs], dtype=np.float64)
-
-
-def scenario_scores(
-    episodes: Sequence[Mapping[str, Any]], splits: Mapping[str, str], seed: int = 0
-) -> list[dict[str, Any]]:
-    """Per (controller, scenario): the mean normalised score over the row's episodes with its
-    95 % interval (stratified over training seeds), for the controller × scenario table."""
-    scored = normalised_scores(episodes)
-    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = defaultdict(list)
-    for ep in scored:
-        if ep.get("score") is not None:
-            groups[(ep["controller"], ep["scenario"])].append(ep)
-    out = []
-    for (controller, scenario), eps in sorted(groups.items()):
-        ci = row_intervals(eps, ["score"], seed=seed)["score_ci95"]
-        out.append(
-            {
-                "controller": controller,
-                "scenario": scenario,
-                "split": splits.get(scenario, "catalogue"),
-                "score_mean": float(np.mean([ep["score"] for ep in eps])),
-                "score_ci95": ci,
-                "episodes": len(eps),
-            }
-        )
-    return out
 
 
 def interquartile_mean(scores: np.ndarray) -> float:
@@ -189,6 +227,12 @@ def interquartile_mean(scores: np.ndarray) -> float:
     low = int(0.25 * a.size)
     high = a.size - low
     return np.mean(np.partition(a, (low, high - 1))[low:high])
+
+
+def geometric_mean(ratios: np.ndarray) -> float:
+    """exp(mean(log r)) over all runs and tasks (the mean of ratios on a log scale)."""
+    with np.errstate(divide="ignore"):
+        return np.exp(np.mean(np.log(np.asarray(ratios, dtype=np.float64))))
 
 
 def probability_of_improvement(scores_x: np.ndarray, scores_y: np.ndarray) -> float:
@@ -203,80 +247,244 @@ def probability_of_improvement(scores_x: np.ndarray, scores_y: np.ndarray) -> fl
     return np.mean(np.where(same, 0.5, per_task))
 
 
-def _tasks(scored: Sequence[Mapping[str, Any]], controller: str, split_scenarios: set[str]):
+def probability_of_lower_ratio(ratios_x: np.ndarray, ratios_y: np.ndarray) -> float:
+    """P(X < Y) + ½ P(X = Y) per task, averaged over tasks: the probability of improvement
+    when lower is better (:func:`probability_of_improvement` of the negated ratios)."""
+    return probability_of_improvement(-ratios_x, -ratios_y)
+
+
+def _ratio_estimates(ratios: np.ndarray) -> np.ndarray:
+    return np.array([interquartile_mean(ratios), geometric_mean(ratios)])
+
+
+def _failure_estimate(failures: np.ndarray) -> np.ndarray:
+    return np.array([np.mean(failures)])
+
+
+def interval_estimate(
+    scores: np.ndarray | list[np.ndarray],
+    func: Callable[..., np.ndarray],
+    reps: int = AGGREGATE_REPS,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(point, [low, high] per entry of ``func``'s result): rliable's stratified bootstrap
+    (``get_interval_estimates``; a list of matrices: independent resampling of each), drawn
+    from the global generator seeded with ``seed`` (module doc)."""
+    from rliable import library as rly
+
+    with seeded_global_rng(seed):
+        point, interval = rly.get_interval_estimates({"x": scores}, func, reps=reps)
+    low_high = np.asarray(interval["x"], dtype=np.float64).reshape(2, -1)
+    return np.atleast_1d(np.asarray(point["x"], dtype=np.float64)), low_high
+
+
+def _tasks(scored: Sequence[Mapping[str, Any]], controller: str, scenarios: set[str]) -> list[str]:
+    """The scenarios of ``scenarios`` on which ``controller`` has cost ratios."""
     return sorted(
         {
             ep["scenario"]
             for ep in scored
             if ep["controller"] == controller
-            and ep["scenario"] in split_scenarios
-            and ep.get("score") is not None
+            and ep["scenario"] in scenarios
+            and ep.get("cost_ratio") is not None
         }
     )
+
+
+def controller_kinds(
+    episodes: Iterable[Mapping[str, Any]], kinds: Mapping[str, str] | None = None
+) -> dict[str, str]:
+    """controller → kind: ``kinds`` first, else the episodes' ``kind`` (``classical`` when
+    neither says); the oracle is a reference whatever it is called elsewhere."""
+    out = {ep["controller"]: ep.get("kind") or "classical" for ep in episodes}
+    out.update({c: k for c, k in (kinds or {}).items() if c in out})
+    if ORACLE in out:
+        out[ORACLE] = REFERENCE_KIND
+    return out
+
+
+def _pairs(values: np.ndarray, i: int) -> list[float]:
+    return [float(values[0, i]), float(values[1, i])]
+
+
+def ranking_row(
+    scored: Sequence[Mapping[str, Any]],
+    controller: str,
+    kind: str,
+    split: str,
+    tasks: list[str],
+    reps: int = AGGREGATE_REPS,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """One ``aggregate.json`` object (:data:`AGGREGATE_FIELDS`): ``controller`` over
+    ``tasks``; the probability of improvement is None where ``pid_los`` lacks a task."""
+    ratios = run_matrix(scored, controller, tasks)
+    point, interval = interval_estimate(ratios, _ratio_estimates, reps, seed)
+    fail_point, fail_interval = interval_estimate(
+        run_matrix(scored, controller, tasks, "failure"), _failure_estimate, reps, seed
+    )
+    prob: float | None = None
+    prob_ci: list[float] | None = None
+    if set(tasks) <= set(_tasks(scored, BASELINE, set(tasks))):
+        pair = [ratios, run_matrix(scored, BASELINE, tasks)]
+        p_point, p_interval = interval_estimate(pair, probability_of_lower_ratio, reps, seed)
+        prob, prob_ci = float(p_point[0]), _pairs(p_interval, 0)
+    trained = {ep.get("training_seed") for ep in scored if ep["controller"] == controller}
+    return {
+        "controller": controller,
+        "kind": kind,
+        "split": split,
+        "scenarios": tasks,
+        "runs": int(ratios.shape[0]),
+        "training_seeds": len(trained - {None}),
+        "cost_ratio_iqm": float(point[0]),
+        "cost_ratio_iqm_ci95": _pairs(interval, 0),
+        "cost_ratio_gmean": float(point[1]),
+        "cost_ratio_gmean_ci95": _pairs(interval, 1),
+        f"prob_improvement_over_{BASELINE}": prob,
+        f"prob_improvement_over_{BASELINE}_ci95": prob_ci,
+        "failure_rate": float(fail_point[0]),
+        "failure_rate_ci95": _pairs(fail_interval, 0),
+    }
+
+
+def ranked_scenarios(
+    scored: Sequence[Mapping[str, Any]], split_scenarios: Iterable[str]
+) -> list[str]:
+    """The scenarios of a split that can be ranked: those with the oracle's episodes."""
+    return _tasks(scored, ORACLE, set(split_scenarios))
 
 
 def aggregate_ranking(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
-    kinds: Mapping[str, str],
+    kinds: Mapping[str, str] | None = None,
     reps: int = AGGREGATE_REPS,
     seed: int = 0,
 ) -> list[dict[str, Any]]:
-    """The ``aggregate.json`` rows: per controller and split (module doc), ranked by IQM.
-
-    ``splits``: scenario → "catalogue" | "heldout"; ``kinds``: controller → "classical" |
-    "learned".  Scores are NaN-free by construction; a controller without scored episodes
-    in a split has no row there.
-    """
-    from rliable import library as rly
-    from rliable import metrics as rmetrics
-
-    scored = normalised_scores(episodes)
-    controllers = sorted({ep["controller"] for ep in scored})
+    """The ``aggregate.json`` rows (module doc): per split, every competing controller (kind
+    not ``reference``) on the same scenarios (those with the oracle's episodes), ranked by
+    the cost ratio's IQM, ascending; a competitor without ratios on some of them is ranked on
+    its own in the split ``"<split>:partial"``.  ``splits``: scenario → "catalogue" |
+    "heldout"; ``kinds``: controller → kind (default: the episodes').  Empty without the
+    oracle's episodes."""
+    scored = scored_episodes(episodes)
+    kind_of = controller_kinds(episodes, kinds)
+    competitors = sorted(c for c, k in kind_of.items() if k != REFERENCE_KIND)
     rows: list[dict[str, Any]] = []
     for split in sorted(set(splits.values())):
-        in_split = {s for s, sp in splits.items() if sp == split}
-        for controller in controllers:
-            tasks = _tasks(scored, controller, in_split)
-            if not tasks:
-                continue
-            x = score_matrix(scored, controller, tasks)
-            ref = score_matrix(scored, SCORE_ONE, tasks)
-            with _quiet_arch():
-                point, interval = rly.get_interval_estimates(
-                    {controller: x},
-                    lambda m: np.array([rmetrics.aggregate_mean(m), interquartile_mean(m)]),
-                    reps=reps,
-                    random_state=np.random.RandomState(seed),
+        common = ranked_scenarios(scored, [s for s, sp in splits.items() if sp == split])
+        for controller in competitors:
+            tasks = _tasks(scored, controller, set(common))
+            if tasks:
+                label = split if tasks == common else split + PARTIAL
+                rows.append(
+                    ranking_row(scored, controller, kind_of[controller], label, tasks, reps, seed)
                 )
-                p_point, p_interval = rly.get_interval_estimates(
-                    {controller: [x, ref]},
-                    probability_of_improvement,
-                    reps=reps,
-                    random_state=np.random.RandomState(seed),
-                )
-            mean, iqm = point[controller]
-            runs = {(ep.get("training_seed")) for ep in scored if ep["controller"] == controller}
-            rows.append(
+    rows.sort(key=lambda r: (r["split"], r["cost_ratio_iqm"], r["controller"]))
+    return rows
+
+
+def is_partial(split: str) -> bool:
+    """Whether ``split`` labels a table of controllers ranked on fewer scenarios."""
+    return split.endswith(PARTIAL)
+
+
+def resolution(board: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """Per main table of ``board`` (aggregate rows): how well the ranking separates its
+    controllers — the median width of the ``cost_ratio_iqm`` intervals, the range (max − min)
+    of ``cost_ratio_iqm`` over the competitors and whether the width is below a fifth of the
+    range (``resolved``; issue 17's target)."""
+    out = []
+    for split in dict.fromkeys(r["split"] for r in board):
+        if is_partial(split):
+            continue
+        mine = [r for r in board if r["split"] == split]
+        widths = [r["cost_ratio_iqm_ci95"][1] - r["cost_ratio_iqm_ci95"][0] for r in mine]
+        iqms = [r["cost_ratio_iqm"] for r in mine]
+        width, spread = float(np.median(widths)), float(max(iqms) - min(iqms))
+        out.append(
+            {
+                "split": split,
+                "controllers": len(mine),
+                "median_ci_width": width,
+                "iqm_range": spread,
+                "resolved": width < spread / 5.0,
+            }
+        )
+    return out
+
+
+def resolution_lines(board: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Per main table: the median width of the IQM intervals against the range of the IQM
+    over its competitors (:func:`resolution`; target: width < range / 5)."""
+    lines = []
+    for res in resolution(board):
+        verdict = "met" if res["resolved"] else "not met"
+        lines.append(
+            f"Resolution, {res['split']}: median width of the cost-ratio IQM intervals "
+            f"{res['median_ci_width']:.3f}, range of the IQM over the {res['controllers']} "
+            f"competing controller(s) {res['iqm_range']:.3f} (target width < range / 5: "
+            f"{verdict})."
+        )
+    return [*lines, ""] if lines else []
+
+
+def _log_ratio_cell(eps: Sequence[Mapping[str, Any]], seed: int) -> dict[str, Any]:
+    """The geometric mean of the cell's ratios and its interval (the exp of the stratified
+    bootstrap interval of the mean log ratio: exp is monotone)."""
+    with np.errstate(divide="ignore"):
+        logs = np.log([ep["cost_ratio"] for ep in eps])
+    rows = [{**ep, "log_ratio": v} for ep, v in zip(eps, logs, strict=True)]
+    ci = row_intervals(rows, ["log_ratio"], seed=seed)["log_ratio_ci95"]
+    return {
+        "cost_ratio_gmean": float(np.exp(np.mean(logs))),
+        "cost_ratio_gmean_ci95": None if ci is None else [math.exp(v) for v in ci],
+    }
+
+
+def scenario_scores(
+    episodes: Sequence[Mapping[str, Any]],
+    splits: Mapping[str, str],
+    kinds: Mapping[str, str] | None = None,
+    seed: int = 0,
+) -> list[dict[str, Any]]:
+    """``scenario_scores.json``: per scenario with the oracle's episodes, the oracle's mean
+    cost with its 95 % interval and, per other controller (references included), its mean
+    cost and the geometric mean of its cost ratios with a 95 % interval (stratified over
+    training seeds), over the row's episodes."""
+    scored = scored_episodes(episodes)
+    kind_of = controller_kinds(episodes, kinds)
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
+    for ep in scored:
+        if ep["cost_ratio"] is not None:
+            groups[(ep["scenario"], ep["controller"])].append(ep)
+    out = []
+    for scenario in sorted({s for s, c in groups if c == ORACLE}):
+        oracle = groups[(scenario, ORACLE)]
+        cells = []
+        for controller in sorted(c for s, c in groups if s == scenario and c != ORACLE):
+            eps = groups[(scenario, controller)]
+            cells.append(
                 {
                     "controller": controller,
-                    "kind": kinds.get(controller, "classical"),
-                    "split": split,
-                    "scenarios": tasks,
-                    "runs": int(x.shape[0]),
-                    "training_seeds": len(runs - {None}),
-                    "score_mean": float(mean),
-                    "score_mean_ci95": [float(v) for v in interval[controller][:, 0]],
-                    "score_iqm": float(iqm),
-                    "score_iqm_ci95": [float(v) for v in interval[controller][:, 1]],
-                    "prob_improvement_over_pid_los": float(np.asarray(p_point[controller])),
-                    "prob_improvement_over_pid_los_ci95": [
-                        float(v) for v in np.asarray(p_interval[controller]).ravel()
-                    ],
+                    "kind": kind_of[controller],
+                    "cost": float(np.mean([ep["cost"] for ep in eps])),
+                    **_log_ratio_cell(eps, seed),
+                    "episodes": len(eps),
                 }
             )
-    rows.sort(key=lambda r: (r["split"], -r["score_iqm"], r["controller"]))
-    return rows
+        out.append(
+            {
+                "scenario": scenario,
+                "split": splits.get(scenario, "catalogue"),
+                "oracle_cost": float(np.mean([ep["cost"] for ep in oracle])),
+                "oracle_cost_ci95": row_intervals(oracle, ["cost"], seed=seed)["cost_ci95"],
+                "oracle_episodes": len(oracle),
+                "controllers": cells,
+            }
+        )
+    return out
 
 
 def performance_profiles(
@@ -287,21 +495,17 @@ def performance_profiles(
     reps: int = 500,
     seed: int = 0,
 ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """rliable's score distributions (fraction of runs with score > τ) and their 95 %
-    intervals, per controller, over its scenarios of ``split``."""
+    """rliable's run-score distributions of the cost ratio (fraction of runs with ratio > τ;
+    lower curves are better) and their 95 % intervals, per controller, over its scenarios of
+    ``split`` that have the oracle's episodes."""
     from rliable import library as rly
 
-    scored = normalised_scores(episodes)
-    in_split = {s for s, sp in splits.items() if sp == split}
+    scored = scored_episodes(episodes)
+    common = set(ranked_scenarios(scored, [s for s, sp in splits.items() if sp == split]))
     matrices = {}
     for controller in sorted({ep["controller"] for ep in scored}):
-        tasks = _tasks(scored, controller, in_split)
+        tasks = _tasks(scored, controller, common)
         if tasks:
-            matrices[controller] = score_matrix(scored, controller, tasks)
-    state = np.random.get_state()  # noqa: NPY002 (rliable's profile bootstrap draws from
-    np.random.seed(seed)  # noqa: NPY002 numpy's global generator: seeded, then restored)
-    try:
-        with _quiet_arch():
-            return rly.create_performance_profile(matrices, taus, reps=reps)
-    finally:
-        np.random.set_state(state)  # noqa: NPY002
+            matrices[controller] = run_matrix(scored, controller, tasks)
+    with seeded_global_rng(seed):
+        return rly.create_performance_profile(matrices, taus, reps=reps)

@@ -35,6 +35,7 @@ __all__ = [
     "MetricSettings",
     "aggregate",
     "compute_metrics",
+    "episode_cost",
 ]
 
 #: Reference ship of Liu et al. (2019): L = 0.95 m, t_c threshold 0.05 m.
@@ -69,6 +70,8 @@ class EpisodeLog:
         dt: control period Ts (s).
         change_time: time of the first parameter change (s), ``None`` if nothing changes.
         reached_goal: whether the last waypoint was reached.
+        goal_bonus: the reward's bonus for reaching the goal (in ``reward`` of the last
+            step when ``reached_goal``); the cost leaves it out.
 
     Raises:
         ValueError: empty log, unequal lengths, non-finite values (NaN/inf) in any array,
@@ -86,6 +89,7 @@ class EpisodeLog:
     dt: float
     change_time: float | None = None
     reached_goal: bool = False
+    goal_bonus: float = 0.0
 
     def __post_init__(self) -> None:
         n: int | None = None
@@ -105,6 +109,7 @@ class EpisodeLog:
         if self.change_time is not None:
             self.change_time = float(self.change_time)
         self.reached_goal = bool(self.reached_goal)
+        self.goal_bonus = float(self.goal_bonus)
         self.validate()
 
     @property
@@ -142,6 +147,8 @@ class EpisodeLog:
             raise ValueError(f"EpisodeLog.dt: must be > 0 s, got {self.dt!r}")
         if self.change_time is not None and not math.isfinite(self.change_time):
             raise ValueError(f"EpisodeLog.change_time: must be finite, got {self.change_time!r}")
+        if not math.isfinite(self.goal_bonus):
+            raise ValueError(f"EpisodeLog.goal_bonus: must be finite, got {self.goal_bonus!r}")
 
     @classmethod
     def from_records(cls, records: Sequence[Mapping[str, Any]], **scalars: Any) -> EpisodeLog:
@@ -151,7 +158,7 @@ class EpisodeLog:
         ``rudder_angle``, ``rudder_command``, ``reward``. Other keys (e.g. the rest of an env
         ``info``) are ignored.
         ``scalars`` are the remaining constructor arguments: ``ship_length``, ``dt`` and
-        optionally ``change_time``, ``reached_goal``.
+        optionally ``change_time``, ``reached_goal``, ``goal_bonus``.
 
         Raises:
             ValueError: no records, or a record lacks a required key (named in the message).
@@ -263,6 +270,9 @@ def compute_metrics(
             episode and is discretised as a right Riemann sum Σ_k (λy e_k² + λψ ψ̃_k² +
             λδ δ_k²)·dt over the end-of-step samples. A constant e gives λy·e²·T, T = n·dt.
         return: Σ reward.
+        cost (-): the episode cost C = Σ step costs + any corridor (or divergence) penalty,
+            i.e. −(return − goal bonus when the goal was reached); ≥ 0 for the env's reward
+            (every term a cost). The leaderboard's score divides it by the oracle's.
         success (bool): ``log.reached_goal``.
         steps (int): n.
         duration (s): n·dt.
@@ -316,10 +326,18 @@ def compute_metrics(
         "rudder_command_travel": float(np.sum(np.abs(np.diff(log.rudder_command)))),
         "J": J,
         "return": float(np.sum(log.reward)),
+        "cost": episode_cost(log),
         "success": bool(log.reached_goal),
         "steps": int(n),
         "duration": float(n * log.dt),
     }
+
+
+def episode_cost(log: EpisodeLog) -> float:
+    """The episode cost C = (goal bonus if reached) − Σ reward: every step cost and penalty,
+    without the bonus (see :func:`compute_metrics`)."""
+    bonus = log.goal_bonus if log.reached_goal else 0.0
+    return float(bonus - np.sum(log.reward))
 
 
 def _as_float(value: Any, key: str) -> float:

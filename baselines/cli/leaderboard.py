@@ -58,7 +58,8 @@ def evaluate_folder(policy: str) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the suite (with ``evaluate``: only ``args.policy``), print the table or rows."""
+    """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
+    the rows)."""
     from baselines.runs import check_out_dir
 
     policy = getattr(args, "policy", None)
@@ -67,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         out = evaluate_folder(policy)
         note = f" (evaluate's folder for {policy!r}; give --out for another)"
     check_out_dir(out, resume=args.resume, force=args.force, note=note)  # before any work
-    from baselines.leaderboard import markdown_table, run_leaderboard
+    from baselines.leaderboard import run_leaderboard, terminal_summary
 
     rows = run_leaderboard(
         suite=args.suite,
@@ -81,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         command=command_line(args),
     )
-    emit(args, rows, markdown_table(rows))
     if not args.json:
         sys.stderr.write(f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes\n")
+    emit(args, rows, terminal_summary(out))  # ends with the ranking and the page's path
     return 0

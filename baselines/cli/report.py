@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
     from baselines.report import write_report
 
     rows, sources = write_report(args.runs, args.out, force=args.force, command=command_line(args))
-    from baselines.leaderboard import markdown_table
+    from baselines.leaderboard import terminal_summary
 
     for source in sources:
         if source["status"] != "complete":
@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
                 f"note: {source['folder']} is {source['status']}: {source['episodes']} of "
                 f"{source['jobs']} episodes\n"
             )
-    emit(args, rows, markdown_table(rows))
     if not args.json:
         sys.stderr.write(f"wrote {args.out}: leaderboard.md, .csv, .json, plots, report.json\n")
+    emit(args, rows, terminal_summary(args.out))  # ends with the ranking and the page's path
     return 0

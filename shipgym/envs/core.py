@@ -323,5 +323,6 @@ def episode_log(
         change_time=scenario.change_time,
         ship_length=scenario.ship_length,
         reached_goal=reached_goal,
+        goal_bonus=scenario.config.reward.goal_bonus,
         dt=scenario.control_period,
     )

@@ -65,8 +65,8 @@ def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
     }
     for row in on_disk:
         assert required <= set(row)
-        assert row["kind"] in ("classical", "learned")
-    assert {r["kind"] for r in on_disk} == {"classical", "learned"}
+        assert row["kind"] in ("classical", "learned", "reference")
+    assert {r["kind"] for r in on_disk} == {"classical", "learned", "reference"}
     pid = {r["scenario"]: r for r in on_disk if r["controller"] == "pid_los"}
     zero = {r["scenario"]: r for r in on_disk if r["controller"] == "zero_rudder"}
     for scenario in pid:

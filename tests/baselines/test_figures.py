@@ -60,6 +60,7 @@ def scenario_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
         "lqr": (10003, trajectory(3.0)),
         "ppo": DrawnEpisode(10003, trajectory(4.0), 1),
         "zero_rudder": DrawnEpisode(10003, trajectory(20.0), None),
+        "oracle": DrawnEpisode(10003, trajectory(0.5), None),
     }
     path = np.array([[0.0, 0.0], [240.0, 0.0]])
     out = tmp_path_factory.mktemp("figures")
@@ -88,10 +89,15 @@ def test_a_controller_has_its_colour_in_every_figure(
     scenario_files: list[Path], tmp_path: Path
 ) -> None:
     episodes = [
-        {"scenario": s, "controller": c, "kind": "classical", "seed": seed, "return": r + seed % 3}
+        {"scenario": s, "controller": c, "kind": k, "seed": seed, "cost": r + seed % 3}
         for s in ("a", "b")
         for seed in (10000, 10001, 10002)
-        for c, r in (("zero_rudder", -50.0), ("pid_los", -10.0), ("lqr", -12.0))
+        for c, k, r in (
+            ("oracle", "reference", 8.0),
+            ("zero_rudder", "reference", 50.0),
+            ("pid_los", "classical", 10.0),
+            ("lqr", "classical", 12.0),
+        )
     ]
     splits = {"a": "catalogue", "b": "catalogue"}
     aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
@@ -106,10 +112,23 @@ def test_a_controller_has_its_colour_in_every_figure(
         colour = controller_style(name).color.lower()
         assert stroke(scenario_files[1], f"{name}/track") == colour
         assert stroke(scenario_files[1], f"{name}/e") == colour
-        assert stroke(files[1], f"{name}/interval/score_iqm") == colour
+        assert stroke(files[1], f"{name}/interval/cost_ratio_iqm") == colour
         assert stroke(files[3], f"{name}/profile") == colour
     with Image.open(files[0]) as image:
         assert image.info["dpi"] == pytest.approx((FIGURE_DPI, FIGURE_DPI), abs=0.01)
+    ranking = svg_text(files[1])
+    assert "cost ratio C / C_oracle [–] (log)" in ranking and "zero_rudder" not in ranking
+
+
+def test_the_oracle_is_drawn_in_every_column_as_the_reference(scenario_files: list[Path]) -> None:
+    """The oracle's track, e(t) and δ(t) in each family's column (PID, LQR, learned,
+    references), named in the legends; it has no column of its own."""
+    root = ET.parse(scenario_files[1]).getroot()
+    tracks = [g for g in root.iter(f"{SVG}g") if g.get("id") == "oracle/track"]
+    assert len(tracks) == 4
+    assert stroke(scenario_files[1], "oracle/track") == "#000000"
+    text = svg_text(scenario_files[1])
+    assert text.count("oracle (seed 10003), the reference") == 4
 
 
 def test_the_median_ace_episode_is_an_episode_of_the_pair() -> None:

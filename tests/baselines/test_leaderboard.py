@@ -19,7 +19,7 @@ RANDOMIZE = {
     "heading_error_deg": [-10.0, 10.0],
     "jump_time_jitter_s": [-5.0, 5.0],
 }
-#: aggregate.json's fields (issue 13)
+#: aggregate.json's fields (issue 17), exactly
 AGGREGATE_KEYS = {
     "controller",
     "kind",
@@ -27,17 +27,51 @@ AGGREGATE_KEYS = {
     "scenarios",
     "runs",
     "training_seeds",
-    "score_mean",
-    "score_mean_ci95",
-    "score_iqm",
-    "score_iqm_ci95",
+    "cost_ratio_iqm",
+    "cost_ratio_iqm_ci95",
+    "cost_ratio_gmean",
+    "cost_ratio_gmean_ci95",
     "prob_improvement_over_pid_los",
     "prob_improvement_over_pid_los_ci95",
+    "failure_rate",
+    "failure_rate_ci95",
 }
+#: the stand-in oracle's cost: this fraction of pid_los's on the same trial
+STAND_IN = 0.8
 
 
 def run(suite: str, out: Path, **kwargs: object) -> list[dict]:
     return run_leaderboard(suite, out_dir=out, workers=1, show_progress=False, **kwargs)
+
+
+def with_stand_in_oracle(run_folder: Path, out: Path) -> Path:
+    """A copy of a run record (``run.json``, ``episodes.jsonl``) with a stand-in ``oracle``
+    (kind reference): each pid_los episode again, its cost × :data:`STAND_IN`; then the
+    report of it in ``out / "report"``, whose folder is returned."""
+    from baselines.report import write_report
+
+    record = json.loads((run_folder / "run.json").read_text())
+    entry = {"name": "oracle", "controller": "oracle", "kind": "reference"}
+    record["suite"]["controllers"].append({**entry, "training_seeds": [None]})
+    copy = out / "record"
+    copy.mkdir(parents=True)
+    (copy / "run.json").write_text(json.dumps(record))
+    lines = []
+    for line in (run_folder / "episodes.jsonl").read_text().splitlines():
+        lines.append(line)
+        episode = json.loads(line)  # strict JSON: "inf" stays a string
+        if episode["controller"] == "pid_los":
+            oracle = {**episode, "controller": "oracle", "kind": "reference"}
+            lines.append(json.dumps({**oracle, "cost": STAND_IN * episode["cost"]}))
+    (copy / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    write_report([copy], out / "report")
+    return out / "report"
+
+
+@pytest.fixture(scope="module")
+def ranked(randomised: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The randomised run reported with a stand-in oracle."""
+    return with_stand_in_oracle(randomised, tmp_path_factory.mktemp("ranked"))
 
 
 def untimed_episodes(folder: Path) -> list[dict]:
@@ -91,44 +125,65 @@ def test_rows_carry_an_interval_for_every_metric(randomised: Path) -> None:
     assert never["t_c"] is None and never["t_c_ci95"] is None  # never converged
 
 
-def test_aggregate_json_scores_pid_los_one_and_zero_rudder_zero(randomised: Path) -> None:
-    board = json.loads((randomised / "aggregate.json").read_text())
-    assert [(r["split"], r["controller"]) for r in board] == [
-        ("catalogue", "pid_los"),
-        ("catalogue", "zero_rudder"),
-    ]
-    for row in board:
-        assert set(row) >= AGGREGATE_KEYS
-        assert row["scenarios"] == ["nominal", "rudder_aging"]
-        assert row["runs"] == 3 and row["training_seeds"] == 0 and row["kind"] == "classical"
-    pid, zero = board
-    for key in ("score_mean", "score_iqm"):
-        assert pid[key] == 1.0 and pid[f"{key}_ci95"] == [1.0, 1.0]
-        assert zero[key] == 0.0 and zero[f"{key}_ci95"] == [0.0, 0.0]
+def test_without_the_oracle_the_ranking_says_what_it_needs(randomised: Path) -> None:
+    from baselines.leaderboard import terminal_summary
+
+    assert json.loads((randomised / "aggregate.json").read_text()) == []
+    assert json.loads((randomised / "scenario_scores.json").read_text()) == []
+    for text in ((randomised / "leaderboard.md").read_text(), terminal_summary(randomised)):
+        assert "No ranking: the cost ratio needs the episodes of the reference `oracle`" in text
+    assert terminal_summary(randomised).endswith(f"leaderboard: {randomised}/leaderboard.html")
+
+
+def test_aggregate_json_ranks_by_cost_over_the_oracle(randomised: Path, ranked: Path) -> None:
+    board = json.loads((ranked / "aggregate.json").read_text())
+    assert [(r["split"], r["controller"]) for r in board] == [("catalogue", "pid_los")]
+    (pid,) = board  # zero_rudder and the oracle are references: not ranked
+    assert set(pid) == AGGREGATE_KEYS
+    assert pid["scenarios"] == ["nominal", "rudder_aging"] and pid["kind"] == "classical"
+    assert pid["runs"] == 3 and pid["training_seeds"] == 0
+    for key in ("cost_ratio_iqm", "cost_ratio_gmean"):
+        assert pid[key] == pytest.approx(1 / STAND_IN)
+        assert pid[f"{key}_ci95"] == pytest.approx([1 / STAND_IN] * 2)
     assert pid["prob_improvement_over_pid_los"] == 0.5  # against itself
-    assert zero["prob_improvement_over_pid_los"] == 0.0
-    scores = json.loads((randomised / "scenario_scores.json").read_text())
-    assert {(s["controller"], s["scenario"], s["score_mean"]) for s in scores} == {
-        ("pid_los", "nominal", 1.0),
-        ("pid_los", "rudder_aging", 1.0),
-        ("zero_rudder", "nominal", 0.0),
-        ("zero_rudder", "rudder_aging", 0.0),
-    }
+    assert pid["failure_rate"] == 0.0 and pid["failure_rate_ci95"] == [0.0, 0.0]
+    episodes = read_episodes(randomised)
+    scores = {s["scenario"]: s for s in json.loads((ranked / "scenario_scores.json").read_text())}
+    assert sorted(scores) == ["nominal", "rudder_aging"]
+    for scenario, entry in scores.items():
+        pid_costs = [
+            e["cost"] for e in episodes if (e["controller"], e["scenario"]) == ("pid_los", scenario)
+        ]
+        assert entry["oracle_cost"] == pytest.approx(STAND_IN * sum(pid_costs) / 3)
+        cells = {c["controller"]: c for c in entry["controllers"]}
+        assert cells["pid_los"]["cost_ratio_gmean"] == pytest.approx(1 / STAND_IN)
+        assert cells["zero_rudder"]["cost_ratio_gmean"] > 2.0  # doing nothing costs
     for name in ("ranking_catalogue.png", "profile_catalogue.png", "ranking_catalogue.svg"):
-        assert (randomised / name).is_file(), name
+        assert (ranked / name).is_file(), name
 
 
-def test_the_markdown_opens_with_the_ranking(randomised: Path) -> None:
-    text = (randomised / "leaderboard.md").read_text()
-    assert text.startswith("# Leaderboard\n\n## Ranking\n")
-    ranking, rest = text.split("## Scores per scenario", 1)
-    assert "| rank | controller | kind | training seeds |" in ranking
+def test_the_same_episodes_give_the_same_aggregate_json_bit_for_bit(
+    randomised: Path, ranked: Path, tmp_path: Path
+) -> None:
+    again = with_stand_in_oracle(randomised, tmp_path)
+    for name in ("aggregate.json", "scenario_scores.json"):
+        assert (again / name).read_bytes() == (ranked / name).read_bytes(), name
+
+
+def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
+    text = (ranked / "leaderboard.md").read_text()
+    assert text.startswith("# Leaderboard\n\n## Ranking\n\nAn episode's cost is the sum")
+    ranking, rest = text.split("## Cost ratio per scenario", 1)
+    assert "### Catalogue scenarios (2, the same for every controller)" in ranking
+    assert "| rank | controller | kind | training seeds | scenarios | cost ratio IQM" in ranking
     first = next(line for line in ranking.splitlines() if line.startswith("| 1 |"))
-    assert first.startswith("| 1 | pid_los | classical | – | 2 | 1.00 [1.00, 1.00] |")
+    assert first.startswith("| 1 | pid_los | classical | – | 2 | 1.250 [1.250, 1.250] |")
+    assert "Resolution, catalogue: median width of the cost-ratio IQM intervals 0.000" in ranking
     scores, rows = rest.split("## All rows", 1)
     assert "| controller | nominal | rudder_aging |" in scores
-    assert "| zero_rudder | 0.00 [0.00, 0.00] | 0.00 [0.00, 0.00] |" in scores
-    assert "| rudder_aging | zero_rudder | classical | 3 |" in rows
+    assert "| pid_los | 1.250 [1.250, 1.250] | 1.250 [1.250, 1.250] |" in scores
+    assert "| oracle (cost) |" in scores
+    assert "| rudder_aging | zero_rudder | reference | 3 |" in rows
 
 
 def test_trials_are_reproducible_per_seed_and_differ_across_seeds(
@@ -200,7 +255,7 @@ def with_agent(tmp_path_factory: pytest.TempPathFactory, agent: Path) -> tuple[s
 
 
 def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
-    with_agent: tuple[str, Path],
+    with_agent: tuple[str, Path], tmp_path: Path
 ) -> None:
     _, clean = with_agent
     learned = [e for e in read_episodes(clean) if e["controller"] == "agent"]
@@ -214,7 +269,8 @@ def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
     (row,) = [r for r in rows if r["kind"] == "learned"]
     assert (row["seeds"], row["training_seeds"], row["training_seed_list"]) == (2, 2, [0, 1])
     assert row["episodes"] == 4 and len(row["ace_ci95"]) == len(row["return_ci95"]) == 2
-    board = {r["controller"]: r for r in json.loads((clean / "aggregate.json").read_text())}
+    ranked = with_stand_in_oracle(clean, tmp_path)
+    board = {r["controller"]: r for r in json.loads((ranked / "aggregate.json").read_text())}
     assert (board["agent"]["training_seeds"], board["agent"]["runs"]) == (2, 4)
     controllers = read_run(clean)["suite"]["controllers"]
     assert [c["training_seeds"] for c in controllers] == [[0, 1], [None], [None]]
@@ -225,6 +281,8 @@ def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
 def test_resume_with_training_seeds_equals_a_clean_run(
     with_agent: tuple[str, Path], tmp_path: Path
 ) -> None:
+    """Cut short, then resumed with 2 workers: the same rows, and (with the stand-in oracle)
+    the same aggregate.json and scenario_scores.json, bit for bit."""
     suite, clean = with_agent
     out = tmp_path / "out"
 
@@ -237,13 +295,36 @@ def test_resume_with_training_seeds_equals_a_clean_run(
         run(suite, out, on_episode=stop_after_three)
     assert len(read_episodes(out)) == 3
     ran: list[object] = []
-    rows = run(suite, out, resume=True, on_episode=ran.append)
-    assert [(r.controller, r.training_seed) for r in ran[:1]] == [("agent", 1)]
+    rows = run_leaderboard(
+        suite, out_dir=out, workers=2, show_progress=False, resume=True, on_episode=ran.append
+    )
+    assert ("agent", 1) in [(r.controller, r.training_seed) for r in ran]
     assert len(ran) == 5 and len(read_episodes(out)) == 8
     board = json.loads((clean / "leaderboard.json").read_text())
     assert untimed(rows) == untimed(board)
     for name in ("aggregate.json", "scenario_scores.json"):
         assert (out / name).read_text() == (clean / name).read_text(), name
+    resumed = with_stand_in_oracle(out, tmp_path / "resumed")
+    reference = with_stand_in_oracle(clean, tmp_path / "clean")
+    ranked = json.loads((resumed / "aggregate.json").read_text())
+    assert sorted(r["controller"] for r in ranked) == ["agent", "pid_los"]
+    for name in ("aggregate.json", "scenario_scores.json"):
+        assert (resumed / name).read_bytes() == (reference / name).read_bytes(), name
     assert sorted(p.name for p in (out / "trajectories").iterdir()) == sorted(
         p.name for p in (clean / "trajectories").iterdir()
     )
+
+
+def test_the_terminal_ends_with_the_ranking_and_the_page(
+    ranked: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``report`` (like ``leaderboard``) prints the ranking and where the page is, not the
+    long rows."""
+    from baselines.cli import main
+
+    out = tmp_path / "again"
+    assert main(["report", str(ranked.parent / "record"), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert text.rstrip().endswith(f"leaderboard: {out / 'leaderboard.html'}")
+    assert "| 1 | pid_los | classical |" in text and "Resolution, catalogue" in text
+    assert "| scenario | controller |" not in text

@@ -40,16 +40,18 @@ SCENARIOS = {"nominal": "catalogue", "rudder_aging": "catalogue", "heldout:0": "
 LEARNED = {"ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3"}
 
 
-def _score(i: int, j: int) -> float:
-    """A distinct synthetic score of controller i on scenario j."""
-    return round(1.2 - 0.06 * i + 0.013 * ((i * 7 + j * 5) % 11), 4)
+def _ratio(i: int, j: int) -> float:
+    """A distinct synthetic cost ratio of controller i on scenario j."""
+    return round(1.05 + 0.06 * i + 0.013 * ((i * 7 + j * 5) % 11), 4)
 
 
 def synthetic_tables() -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
     """(rows, aggregate, scores) shaped as leaderboard.json, aggregate.json and
-    ranking.scenario_scores give them."""
+    scenario_scores.json give them."""
     rows, scores, aggregate = [], [], []
+    ratios: dict[tuple[str, str], float] = {}
     for j, (scenario, split) in enumerate(SCENARIOS.items()):
+        cells = []
         for i, name in enumerate(CONTROLLERS):
             kind = "learned" if name in LEARNED else "classical"
             applies = not (name == "nmpc" and scenario == "heldout:0")
@@ -61,27 +63,33 @@ def synthetic_tables() -> tuple[list[dict[str, Any]], list[dict[str, Any]], list
                 row |= {"t_c": float("inf") if i % 5 == 0 else 30.0 + i, "success": 1.0}
                 if kind == "learned":
                     row["training_seeds"] = 3
-                s = _score(i, j)
-                scores.append(
-                    {"controller": name, "scenario": scenario, "split": split}
-                    | {"score_mean": s, "score_ci95": [s - 0.02, s + 0.02], "episodes": 10}
+                r = ratios[(name, scenario)] = _ratio(i, j)
+                cells.append(
+                    {"controller": name, "kind": kind, "cost": 80.0 * r}
+                    | {"cost_ratio_gmean": r, "cost_ratio_gmean_ci95": [r - 0.02, r + 0.02]}
+                    | {"episodes": 10}
                 )
             rows.append(row)
+        scores.append(
+            {"scenario": scenario, "split": split, "oracle_cost": 80.0}
+            | {"oracle_cost_ci95": [78.0, 82.0], "oracle_episodes": 10, "controllers": cells}
+        )
     for split in ("catalogue", "heldout"):
         for i, name in enumerate(CONTROLLERS):
-            mine = [s for s in scores if s["controller"] == name and s["split"] == split]
+            mine = [s for (c, s), _ in ratios.items() if c == name and SCENARIOS[s] == split]
             if not mine:
                 continue
-            m = float(np.mean([s["score_mean"] for s in mine]))
+            m = float(np.mean([ratios[(name, s)] for s in mine]))
             aggregate.append(
                 {"controller": name, "kind": rows[i]["kind"], "split": split}
-                | {"scenarios": [s["scenario"] for s in mine], "runs": 10, "training_seeds": 0}
-                | {"score_mean": m, "score_mean_ci95": [m - 0.03, m + 0.03]}
-                | {"score_iqm": m, "score_iqm_ci95": [m - 0.04, m + 0.04]}
+                | {"scenarios": mine, "runs": 10, "training_seeds": 0}
+                | {"cost_ratio_iqm": m, "cost_ratio_iqm_ci95": [m - 0.04, m + 0.04]}
+                | {"cost_ratio_gmean": m, "cost_ratio_gmean_ci95": [m - 0.03, m + 0.03]}
                 | {"prob_improvement_over_pid_los": 0.5}
                 | {"prob_improvement_over_pid_los_ci95": [0.4, 0.6]}
+                | {"failure_rate": 0.1, "failure_rate_ci95": [0.0, 0.2]}
             )
-    aggregate.sort(key=lambda r: (r["split"], -r["score_iqm"]))
+    aggregate.sort(key=lambda r: (r["split"], r["cost_ratio_iqm"]))
     return rows, aggregate, scores
 
 
@@ -141,9 +149,13 @@ def test_the_page_is_self_contained_and_escaped() -> None:
 def test_a_cell_shows_the_interval_and_n_a_where_a_controller_does_not_apply() -> None:
     rows, aggregate, scores = synthetic_tables()
     text = page(rows, aggregate, scores)
-    cell = next(s for s in scores if (s["controller"], s["scenario"]) == ("lqr", "nominal"))
-    lo, hi = cell["score_ci95"]
+    (nominal,) = [s for s in scores if s["scenario"] == "nominal"]
+    cell = next(c for c in nominal["controllers"] if c["controller"] == "lqr")
+    lo, hi = cell["cost_ratio_gmean_ci95"]
     assert f"[{lo:.3f}, {hi:.3f}]" in text
+    assert "oracle cost 80.000" in text  # under the scenario's name
+    assert "An episode&#x27;s cost is the sum of its step costs" in text
+    assert "Resolution, catalogue: median width of the cost-ratio IQM intervals 0.080" in text
     assert 'title="does not apply">n/a</td>' in text
     assert ">never<" in text  # t_c = inf in the long table
 
@@ -206,19 +218,20 @@ def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
 @pytest.mark.parametrize(
     ("fragment", "order"),
-    [("#sort=rudder_aging", "descending"), ("#sort=iqm:heldout:asc", "ascending")],
+    [("#sort=rudder_aging", "ascending"), ("#sort=iqm:heldout:desc", "descending")],
 )
 def test_the_table_sorts_by_a_clicked_header(built_page: Path, fragment: str, order: str) -> None:
     # the page clicks the header named in its address's hash (twice for the other order)
     dom = chromium(built_page.as_uri() + fragment, built_page.parent, "--dump-dom")
     shown = score_rows(dom)
-    key = fragment.removeprefix("#sort=").removesuffix(":asc")
+    key = fragment.removeprefix("#sort=").removesuffix(":desc")
     assert shown.sorted == {key: order}
     _, aggregate, scores = synthetic_tables()
-    if key == "rudder_aging":
-        value = {s["controller"]: s["score_mean"] for s in scores if s["scenario"] == key}
+    if key == "rudder_aging":  # a cost ratio: lowest first on the first click
+        (cells,) = [s["controllers"] for s in scores if s["scenario"] == key]
+        value = {c["controller"]: c["cost_ratio_gmean"] for c in cells}
     else:
-        value = {r["controller"]: r["score_iqm"] for r in aggregate if r["split"] == "heldout"}
+        value = {r["controller"]: r["cost_ratio_iqm"] for r in aggregate if r["split"] == "heldout"}
     ranked = sorted(value, key=value.__getitem__, reverse=order == "descending")
     missing = [n for n in CONTROLLERS if n not in value]  # n/a: last in either order
     assert shown.names == ranked + missing

@@ -47,7 +47,7 @@ def test_report_merges_two_evaluate_runs_into_the_leaderboard_table(
     # the ranking of the merged runs is the leaderboard's
     aggregate = (out / "aggregate.json").read_text()
     assert aggregate == (evaluated["both"] / "aggregate.json").read_text()
-    assert [r["controller"] for r in json.loads(aggregate)] == ["pid_los", "zero_rudder"]
+    assert json.loads(aggregate) == []  # no ranking without the oracle's episodes
     report = json.loads((out / "report.json").read_text())
     assert [r["folder"] for r in report["runs"]] == runs
     assert [r["episodes"] for r in report["runs"]] == [4, 4]

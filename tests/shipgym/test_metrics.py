@@ -25,6 +25,7 @@ def make_log(
     reward: np.ndarray | None = None,
     ship_length: float = L,
     reached_goal: bool = False,
+    goal_bonus: float = 0.0,
 ) -> EpisodeLog:
     e = np.asarray(e, dtype=float)
     n = e.size
@@ -39,6 +40,7 @@ def make_log(
         change_time=change_time,
         ship_length=ship_length,
         reached_goal=reached_goal,
+        goal_bonus=goal_bonus,
         dt=dt,
     )
 
@@ -154,6 +156,23 @@ def test_statistics_return_success_and_no_wall_clock() -> None:
     assert m["steps"] == 2
     assert not any(key.startswith("compute") for key in m)  # the evaluation loop times
     assert all(isinstance(v, float | bool | int) for v in m.values())
+
+
+def test_cost_is_the_return_without_the_goal_bonus() -> None:
+    """C = −(Σ reward − bonus): the bonus in the last step's reward is left out, only when
+    the goal was reached."""
+    reward = np.array([-1.0, -2.5, 10.0 - 0.5])  # the last step: its cost 0.5 and the bonus
+    reached = compute_metrics(
+        make_log(np.zeros(3), reward=reward, reached_goal=True, goal_bonus=10.0)
+    )
+    assert reached["cost"] == pytest.approx(4.0) and reached["return"] == pytest.approx(6.0)
+    missed = compute_metrics(
+        make_log(np.zeros(3), reward=reward - 10.0 * (reward > 5), goal_bonus=10.0)
+    )
+    assert missed["cost"] == pytest.approx(4.0) and missed["return"] == pytest.approx(-4.0)
+    assert compute_metrics(make_log(np.zeros(2)))["cost"] == 0.0  # not −0.0
+    with pytest.raises(ValueError, match="goal_bonus"):
+        make_log(np.zeros(2), goal_bonus=math.inf)
 
 
 def test_default_threshold_liu_scaling() -> None:

@@ -583,6 +583,32 @@ def test_corridor_exit_penalty() -> None:
     assert reward == pytest.approx(base - (e_max / L) * (max_steps - k), rel=1e-12)
 
 
+def _run_to_the_end(env: Any, action: np.ndarray) -> tuple[float, dict[str, Any]]:
+    """(return, last info) of one episode with a constant action."""
+    total = 0.0
+    while True:
+        _, reward, terminated, truncated, info = env.step(action)
+        total += float(reward)
+        if terminated or truncated:
+            return total, info
+
+
+@pytest.mark.parametrize(("mode", "reason"), [("guidance", "goal"), ("rudder", "corridor")])
+def test_episode_cost_is_minus_the_return_without_the_goal_bonus(mode: str, reason: str) -> None:
+    """A real episode: the env's autopilot (guidance mode, a = 0) reaches the goal, no rudder
+    leaves the corridor; the metric ``cost`` is −(return − goal bonus if reached), ≥ 0."""
+    env = gym.make("ShipPathFollow-v0", scenario="nominal", action_mode=mode)
+    bonus = env.unwrapped.scenario.config.reward.goal_bonus
+    env.reset(seed=0)
+    total, info = _run_to_the_end(env, np.zeros(env.action_space.shape, dtype=np.float32))
+    assert info["termination_reason"] == reason
+    metrics = info["episode_metrics"]
+    assert metrics["return"] == pytest.approx(total, rel=1e-12)
+    reached = bonus if reason == "goal" else 0.0
+    assert bonus > 0 and metrics["cost"] == pytest.approx(-(total - reached), rel=1e-12)
+    assert metrics["cost"] > 0
+
+
 # --------------------------------------------------------------------------------------------
 # Rendering and constructor arguments
 # --------------------------------------------------------------------------------------------
