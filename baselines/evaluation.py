@@ -259,7 +259,8 @@ def evaluate(
         privileged = False
         if isinstance(controller, str | ControllerEntry):
             policy, mode = make_controller(controller, **settings)
-            privileged = not settings and grants_truth(controller)
+            plain = all(k == "training_seed" and v is None for k, v in settings.items())
+            privileged = plain and grants_truth(controller)
         else:
             policy, mode = controller, settings.get("action_mode")
         results.append(run_episode(policy, scenario, seed, mode, privileged=privileged))

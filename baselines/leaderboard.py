@@ -44,6 +44,7 @@ from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from baselines.figures import median_ace_episode
 from baselines.jsonout import dumps
 from baselines.plugins import ControllerSpec
+from baselines.privileged import grants_truth
 from baselines.ranking import (
     BASELINE,
     NO_RANKING,
@@ -56,6 +57,7 @@ from baselines.ranking import (
     row_intervals,
 )
 from baselines.ranking import scenario_scores as score_table
+from baselines.references import result_from_entry, shipped_table
 from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
 from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
 from baselines.style import FIGURE_DPI, controller_style
@@ -119,6 +121,9 @@ class Job(NamedTuple):
     seeds: tuple[int, ...]
     training_seed: int | None = None
     randomize: dict[str, Any] | None = None
+    #: the oracle's episodes: "table" (the shipped reference table, running only a trial it
+    #: lacks) or "recompute" (run every trial)
+    references: str = "table"
 
 
 @functools.lru_cache(maxsize=128)
@@ -174,9 +179,25 @@ def run_batch(job: Job) -> list[EpisodeResult]:
     return _named(list(results), job)
 
 
+def reference_work(job: Job) -> list[EpisodeResult]:
+    """The oracle's episodes of ``job``: each trial's entry of the shipped reference table
+    (:mod:`baselines.references`), the oracle run for a trial the table lacks."""
+    table = shipped_table()
+    out = []
+    for seed, trial in zip(job.seeds, trials(job), strict=True):
+        entry = table.lookup(trial, seed)
+        if entry is not None:
+            out.append(result_from_entry(entry, job.scenario, seed))
+        else:
+            out += _named(evaluation.evaluate(job.controller, trial, [seed]), job)
+    return out
+
+
 def work(job: Job) -> list[EpisodeResult]:
-    """A job's episodes: a single seed through :func:`run_job`, several through
-    :func:`run_batch`."""
+    """A job's episodes: the oracle's from the reference table (:func:`reference_work`), a
+    single seed through :func:`run_job`, several through :func:`run_batch`."""
+    if job.references == "table" and grants_truth(job.controller):
+        return reference_work(job)
     if len(job.seeds) == 1:
         return [run_job((job.controller, job.scenario, job.seeds[0], *job[3:]))]
     return run_batch(job)
@@ -284,6 +305,7 @@ def plan_jobs(
     seeds_of: Mapping[str, list[int | None]],
     randomize: dict[str, Any] | None,
     skip: set[tuple[str, str]],
+    references: str = "table",
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job per seed for
     a classical controller, one job of all seeds per training seed for a learned agent."""
@@ -297,7 +319,9 @@ def plan_jobs(
                 if controller_kind(label) == "learned":
                     jobs.append(Job(c, scenario, tuple(seed_list), k, randomize))
                 else:
-                    jobs += [Job(c, scenario, (seed,), k, randomize) for seed in seed_list]
+                    jobs += [
+                        Job(c, scenario, (seed,), k, randomize, references) for seed in seed_list
+                    ]
     return jobs
 
 
@@ -324,6 +348,7 @@ def run_leaderboard(
     force: bool = False,
     command: list[str] | None = None,
     on_episode: Callable[[EpisodeResult], None] | None = None,
+    recompute_references: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -332,7 +357,9 @@ def run_leaderboard(
     ``episodes.jsonl``: a job whose episodes are partly there runs the missing seeds) or
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
-    recorded.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
+    recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
+    its shipped reference table (:mod:`baselines.references`).  Ctrl-C raises
+    :class:`~baselines.runs.RunInterrupted`.
     """
     check_out_dir(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
@@ -347,7 +374,10 @@ def run_leaderboard(
     scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
-    jobs = plan_jobs(names, scenarios, seed_list, seeds_of, record["randomize"], skip)
+    references = "recompute" if recompute_references else "table"
+    jobs = plan_jobs(
+        names, scenarios, seed_list, seeds_of, record["randomize"], skip, references
+    )
     n_episodes = sum(len(job.seeds) for job in jobs)
     log = RunLog.open(
         out_dir,

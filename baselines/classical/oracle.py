@@ -45,6 +45,7 @@ J = ∂z/∂u are one CasADi function compiled to C (cached, :mod:`shipgym.codeg
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import time
 from typing import Any, ClassVar
@@ -66,11 +67,11 @@ from shipgym.models.base import ShipModel
 class OracleSettings:
     """Numerical choices of the oracle (module doc); the objective is the env's."""
 
-    horizon_factor: float = 2.0  # k in H = k(T + L/U) + δmax/δ̇max
+    horizon_factor: float = 2.0  # k in H = k(T + (L + R0)/U) + δmax/δ̇max
     blocks: int = 20  # command intervals after the first (move blocking)
     legs: int = 4  # path segments ahead in the prediction
     smooth_abs: float = 1e-3  # ε of √(z² + ε²) on e/L and ψ̃ [rad]
-    switch_width_L: float = 0.25  # width of the smooth leg switch [L]
+    switch_width_L: float = 0.1  # width of the smooth leg switch [L]
     max_iter: int = 10  # generalised Gauss–Newton iterations per control step
     step_tolerance: float = 1e-4  # rad: stop when the accepted step is smaller
     cost_tolerance: float = 1e-3  # stop when an iteration lowers the cost by less (relative)
@@ -98,12 +99,18 @@ class OracleGrid:
 
 
 def horizon_seconds(
-    time_constant: float, length: float, speed: float, limit: float, rate: float, k: float = 2.0
+    time_constant: float,
+    length: float,
+    speed: float,
+    limit: float,
+    rate: float,
+    acceptance_radius: float,
+    k: float = 2.0,
 ) -> float:
-    """H = k(T + L/U) + δmax/δ̇max [s] (module doc); T [s], L [m], U [m/s], δmax [rad],
-    δ̇max [rad/s] (inf: no rate limit)."""
+    """H = k(T + (L + R0)/U) + δmax/δ̇max [s] (module doc); T [s], L [m], U [m/s], δmax
+    [rad], δ̇max [rad/s] (inf: no rate limit), R0 [m] the acceptance radius."""
     travel = limit / rate if math.isfinite(rate) and rate > 0 else 0.0
-    return k * (time_constant + length / speed) + travel
+    return k * (time_constant + (length + acceptance_radius) / speed) + travel
 
 
 def prediction_substeps(model: ShipModel, control_period: float, fine_step: float) -> int:
@@ -111,7 +118,9 @@ def prediction_substeps(model: ShipModel, control_period: float, fine_step: floa
     is stable to 2.79 on the negative real axis), at most Ts/h (never finer than the env's
     own step)."""
     x = ca.SX.sym("x", model.n_states)
-    jac = ca.Function("a", [x], [ca.jacobian(model.casadi_rhs(x, 0.0, 0.0, model.params.to_vector()), x)])
+    jac = ca.Function(
+        "a", [x], [ca.jacobian(model.casadi_rhs(x, 0.0, 0.0, model.params.to_vector()), x)]
+    )
     a = np.array(jac(model.cruise_state()))
     fastest = float(np.max(np.abs(np.linalg.eigvals(a)))) if a.size else 0.0
     most = max(1, round(control_period / fine_step))
@@ -128,6 +137,7 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
         context.nominal_speed,
         context.rudder_limit,
         model.rudder_rate_limit,
+        context.acceptance_radius,
         settings.horizon_factor,
     )
     ts = context.control_period
@@ -140,71 +150,95 @@ def _smooth_step(z: Any) -> Any:
     return 0.5 * (1.0 + ca.tanh(z))
 
 
-def _period_function(model: ShipModel, hp: float, substeps: int) -> ca.Function:
-    """x(t + Ts) from x(t): ``substeps`` RK4 steps of h_p [s] with u, w, θ held (SX)."""
+#: layout of one leg in the solver's parameters: start (x0, y0), unit direction (c, s), ℓ
+LEG_SIZE = 5
+
+
+def _geometry(model: ShipModel, x: Any, legs: Any, j: int) -> tuple[Any, Any, Any]:
+    """(along-track [m], cross-track e [m], ψ̃ [rad]) of state ``x`` on leg ``j``."""
+    x0, y0, c, s, _ = (legs[LEG_SIZE * j + i] for i in range(LEG_SIZE))
+    rx, ry = x[model.state_index("x")] - x0, x[model.state_index("y")] - y0
+    psi = x[model.state_index("psi")]
+    heading = ca.atan2(ca.sin(psi) * c - ca.cos(psi) * s, ca.cos(psi) * c + ca.sin(psi) * s)
+    return rx * c + ry * s, -rx * s + ry * c, heading
+
+
+def _period_function(
+    model: ShipModel, hp: float, substeps: int, n_legs: int, width: float
+) -> ca.Function:
+    """(x, q, u, w, θ, legs, R0, circle) -> (x, q) one control period later: ``substeps`` RK4
+    steps of h_p [s] with u, w, θ held, then the leg latches q_j ∈ [0, 1] ("leg j is done")
+    updated at the period's end as the env's tracker switches legs:
+    q_j⁺ = q_j + (1 − q_j)·σ_j, σ_j the smooth switching rule of leg j (``circle`` = 1: inside
+    the acceptance circle R0 of its end, Liu eq. (13); 0: along-track past ℓ − R0, Borkowski
+    eq. (27)), over ``width`` [m].  The latches make a switch permanent, as in the env."""
     step = model.casadi_step(hp)
     x = ca.SX.sym("x", model.n_states)
+    q = ca.SX.sym("q", n_legs - 1)
     u = ca.SX.sym("u")
     w = ca.SX.sym("w", model.n_disturbances)
     theta = ca.SX.sym("theta", model.n_params)
+    legs = ca.SX.sym("legs", LEG_SIZE * n_legs)
+    radius = ca.SX.sym("R0")
+    circle = ca.SX.sym("circle")
     xk = x
     for _ in range(substeps):
         xk = step(xk, u, w, theta)
-    return ca.Function("oracle_period", [x, u, w, theta], [xk])
+    latches = []
+    for j in range(n_legs - 1):
+        along, cross, _ = _geometry(model, xk, legs, j)
+        ell = legs[LEG_SIZE * j + 4]
+        # 2·width inside the rule's edge: the prediction switches only where the env surely does
+        inside = _smooth_step((radius - ca.sqrt((along - ell) ** 2 + cross**2)) / width - 2.0)
+        past = _smooth_step((along - (ell - radius)) / width - 2.0)
+        latches.append(q[j] + (1.0 - q[j]) * (circle * inside + (1.0 - circle) * past))
+    xa = ca.vertcat(x, q)
+    xa_next = ca.vertcat(xk, *latches)
+    return ca.Function("oracle_period", [xa, u, w, theta, legs, radius, circle], [xa_next])
 
 
-def _stage_function(model: ShipModel, n_legs: int, width: float, length: float) -> ca.Function:
-    """[e/L, ψ̃ [rad]] of a state to the active leg of ``n_legs`` (x0, y0, c, s, ℓ), switched
-    smoothly at ℓ − R0 over ``width`` [m] (module doc)."""
-    x = ca.SX.sym("x", model.n_states)
-    legs = ca.SX.sym("legs", 5 * n_legs)
-    switch_radius = ca.SX.sym("R0")
-    px, py = x[model.state_index("x")], x[model.state_index("y")]
-    psi = x[model.state_index("psi")]
+def _stage_function(model: ShipModel, n_legs: int, length: float) -> ca.Function:
+    """[e/L, ψ̃ [rad]] of an augmented state (x, q) to its active leg: leg j weighs
+    q_0⋯q_{j−1}(1 − q_j) (the last leg q_0⋯q_{K−2})."""
+    xa = ca.SX.sym("xa", model.n_states + n_legs - 1)
+    legs = ca.SX.sym("legs", LEG_SIZE * n_legs)
+    q = xa[model.n_states :]
     e_sum, h_sum = 0.0, 0.0
-    reached = 1.0  # product of the earlier legs' switch indicators
+    reached = 1.0
     for j in range(n_legs):
-        x0, y0, c, s, ell = (legs[5 * j + i] for i in range(5))
-        rx, ry = px - x0, py - y0
-        if j == n_legs - 1:
-            weight = reached
-        else:
-            passed = _smooth_step((rx * c + ry * s - (ell - switch_radius)) / width)
-            weight = reached * (1.0 - passed)
-            reached = reached * passed
-        e_sum += weight * (-rx * s + ry * c)
-        h_sum += weight * ca.atan2(
-            ca.sin(psi) * c - ca.cos(psi) * s, ca.cos(psi) * c + ca.sin(psi) * s
-        )
-    return ca.Function("oracle_stage", [x, legs, switch_radius], [ca.vertcat(e_sum / length, h_sum)])
+        _, cross, heading = _geometry(model, xa, legs, j)
+        weight = reached if j == n_legs - 1 else reached * (1.0 - q[j])
+        if j < n_legs - 1:
+            reached = reached * q[j]
+        e_sum += weight * cross
+        h_sum += weight * heading
+    return ca.Function("oracle_stage", [xa, legs], [ca.vertcat(e_sum / length, h_sum)])
 
 
 def _sensitivity_function(period: ca.Function, n_u: int) -> ca.Function:
-    """(x, S, u, w, θ, e) -> (x⁺, A·S + B·eᵀ): one period with the forward sensitivity
-    S = ∂x/∂(plan) [nx × n_u]; A = ∂x⁺/∂x, B = ∂x⁺/∂u, e the one-hot of the step's interval."""
-    x = ca.SX.sym("x", period.size1_in(0))
-    sens = ca.SX.sym("S", period.size1_in(0), n_u)
+    """(x, S, u, …, e) -> (x⁺, A·S + B·eᵀ): one period with the forward sensitivity
+    S = ∂x/∂(plan) [n × n_u]; A = ∂x⁺/∂x, B = ∂x⁺/∂u, e the one-hot of the step's interval;
+    the other inputs pass through to ``period``."""
+    n = period.size1_in(0)
+    x = ca.SX.sym("x", n)
+    sens = ca.SX.sym("S", n, n_u)
     u = ca.SX.sym("u")
-    w = ca.SX.sym("w", period.size1_in(2))
-    theta = ca.SX.sym("theta", period.size1_in(3))
+    rest = [ca.SX.sym(f"a{i}", period.size1_in(i)) for i in range(2, period.n_in())]
     onehot = ca.SX.sym("e", n_u)
-    xn = period(x, u, w, theta)
+    xn = period(x, u, *rest)
     a, b = ca.jacobian(xn, x), ca.jacobian(xn, u)
     return ca.Function(
-        "oracle_period_s", [x, sens, u, w, theta, onehot], [xn, a @ sens + b @ onehot.T]
+        "oracle_period_s", [x, sens, u, *rest, onehot], [xn, a @ sens + b @ onehot.T]
     )
 
 
 def _stage_jacobian_function(stage: ca.Function, n_u: int) -> ca.Function:
-    """(x, S, legs, R0) -> (g(x), ∂g/∂x · S): the stage errors and their plan derivatives."""
+    """(x, S, legs) -> (g(x), ∂g/∂x · S): the stage errors and their plan derivatives."""
     x = ca.SX.sym("x", stage.size1_in(0))
     sens = ca.SX.sym("S", stage.size1_in(0), n_u)
     legs = ca.SX.sym("legs", stage.size1_in(1))
-    radius = ca.SX.sym("R0")
-    g = stage(x, legs, radius)
-    return ca.Function(
-        "oracle_stage_s", [x, sens, legs, radius], [g, ca.jacobian(g, x) @ sens]
-    )
+    g = stage(x, legs)
+    return ca.Function("oracle_stage_s", [x, sens, legs], [g, ca.jacobian(g, x) @ sens])
 
 
 class OracleSolver:
@@ -227,36 +261,44 @@ class OracleSolver:
         nx, npar, nw = model.n_states, model.n_params, model.n_disturbances
         n_u = 1 + grid.blocks
         n_legs = s.legs
-        hp = control_period / grid.substeps
-        period = _period_function(model, hp, grid.substeps)
-        stage = _stage_function(model, n_legs, s.switch_width_L * length, length)
+        period = _period_function(
+            model, control_period / grid.substeps, grid.substeps, n_legs, s.switch_width_L * length
+        )
+        stage = _stage_function(model, n_legs, length)
         steps = grid.steps
         interval = [j for j, n in enumerate(grid.lengths) for _ in range(n)]  # per step
         u = ca.MX.sym("u", n_u)
-        # parameters: x0, δc_prev, switch radius R0, legs (x0, y0, c, s, ℓ) each, θ, w per interval
-        n_p = nx + 2 + 5 * n_legs + npar + nw * n_u
+        # parameters: x0, δc_prev, R0, circle rule (1/0), legs (x0, y0, c, s, ℓ) each, θ, w
+        # per interval
+        n_p = nx + 3 + LEG_SIZE * n_legs + npar + nw * n_u
         p = ca.MX.sym("p", n_p)
-        x0, u_prev, switch_radius = p[:nx], p[nx], p[nx + 1]
-        legs = p[nx + 2 : nx + 2 + 5 * n_legs]
-        theta = p[nx + 2 + 5 * n_legs : nx + 2 + 5 * n_legs + npar]
-        w_all = ca.reshape(p[nx + 2 + 5 * n_legs + npar :], nw, n_u)
+        x0, u_prev, radius, circle = p[:nx], p[nx], p[nx + 1], p[nx + 2]
+        i_legs = nx + 3
+        i_theta = i_legs + LEG_SIZE * n_legs
+        legs = p[i_legs:i_theta]
+        theta = p[i_theta : i_theta + npar]
+        w_all = ca.reshape(p[i_theta + npar :], nw, n_u)
+        xa0 = ca.vertcat(x0, ca.DM.zeros(n_legs - 1))  # no leg done at the start
         # the control steps of the horizon in one C loop (mapaccum), their errors mapped;
         # J by forward sensitivities S = ∂x/∂u carried along (S⁺ = A·S + B·e_jᵀ)
-        inputs = (u[interval].T, w_all[:, interval], ca.repmat(theta, 1, steps))
+        inputs = (
+            u[interval].T,
+            w_all[:, interval],
+            ca.repmat(theta, 1, steps),
+            ca.repmat(legs, 1, steps),
+            ca.repmat(radius, 1, steps),
+            ca.repmat(circle, 1, steps),
+        )
         onehot = ca.DM.zeros(n_u, steps)
         for k, j in enumerate(interval):
             onehot[j, k] = 1.0
-        states = period.mapaccum("roll", steps)(x0, *inputs)
-        errors = stage.map(steps)(
-            states, ca.repmat(legs, 1, steps), ca.repmat(switch_radius, 1, steps)
+        states = period.mapaccum("roll", steps)(xa0, *inputs)
+        errors = stage.map(steps)(states, ca.repmat(legs, 1, steps))
+        states_s, sens = _sensitivity_function(period, n_u).mapaccum("roll_s", steps, 2)(
+            xa0, ca.DM.zeros(xa0.shape[0], n_u), *inputs, onehot
         )
-        sens_period = _sensitivity_function(period, n_u)
-        sens_stage = _stage_jacobian_function(stage, n_u)
-        states_s, sens = sens_period.mapaccum("roll_s", steps, 2)(
-            x0, ca.DM.zeros(nx, n_u), *inputs, onehot
-        )
-        errors_s, d_errors = sens_stage.map(steps)(
-            states_s, sens, ca.repmat(legs, 1, steps), ca.repmat(switch_radius, 1, steps)
+        errors_s, d_errors = _stage_jacobian_function(stage, n_u).map(steps)(
+            states_s, sens, ca.repmat(legs, 1, steps)
         )
         z_u = u / rudder_limit
         z_du = ca.vertcat(u[0] - u_prev, u[1:] - u[:-1]) / rudder_limit
@@ -282,7 +324,6 @@ class OracleSolver:
         )
         self.is_abs = np.concatenate([np.ones(2 * steps, bool), np.zeros(2 * n_u, bool)])
         self.n_z, self.n_u, self.n_p = z.shape[0], n_u, n_p
-        self.layout = (nx, n_legs, npar, nw)
         tag = (
             f"{model.name}_b{grid.blocks}x{grid.block}_s{grid.substeps}_l{n_legs}"
             f"_{abs(hash((control_period, rudder_limit, weights, length, s))) % 10**8}"
@@ -301,6 +342,7 @@ class OracleSolver:
         self.lb = np.full(n_u, -rudder_limit)
         self.ub = np.full(n_u, rudder_limit)
         self._qp = BoxQP(n_u)
+        self.iterations: list[int] = []
 
     # ---------------------------------------------------------------- cost and SQP
     def _outer(self, z: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -325,7 +367,6 @@ class OracleSolver:
 
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Plan (one command per interval, rad), success flag, iterations."""
-        self.iterations = getattr(self, "iterations", [])
         u = np.clip(guess, self.lb, self.ub)
         self._p[:] = p
         cost = self.cost(u, p)
@@ -362,6 +403,7 @@ class OracleSolver:
         state: np.ndarray,
         previous_command: float,
         switch_radius: float,
+        circle: bool,
         legs: np.ndarray,
         theta: np.ndarray,
         disturbances: np.ndarray,
@@ -369,7 +411,13 @@ class OracleSolver:
         """The solver's parameter vector; ``legs`` (legs, 5) rows (x0, y0, c, s, ℓ),
         ``disturbances`` (intervals, n_w)."""
         return np.concatenate(
-            [state, [previous_command, switch_radius], legs.ravel(), theta, disturbances.ravel()]
+            [
+                state,
+                [previous_command, switch_radius, float(circle)],
+                legs.ravel(),
+                theta,
+                disturbances.ravel(),
+            ]
         )
 
 
@@ -389,48 +437,67 @@ def get_solver(context: ControllerContext, settings: OracleSettings, weights) ->
     """One solver per process for a ship class, grid, timing and reward weights."""
     grid = oracle_grid(context, settings)
     model = context.nominal_model
-    key = (type(model).__name__, model.variant, context.ship_length, grid, settings,
-           context.control_period, context.rudder_limit, weights)
+    key = (
+        type(model).__name__,
+        model.variant,
+        context.ship_length,
+        grid,
+        settings,
+        context.control_period,
+        context.rudder_limit,
+        weights,
+    )
     if key not in _SOLVERS:
         _SOLVERS[key] = OracleSolver(
-            model, grid, settings, context.control_period, context.rudder_limit, weights,
+            model,
+            grid,
+            settings,
+            context.control_period,
+            context.rudder_limit,
+            weights,
             context.ship_length,
         )
     return _SOLVERS[key]
 
 
-def legs_ahead(context: ControllerContext, tracker: Any, frame: Any, horizon_m: float, n: int):
-    """(n, 5) legs (x0, y0, c, s, ℓ) from the active one on: the waypoint legs (the last one
-    extended past the goal), or the chords of a PCHIP route ahead of the closest point."""
-    rows = []
+def _curve_point(path: Any, s: float) -> np.ndarray:
+    """The point at arc length s [m] of a PCHIP route, continued along its final tangent
+    past the end."""
+    if s <= path.length:
+        return np.asarray(path.point(s), dtype=float)
+    angle = float(path.angle(path.length))
+    end = np.asarray(path.point(path.length), dtype=float)
+    return end + (s - path.length) * np.array([math.cos(angle), math.sin(angle)])
+
+
+def _leg_row(a: np.ndarray, b: np.ndarray, length: float | None = None) -> list[float]:
+    """(x0, y0, c, s, ℓ) of the segment a → b [m] (ℓ overridden by ``length``)."""
+    d = b - a
+    ell = float(np.hypot(*d))
+    return [a[0], a[1], d[0] / ell, d[1] / ell, ell if length is None else length]
+
+
+#: the length given to the last leg of a route: the env never leaves it
+LAST_LEG = 1e6
+
+
+def legs_ahead(
+    context: ControllerContext, tracker: Any, frame: Any, horizon_m: float, n: int
+) -> tuple[np.ndarray, float]:
+    """(n, 5) legs (x0, y0, c, s, ℓ) from the active one on, and the switching radius [m]:
+    the waypoint legs (the last one never left) with the acceptance radius, or the chords of
+    a PCHIP route over 1.3 horizons ahead of the closest point, switched at their ends."""
     if tracker.is_curve:
-        path = tracker.path
         ds = 1.3 * horizon_m / n
         s0 = float(frame.along_track)
-        points = [np.asarray(path.point(min(s0 + i * ds, path.length))) for i in range(n + 1)]
-        if s0 + n * ds > path.length:  # past the end: continue along the final tangent
-            angle = float(path.angle(path.length))
-            end = np.asarray(path.point(path.length))
-            points = [
-                p if s0 + i * ds <= path.length
-                else end + (s0 + i * ds - path.length) * np.array([math.cos(angle), math.sin(angle)])
-                for i, p in enumerate(points)
-            ]
-        for a, b in zip(points[:-1], points[1:], strict=True):
-            d = b - a
-            ell = float(np.hypot(*d))
-            if ell < 1e-9:
-                angle = float(path.angle(path.length))
-                d, ell = np.array([math.cos(angle), math.sin(angle)]), 1.0
-            rows.append([a[0], a[1], d[0] / ell, d[1] / ell, ell])
-        return np.array(rows), 0.0
-    wp = context.waypoints
-    last = len(wp) - 2  # the env never leaves the last leg
+        points = [_curve_point(tracker.path, s0 + i * ds) for i in range(n + 1)]
+        return np.array([_leg_row(a, b) for a, b in itertools.pairwise(points)]), 0.0
+    wp = np.asarray(context.waypoints, dtype=float)
+    last = len(wp) - 2
+    rows = []
     for j in range(int(frame.leg), int(frame.leg) + n):
         i = min(j, last)
-        d = wp[i + 1] - wp[i]
-        ell = float(np.hypot(*d))
-        rows.append([wp[i][0], wp[i][1], d[0] / ell, d[1] / ell, 1e6 if i == last else ell])
+        rows.append(_leg_row(wp[i], wp[i + 1], LAST_LEG if i == last else None))
     return np.array(rows), context.acceptance_radius
 
 
@@ -481,12 +548,13 @@ class Oracle:
         legs, radius = legs_ahead(
             ctx, self.tracker, frame, grid.horizon_s * ctx.nominal_speed, self.settings.legs
         )
-        starts = np.cumsum([0] + grid.lengths[:-1]) * ctx.control_period
+        starts = np.cumsum([0, *grid.lengths[:-1]]) * ctx.control_period
         mids = truth.t + starts + 0.5 * np.array(grid.lengths) * ctx.control_period
         p = self.solver.parameters(
             truth.state,
             self.command,
             radius,
+            ctx.switching == "circle" and not self.tracker.is_curve,
             legs,
             truth.params.to_vector(),
             truth.disturbance_forecast(mids),

@@ -13,6 +13,7 @@ from baselines.cli import (
     bench,
     leaderboard,
     manoeuvre,
+    references,
     report,
     reproduce,
     run,
@@ -32,6 +33,7 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     manoeuvre.add_parser,
     scenarios.add_parser,
     bench.add_parser,
+    references.add_parser,
 )
 
 #: exit code of a bad input (a :class:`ShipgymError`), as argparse's own usage errors

@@ -28,6 +28,11 @@ def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
         help="run these instead of the suite's: names, specs module:Attr / file.py:Attr, "
         "trained agents' folders or SB3 model zips",
     )
+    p.add_argument(
+        "--recompute-references",
+        action="store_true",
+        help="run the oracle on every trial instead of reading its shipped reference table",
+    )
     p.set_defaults(func=run)
 
 
@@ -81,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         resume=args.resume,
         force=args.force,
         command=command_line(args),
+        recompute_references=getattr(args, "recompute_references", False),
     )
     if not args.json:
         sys.stderr.write(f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes\n")

@@ -42,8 +42,8 @@ from shipgym.angles import wrap_angle
 from shipgym.disturbances import SensorModel
 from shipgym.envs import core
 from shipgym.envs.context import ControllerContext
-from shipgym.envs.truth import PlantTruth
 from shipgym.envs.core import GUIDANCE_OFFSET_MAX, LOG_FIELDS, OBS_HIGH, OBS_LOW, OBS_NAMES
+from shipgym.envs.truth import PlantTruth
 from shipgym.metrics import EpisodeLog, compute_metrics
 from shipgym.numerics import SCALAR
 from shipgym.scenarios import Scenario, load_scenario

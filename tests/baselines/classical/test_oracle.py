@@ -1,0 +1,240 @@
+"""The privileged ``oracle`` reference: its optimiser, its channel, its reference table."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from baselines.classical.oracle import (
+    LAST_LEG,
+    Oracle,
+    OracleSettings,
+    OracleSolver,
+    horizon_seconds,
+    oracle_grid,
+)
+from baselines.errors import ControllerError
+from baselines.evaluation import evaluate, run_episode
+from baselines.leaderboard import Job, trials, work
+from baselines.plugins import ControllerEntry
+from baselines.privileged import grants_truth
+from baselines.references import ReferenceTable, entry_key, shipped_table, table_path
+from baselines.suite import load_suite
+from shipgym.envs.context import ControllerContext
+from shipgym.scenarios import load_scenario
+
+
+# ------------------------------------------------------------------ the optimiser
+def _direct_solution(ctx: ControllerContext, solver: OracleSolver, x0: np.ndarray) -> tuple:
+    """The same discretised problem (model, RK4 grid, stage cost of the env with the same
+    smoothed |·|, bounds) written out here and solved by IPOPT from the same start."""
+    model, grid, s = ctx.nominal_model, solver.grid, solver.settings
+    reward, L, dmax = ctx.reward, ctx.ship_length, ctx.rudder_limit
+    step = model.casadi_step(ctx.control_period / grid.substeps)
+    u = ca.SX.sym("u", solver.n_u)
+    theta = model.params.to_vector()
+    w = np.zeros(model.n_disturbances)
+    x, cost, eps = ca.DM(x0), 0.0, s.smooth_abs
+    iy, ipsi = model.state_index("y"), model.state_index("psi")
+    for j, periods in enumerate(grid.lengths):
+        for _ in range(periods):
+            for _ in range(grid.substeps):
+                x = step(x, u[j], w, theta)
+            e, heading = x[iy], ca.atan2(ca.sin(x[ipsi]), ca.cos(x[ipsi]))  # leg along +x
+            cost += ca.sqrt((e / L) ** 2 + eps**2) + reward.heading_weight * ca.sqrt(
+                heading**2 + eps**2
+            )
+        previous = 0.0 if j == 0 else u[j - 1]
+        cost += reward.rudder_weight * periods * (u[j] / dmax) ** 2
+        cost += reward.rudder_rate_weight * ((u[j] - previous) / dmax) ** 2
+    nlp = ca.nlpsol(
+        "direct",
+        "ipopt",
+        {"x": u, "f": cost},
+        {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": 1e-10},
+    )
+    sol = nlp(x0=np.zeros(solver.n_u), lbx=-dmax, ubx=dmax)
+    return np.array(sol["x"]).ravel(), float(sol["f"])
+
+
+def test_the_oracles_optimiser_reaches_a_direct_optimal_control_solution() -> None:
+    """One short nominal problem (nomoto2 2 L off a straight leg): the generalised
+    Gauss–Newton SQP reaches IPOPT's optimum of the same problem: cost within 0.1 %, first
+    command within 0.3°."""
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    settings = OracleSettings(max_iter=200, cost_tolerance=0.0, step_tolerance=1e-12, compile=False)
+    weights = (ctx.reward.heading_weight, ctx.reward.rudder_weight, ctx.reward.rudder_rate_weight)
+    grid = oracle_grid(ctx, settings)
+    solver = OracleSolver(
+        ctx.nominal_model,
+        grid,
+        settings,
+        ctx.control_period,
+        ctx.rudder_limit,
+        weights,
+        ctx.ship_length,
+    )
+    model = ctx.nominal_model
+    x0 = model.cruise_state(y=2.0 * ctx.ship_length)
+    legs = np.array([[0.0, 0.0, 1.0, 0.0, LAST_LEG]] * settings.legs)
+    p = solver.parameters(
+        x0,
+        0.0,
+        ctx.acceptance_radius,
+        True,
+        legs,
+        model.params.to_vector(),
+        np.zeros((solver.n_u, model.n_disturbances)),
+    )
+    plan, ok, _ = solver.solve(p, np.zeros(solver.n_u))
+    direct_plan, direct_cost = _direct_solution(ctx, solver, x0)
+    assert ok
+    assert solver.cost(plan, p) == pytest.approx(direct_cost, rel=1e-3)
+    assert abs(plan[0] - direct_plan[0]) < math.radians(0.3)
+    assert direct_cost < solver.cost(np.zeros(solver.n_u), p)  # a problem worth solving
+
+
+def test_the_horizon_rule_by_ship() -> None:
+    """H = 2(T + (L + R0)/U) + δmax/δ̇max: nomoto2 has no rate limit, so H = 2(T + (L+R0)/U)."""
+    assert horizon_seconds(1.0, 1.0, 1.0, 0.5, math.inf, 2.0) == pytest.approx(8.0)
+    assert horizon_seconds(1.0, 1.0, 1.0, 0.5, 0.1, 2.0) == pytest.approx(13.0)
+    for name in ("nominal", "mariner_track", "osaka_curved", "blanke_current_shift"):
+        ctx = ControllerContext.of(load_scenario(name), "rudder")
+        grid = oracle_grid(ctx, OracleSettings())
+        assert grid.steps * ctx.control_period >= grid.horizon_s - 1e-9
+
+
+# ------------------------------------------------------------------ the privileged channel
+SPY = """
+import numpy as np
+from baselines.classical.oracle import Oracle
+
+class Spy:
+    name = "spy"
+    kind = "classical"
+
+    def reset(self, context, seed=None):
+        self.was_reset = True
+
+    def reset_privileged(self, context, truth, seed=None):
+        raise AssertionError(f"a plug-in was handed the truth: {truth}")
+
+    def act(self, obs, info):
+        return np.zeros(1, dtype=np.float32)
+
+
+class Imitator(Oracle):
+    name = "imitator"
+    kind = "classical"
+
+
+def borrowed():
+    policy = Oracle()
+    policy.kind = "classical"
+    return policy
+"""
+
+
+@pytest.fixture
+def spy_module(tmp_path: Path) -> Any:
+    file = tmp_path / "oracle_spy.py"
+    file.write_text(SPY)
+    yield file
+    sys.modules.pop("oracle_spy", None)
+
+
+def test_the_privileged_channel_is_unreachable_from_a_plugin(spy_module: Path) -> None:
+    """Only the registered oracle, named ``oracle`` without settings, reads the truth: a
+    plug-in offering ``reset_privileged`` is reset as any other; the oracle's class as a
+    spec, a subclass or under another name gets no truth and stops with an error."""
+    (result,) = evaluate(f"{spy_module}:Spy", "nominal", seeds=[0])
+    assert result.controller == "spy" and result.metrics["termination_reason"] == "corridor"
+    for spec in (
+        f"{spy_module}:Imitator",
+        f"{spy_module}:borrowed",
+        "baselines.classical.oracle:Oracle",
+        ControllerEntry(controller="oracle", name="my_oracle"),
+        ControllerEntry(controller="oracle", settings={"settings": OracleSettings(blocks=5)}),
+    ):
+        assert not grants_truth(spec)
+        with pytest.raises(ControllerError, match="privileged channel"):
+            evaluate(spec, "nominal", seeds=[0])
+    with pytest.raises(ControllerError, match="privileged channel"):
+        run_episode(Oracle(), "nominal", seed=0)  # an instance: no truth either
+    assert grants_truth("oracle")
+
+
+def test_the_truth_reaches_neither_info_nor_the_context() -> None:
+    """The context carries the nominal model only; ``info`` has no parameter record."""
+    sc = load_scenario("maneuverability_change")
+    ctx = ControllerContext.of(sc, "rudder")
+    assert ctx.nominal_params == sc.nominal_params
+    assert not any(f.name in ("params", "schedule", "truth") for f in dataclasses.fields(ctx))
+
+
+# ------------------------------------------------------------------ the reference table
+def _smoke_trials(scenario: str) -> list[tuple[Job, Any]]:
+    spec = load_suite("smoke")
+    randomize = spec.randomize.model_dump(mode="json")
+    jobs = [Job("oracle", scenario, (10_000 + i,), None, randomize) for i in range(spec.seeds)]
+    return [(job, trials(job)[0]) for job in jobs]
+
+
+def test_the_shipped_table_covers_the_smoke_suite_and_the_leaderboard_reads_it() -> None:
+    """Every smoke trial has its entry; the leaderboard's oracle job returns it (not a run)."""
+    table = shipped_table()
+    for scenario in load_suite("smoke").all_scenarios():
+        for job, trial in _smoke_trials(scenario):
+            entry = table.lookup(trial, job.seeds[0])
+            assert entry is not None, f"no reference for {scenario} seed {job.seeds[0]}"
+    job, trial = _smoke_trials("rudder_aging")[0]
+    (result,) = work(job)
+    assert result.controller == "oracle" and result.kind == "reference"
+    assert result.metrics["cost"] == table.lookup(trial, job.seeds[0])["metrics"]["cost"]
+
+
+def test_a_sample_of_the_shipped_references_recomputes_to_the_same_cost() -> None:
+    """Two shipped entries (the short nomoto2 trials of the smoke suite) run again give
+    the shipped costs (to 1e-6, relative: the same compiled solver, any machine)."""
+    table = shipped_table()
+    for job, trial in _smoke_trials("rudder_aging"):
+        (result,) = work(job._replace(references="recompute"))
+        shipped = table.lookup(trial, job.seeds[0])["metrics"]
+        assert result.metrics["cost"] == pytest.approx(shipped["cost"], rel=1e-6)
+        assert result.metrics["termination_reason"] == shipped["termination_reason"]
+
+
+def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
+    """What is achievable: on every smoke trial the oracle's cost is below pid_los's."""
+    table = shipped_table()
+    for scenario in load_suite("smoke").all_scenarios():
+        for job, trial in _smoke_trials(scenario):
+            (pid,) = evaluate("pid_los", trial, seeds=list(job.seeds))
+            oracle = table.lookup(trial, job.seeds[0])["metrics"]["cost"]
+            assert oracle < pid.metrics["cost"], (scenario, job.seeds, oracle)
+
+
+def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:
+    """Entries are valid for one env revision and oracle settings only."""
+    sc = load_scenario("nominal")
+    file = tmp_path / "t.json.gz"
+    table = ReferenceTable({entry_key(sc, 1): {"metrics": {"cost": 1.0}}}, file)
+    table.save()
+    assert ReferenceTable.load(file).lookup(sc, 1) == {"metrics": {"cost": 1.0}}
+    import gzip
+    import json
+
+    with gzip.open(file, "rt") as f:
+        data = json.load(f)
+    data["env_revision"] = -1
+    with gzip.open(file, "wt") as f:
+        json.dump(data, f)
+    assert ReferenceTable.load(file).lookup(sc, 1) is None
+    assert table_path().name == "oracle.json.gz"
