@@ -22,11 +22,15 @@ them: to the active leg, which switches to the next at the along-track point ℓ
 env's switching rule (smoothly, over ``switch_width_L``·L); a PCHIP route enters as its
 chords ahead of the closest point.
 
-**Horizon rule.**  H = 2(T + L/U) + δmax/δ̇max: two of the ship's yaw time constants T (its
-first-order Nomoto T of the nominal model, the one the classical controllers use) to
-settle a turn, two ship-length transit times L/U to come back to the path, plus the time
-the rudder needs to travel its range at its rate limit (0 without a rate limit).  Per ship:
-nomoto2 ≈ 5.3 s, Esso Osaka (1:100) ≈ 32 s, Mariner ≈ 140 s, Blanke ≈ 26 s.
+**Horizon rule.**  H = 2(T + (L + R0)/U) + δmax/δ̇max: two of the ship's yaw time constants T
+(its first-order Nomoto T of the nominal model, the one the classical controllers use) to
+settle a turn; twice the time to cross one ship length plus the acceptance radius R0 of a
+waypoint route (0 on a PCHIP route), so that the prediction sees past a leg switch, where
+the env's cross-track error jumps to the next leg (shorter horizons were measured to
+avoid the acceptance circle on nomoto2 and miss the goal); plus the time the rudder needs
+to travel its range at its rate limit (0 without a rate limit).  Catalogue values:
+nomoto2 10.0 s (21 steps of 0.5 s), Esso Osaka (1:100) 32 s on its curved route, Mariner
+268 s on its waypoint route, Blanke 51 s.
 
 **Decisions and grid.**  Move blocking: the first command acts for one control period Ts
 (the one applied); the horizon's rest is split into ``blocks`` equal intervals of m·Ts
@@ -137,7 +141,7 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
         context.nominal_speed,
         context.rudder_limit,
         model.rudder_rate_limit,
-        context.acceptance_radius,
+        context.acceptance_radius if context.path_type == "waypoints" else 0.0,
         settings.horizon_factor,
     )
     ts = context.control_period
