@@ -22,6 +22,12 @@ class ControllerError(ShipgymError, KeyError):
         return Exception.__str__(self)
 
 
+class UnsafeFileError(ControllerError):
+    """A file that only unpickling can read (an SB3 zip's pickled parts a scoring run needs,
+    a ``vecnormalize.pkl``): unpickling runs any code the file holds, so it is refused
+    unless the user passes ``--trust-pickle`` (:mod:`baselines.learned.trust`)."""
+
+
 class RunError(ShipgymError, ValueError):
     """A run (leaderboard, reproduction, training, manoeuvre) cannot start as asked: an
     unknown ship, a bad seed count, backend or option combination, nothing to resume or
@@ -49,6 +55,7 @@ __all__ = [
     "ConfigError",
     "ControllerError",
     "RunError",
+    "UnsafeFileError",
     "check_count",
     "check_seeds",
 ]
