@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.identification.errors import check_log_span, check_sample_keys, check_sampling_step
+from shipgym.identification.errors import check_sample_keys, check_sampling_step
 from shipgym.identification.front_end import FrontEndSettings
 from shipgym.identification.lssvm import LSSVMSolution
 from shipgym.identification.nomoto import (
@@ -115,10 +115,6 @@ class _SlidingWindowNomoto:
         self._source = self.front_end.make(h)
         self.gamma = self.front_end.gamma if gamma is None else gamma
         self.params = initial if initial is not None else Nomoto2Params()
-        try:  # a window shorter than the model's time constants identifies a wrong model
-            check_log_span(window, h, self.params.T1, "the initial model")
-        except IdentificationError as exc:
-            raise IdentificationError(f"window of {exc}") from None
         self._base = self.params
         self.sub1 = _SubModel(theta1_from_params(self.params))
         self.sub2 = _SubModel(np.array([self._theta2_of(self.params.Tc)]))

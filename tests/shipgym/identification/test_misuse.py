@@ -66,5 +66,3 @@ def test_finding10_a_log_too_short_for_the_time_constants_names_the_minimum(log)
     slow = Nomoto2Params(T1=0.2, T2=0.1)
     with pytest.raises(IdentificationError, match="too short to identify the identified model"):
         fit_nomoto2(psi[:200], delta[:200], delta_c[:200], H, base=slow)
-    with pytest.raises(IdentificationError, match=r"window of 300 samples .* at least 626"):
-        LambdaLSSVM(H, window=300)
