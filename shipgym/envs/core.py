@@ -34,11 +34,11 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains, pid_step
 from shipgym.disturbances import Disturbances
 from shipgym.guidance import desired_heading
-from shipgym.identification import first_order_nomoto
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.events import ParameterSchedule
+from shipgym.scenarios.loader import nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
 
 ACTION_MODES = ("rudder", "guidance")
@@ -157,7 +157,7 @@ class EnvParts:
         gains = None
         if action_mode == "guidance":
             # pole placement on the nominal model's first-order Nomoto (K, T): never the truth
-            gains = PIDGains.from_nomoto(*first_order_nomoto(model, sc.nominal_params))
+            gains = PIDGains.from_nomoto(*nominal_nomoto(sc))
         return cls(
             scenario=sc,
             action_mode=action_mode,

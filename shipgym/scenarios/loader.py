@@ -22,9 +22,11 @@ from shipgym.config import (
     resolve,
     validate_model,
 )
+from shipgym.identification import first_order_nomoto
 from shipgym.models import MODELS, ParameterError, ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
+from shipgym.scenarios.nominal import nominal_problem
 from shipgym.scenarios.schema import ScenarioConfig
 
 DEG = math.pi / 180.0
@@ -205,6 +207,17 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
     return Scenario(config, model, path, schedule, origin if origin != "<scenario>" else None)
 
 
+def nominal_nomoto(scenario: Scenario) -> tuple[float, float]:
+    """First-order Nomoto (K [1/s], T [s]) of the scenario's nominal ship, as guidance mode
+    and the model-based controllers use it; a :class:`ScenarioError` naming the key when
+    there is none (:func:`shipgym.scenarios.nominal.nominal_problem`)."""
+    found = nominal_problem(scenario)
+    if found is not None:
+        problem = Problem(*found)
+        raise ScenarioError(problem.text(scenario.source_file or scenario.name), [problem])
+    return first_order_nomoto(scenario.model, scenario.nominal_params)  # cached: not rerun
+
+
 def scenario_from_dict(data: Any, origin: str = "<dict>") -> Scenario:
     """A scenario from a mapping of the YAML keys; errors name ``origin`` and the key."""
     return build_scenario(validate_model(data, ScenarioConfig, origin, ScenarioError), origin)
@@ -222,7 +235,8 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     Unlike :func:`load_scenario_file`, which stops at the first failing stage, this lists
     all schema problems pydantic finds (types, ranges, unknown keys, non-finite numbers,
     events after the time limit) and, when the schema passes, all problems of building
-    the scenario (non-physical parameters, a bad path, …)."""
+    the scenario (non-physical parameters, a bad path, …), then the nominal model's
+    identification (:func:`nominal_nomoto`): every file it accepts makes an env."""
     try:
         file = resolve("scenarios", path, error=ScenarioError)
         text = file.read_text(encoding="utf-8")
@@ -242,7 +256,8 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     if not isinstance(data, Mapping):
         return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
     try:
-        build_scenario(ScenarioConfig.model_validate(data), str(file))
+        scenario = build_scenario(ScenarioConfig.model_validate(data), str(file))
+        nominal_nomoto(scenario)  # what construction builds (guidance mode, controllers)
     except ValidationError as exc:
         found = [
             Problem(".".join(str(part) for part in item["loc"]), item["msg"])
