@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from shipgym.config import ConfigError
 from shipgym.errors import ShipgymError
+from shipgym.limits import MAX_SEEDS
 
 
 class ControllerError(ShipgymError, KeyError):
@@ -46,8 +47,11 @@ def check_count(count: int, option: str) -> None:
 
 
 def check_seeds(seeds: int, option: str = "seeds") -> None:
-    """Raise :class:`RunError` unless the number of seeds is at least 1."""
+    """Raise :class:`RunError` unless the number of seeds is at least 1 and at most
+    :data:`shipgym.limits.MAX_SEEDS`."""
     check_count(seeds, option)
+    if seeds > MAX_SEEDS:
+        raise RunError(f"{option} is {seeds}, beyond the limit of {MAX_SEEDS} seeds per scenario")
 
 
 __all__ = [

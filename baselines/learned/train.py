@@ -43,6 +43,7 @@ from baselines.learned.agents import (
     make_training_env,
 )
 from baselines.runs import check_out_dir, clear_outputs
+from shipgym.limits import worker_count
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 #: what a training run writes into its directory (``force`` clears these, and only these)
@@ -385,7 +386,8 @@ def train_sweep(
     """Run training jobs (agents × seeds) sequentially, in a local process pool
     (``workers`` > 1) or on Ray (``backend="ray"``, ``RAY_ADDRESS`` or a local instance);
     the metas come back in job order.  Each run is seeded, so where it runs does not change
-    its result (tested)."""
+    its result (tested).  ``workers`` below 1 is refused, more than the jobs clamped."""
+    workers = worker_count(workers, len(jobs))
     if backend == "ray":
         try:
             import ray
