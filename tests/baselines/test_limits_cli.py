@@ -80,3 +80,9 @@ def test_finding8_workers_beyond_the_jobs_are_clamped(tmp_path: Path, monkeypatc
     ]
     assert main(argv) == 0
     assert started == [1]  # one job: one process, not 100
+
+
+def test_finding8_heldout_scenarios_beyond_the_limit_are_refused(tmp_path: Path, capsys) -> None:
+    suite = _suite(tmp_path, heldout_scenarios=10**9)
+    err = _refused(capsys, ["leaderboard", "--suite", suite, "--out", str(tmp_path / "o")])
+    assert "heldout_scenarios" in err and "less than or equal to 1000" in err

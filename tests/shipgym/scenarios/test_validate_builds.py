@@ -66,3 +66,15 @@ def test_finding9_construction_errors_name_the_scenario_key(tmp_path: Path, caps
     assert problem.key == "ship.params" and "no nominal model" in problem.message
     with pytest.raises(ScenarioError, match=r"key 'ship\.params': no nominal model"):
         gym.make(ENV_ID, scenario=str(diverging), action_mode="guidance", compile=False)
+
+
+def test_finding9_a_controller_meets_the_key_not_a_zigzag_error(tmp_path: Path, capsys) -> None:
+    """Rudder mode builds no autopilot, but the controller context (what model-based
+    controllers design on) names the key too: ``shipgym run`` says it in one line."""
+    file = _osaka(tmp_path, delta_max=0.1)
+    env = gym.make(ENV_ID, scenario=str(file), action_mode="rudder", compile=False)
+    with pytest.raises(ScenarioError, match=r"key 'ship\.params\.delta_max'"):
+        _ = env.unwrapped.controller_context
+    code = main(["run", str(file), "pid_los", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "ship.params.delta_max" in err
