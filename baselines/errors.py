@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from shipgym.config import ConfigError
 from shipgym.errors import ShipgymError
+from shipgym.limits import MAX_SEEDS
 
 
 class ControllerError(ShipgymError, KeyError):
@@ -20,6 +21,12 @@ class ControllerError(ShipgymError, KeyError):
 
     def __str__(self) -> str:  # the message as written, not KeyError's repr of it
         return Exception.__str__(self)
+
+
+class UnsafeFileError(ControllerError):
+    """A file that only unpickling can read (an SB3 zip's pickled parts a scoring run needs,
+    a ``vecnormalize.pkl``): unpickling runs any code the file holds, so it is refused
+    unless the user passes ``--trust-pickle`` (:mod:`baselines.learned.trust`)."""
 
 
 class RunError(ShipgymError, ValueError):
@@ -40,8 +47,11 @@ def check_count(count: int, option: str) -> None:
 
 
 def check_seeds(seeds: int, option: str = "seeds") -> None:
-    """Raise :class:`RunError` unless the number of seeds is at least 1."""
+    """Raise :class:`RunError` unless the number of seeds is at least 1 and at most
+    :data:`shipgym.limits.MAX_SEEDS`."""
     check_count(seeds, option)
+    if seeds > MAX_SEEDS:
+        raise RunError(f"{option} is {seeds}, beyond the limit of {MAX_SEEDS} seeds per scenario")
 
 
 __all__ = [
@@ -49,6 +59,7 @@ __all__ = [
     "ConfigError",
     "ControllerError",
     "RunError",
+    "UnsafeFileError",
     "check_count",
     "check_seeds",
 ]

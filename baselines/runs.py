@@ -347,6 +347,18 @@ def trajectory_file(key: Key) -> str:
     return f"{TRAJECTORY_DIR}/{digest}.npz"
 
 
+def _inside(folder: Path, name: Any) -> Path:
+    """``folder / name`` if that is a file path inside ``folder`` (a record's
+    ``trajectory`` may name nothing else), else a :class:`RunError`."""
+    file = folder / str(name)
+    if not isinstance(name, str) or not file.resolve().is_relative_to(folder.resolve()):
+        raise RunError(
+            f"{folder / EPISODES_FILE}: a record's trajectory {name!r} is not a file inside "
+            "its run folder"
+        )
+    return file
+
+
 def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> EpisodeResult:
     """An :class:`~baselines.evaluation.EpisodeResult` from a record of ``folder``'s
     ``episodes.jsonl`` (its trajectory read if it was kept, else empty; a record of an
@@ -356,7 +368,7 @@ def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> Epis
     trajectory: dict[str, np.ndarray] = {}
     name = record.get("trajectory") or trajectory_file(episode_key(record))
     if name:
-        file = Path(folder) / name
+        file = _inside(Path(folder), name)
         if file.is_file():
             with np.load(file) as data:
                 trajectory = {k: data[k] for k in data.files}

@@ -12,6 +12,7 @@ from pydantic import Discriminator, Field, Tag, model_validator
 from baselines.errors import ConfigError
 from baselines.plugins import ControllerEntry, ControllerSpec, anchored
 from shipgym.config import ConfigFile, StrictModel, is_path, list_names, load_yaml_model, resolve
+from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_SEEDS
 from shipgym.scenarios.trials import TrialRandomization
 
 
@@ -47,9 +48,9 @@ class SuiteConfig(StrictModel):
     name: str
     description: str = ""
     scenarios: list[str] = Field(default_factory=list)
-    heldout_scenarios: int = Field(0, ge=0)
+    heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
     controllers: list[SuiteController] = Field(min_length=1)
-    seeds: int = Field(5, ge=1)
+    seeds: int = Field(5, ge=1, le=MAX_SEEDS)
     randomize: TrialRandomization | None = None
 
     @model_validator(mode="after")

@@ -29,6 +29,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from shipgym.errors import ShipgymError
+from shipgym.limits import MAX_CONFIG_BYTES
 
 #: kind (folder of configs/) -> what one file of it is called in messages
 KINDS: dict[str, str] = {
@@ -163,12 +164,25 @@ def format_validation_error(err: ValidationError, origin: str) -> str:
     return "\n".join(lines)
 
 
-def read_yaml(file: ConfigFile, error: type[Exception] = ConfigError) -> Any:
-    """The parsed YAML of ``file``; malformed YAML fails naming the file and the line."""
+def read_config_text(file: ConfigFile, error: type[Exception] = ConfigError) -> str:
+    """The text of a config file; one larger than :data:`shipgym.limits.MAX_CONFIG_BYTES`
+    is refused before it is read (parsing it would take minutes), naming the limit."""
     try:
-        text = file.read_text(encoding="utf-8")
+        with file.open("rb") as fh:
+            data = fh.read(MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise error(f"{file}: cannot read: {exc.strerror or exc}") from None
+    if len(data) > MAX_CONFIG_BYTES:
+        raise error(f"{file}: larger than the limit of {MAX_CONFIG_BYTES} bytes for a config file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{file}: cannot read: not UTF-8 text ({exc.reason})") from None
+
+
+def read_yaml(file: ConfigFile, error: type[Exception] = ConfigError) -> Any:
+    """The parsed YAML of ``file``; malformed YAML fails naming the file and the line."""
+    text = read_config_text(file, error)
     try:
         return yaml.safe_load(text)
     except yaml.MarkedYAMLError as exc:

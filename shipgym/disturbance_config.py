@@ -155,3 +155,11 @@ class SensorConfig(StrictModel):
     outlier_probability: float = Field(0.0, ge=0, le=1)  # per fine sample
     outlier_magnitude_deg: tuple[float, float] = (5.0, 15.0)  # |spike| range on heading
     dropout_probability: float = Field(0.0, ge=0, le=1)  # per fine sample: hold last value
+
+    @field_validator("outlier_magnitude_deg")
+    @classmethod
+    def _a_range(cls, v: tuple[float, float]) -> tuple[float, float]:
+        """A range of spike sizes: 0 ≤ low ≤ high (what the sensor draws from)."""
+        if not 0 <= v[0] <= v[1]:
+            raise ValueError(f"must be [low, high] with 0 ≤ low ≤ high, got {list(v)}")
+        return v

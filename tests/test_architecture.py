@@ -24,6 +24,7 @@ LAYERS: dict[str, int] = {
     # 0 — foundations: the error base, config files, scalar/array operation sets, angle
     #     arithmetic, path geometry
     "shipgym.errors": 0,
+    "shipgym.limits": 0,
     "shipgym.config": 0,
     "shipgym.numerics": 0,
     "shipgym.angles": 0,

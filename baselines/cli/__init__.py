@@ -56,8 +56,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)  # a run's record keeps it
+    from baselines.learned.trust import trusting_pickle
+
     try:
-        return int(args.func(args))
+        with trusting_pickle(getattr(args, "trust_pickle", False)):
+            return int(args.func(args))
     except ShipgymError as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return EXIT_USAGE

@@ -20,6 +20,17 @@ def add_progress_option(parser: argparse.ArgumentParser, help: str | None = None
     parser.add_argument("--no-progress", action="store_true", help=help)
 
 
+def add_trust_pickle_option(parser: argparse.ArgumentParser) -> None:
+    """``--trust-pickle``: read model files that only unpickling can read (it runs any code
+    they hold; :mod:`baselines.learned.trust`)."""
+    parser.add_argument(
+        "--trust-pickle",
+        action="store_true",
+        help="read agent files that need unpickling (a pickled VecNormalize, an SB3 zip's "
+        "pickled policy class or kwargs): unpickling runs any code in them",
+    )
+
+
 def add_backend_option(parser: argparse.ArgumentParser) -> None:
     """``--backend``: a local process pool or a Ray cluster."""
     parser.add_argument("--backend", choices=BACKENDS, default="local")
@@ -50,7 +61,8 @@ def add_run_options(
     out_help: str = "output directory (refused if not empty: see --resume, --force)",
 ) -> None:
     """The options of a suite run (``leaderboard``, ``evaluate``): --suite, --seeds, --out
-    (default ``out``) with --resume / --force, --backend, --workers, --no-progress, --json."""
+    (default ``out``) with --resume / --force, --backend, --workers, --trust-pickle,
+    --no-progress, --json."""
     parser.add_argument(
         "--suite", default="default", help="suite name in configs/suites or a YAML path"
     )
@@ -62,6 +74,7 @@ def add_run_options(
     parser.add_argument(
         "--workers", type=int, default=None, help="local processes (default: cores)"
     )
+    add_trust_pickle_option(parser)
     add_progress_option(parser, progress_help)
     add_json_option(parser, "print the rows as JSON on stdout")
 

@@ -13,7 +13,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from baselines.cli.options import add_json_option, add_out_options, emit
+from baselines.cli.options import (
+    add_json_option,
+    add_out_options,
+    add_trust_pickle_option,
+    emit,
+)
 from baselines.errors import RunError
 from baselines.evaluation import EVAL_SEED_OFFSET
 
@@ -47,6 +52,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "empty: see --force)",
         resume_help=None,
     )
+    add_trust_pickle_option(p)
     add_json_option(p, "print the episode's metrics as one JSON object")
     p.set_defaults(func=run)
 

@@ -2,10 +2,12 @@
 
 Any stable-baselines3 / sb3-contrib model zip is scored by its path, as ``model.save(path)``
 wrote it: the algorithm is read from the zip (:func:`detect_algorithm`), the action mode from
-its action space (shape (1,): rudder, (2,): guidance), and a ``vecnormalize.pkl`` beside it
-normalises the observation as in training.  A ``meta.json`` beside it (what ``shipgym
-train`` writes) is optional; its keys are checked (:class:`PolicyMeta`) and its training
-cost becomes leaderboard columns.  Every unreadable file is a
+its action space (shape (1,): rudder, (2,): guidance), and the observation statistics beside
+it (``vecnormalize.json``; a ``vecnormalize.pkl`` only with ``--trust-pickle``) normalise
+the observation as in training.  Nothing is unpickled unless the command trusts pickles
+(:mod:`baselines.learned.loading`, :mod:`baselines.learned.trust`).  A ``meta.json`` beside
+it (what ``shipgym train`` writes) is optional; its keys are checked (:class:`PolicyMeta`)
+and its training cost becomes leaderboard columns.  Every unreadable file is a
 :class:`~baselines.errors.ControllerError` naming the file (and the key).
 
 A policy trained with several seeds is a folder of ``seed_<k>/`` folders, each a policy
@@ -44,7 +46,10 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from baselines.errors import ControllerError
+from baselines.errors import ControllerError, UnsafeFileError
+from baselines.learned.loading import load_data_only
+from baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
+from baselines.learned.trust import pickle_trusted
 from baselines.policy import check_action_mode
 from shipgym.config import validate_model
 from shipgym.envs.context import ControllerContext
@@ -80,7 +85,6 @@ ACTION_MODE_OF_SIZE = {1: "rudder", 2: "guidance"}
 
 #: the optional files beside a model zip
 META_FILE = "meta.json"
-VECNORMALIZE_FILE = "vecnormalize.pkl"
 #: the model zips a policy folder is read from, in this order (else its one ``.zip``)
 MODEL_FILES = ("model.zip", "best_model.zip")
 #: the folder of one training seed inside a policy folder: ``seed_<k>``
@@ -157,7 +161,8 @@ class SavedModel:
 @dataclasses.dataclass(frozen=True)
 class PolicyFiles:
     """A learned policy's files: the model, its checked ``meta.json`` (``meta``: as written,
-    empty without one), the ``vecnormalize.pkl`` beside it, if any, and the training seed
+    empty without one), the observation statistics beside it, if any
+    (:func:`~baselines.learned.normalizer.normalizer_file`), and the training seed
     (its ``seed_<k>`` folder's, else the meta's; None when neither says)."""
 
     model: SavedModel
@@ -352,7 +357,7 @@ def _read_meta(file: Path) -> tuple[dict[str, Any], PolicyMeta]:
 def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> PolicyFiles:
     """A learned policy's files, checked: the zip (:func:`read_model`), ``meta.json`` if
     present (its ``algo`` and ``action_mode`` must be the zip's, its ``seed`` the
-    ``seed_<k>`` folder's), ``vecnormalize.pkl``.  ``training_seed``: which seed's files
+    ``seed_<k>`` folder's), the observation statistics.  ``training_seed``: which seed's files
     (None: the first; a single model's must be its meta's seed)."""
     folder, seed = _seed_folder(_source(name_or_path), training_seed)
     saved = read_model(_folder_model(folder))
@@ -386,19 +391,20 @@ def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> P
             f"{meta_file}: key 'action_mode' is {checked.action_mode!r}, but "
             f"{saved.path.name} acts in {saved.action_mode!r} mode (its action space)"
         )
-    vecnormalize = saved.path.parent / VECNORMALIZE_FILE
     return PolicyFiles(
         model=saved,
         algo=algo,
         meta=meta,
         cost=checked,
-        vecnormalize=vecnormalize if vecnormalize.is_file() else None,
+        vecnormalize=normalizer_file(saved.path.parent),
         training_seed=seed,
     )
 
 
-def load_model(path: Path, algo: str) -> Any:
-    """The SB3 model of a zip, on the CPU; a zip that does not load is a clear error."""
+def load_model(path: Path, algo: str, action_mode: str) -> Any:
+    """The SB3 model of a zip, on the CPU, read as data (:func:`load_data_only`); a zip
+    that only unpickling can read is refused unless the command trusts pickles, then
+    loaded by SB3; a zip that does not load is a clear error."""
     module, name = ALGORITHMS[algo]
     try:
         algorithm = getattr(importlib.import_module(module), name)
@@ -407,6 +413,11 @@ def load_model(path: Path, algo: str) -> Any:
         raise ControllerError(
             f"{path}: a {name} model needs {package} (pip install {package}): {exc}"
         ) from exc
+    try:
+        return load_data_only(path, algorithm, action_mode)
+    except UnsafeFileError:
+        if not pickle_trusted():
+            raise
     try:
         return algorithm.load(str(path), device="cpu", custom_objects=_INFERENCE_ONLY)
     except (
@@ -419,22 +430,6 @@ def load_model(path: Path, algo: str) -> Any:
         KeyError,
     ) as exc:
         raise ControllerError(f"{path}: cannot load it as a {name} model: {exc}") from exc
-
-
-def load_obs_normalizer(file: Path) -> Any:
-    """The ``VecNormalize`` statistics of ``file`` (no env attached: only
-    ``normalize_obs`` is used); an unreadable file is a clear error."""
-    from stable_baselines3.common.vec_env import VecNormalize
-
-    try:
-        with open(file, "rb") as fh:
-            normalizer = pickle.load(fh)
-    except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, ValueError) as exc:
-        raise ControllerError(f"{file}: not a readable VecNormalize file: {exc}") from exc
-    if not isinstance(normalizer, VecNormalize):
-        raise ControllerError(f"{file}: holds a {type(normalizer).__name__}, not a VecNormalize")
-    normalizer.training = False
-    return normalizer
 
 
 @dataclasses.dataclass
@@ -470,9 +465,9 @@ class LearnedPolicy:
         import torch
 
         torch.set_num_threads(1)  # one small MLP per episode; leaderboard workers share cores
-        self.model = load_model(self.model_path, self.algo)
-        self.obs_normalizer = (
-            load_obs_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
+        self.model = load_model(self.model_path, self.algo, self.action_mode)
+        self.obs_normalizer: ObsNormalizer | None = (
+            load_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
         )
         self.recurrent = self.algo in RECURRENT
         self._memory = _Memory()

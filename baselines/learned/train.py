@@ -14,8 +14,10 @@ Otherwise an output directory that is not empty is refused, unless ``force=True`
 earlier outputs, :data:`TRAINING_OUTPUTS`, are removed first).
 
 :func:`export_policy` copies what :class:`~baselines.learned.policy.LearnedPolicy` needs (the
-best model, its meta, ``vecnormalize.pkl`` if the run has one; no checkpoints, replay buffers
-or logs) into a policy directory; :func:`ship_policy` into the shipped layout
+best model, its meta, the observation statistics ``vecnormalize.json`` if the run
+normalises observations (data, not a pickle: :mod:`baselines.learned.normalizer`); no
+checkpoints, replay buffers or logs) into a policy directory; :func:`ship_policy` into the
+shipped layout
 ``baselines/learned/policies/<name>/seed_<k>/``.  So ``shipgym train all --seeds 0 1 2
 --ship --resume`` on finished runs only exports them.
 """
@@ -41,10 +43,19 @@ from baselines.learned.agents import (
     make_training_env,
 )
 from baselines.runs import check_out_dir, clear_outputs
+from shipgym.limits import worker_count
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 #: what a training run writes into its directory (``force`` clears these, and only these)
-TRAINING_OUTPUTS = ("model.zip", "best_model.zip", "meta.json", "checkpoints", "eval", "tb")
+TRAINING_OUTPUTS = (
+    "model.zip",
+    "best_model.zip",
+    "meta.json",
+    "vecnormalize.json",
+    "checkpoints",
+    "eval",
+    "tb",
+)
 
 
 def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
@@ -261,8 +272,23 @@ def train(
         },
     }
     (out / "meta.json").write_text(json.dumps(meta, indent=2))
+    save_obs_statistics(venv, out)
     venv.close()
     return meta
+
+
+def save_obs_statistics(venv: Any, out: Path) -> Path | None:
+    """Write the observation statistics of a training env that normalises observations as
+    ``out/vecnormalize.json`` (data: :class:`~baselines.learned.normalizer.ObsNormalizer`);
+    None (and no file) for one that does not."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer
+
+    (out / NORMALIZER_FILE).unlink(missing_ok=True)  # not a stale one
+    if not (isinstance(venv, VecNormalize) and venv.norm_obs):
+        return None
+    return ObsNormalizer.of(venv).save(out / NORMALIZER_FILE)
 
 
 def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
@@ -281,13 +307,15 @@ def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:
     check_out_dir(out, force=force, note=f" (agent folder of {name})")
 
 
-#: the files of a policy folder (what LearnedPolicy reads), written by export_policy
-POLICY_FILES = ("model.zip", "meta.json", "vecnormalize.pkl")
+#: the files of a policy folder (what LearnedPolicy reads), written by export_policy (and
+#: the pickled statistics an earlier version exported, removed on export)
+POLICY_FILES = ("model.zip", "meta.json", "vecnormalize.json", "vecnormalize.pkl")
 
 
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     """Copy the best model (else the final one) as ``model.zip``, ``meta.json`` and the
-    run's ``vecnormalize.pkl`` (if any) into ``dest`` (a policy dir); nothing else."""
+    run's ``vecnormalize.json`` (if any) into ``dest`` (a policy dir); nothing else (no
+    pickle: a stale ``vecnormalize.pkl`` there is removed)."""
     src = Path(out_dir)
     model = src / "best_model.zip"
     if not model.is_file():
@@ -298,11 +326,11 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     target.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(model, target / "model.zip")
     shutil.copyfile(src / "meta.json", target / "meta.json")
-    normalizer = src / "vecnormalize.pkl"
-    if normalizer.is_file():
-        shutil.copyfile(normalizer, target / "vecnormalize.pkl")
-    else:
-        (target / "vecnormalize.pkl").unlink(missing_ok=True)  # not a stale one
+    for name in POLICY_FILES[2:]:
+        (target / name).unlink(missing_ok=True)  # not a stale one
+    statistics = src / POLICY_FILES[2]
+    if statistics.is_file():
+        shutil.copyfile(statistics, target / statistics.name)
     return target
 
 
@@ -358,7 +386,8 @@ def train_sweep(
     """Run training jobs (agents × seeds) sequentially, in a local process pool
     (``workers`` > 1) or on Ray (``backend="ray"``, ``RAY_ADDRESS`` or a local instance);
     the metas come back in job order.  Each run is seeded, so where it runs does not change
-    its result (tested)."""
+    its result (tested).  ``workers`` below 1 is refused, more than the jobs clamped."""
+    workers = worker_count(workers, len(jobs))
     if backend == "ray":
         try:
             import ray

@@ -10,6 +10,7 @@ import numpy as np
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios import Scenario
+from shipgym.scenarios.loader import nominal_nomoto
 from shipgym.tracking import PathTracker
 
 
@@ -42,8 +43,12 @@ class ControllerContext:
 
     @classmethod
     def of(cls, scenario: Scenario, action_mode: str) -> ControllerContext:
-        """The context of ``scenario`` (its nominal model, path and timing)."""
+        """The context of ``scenario`` (its nominal model, path and timing).  A nominal ship
+        that gives no first-order Nomoto model (what model-based controllers design on) is
+        a :class:`~shipgym.scenarios.ScenarioError` naming the key, as validation reports
+        it (:func:`~shipgym.scenarios.loader.nominal_nomoto`; cached per ship)."""
         sc = scenario
+        nominal_nomoto(sc)
         return cls(
             ship=sc.model.name,
             nominal_model=sc.model.with_params(sc.nominal_params),

@@ -34,11 +34,11 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains, pid_step
 from shipgym.disturbances import Disturbances
 from shipgym.guidance import desired_heading
-from shipgym.identification import first_order_nomoto
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.events import ParameterSchedule
+from shipgym.scenarios.loader import nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
 
 ACTION_MODES = ("rudder", "guidance")
@@ -112,6 +112,17 @@ class StepConstants:
         )
 
 
+def observation_space() -> spaces.Box:
+    """The envs' observation space: :data:`OBS_NAMES`, scaled to [OBS_LOW, OBS_HIGH]."""
+    return spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
+
+
+def action_space(action_mode: str) -> spaces.Box:
+    """The envs' action space: one rudder command, or the two guidance actions, in [-1, 1]."""
+    n_act = 1 if action_mode == "rudder" else 2
+    return spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32)
+
+
 @dataclasses.dataclass
 class EnvParts:
     """Everything an env builds from its scenario, for one ship (``batch=None``) or N."""
@@ -151,8 +162,7 @@ class EnvParts:
         gains = None
         if action_mode == "guidance":
             # pole placement on the nominal model's first-order Nomoto (K, T): never the truth
-            gains = PIDGains.from_nomoto(*first_order_nomoto(model, sc.nominal_params))
-        n_act = 1 if action_mode == "rudder" else 2
+            gains = PIDGains.from_nomoto(*nominal_nomoto(sc))
         return cls(
             scenario=sc,
             action_mode=action_mode,
@@ -160,8 +170,8 @@ class EnvParts:
             integrator=integrator,
             disturbances=disturbances,
             tracker=tracker,
-            observation_space=spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32),
-            action_space=spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32),
+            observation_space=observation_space(),
+            action_space=action_space(action_mode),
             metric_settings=MetricSettings(convergence_threshold=sc.config.convergence_threshold),
             autopilot_gains=gains,
         )

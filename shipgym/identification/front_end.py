@@ -41,7 +41,12 @@ from typing import Any, ClassVar, Protocol
 import numpy as np
 from scipy.linalg import expm
 
-from shipgym.identification.errors import IdentificationError, check_sampling_step
+from shipgym.identification.errors import (
+    IdentificationError,
+    check_log_arrays,
+    check_sampling_step,
+    describe_nonfinite,
+)
 
 #: the two sources of the derivatives
 FRONT_ENDS = ("differences", "svf")
@@ -143,13 +148,10 @@ class FrontEnd(Protocol):
 
 
 def _columns(psi: Any, delta: Any, delta_c: Any) -> np.ndarray:
-    return np.column_stack(
-        [
-            np.asarray(psi, float).ravel(),
-            np.asarray(delta, float).ravel(),
-            np.asarray(delta_c, float).ravel(),
-        ]
-    )
+    """The samples as (n, 3) columns; arrays of different lengths are an error naming them
+    (non-finite samples are dropped samples here: each front end says what it did)."""
+    arrays = [np.asarray(a, float).ravel() for a in (psi, delta, delta_c)]
+    return np.column_stack(check_log_arrays(arrays, finite=False))
 
 
 class DifferencesFrontEnd:
@@ -168,7 +170,11 @@ class DifferencesFrontEnd:
     ) -> tuple[RegressionSignals, str | None]:
         new = _columns(psi, delta, delta_c)
         finite = np.all(np.isfinite(new), axis=1)
-        note = None if np.all(finite) else "non-finite samples: difference chain restarted"
+        note = (
+            None
+            if np.all(finite)
+            else f"non-finite samples ({describe_nonfinite(new)}): difference chain restarted"
+        )
         parts = []
         start = 0
         breaks = np.flatnonzero(~finite)
@@ -401,7 +407,7 @@ class _Cleaner:
             self._started = True
         if not np.all(finite):
             note = (
-                "non-finite samples replaced ("
+                f"non-finite samples ({describe_nonfinite(new)}) replaced ("
                 + ("outlier filter's median" if self.hampel is not None else "last value held")
                 + ")"
             )

@@ -29,7 +29,12 @@ import math
 
 import numpy as np
 
-from shipgym.identification.errors import IdentificationError, check_sampling_step
+from shipgym.identification.errors import (
+    IdentificationError,
+    check_log_arrays,
+    check_log_span,
+    check_sampling_step,
+)
 from shipgym.identification.front_end import (
     PAPER_GAMMA,
     FrontEndSettings,
@@ -87,12 +92,7 @@ def regression_rows(signals: RegressionSignals, h: float) -> NomotoRegression:
 
 
 def _check_log(psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray) -> tuple[np.ndarray, ...]:
-    psi = np.asarray(psi, dtype=float)
-    delta = np.asarray(delta, dtype=float)
-    delta_c = np.asarray(delta_c, dtype=float)
-    if not (psi.shape == delta.shape == delta_c.shape) or psi.ndim != 1:
-        raise IdentificationError("psi, delta and delta_c must be 1-D arrays of equal length")
-    return psi, delta, delta_c
+    return tuple(check_log_arrays((psi, delta, delta_c), finite=True))
 
 
 def nomoto_regressors(
@@ -208,7 +208,10 @@ def fit_nomoto2(
     :class:`FrontEndSettings`; ``gamma`` None: the front end's γ (the paper's 1e15 with the
     differences, 1e20 with the SVF: ``FrontEndSettings.gamma``).  Returns a
     :class:`Nomoto2Params` in SI units (u0, L, Kc from ``base``).  Raises
-    IdentificationError (naming the reason) on bad input or degenerate data.
+    IdentificationError (naming the reason) on bad input or degenerate data: a non-finite
+    sample (array and index), arrays of different lengths (their names), a log shorter than
+    5 × T1 of ``base`` (default: Liu's ship) or of the identified model (the minimum
+    length).
     """
     h = check_sampling_step(h)
     settings = front_end_settings(
@@ -227,14 +230,17 @@ def fit_nomoto2(
                 "front end's start transient and delay: need a longer log"
             )
         reg = regression_rows(signals, h)
+    base = base if base is not None else Nomoto2Params()
     problem = excitation_problem(reg.x1, reg.x2)
     if problem is not None:
         raise IdentificationError(problem)
+    n = np.asarray(psi).shape[0]
+    check_log_span(n, h, base.T1, "the base model")
     sol1, _ = solve_theta(reg.x1, reg.y1, gamma, weighted, bias_penalty)
     sol2, _ = solve_theta(reg.x2, reg.y2, gamma, weighted, bias_penalty)
     values = params_from_theta1(sol1.theta)
     values["Tc"] = tc_from_theta2(float(sol2.theta[0]), h, servo_model)
-    base = base if base is not None else Nomoto2Params()
+    check_log_span(n, h, values["T1"], "the identified model")
     try:
         return base.replace(**values)
     except ValueError as exc:

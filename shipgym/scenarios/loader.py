@@ -18,13 +18,17 @@ from shipgym.config import (
     is_path,
     list_names,
     load_yaml_model,
+    read_config_text,
     read_yaml,
     resolve,
     validate_model,
 )
+from shipgym.identification import first_order_nomoto
+from shipgym.limits import MAX_EPISODE_STEPS, MAX_SUBSTEPS
 from shipgym.models import MODELS, ParameterError, ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
+from shipgym.scenarios.nominal import nominal_problem
 from shipgym.scenarios.schema import ScenarioConfig
 
 DEG = math.pi / 180.0
@@ -190,9 +194,41 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
         model.initial_state(**config.initial_state.states)
     except KeyError as exc:
         problems.append(Problem("initial_state.states", str(exc.args[0])))
+    problems += timing_problems(config, model)
+    if problems:
+        raise ScenarioError("\n".join(p.text(origin) for p in problems), problems=problems)
+    return Scenario(config, model, path, schedule, origin if origin != "<scenario>" else None)
+
+
+def nominal_nomoto(scenario: Scenario) -> tuple[float, float]:
+    """First-order Nomoto (K [1/s], T [s]) of the scenario's nominal ship, as guidance mode
+    and the model-based controllers use it; a :class:`ScenarioError` naming the key when
+    there is none (:func:`shipgym.scenarios.nominal.nominal_problem`)."""
+    found = nominal_problem(scenario)
+    if found is not None:
+        problem = Problem(*found)
+        raise ScenarioError(problem.text(scenario.source_file or scenario.name), [problem])
+    return first_order_nomoto(scenario.model, scenario.nominal_params)  # cached: not rerun
+
+
+def timing_problems(config: ScenarioConfig, model: ShipModel) -> list[Problem]:
+    """Problems of the episode's timing: a control period that is not a whole multiple of
+    the fine step, and the limits of :mod:`shipgym.limits` — substeps per control period
+    (named under ``fine_step`` when the file sets it, else ``control_period``) and steps
+    per episode (``time_limit``)."""
     fine = config.fine_step or model.fine_step
     period = config.control_period or model.control_period
     ratio = period / fine
+    if ratio > MAX_SUBSTEPS:
+        key = "fine_step" if config.fine_step is not None else "control_period"
+        return [
+            Problem(
+                key,
+                f"control_period / fine_step = {period:.6g} s / {fine:.6g} s = {ratio:.6g} "
+                f"substeps per step, beyond the limit of {MAX_SUBSTEPS}",
+            )
+        ]
+    problems = []
     if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
         problems.append(
             Problem(
@@ -200,9 +236,16 @@ def build_scenario(config: ScenarioConfig, origin: str = "<scenario>") -> Scenar
                 f"{period} s is not a whole multiple of the fine step {fine} s",
             )
         )
-    if problems:
-        raise ScenarioError("\n".join(p.text(origin) for p in problems), problems=problems)
-    return Scenario(config, model, path, schedule, origin if origin != "<scenario>" else None)
+    steps = config.time_limit / period
+    if steps > MAX_EPISODE_STEPS:
+        problems.append(
+            Problem(
+                "time_limit",
+                f"time_limit / control_period = {config.time_limit:.6g} s / {period:.6g} s = "
+                f"{steps:.6g} steps per episode, beyond the limit of {MAX_EPISODE_STEPS}",
+            )
+        )
+    return problems
 
 
 def scenario_from_dict(data: Any, origin: str = "<dict>") -> Scenario:
@@ -222,11 +265,12 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     Unlike :func:`load_scenario_file`, which stops at the first failing stage, this lists
     all schema problems pydantic finds (types, ranges, unknown keys, non-finite numbers,
     events after the time limit) and, when the schema passes, all problems of building
-    the scenario (non-physical parameters, a bad path, …)."""
+    the scenario (non-physical parameters, a bad path, …), then the nominal model's
+    identification (:func:`nominal_nomoto`): every file it accepts makes an env."""
     try:
         file = resolve("scenarios", path, error=ScenarioError)
-        text = file.read_text(encoding="utf-8")
-    except (ScenarioError, OSError) as exc:
+        text = read_config_text(file, ScenarioError)
+    except ScenarioError as exc:
         return [Problem("", str(exc))]
     try:
         root = yaml.compose(text)  # the node tree: where each key is written
@@ -242,7 +286,8 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     if not isinstance(data, Mapping):
         return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
     try:
-        build_scenario(ScenarioConfig.model_validate(data), str(file))
+        scenario = build_scenario(ScenarioConfig.model_validate(data), str(file))
+        nominal_nomoto(scenario)  # what construction builds (guidance mode, controllers)
     except ValidationError as exc:
         found = [
             Problem(".".join(str(part) for part in item["loc"]), item["msg"])

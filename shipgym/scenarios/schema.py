@@ -12,9 +12,9 @@ that relate two keys (an event after the time limit) name the key at fault.
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import AfterValidator, Field, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
 from shipgym.config import StrictModel
@@ -27,6 +27,7 @@ from shipgym.disturbance_config import (
     TwoPhaseCurrent,
     WaveConfig,
 )
+from shipgym.limits import MAX_POSITION_M, MAX_WAYPOINTS
 from shipgym.models import MODELS, ParameterError
 
 #: one problem found by a check across keys: (location, message, the input at fault)
@@ -91,9 +92,16 @@ class ShipConfig(StrictModel):
         return self
 
 
+def check_position(value: float) -> float:
+    """A coordinate [m] within the documented limit ±MAX_POSITION_M (shipgym.limits)."""
+    if abs(value) > MAX_POSITION_M:
+        raise ValueError(f"{value:.6g} m is beyond the limit of ±{MAX_POSITION_M:.6g} m")
+    return value
+
+
 class InitialState(StrictModel):
-    x: float = 0.0  # m
-    y: float = 0.0  # m
+    x: Annotated[float, AfterValidator(check_position)] = 0.0  # m
+    y: Annotated[float, AfterValidator(check_position)] = 0.0  # m
     heading_deg: float = 0.0  # deg
     states: dict[str, float] = Field(default_factory=dict)  # other states, SI
 
@@ -109,6 +117,11 @@ class PathConfig(StrictModel):
     def _at_least_two(cls, v: list[tuple[float, float]]) -> list[tuple[float, float]]:
         if len(v) < 2:
             raise ValueError("a path needs at least 2 waypoints")
+        if len(v) > MAX_WAYPOINTS:
+            raise ValueError(f"{len(v)} waypoints, beyond the limit of {MAX_WAYPOINTS}")
+        for point in v:
+            for c in point:
+                check_position(c)
         return v
 
 

@@ -28,9 +28,10 @@ import math
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import AfterValidator
+from pydantic import AfterValidator, ValidationInfo, field_validator
 
 from shipgym.config import StrictModel
+from shipgym.limits import RANDOMIZE_BOUNDS
 
 #: the trial draws' stream, apart from the env's own seeding
 TRIAL_STREAM = 0x7121A1
@@ -46,13 +47,24 @@ Range = Annotated[tuple[float, float], AfterValidator(_ordered)]
 
 
 class TrialRandomization(StrictModel):
-    """Uniform ranges of what each evaluation seed draws (module doc); None: fixed."""
+    """Uniform ranges of what each evaluation seed draws (module doc); None: fixed.  Each
+    lies within its documented bounds (:data:`shipgym.limits.RANDOMIZE_BOUNDS`)."""
 
     cross_track_offset_L: Range | None = None
     heading_error_deg: Range | None = None
     jump_time_jitter_s: Range | None = None
     current_speed_factor: Range | None = None
     current_direction_deg: Range | None = None
+
+    @field_validator(*RANDOMIZE_BOUNDS)
+    @classmethod
+    def _within_limits(
+        cls, r: tuple[float, float] | None, info: ValidationInfo
+    ) -> tuple[float, float] | None:
+        low, high = RANDOMIZE_BOUNDS[str(info.field_name)]
+        if r is not None and not (low <= r[0] and r[1] <= high):
+            raise ValueError(f"{list(r)} is beyond the limit [{low:g}, {high:g}]")
+        return r
 
 
 _ORDER = (

@@ -1,5 +1,5 @@
 """A plain stable-baselines3 zip is scored by its path (issue 12 items 2 and 5): algorithm
-from the zip, action mode from its action space, ``vecnormalize.pkl`` beside it used,
+from the zip, action mode from its action space, ``vecnormalize.pkl`` beside it used (when trusted),
 ``meta.json`` optional and checked, a truncated or corrupt zip a clear error.  An agent
 trained with several seeds is a folder of ``seed_<k>`` folders (issue 13 item 2)."""
 
@@ -27,6 +27,7 @@ from baselines.learned.policy import (
     read_policy,
     shipped_policies,
 )
+from baselines.learned.trust import trusting_pickle
 from baselines.plugins import ControllerEntry
 from baselines.registry import (
     controller_kind,
@@ -170,7 +171,8 @@ def test_vecnormalize_beside_the_zip_normalises_the_observation(tmp_path: Path) 
     model.learn(total_timesteps=64)  # the running mean and variance move away from 0, 1
     model.save(tmp_path / "model")
     venv.save(str(tmp_path / "vecnormalize.pkl"))
-    policy = LearnedPolicy(tmp_path)
+    with trusting_pickle(True):  # a pickle: read only when trusted (issue 19, finding 7)
+        policy = LearnedPolicy(tmp_path)
     assert policy.obs_normalizer is not None
     for obs in _observations(5):
         np.testing.assert_array_equal(policy.act(obs, {}), _predict(model, venv.normalize_obs(obs)))
@@ -178,7 +180,10 @@ def test_vecnormalize_beside_the_zip_normalises_the_observation(tmp_path: Path) 
     acted = np.array([policy.act(o, {}) for o in _observations(5)])
     assert not np.array_equal(raw, acted)  # the statistics were used
     (tmp_path / "vecnormalize.pkl").write_bytes(b"not a pickle")
-    with pytest.raises(ControllerError, match=r"vecnormalize\.pkl: not a readable VecNormalize"):
+    with (
+        trusting_pickle(True),
+        pytest.raises(ControllerError, match=r"vecnormalize\.pkl: not a readable VecNormalize"),
+    ):
         LearnedPolicy(tmp_path)
 
 
@@ -243,7 +248,8 @@ def test_a_meta_json_gives_name_and_training_cost(trained: dict[str, Path], tmp_
 def test_a_meta_json_names_the_algorithm_the_zip_does_not(
     trained: dict[str, Path], tmp_path: Path
 ) -> None:
-    """A zip whose policy class is the user's own (not one of SB3's) needs ``algo``."""
+    """A zip whose policy class is the user's own (not one of SB3's) needs ``algo`` (and
+    ``--trust-pickle``: the class is pickled)."""
     source = _copy(trained, tmp_path / "src")
     custom = tmp_path / "agent" / "model.zip"
     custom.parent.mkdir()
@@ -258,7 +264,11 @@ def test_a_meta_json_names_the_algorithm_the_zip_does_not(
     with pytest.raises(ControllerError, match=r"cannot tell which algorithm saved it"):
         make_controller(str(custom))
     (custom.parent / "meta.json").write_text('{"algo": "ppo"}')
-    policy, _ = make_controller(str(custom))
+    # the user's own class lives only in the pickle (issue 19, finding 7)
+    with pytest.raises(ControllerError, match=r"my_package\.policies.*--trust-pickle"):
+        make_controller(str(custom))
+    with trusting_pickle(True):
+        policy, _ = make_controller(str(custom))
     assert policy.algo == "ppo"
 
 

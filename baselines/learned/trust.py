@@ -1,0 +1,54 @@
+"""Whether files that need unpickling may be read (``--trust-pickle``).
+
+A stable-baselines3 zip keeps cloudpickled values beside its JSON, and a
+``vecnormalize.pkl`` is a pickle: unpickling either runs any code its author put in it.
+Scoring third-party agents is this product's purpose, so a model is read as data only
+(:mod:`baselines.learned.loading`, :mod:`baselines.learned.normalizer`) and a file that
+needs unpickling is an :class:`~baselines.errors.UnsafeFileError` unless the user trusts
+it: ``--trust-pickle`` on ``evaluate``, ``run`` and ``leaderboard``.
+
+The choice travels in the environment variable :data:`TRUST_PICKLE_ENV`, so the worker
+processes of a run (forked, spawned or a local Ray instance) see what the command said.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+from baselines.errors import UnsafeFileError
+
+#: set to "1" while a command runs with ``--trust-pickle``
+TRUST_PICKLE_ENV = "SHIPGYM_TRUST_PICKLE"
+#: the command-line option that allows unpickling
+TRUST_PICKLE_OPTION = "--trust-pickle"
+
+
+def pickle_trusted() -> bool:
+    """True while the running command was given ``--trust-pickle``."""
+    return os.environ.get(TRUST_PICKLE_ENV) == "1"
+
+
+@contextlib.contextmanager
+def trusting_pickle(trusted: bool) -> Iterator[None]:
+    """Within the block, files that need unpickling are read (``trusted``) or refused;
+    the previous setting is restored afterwards."""
+    before = os.environ.get(TRUST_PICKLE_ENV)
+    os.environ[TRUST_PICKLE_ENV] = "1" if trusted else "0"
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(TRUST_PICKLE_ENV, None)
+        else:
+            os.environ[TRUST_PICKLE_ENV] = before
+
+
+def refuse_unpickling(file: Path, why: str) -> UnsafeFileError:
+    """The error for ``file``, which only unpickling can read (``why``: what in it)."""
+    return UnsafeFileError(
+        f"{file}: {why}; reading it means unpickling, which runs any code the file holds: "
+        f"refused (pass {TRUST_PICKLE_OPTION} if you trust whoever made it)"
+    )

@@ -1,0 +1,217 @@
+"""Model files are read as data (issue 19, finding 7): an SB3 zip's pickled values are never
+unpickled, the weights load with ``weights_only``, observation statistics come from JSON; a
+file that needs unpickling is refused unless ``--trust-pickle``.  The shipped agents act
+exactly as through SB3's pickle loader (golden actions recorded before the change)."""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+import pickle
+import shutil
+import zipfile
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from baselines.cli import main
+from baselines.errors import UnsafeFileError
+from baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer, read_normalizer
+from baselines.learned.policy import POLICY_DIR, LearnedPolicy
+from baselines.learned.trust import TRUST_PICKLE_ENV, pickle_trusted, trusting_pickle
+from baselines.registry import make_controller
+
+sb3 = pytest.importorskip("stable_baselines3")
+GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "shipped_policy_actions.npz"
+
+
+class _Payload:
+    """Unpickling this creates the file ``target`` (what a hostile pickle could do)."""
+
+    def __init__(self, target: Path) -> None:
+        self.target = str(target)
+
+    def __reduce__(self) -> tuple:
+        return (open, (self.target, "w"))
+
+
+def _serialized(target: Path) -> dict[str, str]:
+    """An SB3 ``data`` value whose unpickling creates ``target``."""
+    return {
+        ":type:": "<class 'x'>",
+        ":serialized:": base64.b64encode(pickle.dumps(_Payload(target))).decode(),
+    }
+
+
+def _rewrite(zip_path: Path, out: Path, data_change=None, entries=None) -> Path:
+    """A copy of the model zip with its ``data`` JSON changed and entries replaced."""
+    with zipfile.ZipFile(zip_path) as src, zipfile.ZipFile(out, "w") as dst:
+        for item in src.infolist():
+            content = src.read(item.filename)
+            if item.filename == "data" and data_change is not None:
+                data = json.loads(content)
+                data_change(data)
+                content = json.dumps(data).encode()
+            if entries and item.filename in entries:
+                content = entries[item.filename]
+            dst.writestr(item.filename, content)
+    return out
+
+
+def _shipped_zip() -> Path:
+    return POLICY_DIR / "ppo" / "seed_0" / "model.zip"
+
+
+def test_finding7_shipped_agents_act_as_through_the_pickle_loader() -> None:
+    import torch
+
+    torch.set_num_threads(1)
+    golden = np.load(GOLDEN, allow_pickle=False)
+    observations = golden["observations"]
+    keys = [k for k in golden.files if k != "observations"]
+    assert len(keys) == 15  # 5 agents × 3 training seeds
+    for key in keys:
+        name, seed = key.split("__seed_")
+        policy = LearnedPolicy(name, training_seed=int(seed))
+        assert not pickle_trusted()
+        actions = np.array([policy.act(obs, {}) for obs in observations])
+        np.testing.assert_array_equal(actions, golden[key], err_msg=key)
+
+
+def test_finding7_a_pickle_payload_in_a_zip_is_not_executed(tmp_path: Path) -> None:
+    """Pickled values scoring does not need (schedules, buffers, spaces) are never read."""
+    target = tmp_path / "pwned"
+
+    def plant(data: dict) -> None:
+        for key in ("lr_schedule", "clip_range", "_last_obs", "ep_info_buffer"):
+            data[key] = _serialized(target)
+        for key in ("policy_class", "observation_space", "action_space"):  # kept as JSON
+            data[key][":serialized:"] = _serialized(target)[":serialized:"]
+
+    (tmp_path / "agent").mkdir()
+    hostile = _rewrite(_shipped_zip(), tmp_path / "agent" / "model.zip", plant)
+    policy = LearnedPolicy(hostile)
+    golden = np.load(GOLDEN, allow_pickle=False)
+    obs = golden["observations"][0]
+    np.testing.assert_array_equal(policy.act(obs, {}), golden["ppo__seed_0"][0])
+    assert not target.exists()
+
+
+def test_finding7_a_zip_that_needs_unpickling_is_refused_naming_the_option(
+    tmp_path: Path, capsys
+) -> None:
+    target = tmp_path / "pwned"
+
+    def kwargs(data: dict) -> None:
+        data["policy_kwargs"]["activation_fn"] = _serialized(target)
+
+    (tmp_path / "agent").mkdir()
+    hostile = _rewrite(_shipped_zip(), tmp_path / "agent" / "model.zip", kwargs)
+    refused = r"policy_kwargs hold pickled objects.*--trust-pickle"
+    with pytest.raises(UnsafeFileError, match=refused):
+        LearnedPolicy(hostile)
+    out = tmp_path / "out"
+    code = main(["run", "nominal", str(hostile), "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "--trust-pickle" in err
+    assert not target.exists()
+    assert TRUST_PICKLE_ENV not in os.environ  # the command restored the setting
+
+
+def test_finding7_weights_are_loaded_with_weights_only(tmp_path: Path) -> None:
+    import io
+
+    import torch
+
+    target = tmp_path / "pwned"
+    buffer = io.BytesIO()
+    torch.save({"weights": _Payload(target)}, buffer)
+    (tmp_path / "agent").mkdir()
+    hostile = _rewrite(
+        _shipped_zip(), tmp_path / "agent" / "model.zip", entries={"policy.pth": buffer.getvalue()}
+    )
+    with pytest.raises(UnsafeFileError, match=r"policy\.pth holds objects"):
+        LearnedPolicy(hostile)
+    assert not target.exists()
+
+
+def test_finding7_a_pickled_vecnormalize_is_refused_unless_trusted(tmp_path: Path) -> None:
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    target = tmp_path / "pwned"
+    folder = tmp_path / "agent"
+    folder.mkdir()
+    shutil.copyfile(_shipped_zip(), folder / "model.zip")
+    (folder / "vecnormalize.pkl").write_bytes(pickle.dumps(_Payload(target)))
+    with pytest.raises(UnsafeFileError, match=r"vecnormalize\.pkl: .*--trust-pickle"):
+        LearnedPolicy(folder)
+    assert not target.exists()
+    # a genuine one, converted to data, normalises exactly as SB3's VecNormalize
+    venv = VecNormalize(DummyVecEnv([lambda: gym.make("ShipPathFollow-v0")]), norm_obs=True)
+    venv.reset()
+    for _ in range(30):
+        venv.step(np.array([[0.5]], dtype=np.float32))
+    venv.save(str(folder / "vecnormalize.pkl"))
+    with trusting_pickle(True):
+        trusted = LearnedPolicy(folder)
+    from baselines.learned.normalizer import main as convert
+
+    assert convert([str(folder / "vecnormalize.pkl")]) == 0
+    data = LearnedPolicy(folder)  # the JSON beside it: no unpickling
+    assert isinstance(data.obs_normalizer, ObsNormalizer)
+    assert read_normalizer(folder / NORMALIZER_FILE) == trusted.obs_normalizer
+    golden = np.load(GOLDEN, allow_pickle=False)["observations"]
+    np.testing.assert_array_equal(
+        data.obs_normalizer.normalize_obs(golden), venv.normalize_obs(golden)
+    )
+    for obs in golden[:10]:
+        np.testing.assert_array_equal(data.act(obs, {}), trusted.act(obs, {}))
+
+
+def test_finding7_trust_pickle_reads_a_zip_sb3_alone_can(tmp_path: Path, capsys) -> None:
+    """A custom activation lives only in the pickle: with --trust-pickle SB3 loads it."""
+    import torch
+
+    model = sb3.PPO(
+        "MlpPolicy",
+        gym.make("ShipPathFollow-v0"),
+        device="cpu",
+        policy_kwargs={"net_arch": [8], "activation_fn": torch.nn.ReLU},
+    )
+    (tmp_path / "relu").mkdir()
+    model.save(tmp_path / "relu" / "model.zip")
+    zip_path = tmp_path / "relu" / "model.zip"
+    with pytest.raises(UnsafeFileError, match="--trust-pickle"):
+        make_controller(str(zip_path))[0]
+    code = main(["run", "nominal", str(zip_path), "--trust-pickle", "--out", str(tmp_path / "o")])
+    assert code == 0, capsys.readouterr().err
+    assert json.loads((tmp_path / "o" / "metrics.json").read_text())["kind"] == "learned"
+
+
+def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    from baselines.learned.train import export_policy, save_obs_statistics
+
+    env = DummyVecEnv([lambda: gym.make("ShipPathFollow-v0")])
+    assert save_obs_statistics(VecNormalize(env, norm_obs=False), tmp_path) is None
+    venv = VecNormalize(env, norm_obs=True)
+    venv.reset()
+    for _ in range(20):
+        venv.step(np.array([[-0.4]], dtype=np.float32))
+    run = tmp_path / "run"
+    run.mkdir()
+    written = save_obs_statistics(venv, run)
+    assert written == run / NORMALIZER_FILE
+    assert read_normalizer(written) == ObsNormalizer.of(venv)
+    shutil.copyfile(_shipped_zip(), run / "model.zip")
+    (run / "meta.json").write_text("{}")
+    dest = tmp_path / "policy"
+    dest.mkdir()
+    (dest / "vecnormalize.pkl").write_bytes(b"stale")
+    export_policy(run, dest)
+    assert sorted(p.name for p in dest.iterdir()) == ["meta.json", "model.zip", NORMALIZER_FILE]
+    assert LearnedPolicy(dest).obs_normalizer == ObsNormalizer.of(venv)
