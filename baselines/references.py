@@ -3,7 +3,8 @@
 The oracle (:mod:`baselines.classical.oracle`) is the denominator of the leaderboard's cost
 ratio on every scenario trial.  Its episodes are deterministic given the trial (the resolved
 scenario a suite's seed draws) and the env seed, so they are computed once per trial, frozen
-per env revision (:data:`shipgym.envs.core.ENV_REVISION`) and oracle settings, and shipped
+per env revision (:data:`shipgym.envs.core.ENV_REVISION`), oracle revision and settings, and
+shipped
 in ``baselines/reference_data/oracle.json.gz``:
 
     {"format": 1, "env_revision": R, "oracle": {settings}, "entries": {
@@ -68,12 +69,12 @@ def entry_key(scenario: Scenario, seed: int) -> str:
 
 def oracle_header() -> dict[str, Any]:
     """The header a table must carry to be valid now (env revision, oracle settings)."""
-    from baselines.classical.oracle import OracleSettings
+    from baselines.classical.oracle import ORACLE_REVISION, OracleSettings
 
     return {
         "format": FORMAT,
         "env_revision": ENV_REVISION,
-        "oracle": dataclasses.asdict(OracleSettings()),
+        "oracle": {"revision": ORACLE_REVISION, **dataclasses.asdict(OracleSettings())},
     }
 
 
