@@ -358,14 +358,10 @@ def run_leaderboard(
     ``episodes.jsonl``: a job whose episodes are partly there runs the missing seeds) or
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
-<<<<<<< HEAD
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
-    its shipped reference table (:mod:`baselines.references`).  Ctrl-C raises
+    its shipped reference table (:mod:`baselines.references`).  ``workers``: local processes
+    (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
     :class:`~baselines.runs.RunInterrupted`.
-=======
-    recorded.  ``workers``: local processes (default: the cores), clamped to the jobs; below
-    1 refused.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
->>>>>>> issue19b
     """
     check_out_dir(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
@@ -380,15 +376,11 @@ def run_leaderboard(
     scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
-<<<<<<< HEAD
     references = "recompute" if recompute_references else "table"
     jobs = plan_jobs(
         names, scenarios, seed_list, seeds_of, record["randomize"], skip, references
     )
-=======
-    jobs = plan_jobs(names, scenarios, seed_list, seeds_of, record["randomize"], skip)
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
->>>>>>> issue19b
     n_episodes = sum(len(job.seeds) for job in jobs)
     log = RunLog.open(
         out_dir,
