@@ -66,7 +66,6 @@ from shipgym.envs.truth import PlantTruth
 from shipgym.identification import first_order_nomoto
 from shipgym.models.base import ShipModel
 
-
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
 ORACLE_REVISION = 1
