@@ -40,7 +40,10 @@ BUILTINS = {
     "nmpc_lambda_lssvm_svf": ("rudder", ("nomoto2",)),
     "zero_rudder": ("rudder", None),
     "random": ("rudder", None),
+    "oracle": ("rudder", None),
 }
+#: the references: shown on every scenario, never ranked
+REFERENCES = {"zero_rudder", "random", "oracle"}
 
 
 def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
@@ -50,7 +53,8 @@ def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
 def test_builtin_controllers_keep_their_names_modes_and_ships() -> None:
     table = {name: (r.action_mode, r.applies_to) for name, r in CONTROLLERS.items()}
     assert table == BUILTINS
-    assert {controller_kind(name) for name in BUILTINS} == {"classical"}
+    assert {controller_kind(name) for name in BUILTINS.keys() - REFERENCES} == {"classical"}
+    assert {controller_kind(name) for name in REFERENCES} == {"reference"}
 
 
 @pytest.mark.parametrize("name", sorted(BUILTINS))
