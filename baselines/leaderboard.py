@@ -23,9 +23,9 @@ from __future__ import annotations
 import contextlib
 import csv
 import functools
+import json
 import math
 import os
-import signal
 import sys
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
@@ -46,7 +46,15 @@ from baselines.plugins import ControllerSpec
 from baselines.ranking import SCORE_ONE, SCORE_ZERO, aggregate_ranking, row_intervals
 from baselines.ranking import scenario_scores as score_table
 from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
+from baselines.runs import (
+    BACKENDS,
+    RunLog,
+    check_out_dir,
+    check_out_usable,
+    episode_result,
+    read_episodes,
+)
+from baselines.signals import worker_init
 from baselines.style import FIGURE_DPI, controller_style
 from baselines.suite import load_suite
 from shipgym.config import is_path
@@ -100,13 +108,16 @@ def scenario_split(scenario: str) -> str:
 class Job(NamedTuple):
     """One unit of work: a controller (trained with ``training_seed``; None: not trained)
     on the trials of scenario ``scenario`` (a name as the suite gives it) that ``seeds``
-    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials)."""
+    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
+    ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
+    as recorded whatever its file says now; None: resolved from ``scenario`` here."""
 
     controller: ControllerSpec
     scenario: str
     seeds: tuple[int, ...]
     training_seed: int | None = None
     randomize: dict[str, Any] | None = None
+    settings: dict[str, Any] | None = None
 
 
 @functools.lru_cache(maxsize=128)
@@ -123,10 +134,23 @@ def suite_scenario(name: str) -> Scenario:
     return _cached_scenario(name, stamp)
 
 
+@functools.lru_cache(maxsize=128)
+def _recorded_scenario(settings: str) -> Scenario:
+    return load_scenario(json.loads(settings))
+
+
+def job_scenario(job: Job) -> Scenario:
+    """The job's scenario: built from its recorded ``settings`` (once per process), else
+    resolved from its name."""
+    if job.settings is None:
+        return suite_scenario(job.scenario)
+    return _recorded_scenario(json.dumps(job.settings, sort_keys=True))
+
+
 def trials(job: Job) -> list[Scenario]:
     """The job's scenario as each of its seeds draws it (the scenario itself without
     randomisation)."""
-    base = suite_scenario(job.scenario)
+    base = job_scenario(job)
     randomization = None if job.randomize is None else TrialRandomization(**job.randomize)
     return [trial_scenario(base, randomization, seed) for seed in job.seeds]
 
@@ -170,18 +194,14 @@ def work(job: Job) -> list[EpisodeResult]:
     return run_batch(job)
 
 
-def _quiet_worker() -> None:
-    """Pool workers ignore Ctrl-C (the parent stops them): no traceback from each."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
-    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes)."""
+    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes,
+    :func:`baselines.signals.worker_init`)."""
     if workers <= 1:
         for job in jobs:
             yield work(job)
         return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=worker_init)
     try:
         for fut in as_completed([pool.submit(work, j) for j in jobs]):
             yield fut.result()
@@ -189,7 +209,7 @@ def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
         workers_running = list((pool._processes or {}).values())  # shutdown forgets them
         pool.shutdown(wait=False, cancel_futures=True)
         for process in workers_running:
-            process.terminate()
+            process.kill()  # workers ignore SIGTERM (baselines.signals)
         raise
     pool.shutdown()
 
@@ -267,25 +287,29 @@ def suite_record(
 
 def plan_jobs(
     names: list[ControllerSpec],
-    scenarios: Iterable[str],
+    scenarios: Iterable[str] | Mapping[str, dict[str, Any]],
     seed_list: list[int],
     seeds_of: Mapping[str, list[int | None]],
     randomize: dict[str, Any] | None,
     skip: set[tuple[str, str]],
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job per seed for
-    a classical controller, one job of all seeds per training seed for a learned agent."""
+    a classical controller, one job of all seeds per training seed for a learned agent.
+    ``scenarios``: names, or name → recorded settings (the jobs run those)."""
     jobs = []
     for scenario in scenarios:
+        settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
         for c in names:
             label = controller_label(c)
             if (scenario, label) in skip:
                 continue
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
-                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize))
+                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
                 else:
-                    jobs += [Job(c, scenario, (seed,), k, randomize) for seed in seed_list]
+                    jobs += [
+                        Job(c, scenario, (seed,), k, randomize, settings) for seed in seed_list
+                    ]
     return jobs
 
 
@@ -322,10 +346,11 @@ def run_leaderboard(
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
     recorded.  Ctrl-C raises :class:`~baselines.runs.RunInterrupted`.
     """
-    check_out_dir(out_dir, resume=resume, force=force)  # before any work
+    check_out_usable(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
         raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
-    spec = load_suite(suite)
+    spec = load_suite(suite)  # a bad suite is named before the state of out_dir
+    check_out_dir(out_dir, resume=resume, force=force)
     n_seeds = int(seeds if seeds is not None else spec.seeds)
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
@@ -335,7 +360,7 @@ def run_leaderboard(
     scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
-    jobs = plan_jobs(names, scenarios, seed_list, seeds_of, record["randomize"], skip)
+    jobs = plan_jobs(names, record["scenarios"], seed_list, seeds_of, record["randomize"], skip)
     n_episodes = sum(len(job.seeds) for job in jobs)
     log = RunLog.open(
         out_dir,
@@ -345,35 +370,34 @@ def run_leaderboard(
         resume=resume,
         force=force,
     )
-    todo = missing(jobs, log.done)
-    rows = row_keys(jobs)
-    bar = tqdm(
-        total=n_episodes,
-        initial=n_episodes - sum(len(job.seeds) for job in todo),
-        desc="leaderboard",
-        file=sys.stderr,
-        disable=not show_progress,
-    )
-    with (
-        log.recording(),
-        closing(iter_results(todo, backend, workers or os.cpu_count() or 1)) as results,
-    ):
+    with log.recording():  # holds out_dir's lock to the end
+        todo = missing(jobs, log.done)
+        rows = row_keys(jobs)
+        bar = tqdm(
+            total=n_episodes,
+            initial=n_episodes - sum(len(job.seeds) for job in todo),
+            desc="leaderboard",
+            file=sys.stderr,
+            disable=not show_progress,
+        )
         try:
-            for batch in results:
-                for result in batch:
-                    if _result_key(result) in log.done:
-                        continue  # recorded before (a resumed job)
-                    log.append(result, keep_trajectory=True)
-                    keep_drawn(log, rows, (result.scenario, result.controller))
-                    bar.update(1)
-                    if on_episode is not None:
-                        on_episode(result)
+            with closing(iter_results(todo, backend, workers or os.cpu_count() or 1)) as results:
+                for batch in results:
+                    for result in batch:
+                        if _result_key(result) in log.done:
+                            continue  # recorded before (a resumed job)
+                        log.append(result, keep_trajectory=True)
+                        keep_drawn(log, rows, (result.scenario, result.controller))
+                        bar.update(1)
+                        if on_episode is not None:
+                            on_episode(result)
         finally:
             bar.close()
         for row in rows:  # rows completed by a run that stopped before pruning them
             keep_drawn(log, rows, row)
-        results = load_results(log.folder)
-        return write_results(log.folder, log.record["suite"], results, workers=workers)
+        with log.manifest.claiming():  # the tables and figures: listed for --force
+            results = load_results(log.folder)
+            return write_results(log.folder, log.record["suite"], results, workers=workers)
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -527,7 +551,7 @@ def _pool(workers: int, figures: int) -> Iterator[Executor | _Inline]:
     if workers <= 1 or figures < POOLED_FIGURES:
         yield _Inline()
         return
-    with ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
+    with ProcessPoolExecutor(max_workers=workers, initializer=worker_init) as pool:
         yield pool
 
 

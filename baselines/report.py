@@ -17,10 +17,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from baselines.errors import RunError
+from baselines.locking import out_lock
+from baselines.manifest import Manifest, clear_listed
 from baselines.runs import (
     Key,
     check_out_dir,
-    clear_outputs,
+    check_out_usable,
     differences,
     episode_key,
     episode_result,
@@ -28,6 +30,7 @@ from baselines.runs import (
     now,
     read_episodes,
     read_run,
+    temporary_file,
     versions,
     write_json,
 )
@@ -85,7 +88,7 @@ def merge_runs(
         ]
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         suite["name"] = suite["name"] or run_suite.get("name")
-        episodes = read_episodes(folder)
+        episodes = read_episodes(folder, suite=run_suite)
         for episode in episodes:
             key = episode_key(episode)
             if key in episode_in:
@@ -126,23 +129,28 @@ def write_report(
         if Path(folder).resolve() == target.resolve():
             raise RunError(f"--out {target} is one of the runs read: choose another folder")
     suite, results, sources = merge_runs(folders)
-    if force:
-        clear_outputs(target)
-    target.mkdir(parents=True, exist_ok=True)
-    from baselines.leaderboard import write_results
+    check_out_usable(target, force=force)
+    with out_lock(target, now()):
+        check_out_dir(target, force=force)  # again, now that no other run can start there
+        if force:
+            clear_listed(target)
+        manifest = Manifest(target)
+        from baselines.leaderboard import write_results
 
-    rows = write_results(target, suite, results)
-    write_json(
-        target / REPORT_FILE,
-        {
-            "command": list(command),
-            "time": now(),
-            "versions": versions(),
-            "git_commit": git_commit(),
-            "runs": sources,
-            "suite": suite,
-        },
-    )
+        with manifest.claiming():
+            rows = write_results(target, suite, results)
+        manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
+        write_json(
+            target / REPORT_FILE,
+            {
+                "command": list(command),
+                "time": now(),
+                "versions": versions(),
+                "git_commit": git_commit(),
+                "runs": sources,
+                "suite": suite,
+            },
+        )
     return rows, sources
 
 
