@@ -479,9 +479,10 @@ def read_episodes(
     first: dict[Key, int] = {}
     for number, line in _lines(file):
         try:
-            record = _check_episode(json.loads(line), file, number)
+            parsed = json.loads(line)
         except ValueError:
             raise _bad_line(file, number, "not JSON") from None
+        record = _check_episode(parsed, file, number)
         key = episode_key(record)
         if keys is not None and (why := _foreign(key, keys)) is not None:
             raise _bad_line(file, number, why)
@@ -490,7 +491,10 @@ def read_episodes(
             if _same(records[key], record):
                 continue  # the same episode written twice: one episode
             raise _bad_line(
-                file, number, f"episode {list(key)} again, other than on line {first[key]}"
+                file,
+                number,
+                f"episode {json.dumps(list(key))} again, with other values than on line "
+                f"{first[key]}",
             )
         records[key], first[key] = record, number
     return list(records.values())
