@@ -39,6 +39,7 @@ from tqdm import tqdm
 
 from baselines import evaluation
 from baselines.errors import BackendError, RunError, check_seeds
+from baselines.escaping import csv_cell, md_cell, plain_text
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from baselines.figures import median_ace_episode
 from baselines.jsonout import dumps
@@ -705,8 +706,8 @@ def ranking_markdown(
         for rank, r in enumerate(mine, start=1):
             cells = [
                 str(rank),
-                r["controller"],
-                r["kind"],
+                md_cell(r["controller"]),
+                md_cell(r["kind"]),
                 str(r["training_seeds"] or "–"),
                 str(len(r["scenarios"])),
                 _interval(r["score_mean"], r["score_mean_ci95"]),
@@ -734,11 +735,11 @@ def scores_markdown(
         "Mean normalised score over each row's episodes [95 % interval, stratified over "
         "training seeds]; – where the controller does not apply.",
         "",
-        "| controller | " + " | ".join(shown) + " |",
+        "| controller | " + " | ".join(map(md_cell, shown)) + " |",
         "|---|" + "---|" * len(shown),
     ]
     for controller in controllers:
-        row = [controller]
+        row = [md_cell(controller)]
         for s in shown:
             found = cell.get((controller, s))
             row.append(
@@ -769,7 +770,7 @@ def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")
         writer.writeheader()
-        writer.writerows(rows)
+        writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
     rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
     (out / "leaderboard.md").write_text(
         (head + "\n" if head else "") + rows_part + generalisation_table(rows)
@@ -817,7 +818,7 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
         "|---|---|---|---|---|---|---|---|",
     ]
     for g in gen:
-        cells = [g["controller"], g["kind"]]
+        cells = [md_cell(g["controller"]), md_cell(g["kind"])]
         cells += [
             _fmt(g[f"{split}_{key}"])
             for key in ("ace_L", "return", "success")
@@ -850,7 +851,7 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     keys = ["ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        cells = [r["scenario"], r["controller"], r["kind"]]
+        cells = [md_cell(r["scenario"]), md_cell(r["controller"]), md_cell(r["kind"])]
         if not r.get("applies", True):
             lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * 11) + " |")
             continue
@@ -919,14 +920,15 @@ def plot_results(
         pts = sc.path.point(np.linspace(0, sc.path.length, 300))
         axes[0].plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="path")
         for name, r in first.items():
-            tr, look = r.trajectory, controller_style(name).kwargs()
-            axes[0].plot(tr["x"], tr["y"], lw=1, label=name, **look)
-            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=name, **look)
-            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=name, **look)
+            tr, look, label = r.trajectory, controller_style(name).kwargs(), plain_text(name)
+            axes[0].plot(tr["x"], tr["y"], lw=1, label=label, **look)
+            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=label, **look)
+            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=label, **look)
         if sc.change_time is not None:
             for ax in axes[1:]:
                 ax.axvline(sc.change_time, color="gray", ls=":", lw=1)
-        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=f"{scenario}: tracks (seed {seed})")
+        title = f"{plain_text(scenario)}: tracks (seed {seed})"
+        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=title)
         axes[0].set_aspect("equal", adjustable="datalim")
         axes[1].set(xlabel="t [s]", ylabel="e [m]", title="cross-track error")
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
