@@ -675,8 +675,10 @@ class RunLog:
             try:
                 np.savez(self.folder / tmp, **result.trajectory)  # uncompressed: 6x faster
                 os.replace(self.folder / tmp, self.folder / name)
-            except BaseException:  # no half-written file left behind (a full disk)
+            except BaseException as exc:  # no half-written file left behind (a full disk)
                 (self.folder / tmp).unlink(missing_ok=True)
+                if isinstance(exc, OSError) and exc.filename is None:
+                    exc.filename = str(self.folder / tmp)  # the message names it
                 raise
         assert self._file is not None, "append after finish"
         self._file.write(json.dumps(record, allow_nan=False) + "\n")
@@ -748,7 +750,8 @@ class RunLog:
 
     def _write_record(self, in_place: bool = False) -> None:
         """``run.json``, atomically; ``in_place``: when that finds no room, overwritten in
-        the room the file has (the final status on a full disk)."""
+        place as compact JSON if that does not make the file longer (the final status on
+        a full disk), else left as it was."""
         file = self.folder / RUN_FILE
         try:
             write_json(file, self.record)
@@ -757,9 +760,11 @@ class RunLog:
                 raise
             from baselines.jsonout import dumps
 
-            with contextlib.suppress(OSError), open(file, "r+", encoding="utf-8") as fh:
-                fh.write(dumps(self.record, indent=2) + "\n")
-                fh.truncate()
+            data = (dumps(self.record) + "\n").encode()
+            if len(data) <= file.stat().st_size:
+                with contextlib.suppress(OSError), open(file, "r+b") as fh:
+                    fh.write(data)
+                    fh.truncate()
 
 
 def _outside_problem(exc: BaseException) -> str | None:
@@ -770,8 +775,8 @@ def _outside_problem(exc: BaseException) -> str | None:
     if isinstance(exc, RunFailed):
         return str(exc)
     if isinstance(exc, OSError) and exc.errno in NO_ROOM:
-        where = f" writing {exc.filename}" if exc.filename else ""
-        return f"no room on the disk{where} ({exc.strerror})"
+        where = exc.filename or "a file"
+        return f"no room to write {where} ({exc.strerror}: disk full?)"
     return None
 
 
