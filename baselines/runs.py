@@ -574,7 +574,7 @@ class RunLog:
         self.done: set[Key] = set(self.episodes)
         self.manifest = manifest or Manifest(folder)
         self._count = len(self.episodes)
-        self._file: IO[str] | None = None
+        self._file: IO[bytes] | None = None
         self._synced = time.monotonic()
         self._lock = contextlib.ExitStack()
 
@@ -658,7 +658,7 @@ class RunLog:
         manifest.claim(RUN_FILE, temporary_file(run_file).name, EPISODES_FILE)
         log = cls(folder, record, episodes, manifest)
         log._write_record()
-        log._file = open(log.episodes_file, "a")  # closed by finish
+        log._file = open(log.episodes_file, "ab", buffering=0)  # closed by finish
         return log
 
     def append(self, result: EpisodeResult, keep_trajectory: bool = False) -> None:
@@ -681,14 +681,33 @@ class RunLog:
                     exc.filename = str(self.folder / tmp)  # the message names it
                 raise
         assert self._file is not None, "append after finish"
-        self._file.write(json.dumps(record, allow_nan=False) + "\n")
-        self._file.flush()
+        self._write_line((json.dumps(record, allow_nan=False) + "\n").encode())
         if time.monotonic() - self._synced >= FSYNC_INTERVAL_S:
             os.fsync(self._file.fileno())
             self._synced = time.monotonic()
         self.episodes[key] = record
         self.done.add(key)
         self._count += 1
+
+    def _write_line(self, data: bytes) -> None:
+        """Append one line to ``episodes.jsonl`` (unbuffered: on disk when this returns);
+        a line that cannot be written whole is cut off again, so no partial line stays
+        between whole ones (a full disk)."""
+        assert self._file is not None
+        start = self._file.seek(0, os.SEEK_END)
+        try:
+            done = 0
+            while done < len(data):
+                written = self._file.write(data[done:])
+                if not written:
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                done += written
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._file.fileno(), start)
+            if exc.filename is None:
+                exc.filename = str(self.episodes_file)
+            raise
 
     def drop_trajectories(self, keys: Iterable[Key]) -> None:
         """Remove the trajectory files of these episodes (those not drawn), if there."""
@@ -697,15 +716,12 @@ class RunLog:
 
     def finish(self, status: str) -> None:
         """Close ``episodes.jsonl`` and write the final status and end time (on a full
-        disk as far as it goes: what cannot be flushed is lost, ``run.json`` is
-        overwritten in place)."""
+        disk ``run.json`` is overwritten in place if it can be: :meth:`_write_record`)."""
         if self._file is not None:
             file, self._file = self._file, None
             with contextlib.suppress(OSError):
-                file.flush()
                 os.fsync(file.fileno())
-            with contextlib.suppress(OSError):
-                file.close()  # closed even when its last flush fails
+            file.close()
         self._count = len(read_episodes(self.folder))  # the file's count: Ctrl-C may cut in
         self.record.update(status=status, end_time=now(), episodes=self._count)
         self._write_record(in_place=status != "complete")

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import datetime
+import errno
+import io
 import json
 import os
 import signal
@@ -17,7 +19,7 @@ import yaml
 
 import baselines.leaderboard
 from baselines.cli import main
-from baselines.errors import RunError
+from baselines.errors import RunError, RunFailed
 from baselines.jsonout import dumps
 from baselines.leaderboard import run_leaderboard
 from baselines.manifest import snapshot
@@ -485,3 +487,45 @@ def test_finding2_a_malformed_run_json_is_one_line_naming_the_file(
     args = ["leaderboard", "--suite", suite, "--out", str(out), "--resume", "--no-progress"]
     assert main(args) == 2
     assert capsys.readouterr().err == f"shipgym leaderboard: error: {out / 'run.json'}: {problem}\n"
+
+
+class _FillsUp(io.FileIO):
+    """A file on a disk that fills up: the first write stores half its bytes, then none."""
+
+    full = False
+
+    def write(self, data: bytes) -> int:  # type: ignore[override]
+        if self.full:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        self.full = True
+        return super().write(bytes(data)[: len(data) // 2])
+
+
+def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_run: Path) -> None:
+    """A full disk cuts an episode's line short: it is cut off again, so no partial line
+    stays between whole ones once there is room again."""
+    from baselines.runs import RunLog, episode_result
+
+    records = read_episodes(clean_run)
+    log = RunLog.open(
+        tmp_path / "out", command=["test"], suite=read_run(clean_run)["suite"], jobs=8
+    )
+    with pytest.raises(RunFailed, match=r"no room to write .*episodes\.jsonl"):
+        with log.recording():
+            log.append(episode_result(records[0], clean_run))
+            full = _FillsUp(log.episodes_file, "ab")
+            log._file, spare = full, log._file
+            spare.close()
+            log.append(episode_result(records[1], clean_run))
+    assert len((log.episodes_file).read_text().splitlines()) == 1
+    assert read_run(tmp_path / "out")["status"] == "failed"
+    ran: list[object] = []
+    run_leaderboard(
+        write_suite(tmp_path),
+        out_dir=tmp_path / "out",
+        workers=1,
+        show_progress=False,
+        resume=True,
+        on_episode=ran.append,
+    )
+    assert len(ran) == 7 and len(read_episodes(tmp_path / "out")) == 8
