@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from baselines.errors import RunError
+from baselines.errors import RunError, RunFailed
 from baselines.locking import out_lock
 from baselines.manifest import Manifest, clear_listed
 from baselines.runs import (
@@ -28,6 +29,7 @@ from baselines.runs import (
     episode_result,
     git_commit,
     now,
+    outside_problem,
     read_episodes,
     read_run,
     temporary_file,
@@ -134,24 +136,40 @@ def write_report(
         check_out_dir(target, force=force)  # again, now that no other run can start there
         if force:
             clear_listed(target)
-        manifest = Manifest(target)
-        from baselines.leaderboard import write_results
-
-        with manifest.claiming():
-            rows = write_results(target, suite, results)
-        manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
-        write_json(
-            target / REPORT_FILE,
-            {
-                "command": list(command),
-                "time": now(),
-                "versions": versions(),
-                "git_commit": git_commit(),
-                "runs": sources,
-                "suite": suite,
-            },
-        )
+        try:
+            rows = _write(target, suite, results, sources, command)
+        except (OSError, BrokenProcessPool) as exc:  # a full disk, a killed worker
+            problem = outside_problem(exc)
+            if problem is None:
+                raise
+            raise RunFailed(f"{problem}; the report in {target} is incomplete") from None
     return rows, sources
+
+
+def _write(
+    target: Path,
+    suite: dict[str, Any],
+    results: list[EpisodeResult],
+    sources: list[dict[str, Any]],
+    command: Sequence[str],
+) -> list[dict[str, Any]]:
+    """The report's files in the locked ``target``, each listed in its manifest."""
+    from baselines.leaderboard import write_results
+
+    manifest = Manifest(target)
+    with manifest.claiming():
+        rows = write_results(target, suite, results)
+    manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
+    document = {
+        "command": list(command),
+        "time": now(),
+        "versions": versions(),
+        "git_commit": git_commit(),
+        "runs": sources,
+        "suite": suite,
+    }
+    write_json(target / REPORT_FILE, document)
+    return rows
 
 
 __all__ = ["REPORT_FILE", "merge_runs", "write_report"]

@@ -747,7 +747,7 @@ class RunLog:
                 self.finish("interrupted")
                 raise RunInterrupted(self.kept(), signal_number(exc)) from None
             except (OSError, RunFailed, BrokenProcessPool) as exc:
-                problem = _outside_problem(exc)
+                problem = outside_problem(exc)
                 if problem is None:
                     self._fail(exc)
                     raise
@@ -783,7 +783,7 @@ class RunLog:
                     fh.truncate()
 
 
-def _outside_problem(exc: BaseException) -> str | None:
+def outside_problem(exc: BaseException) -> str | None:
     """The one-line account of a run stopped from outside (a full disk, a worker that
     died), or None for any other error."""
     if isinstance(exc, BrokenProcessPool):
@@ -808,6 +808,7 @@ __all__ = [
     "clear_outputs",
     "differences",
     "episode_result",
+    "outside_problem",
     "read_episodes",
     "read_run",
     "versions",

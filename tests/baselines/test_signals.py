@@ -151,3 +151,21 @@ def test_finding6_a_full_disk_is_one_line_failed_and_leaves_nothing_that_blocks_
     )
     assert forced.returncode == 0, forced.stderr
     assert read_run(out)["status"] == "complete"
+
+
+def test_finding6_a_full_disk_under_report_is_one_line(tmp_path: Path) -> None:
+    out, suite = tmp_path / "out", write_suite(tmp_path)
+    assert subprocess.run(leaderboard(out, suite), cwd=ROOT, capture_output=True).returncode == 0
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
+
+    report = tmp_path / "report"
+    command = [sys.executable, "-m", "baselines.cli", "report", str(out), "--out", str(report)]
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, preexec_fn=small_files)
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("shipgym report: failed: no room to write ")
+    assert done.stderr.rstrip().endswith(f"the report in {report} is incomplete")
+    assert not [p for p in report.rglob("*") if ".tmp" in p.name]
+    forced = subprocess.run([*command, "--force"], cwd=ROOT, capture_output=True, text=True)
+    assert forced.returncode == 0, forced.stderr
