@@ -35,6 +35,12 @@ class RunError(ShipgymError, ValueError):
     export."""
 
 
+class RunFailed(ShipgymError, RuntimeError):
+    """A run stopped by something outside it, not by bad input: a worker process killed,
+    the disk full.  The message says what happened and what was kept; the CLI prints it
+    as one line (exit code 1)."""
+
+
 class BackendError(ShipgymError, RuntimeError):
     """The requested execution backend is not installed (Ray)."""
 
@@ -59,6 +65,7 @@ __all__ = [
     "ConfigError",
     "ControllerError",
     "RunError",
+    "RunFailed",
     "UnsafeFileError",
     "check_count",
     "check_seeds",

@@ -49,6 +49,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from baselines.escaping import plain_text
 from baselines.ranking import ORACLE
 from baselines.style import FIGURE_DPI, controller_style
 
@@ -345,8 +346,13 @@ def _legend_below(ax: Any, handles: Sequence[Any] | None = None) -> None:
     """The legend of a column under its bottom axes ``ax``, outside the data (in the room
     :func:`_column_axes` leaves)."""
     height = ax.get_position().height * ax.figure.get_figheight()
+    if handles is None:
+        handles, labels = ax.get_legend_handles_labels()
+    else:
+        labels = [h.get_label() for h in handles]
     ax.legend(
-        handles=handles,
+        handles,
+        [plain_text(label) for label in labels],  # names drawn as typed
         loc="upper center",
         bbox_to_anchor=(0.5, -_ROW_GAP / height - 0.02),
         fontsize=6.5,
@@ -474,7 +480,7 @@ def _scenario_title(
     )
     ship = f"ship length L = {ship_length:g} m; " if ship_length else ""
     which = _which_episode(episodes, chosen_by) if episodes else "no episode kept"
-    return f"{scenario} — {ship}{change}; drawn: {which}"
+    return f"{plain_text(scenario)} — {ship}{change}; drawn: {which}"
 
 
 def scenario_geometry(scenario: Any, points: int = 400) -> dict[str, Any]:
@@ -597,7 +603,7 @@ def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str,
         ax.tick_params(labelsize=8)
         for x in refs:
             ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
-    axes[0].set_yticklabels([_ranking_label(r, common) for r in rows], fontsize=9)
+    axes[0].set_yticklabels([plain_text(_ranking_label(r, common)) for r in rows], fontsize=9)
     for i, ax in enumerate(axes):
         for bars in ax.containers:  # rliable labels each interval bar with its controller
             for bar in bars:

@@ -26,7 +26,6 @@ import functools
 import json
 import math
 import os
-import signal
 import sys
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
@@ -40,6 +39,7 @@ from tqdm import tqdm
 
 from baselines import evaluation
 from baselines.errors import BackendError, RunError, check_seeds
+from baselines.escaping import csv_cell, md_cell, plain_text
 from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from baselines.figures import median_ace_episode
 from baselines.jsonout import dumps
@@ -59,7 +59,15 @@ from baselines.ranking import (
 from baselines.ranking import scenario_scores as score_table
 from baselines.references import result_from_entry, shipped_table
 from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from baselines.runs import BACKENDS, RunLog, check_out_dir, episode_result, read_episodes
+from baselines.runs import (
+    BACKENDS,
+    RunLog,
+    check_out_dir,
+    check_out_usable,
+    episode_result,
+    read_episodes,
+)
+from baselines.signals import worker_init
 from baselines.style import FIGURE_DPI, controller_style
 from baselines.suite import load_suite
 from shipgym.config import is_path
@@ -115,13 +123,16 @@ def scenario_split(scenario: str) -> str:
 class Job(NamedTuple):
     """One unit of work: a controller (trained with ``training_seed``; None: not trained)
     on the trials of scenario ``scenario`` (a name as the suite gives it) that ``seeds``
-    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials)."""
+    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
+    ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
+    as recorded whatever its file says now; None: resolved from ``scenario`` here."""
 
     controller: ControllerSpec
     scenario: str
     seeds: tuple[int, ...]
     training_seed: int | None = None
     randomize: dict[str, Any] | None = None
+    settings: dict[str, Any] | None = None
     #: the oracle's episodes: "table" (the shipped reference table, running only a trial it
     #: lacks) or "recompute" (run every trial)
     references: str = "table"
@@ -141,10 +152,23 @@ def suite_scenario(name: str) -> Scenario:
     return _cached_scenario(name, stamp)
 
 
+@functools.lru_cache(maxsize=128)
+def _recorded_scenario(settings: str) -> Scenario:
+    return load_scenario(json.loads(settings))
+
+
+def job_scenario(job: Job) -> Scenario:
+    """The job's scenario: built from its recorded ``settings`` (once per process), else
+    resolved from its name."""
+    if job.settings is None:
+        return suite_scenario(job.scenario)
+    return _recorded_scenario(json.dumps(job.settings, sort_keys=True))
+
+
 def trials(job: Job) -> list[Scenario]:
     """The job's scenario as each of its seeds draws it (the scenario itself without
     randomisation)."""
-    base = suite_scenario(job.scenario)
+    base = job_scenario(job)
     randomization = None if job.randomize is None else TrialRandomization(**job.randomize)
     return [trial_scenario(base, randomization, seed) for seed in job.seeds]
 
@@ -204,18 +228,14 @@ def work(job: Job) -> list[EpisodeResult]:
     return run_batch(job)
 
 
-def _quiet_worker() -> None:
-    """Pool workers ignore Ctrl-C (the parent stops them): no traceback from each."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
-    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes)."""
+    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes,
+    :func:`baselines.signals.worker_init`)."""
     if workers <= 1:
         for job in jobs:
             yield work(job)
         return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=worker_init)
     try:
         for fut in as_completed([pool.submit(work, j) for j in jobs]):
             yield fut.result()
@@ -223,7 +243,7 @@ def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
         workers_running = list((pool._processes or {}).values())  # shutdown forgets them
         pool.shutdown(wait=False, cancel_futures=True)
         for process in workers_running:
-            process.terminate()
+            process.kill()  # workers ignore SIGTERM (baselines.signals)
         raise
     pool.shutdown()
 
@@ -301,7 +321,7 @@ def suite_record(
 
 def plan_jobs(
     names: list[ControllerSpec],
-    scenarios: Iterable[str],
+    scenarios: Iterable[str] | Mapping[str, dict[str, Any]],
     seed_list: list[int],
     seeds_of: Mapping[str, list[int | None]],
     randomize: dict[str, Any] | None,
@@ -309,19 +329,22 @@ def plan_jobs(
     references: str = "table",
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job per seed for
-    a classical controller, one job of all seeds per training seed for a learned agent."""
+    a classical controller, one job of all seeds per training seed for a learned agent.
+    ``scenarios``: names, or name → recorded settings (the jobs run those)."""
     jobs = []
     for scenario in scenarios:
+        settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
         for c in names:
             label = controller_label(c)
             if (scenario, label) in skip:
                 continue
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
-                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize))
+                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
                 else:
                     jobs += [
-                        Job(c, scenario, (seed,), k, randomize, references) for seed in seed_list
+                        Job(c, scenario, (seed,), k, randomize, settings, references)
+                        for seed in seed_list
                     ]
     return jobs
 
@@ -363,10 +386,11 @@ def run_leaderboard(
     (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
     :class:`~baselines.runs.RunInterrupted`.
     """
-    check_out_dir(out_dir, resume=resume, force=force)  # before any work
+    check_out_usable(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
         raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
-    spec = load_suite(suite)
+    spec = load_suite(suite)  # a bad suite is named before the state of out_dir
+    check_out_dir(out_dir, resume=resume, force=force)
     n_seeds = int(seeds if seeds is not None else spec.seeds)
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
@@ -378,7 +402,7 @@ def run_leaderboard(
     skip = {tuple(pair) for pair in record["does_not_apply"]}
     references = "recompute" if recompute_references else "table"
     jobs = plan_jobs(
-        names, scenarios, seed_list, seeds_of, record["randomize"], skip, references
+        names, record["scenarios"], seed_list, seeds_of, record["randomize"], skip, references
     )
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
     n_episodes = sum(len(job.seeds) for job in jobs)
@@ -390,35 +414,34 @@ def run_leaderboard(
         resume=resume,
         force=force,
     )
-    todo = missing(jobs, log.done)
-    rows = row_keys(jobs)
-    bar = tqdm(
-        total=n_episodes,
-        initial=n_episodes - sum(len(job.seeds) for job in todo),
-        desc="leaderboard",
-        file=sys.stderr,
-        disable=not show_progress,
-    )
-    with (
-        log.recording(),
-        closing(iter_results(todo, backend, workers)) as results,
-    ):
+    with log.recording():  # holds out_dir's lock to the end
+        todo = missing(jobs, log.done)
+        rows = row_keys(jobs)
+        bar = tqdm(
+            total=n_episodes,
+            initial=n_episodes - sum(len(job.seeds) for job in todo),
+            desc="leaderboard",
+            file=sys.stderr,
+            disable=not show_progress,
+        )
         try:
-            for batch in results:
-                for result in batch:
-                    if _result_key(result) in log.done:
-                        continue  # recorded before (a resumed job)
-                    log.append(result, keep_trajectory=True)
-                    keep_drawn(log, rows, (result.scenario, result.controller))
-                    bar.update(1)
-                    if on_episode is not None:
-                        on_episode(result)
+            with closing(iter_results(todo, backend, workers)) as results:
+                for batch in results:
+                    for result in batch:
+                        if _result_key(result) in log.done:
+                            continue  # recorded before (a resumed job)
+                        log.append(result, keep_trajectory=True)
+                        keep_drawn(log, rows, (result.scenario, result.controller))
+                        bar.update(1)
+                        if on_episode is not None:
+                            on_episode(result)
         finally:
             bar.close()
         for row in rows:  # rows completed by a run that stopped before pruning them
             keep_drawn(log, rows, row)
-        results = load_results(log.folder)
-        return write_results(log.folder, log.record["suite"], results, workers=workers)
+        with log.manifest.claiming():  # the tables and figures: listed for --force
+            results = load_results(log.folder)
+            return write_results(log.folder, log.record["suite"], results, workers=workers)
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -578,7 +601,7 @@ def _pool(workers: int, figures: int) -> Iterator[Executor | _Inline]:
     if workers <= 1 or figures < POOLED_FIGURES:
         yield _Inline()
         return
-    with ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
+    with ProcessPoolExecutor(max_workers=workers, initializer=worker_init) as pool:
         yield pool
 
 
@@ -711,8 +734,8 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
         for rank, r in enumerate(mine, start=1):
             cells = [
                 str(rank),
-                r["controller"],
-                r["kind"],
+                md_cell(r["controller"]),
+                md_cell(r["kind"]),
                 str(r["training_seeds"] or "–"),
                 str(len(r["scenarios"])),
                 _interval(r["cost_ratio_iqm"], r["cost_ratio_iqm_ci95"], 3),
@@ -767,7 +790,7 @@ def scores_markdown(
         "controller's geometric mean of C / C_oracle over the row's episodes [95 % interval, "
         "stratified over training seeds]; – where the controller does not apply.",
         "",
-        "| controller | " + " | ".join(shown) + " |",
+        "| controller | " + " | ".join(map(md_cell, shown)) + " |",
         "|---|" + "---|" * len(shown),
         f"| {ORACLE} (cost) | "
         + " | ".join(
@@ -777,7 +800,7 @@ def scores_markdown(
         + " |",
     ]
     for controller in controllers:
-        row = [controller]
+        row = [md_cell(controller)]
         for s in shown:
             found = cell.get((controller, s))
             row.append(
@@ -822,7 +845,7 @@ def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")
         writer.writeheader()
-        writer.writerows(rows)
+        writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
     rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
     (out / "leaderboard.md").write_text(
         (head + "\n" if head else "") + rows_part + generalisation_table(rows)
@@ -870,7 +893,7 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
         "|---|---|---|---|---|---|---|---|",
     ]
     for g in gen:
-        cells = [g["controller"], g["kind"]]
+        cells = [md_cell(g["controller"]), md_cell(g["kind"])]
         cells += [
             _fmt(g[f"{split}_{key}"])
             for key in ("ace_L", "return", "success")
@@ -903,7 +926,7 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     keys = ["ace_L", "t_c", "return", "rudder_travel", "J", "success", "compute_ms"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        cells = [r["scenario"], r["controller"], r["kind"]]
+        cells = [md_cell(r["scenario"]), md_cell(r["controller"]), md_cell(r["kind"])]
         if not r.get("applies", True):
             lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * 11) + " |")
             continue
@@ -972,14 +995,15 @@ def plot_results(
         pts = sc.path.point(np.linspace(0, sc.path.length, 300))
         axes[0].plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="path")
         for name, r in first.items():
-            tr, look = r.trajectory, controller_style(name).kwargs()
-            axes[0].plot(tr["x"], tr["y"], lw=1, label=name, **look)
-            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=name, **look)
-            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=name, **look)
+            tr, look, label = r.trajectory, controller_style(name).kwargs(), plain_text(name)
+            axes[0].plot(tr["x"], tr["y"], lw=1, label=label, **look)
+            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=label, **look)
+            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=label, **look)
         if sc.change_time is not None:
             for ax in axes[1:]:
                 ax.axvline(sc.change_time, color="gray", ls=":", lw=1)
-        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=f"{scenario}: tracks (seed {seed})")
+        title = f"{plain_text(scenario)}: tracks (seed {seed})"
+        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=title)
         axes[0].set_aspect("equal", adjustable="datalim")
         axes[1].set(xlabel="t [s]", ylabel="e [m]", title="cross-track error")
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")

@@ -13,21 +13,26 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from baselines.errors import RunError
+from baselines.errors import RunError, RunFailed
+from baselines.locking import out_lock
+from baselines.manifest import Manifest, clear_listed
 from baselines.runs import (
     Key,
     check_out_dir,
-    clear_outputs,
+    check_out_usable,
     differences,
     episode_key,
     episode_result,
     git_commit,
     now,
+    outside_problem,
     read_episodes,
     read_run,
+    temporary_file,
     versions,
     write_json,
 )
@@ -85,7 +90,7 @@ def merge_runs(
         ]
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         suite["name"] = suite["name"] or run_suite.get("name")
-        episodes = read_episodes(folder)
+        episodes = read_episodes(folder, suite=run_suite)
         for episode in episodes:
             key = episode_key(episode)
             if key in episode_in:
@@ -126,24 +131,45 @@ def write_report(
         if Path(folder).resolve() == target.resolve():
             raise RunError(f"--out {target} is one of the runs read: choose another folder")
     suite, results, sources = merge_runs(folders)
-    if force:
-        clear_outputs(target)
-    target.mkdir(parents=True, exist_ok=True)
+    check_out_usable(target, force=force)
+    with out_lock(target, now()):
+        check_out_dir(target, force=force)  # again, now that no other run can start there
+        if force:
+            clear_listed(target)
+        try:
+            rows = _write(target, suite, results, sources, command)
+        except (OSError, BrokenProcessPool) as exc:  # a full disk, a killed worker
+            problem = outside_problem(exc)
+            if problem is None:
+                raise
+            raise RunFailed(f"{problem}; the report in {target} is incomplete") from None
+    return rows, sources
+
+
+def _write(
+    target: Path,
+    suite: dict[str, Any],
+    results: list[EpisodeResult],
+    sources: list[dict[str, Any]],
+    command: Sequence[str],
+) -> list[dict[str, Any]]:
+    """The report's files in the locked ``target``, each listed in its manifest."""
     from baselines.leaderboard import write_results
 
-    rows = write_results(target, suite, results)
-    write_json(
-        target / REPORT_FILE,
-        {
-            "command": list(command),
-            "time": now(),
-            "versions": versions(),
-            "git_commit": git_commit(),
-            "runs": sources,
-            "suite": suite,
-        },
-    )
-    return rows, sources
+    manifest = Manifest(target)
+    with manifest.claiming():
+        rows = write_results(target, suite, results)
+    manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
+    document = {
+        "command": list(command),
+        "time": now(),
+        "versions": versions(),
+        "git_commit": git_commit(),
+        "runs": sources,
+        "suite": suite,
+    }
+    write_json(target / REPORT_FILE, document)
+    return rows
 
 
 __all__ = ["REPORT_FILE", "merge_runs", "write_report"]

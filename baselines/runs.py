@@ -18,11 +18,14 @@
                      row (scenario, controller) is complete only the episode its figure
                      draws is kept (:meth:`RunLog.drop_trajectories`)
 
-A folder that is not empty is refused before any work unless ``resume`` (run the episodes
-missing from ``episodes.jsonl``; the resolved suite must equal ``run.json``'s) or ``force``
-(clear the earlier outputs first).  Tables are always aggregated from ``episodes.jsonl`` (so
-a resumed run's tables equal a clean run's, and ``shipgym report`` rebuilds them from the
-folder).
+A run holds an exclusive lock on its folder (:mod:`baselines.locking`) and lists every path
+it writes in ``manifest.txt`` (:mod:`baselines.manifest`).  A folder that is not empty is
+refused before any work unless ``resume`` (run the episodes missing from ``episodes.jsonl``;
+the resolved suite must equal ``run.json``'s) or ``force`` (delete what the manifest lists
+first; a folder holding anything else is refused).  ``episodes.jsonl`` is read as a set
+keyed by the episode key (:func:`read_episodes`).  Tables are always aggregated from
+``episodes.jsonl`` (so a resumed run's tables equal a clean run's, and ``shipgym report``
+rebuilds them from the folder).
 
 Strict JSON has no infinity or NaN: in ``episodes.jsonl`` a metric of ±inf (t_c = inf, "never
 converged") is the string ``"inf"`` / ``"-inf"`` and NaN is ``null`` (metrics ignore NaN), so
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime
+import errno
 import fnmatch
 import hashlib
 import json
@@ -40,16 +44,21 @@ import math
 import os
 import platform
 import shutil
+import signal
 import subprocess
 import time
 from collections.abc import Iterable, Iterator, Mapping, Sequence
+from concurrent.futures.process import BrokenProcessPool
 from importlib import metadata
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from baselines.errors import RunError
+from baselines.errors import RunError, RunFailed
+from baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
+from baselines.manifest import Manifest, clear_listed
+from baselines.signals import signal_number
 
 if TYPE_CHECKING:
     from baselines.evaluation import EpisodeResult
@@ -57,24 +66,6 @@ if TYPE_CHECKING:
 RUN_FILE = "run.json"
 EPISODES_FILE = "episodes.jsonl"
 TRAJECTORY_DIR = "trajectories"
-#: what a run (or ``shipgym report``) writes into its folder; ``force`` removes these and
-#: refuses to touch anything else.  A new output file of a run belongs here.
-RUN_OUTPUTS = (
-    RUN_FILE,
-    EPISODES_FILE,
-    TRAJECTORY_DIR,
-    "report.json",
-    "leaderboard.md",
-    "leaderboard.csv",
-    "leaderboard.json",
-    "leaderboard.html",
-    "generalisation.json",
-    "aggregate.json",
-    "scenario_scores.json",
-    "*.png",
-    "*.pdf",
-    "*.svg",
-)
 #: most seconds between two fsyncs of ``episodes.jsonl`` (one per episode cost ≈ 5 ms each,
 #: 30 s of a default leaderboard's 6000 episodes)
 FSYNC_INTERVAL_S = 1.0
@@ -99,8 +90,17 @@ BACKENDS = ("local", "ray")
 Key = tuple[str, str, int, int | None]
 
 
+#: errors of a write that found no room: disk full, quota, file size limit
+NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
 class RunInterrupted(KeyboardInterrupt):
-    """Ctrl-C during a run; the message says what was kept and how to resume."""
+    """Ctrl-C (or SIGTERM: ``signum``) during a run; the message says what was kept and how
+    to resume."""
+
+    def __init__(self, message: str, signum: int = signal.SIGINT):
+        super().__init__(message)
+        self.signum = int(signum)
 
     def __str__(self) -> str:
         return str(self.args[0]) if self.args else ""
@@ -109,12 +109,9 @@ class RunInterrupted(KeyboardInterrupt):
 # --- the output folder -----------------------------------------------------------------------
 
 
-def check_out_dir(
-    out: str | os.PathLike, *, resume: bool = False, force: bool = False, note: str = ""
-) -> Path:
-    """``out`` as a Path once it can hold this run; a :class:`RunError` before any work when
-    it cannot: a file, below a file, not writable, or not empty without ``resume`` /
-    ``force`` (``note`` is added to that message, e.g. where a default folder came from)."""
+def check_out_usable(out: str | os.PathLike, *, resume: bool = False, force: bool = False) -> Path:
+    """``out`` as a Path if it can be a run's folder at all; a :class:`RunError` when it
+    cannot: a file, below a file, not writable (checked before the suite is read)."""
     path = Path(out)
     if resume and force:
         raise RunError("--resume and --force exclude each other")
@@ -125,7 +122,21 @@ def check_out_dir(
         raise RunError(f"--out {path}: {existing} is a file, not a folder")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise RunError(f"--out {path}: {existing} is not writable")
-    entries = sorted(p.name for p in path.iterdir()) if path.is_dir() else []
+    return path
+
+
+def check_out_dir(
+    out: str | os.PathLike, *, resume: bool = False, force: bool = False, note: str = ""
+) -> Path:
+    """``out`` as a Path once it can hold this run; a :class:`RunError` before any work when
+    it cannot: unusable (:func:`check_out_usable`), in use by another run (its lock:
+    :mod:`baselines.locking`), or not empty without ``resume`` / ``force`` (``note`` is
+    added to that message, e.g. where a default folder came from)."""
+    path = check_out_usable(out, resume=resume, force=force)
+    holder = lock_holder(path)
+    if holder is not None:
+        raise in_use(path, holder)
+    entries = sorted(p.name for p in path.iterdir() if p.name != LOCK_FILE) if path.is_dir() else []
     if resume and RUN_FILE not in entries:
         raise RunError(f"--resume: {path} holds no run to resume (no {RUN_FILE})")
     if entries and not (resume or force):
@@ -139,15 +150,19 @@ def check_out_dir(
 def _describe(path: Path, entries: list[str]) -> str:
     """What an occupied folder holds, for the refusal message."""
     if RUN_FILE in entries:
-        record = _read_json(path / RUN_FILE)
-        status = record.get("status", "?") if isinstance(record, dict) else "unreadable"
-        return f"an earlier run, {status}, {len(read_episodes(path))} episodes"
+        try:
+            record = _read_json(path / RUN_FILE)
+            status = record.get("status", "?") if isinstance(record, dict) else "unreadable"
+            count = f"{len(read_episodes(path))} episodes"
+        except RunError:
+            return "an earlier run, unreadable"
+        return f"an earlier run, {status}, {count}"
     shown = ", ".join(entries[:3]) + (", …" if len(entries) > 3 else "")
     return f"{len(entries)} entries: {shown}"
 
 
 def clear_outputs(
-    folder: str | os.PathLike, outputs: Sequence[str] = RUN_OUTPUTS, option: str = "--force"
+    folder: str | os.PathLike, outputs: Sequence[str], option: str = "--force"
 ) -> None:
     """Remove the earlier outputs (names or glob patterns of ``outputs``) from ``folder``;
     a :class:`RunError`, before removing anything, when it holds anything else."""
@@ -203,30 +218,83 @@ def git_commit() -> str | None:
 
 
 def read_run(folder: str | os.PathLike) -> dict[str, Any]:
-    """A run folder's ``run.json``; a :class:`RunError` naming the folder if it has none."""
+    """A run folder's ``run.json``; a :class:`RunError` naming the folder if it has none,
+    or naming the file and the line or key where it is not a run record."""
     file = Path(folder) / RUN_FILE
     if not file.is_file():
         raise RunError(f"{folder}: not a run folder (no {RUN_FILE})")
     record = _read_json(file)
-    if not isinstance(record, dict) or not isinstance(record.get("suite"), dict):
-        raise RunError(f"{file}: not a run record (no 'suite')")
+    problem = _run_record_problem(record)
+    if problem:
+        raise RunError(f"{file}: not a run record ({problem})")
     return record
+
+
+def _run_record_problem(record: Any) -> str | None:
+    """What makes ``record`` no run record (the key and the problem), or None."""
+    if not isinstance(record, dict) or not isinstance(record.get("suite"), dict):
+        return "no 'suite'"
+    suite = record["suite"]
+    checks = (
+        ("seeds", list, lambda v: all(type(x) is int for x in v), "a list of integers"),
+        ("scenarios", dict, lambda v: all(isinstance(x, dict) for x in v.values()), "settings"),
+        ("controllers", list, _controller_entries, "entries of name, kind, training_seeds"),
+        ("does_not_apply", list, _pairs, "[scenario, controller] pairs"),
+    )
+    for key, kind, valid, what in checks:
+        value = suite.get(key)
+        if not isinstance(value, kind) or not valid(value):
+            return f"key 'suite.{key}' is {_short(value)}, not {what}"
+    if not isinstance(suite.get("randomize"), dict | None):
+        return f"key 'suite.randomize' is {_short(suite.get('randomize'))}, not ranges or null"
+    return None
+
+
+def _controller_entries(value: list) -> bool:
+    return all(
+        isinstance(c, dict)
+        and isinstance(c.get("name"), str)
+        and isinstance(c.get("kind"), str)
+        and isinstance(c.get("training_seeds"), list)
+        and all(s is None or type(s) is int for s in c["training_seeds"])
+        for c in value
+    )
+
+
+def _pairs(value: list) -> bool:
+    return all(
+        isinstance(p, list) and len(p) == 2 and all(isinstance(x, str) for x in p) for p in value
+    )
 
 
 def _read_json(file: Path) -> Any:
     try:
-        return json.loads(file.read_text())
-    except (OSError, ValueError) as exc:
-        raise RunError(f"{file}: unreadable ({exc})") from None
+        return json.loads(file.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        line = file.read_bytes()[: exc.start].count(b"\n") + 1
+        raise RunError(f"{file}: line {line}: not UTF-8 text") from None
+    except json.JSONDecodeError as exc:
+        raise RunError(f"{file}: line {exc.lineno}: not JSON ({exc.msg})") from None
+    except OSError as exc:
+        raise RunError(f"{file}: unreadable ({exc.strerror})") from None
 
 
 def write_json(file: Path, document: Any) -> None:
     """Write atomically (a temporary file renamed over ``file``)."""
     from baselines.jsonout import dumps
 
-    tmp = file.with_name(f".{file.name}.tmp")
-    tmp.write_text(dumps(document, indent=2) + "\n")
-    os.replace(tmp, file)
+    tmp = temporary_file(file)
+    try:
+        tmp.write_text(dumps(document, indent=2) + "\n")
+        os.replace(tmp, file)
+    except BaseException:  # no half-written temporary left behind (a full disk)
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def temporary_file(file: Path) -> Path:
+    """Where :func:`write_json` writes ``file`` before renaming it over ``file``."""
+    return file.with_name(f".{file.name}.tmp")
 
 
 def as_json(document: Any) -> Any:
@@ -312,23 +380,133 @@ def episode_key(record: Mapping[str, Any]) -> Key:
     )
 
 
-def read_episodes(folder: str | os.PathLike) -> list[dict[str, Any]]:
-    """The finished episodes of a run folder, numbers restored (±inf).  A last line cut
-    short by a kill is left out."""
+#: metrics whose value is text (every other metric is a number, null, "inf" or "-inf")
+TEXT_METRICS = ("termination_reason",)
+
+
+def _bad_line(file: Path, number: int, problem: str) -> RunError:
+    return RunError(f"{file}: line {number}: {problem}")
+
+
+def _check_episode(record: Any, file: Path, number: int) -> dict[str, Any]:
+    """``record`` (one parsed line) if it is an episode record; else a :class:`RunError`
+    naming the file, the line and the problem."""
+    if not isinstance(record, dict):
+        raise _bad_line(file, number, f"not an episode record (a JSON {type(record).__name__})")
+    absent = [k for k in EPISODE_KEYS[:5] if k not in record]
+    if absent:
+        raise _bad_line(file, number, f"not an episode record (no {', '.join(absent)})")
+    for key in ("scenario", "controller", "kind"):
+        if not isinstance(record[key], str):
+            raise _bad_line(file, number, f"{key} {_short(record[key])} is not text")
+    for key in ("seed", "training_seed"):
+        value = record[key]
+        if not (isinstance(value, int) and not isinstance(value, bool)) and not (
+            key == "training_seed" and value is None
+        ):
+            raise _bad_line(file, number, f"{key} {_short(value)} is not an integer")
+    for key, value in record.items():
+        if key in EPISODE_KEYS or key in TEXT_METRICS:
+            continue
+        if isinstance(value, str) and value not in ("inf", "-inf"):
+            raise _bad_line(file, number, f"metric {key} is {_short(value)}, not a number")
+    return record
+
+
+def _lines(file: Path) -> list[tuple[int, str]]:
+    """The complete lines of ``file`` (numbered from 1), a last line cut short by a kill
+    left out; a :class:`RunError` naming the line that is not UTF-8."""
+    data = file.read_bytes()
+    raw = data.split(b"\n")
+    complete = raw[:-1]  # the part after the last newline: empty, or cut short by a kill
+    lines = []
+    for number, line in enumerate(complete, start=1):
+        try:
+            lines.append((number, line.decode("utf-8")))
+        except UnicodeDecodeError:
+            raise _bad_line(file, number, "not UTF-8 text") from None
+    return lines
+
+
+class _SuiteKeys(NamedTuple):
+    """What a resolved suite (``run.json``'s) runs: scenarios, the (scenario, controller)
+    pairs that apply, the evaluation seeds, each controller's training seeds."""
+
+    scenarios: set[str]
+    pairs: set[tuple[str, str]]
+    seeds: set[int]
+    trained: dict[str, set[int | None]]
+
+
+def _suite_keys(suite: Mapping[str, Any]) -> _SuiteKeys:
+    skip = {tuple(pair) for pair in suite["does_not_apply"]}
+    trained = {c["name"]: set(c["training_seeds"]) for c in suite["controllers"]}
+    pairs = {(s, c) for s in suite["scenarios"] for c in trained if (s, c) not in skip}
+    return _SuiteKeys(set(suite["scenarios"]), pairs, set(suite["seeds"]), trained)
+
+
+def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
+    """Why the episode ``key`` is not one of a suite's (``keys``), or None when it is."""
+    scenarios, pairs, seeds, trained = keys
+    scenario, controller, seed, training_seed = key
+    if controller not in trained:
+        return f"controller {controller!r} is not in the run's suite"
+    if scenario not in scenarios:
+        return f"scenario {scenario!r} is not in the run's suite"
+    if (scenario, controller) not in pairs:
+        return f"{controller!r} does not apply to {scenario!r} in the run's suite"
+    if seed not in seeds:
+        return f"seed {seed} is not one of the run's seeds"
+    if training_seed not in trained[controller]:
+        return f"training seed {training_seed} is not one of {controller!r}'s in the run"
+    return None
+
+
+def read_episodes(
+    folder: str | os.PathLike, suite: Mapping[str, Any] | None = None
+) -> list[dict[str, Any]]:
+    """The finished episodes of a run folder, numbers restored (±inf), as a set keyed by
+    the episode key: a line repeating an earlier one is dropped; a last line cut short by
+    a kill is left out.  A :class:`RunError` naming the file and line for a line that is
+    not an episode record (not UTF-8, not JSON, not an object, a key missing, a metric
+    that is text), repeats a key with other content, or (given ``suite``, as ``run.json``
+    records it) holds an episode that is not the suite's."""
     file = Path(folder) / EPISODES_FILE
     if not file.is_file():
         return []
-    records = []
-    lines = file.read_text().splitlines(keepends=True)
-    for number, line in enumerate(lines, start=1):
+    keys = None if suite is None else _suite_keys(suite)
+    records: dict[Key, dict[str, Any]] = {}
+    first: dict[Key, int] = {}
+    for number, line in _lines(file):
         try:
-            record = json.loads(line)
+            parsed = json.loads(line)
         except ValueError:
-            if number == len(lines) and not line.endswith("\n"):
-                break  # written when the run was killed
-            raise RunError(f"{file}: line {number} is not JSON") from None
-        records.append({k: _number(v) for k, v in record.items()})
-    return records
+            raise _bad_line(file, number, "not JSON") from None
+        record = _check_episode(parsed, file, number)
+        key = episode_key(record)
+        if keys is not None and (why := _foreign(key, keys)) is not None:
+            raise _bad_line(file, number, why)
+        record = {k: _number(v) for k, v in record.items()}
+        if key in records:
+            if _same(records[key], record):
+                continue  # the same episode written twice: one episode
+            raise _bad_line(
+                file,
+                number,
+                f"episode {json.dumps(list(key))} again, with other values than on line "
+                f"{first[key]}",
+            )
+        records[key], first[key] = record, number
+    return list(records.values())
+
+
+def _same(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """Two records of one episode say the same, field by field (NaN equal to NaN)."""
+    return _canonical(a) == _canonical(b)
+
+
+def _canonical(record: Mapping[str, Any]) -> str:
+    return json.dumps(_plain(dict(record)), sort_keys=True)
 
 
 def _repair(file: Path) -> None:
@@ -387,21 +565,30 @@ def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> Epis
 
 
 class RunLog:
-    """An open run folder: its ``run.json`` record and the ``episodes.jsonl`` it appends to.
+    """An open run folder: its ``run.json`` record, the ``episodes.jsonl`` it appends to,
+    its manifest (:mod:`baselines.manifest`) and its lock (:mod:`baselines.locking`).
 
-    :meth:`open` starts (or resumes) the run, :meth:`append` records each finished episode,
-    :meth:`recording` sets the final status.
+    :meth:`open` locks the folder and starts (or resumes) the run, :meth:`append` records
+    each finished episode, :meth:`recording` sets the final status and releases the lock.
     """
 
-    def __init__(self, folder: Path, record: dict[str, Any], episodes: list[dict[str, Any]]):
+    def __init__(
+        self,
+        folder: Path,
+        record: dict[str, Any],
+        episodes: list[dict[str, Any]],
+        manifest: Manifest | None = None,
+    ):
         self.folder = folder
         self.record = record
         #: the recorded episodes by key
         self.episodes: dict[Key, dict[str, Any]] = {episode_key(e): e for e in episodes}
         self.done: set[Key] = set(self.episodes)
-        self._count = len(episodes)
-        self._file: IO[str] | None = None
+        self.manifest = manifest or Manifest(folder)
+        self._count = len(self.episodes)
+        self._file: IO[bytes] | None = None
         self._synced = time.monotonic()
+        self._lock = contextlib.ExitStack()
 
     @property
     def episodes_file(self) -> Path:
@@ -418,10 +605,35 @@ class RunLog:
         resume: bool = False,
         force: bool = False,
     ) -> RunLog:
-        """Start a run in ``out`` (``force``: its earlier outputs removed first) or resume
-        the one there (its suite must equal ``suite``: else a :class:`RunError` naming what
-        differs).  Writes ``run.json`` with status "running"."""
-        folder = check_out_dir(out, resume=resume, force=force)
+        """Lock ``out`` and start a run there (``force``: the paths its manifest lists
+        removed first) or resume the one there (its suite must equal ``suite``: else a
+        :class:`RunError` naming what differs).  Writes ``run.json`` with status
+        "running".  The lock is held until :meth:`recording` ends (or this fails)."""
+        check_out_usable(out, resume=resume, force=force)
+        lock = contextlib.ExitStack()
+        start = now()
+        folder = lock.enter_context(out_lock(out, start))
+        try:
+            log = cls._start(folder, command, suite, jobs, resume, force, start)
+        except BaseException:
+            lock.close()
+            raise
+        log._lock = lock
+        return log
+
+    @classmethod
+    def _start(
+        cls,
+        folder: Path,
+        command: Sequence[str],
+        suite: Mapping[str, Any],
+        jobs: int,
+        resume: bool,
+        force: bool,
+        start: str,
+    ) -> RunLog:
+        """:meth:`open` once the folder is locked."""
+        check_out_dir(folder, resume=resume, force=force)
         suite = as_json(suite)
         command = [str(c) for c in command]
         if resume:
@@ -433,33 +645,32 @@ class RunLog:
                     f"--resume: the suite differs from {folder / RUN_FILE}'s: {shown}; run it "
                     "as it was, or use --force to start afresh"
                 )
+            episodes = read_episodes(folder, suite=record["suite"])
             _repair(folder / EPISODES_FILE)
-            episodes = read_episodes(folder)
             resumed = {"time": now(), "command": command, "git_commit": git_commit()}
             record.setdefault("resumed", []).append({**resumed, "versions": versions()})
             record.update(status="running", end_time=None, jobs=jobs)
         else:
             if force:
-                clear_outputs(folder)
-            try:
-                folder.mkdir(parents=True, exist_ok=True)
-            except OSError as exc:
-                raise RunError(f"--out {folder}: cannot create it ({exc.strerror})") from None
+                clear_listed(folder)
             episodes = []
             record = {
                 "command": command,
                 "suite": suite,
                 "versions": versions(),
                 "git_commit": git_commit(),
-                "start_time": now(),
+                "start_time": start,
                 "end_time": None,
                 "status": "running",
                 "jobs": jobs,
                 "episodes": 0,
             }
-        log = cls(folder, record, episodes)
-        log._file = open(log.episodes_file, "a")  # closed by finish
+        manifest = Manifest(folder)
+        run_file = folder / RUN_FILE
+        manifest.claim(RUN_FILE, temporary_file(run_file).name, EPISODES_FILE)
+        log = cls(folder, record, episodes, manifest)
         log._write_record()
+        log._file = open(log.episodes_file, "ab", buffering=0)  # closed by finish
         return log
 
     def append(self, result: EpisodeResult, keep_trajectory: bool = False) -> None:
@@ -469,14 +680,20 @@ class RunLog:
         record = episode_record(result)
         key = episode_key(record)
         if keep_trajectory and result.trajectory:
-            (self.folder / TRAJECTORY_DIR).mkdir(exist_ok=True)
             name = trajectory_file(key)
-            tmp = self.folder / f"{name}.tmp.npz"
-            np.savez(tmp, **result.trajectory)  # uncompressed: 6x faster, 20 % larger
-            os.replace(tmp, self.folder / name)
+            tmp = f"{name}.tmp.npz"
+            self.manifest.claim(TRAJECTORY_DIR, name, tmp)
+            (self.folder / TRAJECTORY_DIR).mkdir(exist_ok=True)
+            try:
+                np.savez(self.folder / tmp, **result.trajectory)  # uncompressed: 6x faster
+                os.replace(self.folder / tmp, self.folder / name)
+            except BaseException as exc:  # no half-written file left behind (a full disk)
+                (self.folder / tmp).unlink(missing_ok=True)
+                if isinstance(exc, OSError) and exc.filename is None:
+                    exc.filename = str(self.folder / tmp)  # the message names it
+                raise
         assert self._file is not None, "append after finish"
-        self._file.write(json.dumps(record, allow_nan=False) + "\n")
-        self._file.flush()
+        self._write_line((json.dumps(record, allow_nan=False) + "\n").encode())
         if time.monotonic() - self._synced >= FSYNC_INTERVAL_S:
             os.fsync(self._file.fileno())
             self._synced = time.monotonic()
@@ -484,57 +701,126 @@ class RunLog:
         self.done.add(key)
         self._count += 1
 
+    def _write_line(self, data: bytes) -> None:
+        """Append one line to ``episodes.jsonl`` (unbuffered: on disk when this returns);
+        a line that cannot be written whole is cut off again, so no partial line stays
+        between whole ones (a full disk)."""
+        assert self._file is not None
+        start = self._file.seek(0, os.SEEK_END)
+        try:
+            done = 0
+            while done < len(data):
+                written = self._file.write(data[done:])
+                if not written:
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                done += written
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._file.fileno(), start)
+            if exc.filename is None:
+                exc.filename = str(self.episodes_file)
+            raise
+
     def drop_trajectories(self, keys: Iterable[Key]) -> None:
         """Remove the trajectory files of these episodes (those not drawn), if there."""
         for key in keys:
             (self.folder / trajectory_file(key)).unlink(missing_ok=True)
 
     def finish(self, status: str) -> None:
-        """Close ``episodes.jsonl`` and write the final status and end time."""
+        """Close ``episodes.jsonl`` and write the final status and end time (on a full
+        disk ``run.json`` is overwritten in place if it can be: :meth:`_write_record`)."""
         if self._file is not None:
-            self._file.flush()
-            os.fsync(self._file.fileno())
-            self._file.close()
-            self._file = None
+            file, self._file = self._file, None
+            with contextlib.suppress(OSError):
+                os.fsync(file.fileno())
+            file.close()
         self._count = len(read_episodes(self.folder))  # the file's count: Ctrl-C may cut in
         self.record.update(status=status, end_time=now(), episodes=self._count)
-        self._write_record()
+        self._write_record(in_place=status != "complete")
+
+    def kept(self) -> str:
+        """What the run kept, and how to finish it."""
+        return (
+            f"{self._count} of {self.record['jobs']} episodes kept in {self.episodes_file}; "
+            "resume with --resume"
+        )
 
     @contextlib.contextmanager
     def recording(self) -> Iterator[RunLog]:
         """The run's body: status "complete" when it ends, "failed" (with ``error``) on an
-        error, and on Ctrl-C "interrupted" and a :class:`RunInterrupted` saying what was
-        kept.  (A killed run keeps "running" and every episode it finished.)"""
-        try:
-            yield self
-        except KeyboardInterrupt:
-            self.finish("interrupted")
-            raise RunInterrupted(
-                f"{self._count} of {self.record['jobs']} episodes kept in "
-                f"{self.episodes_file}; resume with --resume"
-            ) from None
-        except BaseException as exc:
-            self.record["error"] = f"{type(exc).__name__}: {exc}"
-            self.finish("failed")
-            raise
-        self.record.pop("error", None)  # a resumed run that failed before
-        self.finish("complete")
+        error, and on Ctrl-C or SIGTERM "interrupted" and a :class:`RunInterrupted` saying
+        what was kept.  A worker that died or a full disk: "failed" and a
+        :class:`~baselines.errors.RunFailed` saying what was kept.  (A killed run keeps
+        "running" and every episode it finished.)  Releases the folder's lock."""
+        with self._lock:
+            try:
+                yield self
+            except KeyboardInterrupt as exc:
+                self.finish("interrupted")
+                raise RunInterrupted(self.kept(), signal_number(exc)) from None
+            except (OSError, RunFailed, BrokenProcessPool) as exc:
+                problem = outside_problem(exc)
+                if problem is None:
+                    self._fail(exc)
+                    raise
+                self.record["error"] = problem
+                self.finish("failed")
+                raise RunFailed(f"{problem}: {self.kept()}") from None
+            except BaseException as exc:
+                self._fail(exc)
+                raise
+            self.record.pop("error", None)  # a resumed run that failed before
+            self.finish("complete")
 
-    def _write_record(self) -> None:
-        write_json(self.folder / RUN_FILE, self.record)
+    def _fail(self, exc: BaseException) -> None:
+        self.record["error"] = f"{type(exc).__name__}: {exc}"
+        self.finish("failed")
+
+    def _write_record(self, in_place: bool = False) -> None:
+        """``run.json``, atomically; ``in_place``: when that finds no room, overwritten in
+        place as compact JSON if that does not make the file longer (the final status on
+        a full disk), else left as it was."""
+        file = self.folder / RUN_FILE
+        try:
+            write_json(file, self.record)
+        except OSError as exc:
+            if not (in_place and exc.errno in NO_ROOM and file.is_file()):
+                raise
+            from baselines.jsonout import dumps
+
+            data = (dumps(self.record) + "\n").encode()
+            if len(data) <= file.stat().st_size:
+                with contextlib.suppress(OSError), open(file, "r+b") as fh:
+                    fh.write(data)
+                    fh.truncate()
+
+
+def outside_problem(exc: BaseException) -> str | None:
+    """The one-line account of a run stopped from outside (a full disk, a worker that
+    died), or None for any other error."""
+    if isinstance(exc, BrokenProcessPool):
+        return "a worker process died (killed, or out of memory)"
+    if isinstance(exc, RunFailed):
+        return str(exc)
+    if isinstance(exc, OSError) and exc.errno in NO_ROOM:
+        where = exc.filename or "a file"
+        return f"no room to write {where} ({exc.strerror}: disk full?)"
+    return None
 
 
 __all__ = [
     "BACKENDS",
     "EPISODES_FILE",
+    "NO_ROOM",
     "RUN_FILE",
-    "RUN_OUTPUTS",
     "RunInterrupted",
     "RunLog",
     "check_out_dir",
+    "check_out_usable",
     "clear_outputs",
     "differences",
     "episode_result",
+    "outside_problem",
     "read_episodes",
     "read_run",
     "versions",

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from collections.abc import Callable
 
@@ -20,6 +21,8 @@ from baselines.cli import (
     scenarios,
     train,
 )
+from baselines.errors import RunFailed
+from baselines.signals import Terminated, signal_number, terminate_as_interrupt
 from shipgym.errors import ShipgymError
 
 #: the subcommands' parser builders, in the order ``shipgym --help`` lists them
@@ -38,8 +41,12 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
 
 #: exit code of a bad input (a :class:`ShipgymError`), as argparse's own usage errors
 EXIT_USAGE = 2
+#: exit code of a run stopped from outside (a worker killed, a full disk)
+EXIT_FAILED = 1
+#: exit code after a signal: 128 + its number (Ctrl-C: 130, SIGTERM: 143)
+EXIT_SIGNAL = 128
 #: exit code after Ctrl-C (128 + SIGINT)
-EXIT_INTERRUPTED = 130
+EXIT_INTERRUPTED = EXIT_SIGNAL + 2
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -52,22 +59,30 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one subcommand; a :class:`ShipgymError` (bad input) prints one line and exits 2,
-    any other exception is a bug and keeps its traceback."""
+    a :class:`~baselines.errors.RunFailed` one line and exit 1, Ctrl-C or SIGTERM one line
+    and 128 + the signal's number; any other exception is a bug and keeps its
+    traceback."""
     parser = build_parser()
     args = parser.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)  # a run's record keeps it
     from baselines.learned.trust import trusting_pickle
 
     try:
-        with trusting_pickle(getattr(args, "trust_pickle", False)):
+        # SIGTERM ends a run as Ctrl-C does
+        with trusting_pickle(getattr(args, "trust_pickle", False)), terminate_as_interrupt():
             return int(args.func(args))
+    except RunFailed as exc:  # a worker killed, a full disk: what was kept
+        sys.stderr.write(f"shipgym {args.command}: failed: {exc}\n")
+        return EXIT_FAILED
     except ShipgymError as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return EXIT_USAGE
     except KeyboardInterrupt as exc:  # a run says what it kept (baselines.runs.RunInterrupted)
-        detail = f": {exc}" if str(exc) else ""
-        sys.stderr.write(f"shipgym {args.command}: interrupted{detail}\n")
-        return EXIT_INTERRUPTED
+        signum = signal_number(exc)
+        by = "" if signum == signal.SIGINT else f" by {signal.Signals(signum).name}"
+        detail = f": {exc}" if str(exc) and not isinstance(exc, Terminated) else ""
+        sys.stderr.write(f"shipgym {args.command}: interrupted{by}{detail}\n")
+        return EXIT_SIGNAL + signum
 
 
 __all__ = ["build_parser", "main"]

@@ -65,14 +65,18 @@ def evaluate_folder(policy: str) -> Path:
 def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
     the rows)."""
-    from baselines.runs import check_out_dir
+    from baselines.runs import check_out_dir, check_out_usable
+    from baselines.suite import load_suite
 
     policy = getattr(args, "policy", None)
     out, note = args.out, ""
     if out is None:
         out = evaluate_folder(policy)
         note = f" (evaluate's folder for {policy!r}; give --out for another)"
-    check_out_dir(out, resume=args.resume, force=args.force, note=note)  # before any work
+    # before any work: an unusable --out, then a bad suite, then --out in use or not empty
+    check_out_usable(out, resume=args.resume, force=args.force)
+    load_suite(args.suite)
+    check_out_dir(out, resume=args.resume, force=args.force, note=note)
     from baselines.leaderboard import run_leaderboard, terminal_summary
 
     rows = run_leaderboard(

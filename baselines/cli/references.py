@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
         for scenario in spec.all_scenarios():
             suite_scenario(scenario)  # a bad name fails here, before any work
             for seed in (EVAL_SEED_OFFSET + i for i in range(n)):
-                job = Job(ORACLE, scenario, (seed,), None, randomize, "recompute")
+                job = Job(ORACLE, scenario, (seed,), None, randomize, references="recompute")
                 (trial,) = trials(job)
                 if table.lookup(trial, seed) is not None:
                     held += 1

@@ -236,3 +236,20 @@ def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
         "nmpc_wlssvm_svf",
     }
     assert (tmp_path / "liu2019.md").is_file() and (tmp_path / "rudder_aging_si.png").is_file()
+
+
+def test_finding11_a_bad_suite_is_named_before_the_state_of_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Run where the main job ran before (``results/leaderboard`` holds a run): a
+    misspelt --suite is reported as such, not as "--out is not empty"."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "results" / "leaderboard").mkdir(parents=True)
+    (tmp_path / "results" / "leaderboard" / "run.json").write_text("{}")
+    for command in (["leaderboard"], ["evaluate", "pid_los"]):
+        out = [] if command[0] == "leaderboard" else ["--out", "results/leaderboard"]
+        assert main([*command, "--suite", "smok", *out, "--no-progress"]) == 2
+        message = _error_line(capsys, command[0])
+        assert "smok" in message and "valid: default" in message and "not empty" not in message
+    assert main(["leaderboard", "--suite", "smoke", "--no-progress"]) == 2  # then the folder
+    assert "--out results/leaderboard is not empty" in _error_line(capsys, "leaderboard")

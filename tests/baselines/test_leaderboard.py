@@ -328,3 +328,41 @@ def test_the_terminal_ends_with_the_ranking_and_the_page(
     assert text.rstrip().endswith(f"leaderboard: {out / 'leaderboard.html'}")
     assert "| 1 | pid_los | classical |" in text and "Resolution, catalogue" in text
     assert "| scenario | controller |" not in text
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, workers: int) -> None:
+    """The scenario file is rewritten (a 20 s time limit instead of 90 s, another start)
+    once the first episode is recorded: every episode still runs the scenario as run.json
+    recorded it at the start, in the parent and in the pool's workers."""
+    case = tmp_path / "case.yaml"
+    original = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    case.write_text(original)
+    suite = write_suite(tmp_path, scenarios=[str(case)], seeds=4)
+
+    def edit_once(result: object, seen: list[object] = []) -> None:  # noqa: B006
+        seen.append(result)
+        if len(seen) == 1:
+            edited = original.replace("time_limit: 90.0", "time_limit: 20.0")
+            case.write_text(edited.replace("heading_deg: 0.0", "heading_deg: 40.0"))
+
+    out = tmp_path / "out"
+    run_leaderboard(suite, out_dir=out, workers=workers, show_progress=False, on_episode=edit_once)
+    assert "time_limit: 20.0" in case.read_text()
+    record = read_run(out)
+    settings = record["suite"]["scenarios"][str(case)]
+    assert settings["time_limit"] == 90.0 and settings["initial_state"]["heading_deg"] == 0.0
+    assert record["status"] == "complete"
+    for controller in ("pid_los", "zero_rudder"):
+        episodes = [e for e in untimed_episodes(out) if e["controller"] == controller]
+        assert len(episodes) == 4
+        # no randomisation: every seed's episode is the recorded scenario's, step for step
+        assert len({(e["steps"], e["ace"], e["duration"]) for e in episodes}) == 1
+    # the edit matters: the file as it is now gives other episodes
+    recorded = {e["controller"]: e for e in untimed_episodes(out)}
+    for controller in ("pid_los", "zero_rudder"):
+        now = run_job((controller, str(case), 10_000)).metrics
+        assert (now["steps"], now["ace"]) != (
+            recorded[controller]["steps"],
+            recorded[controller]["ace"],
+        )

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import datetime
+import errno
+import io
 import json
 import os
 import signal
@@ -17,9 +19,10 @@ import yaml
 
 import baselines.leaderboard
 from baselines.cli import main
-from baselines.errors import RunError
+from baselines.errors import RunError, RunFailed
 from baselines.jsonout import dumps
 from baselines.leaderboard import run_leaderboard
+from baselines.manifest import snapshot
 from baselines.runs import (
     RunInterrupted,
     check_out_dir,
@@ -156,24 +159,54 @@ def test_an_unusable_out_is_refused_first(tmp_path: Path, capsys) -> None:
             check_out_dir(locked / "out")
 
 
-def test_force_clears_the_earlier_outputs(tmp_path: Path, clean_run: Path) -> None:
-    out = tmp_path / "out"
-    out.mkdir()
-    for name in ("old_scenario.png", "leaderboard.md", "episodes.jsonl", "run.json"):
-        (out / name).write_text("stale")
-    (out / "trajectories").mkdir()
-    (out / "trajectories" / "000099.npz").write_text("stale")
-    suite = write_suite(tmp_path)
+def test_finding4_force_deletes_only_what_the_manifest_lists(
+    tmp_path: Path, clean_run: Path
+) -> None:
+    """A user's files that look like outputs (``*.png``, a directory named ``*.png``, their
+    own file in ``trajectories/``, a ``report.json``) make --force refuse, deleting
+    nothing; without them --force deletes exactly what the earlier run listed."""
+    out, suite = tmp_path / "out", write_suite(tmp_path)
+    run_leaderboard(suite, seeds=1, out_dir=out, workers=1, show_progress=False)
+    listed = set((out / "manifest.txt").read_text().splitlines())
+    assert {"run.json", "episodes.jsonl", "leaderboard.md", "scenario_nominal.png"} <= listed
+    assert snapshot(out) <= listed | {"manifest.txt"}  # every path the run wrote is listed
+    mine = ["my_plot.png", "figures.png/keep.txt", "trajectories/mine.npz", "report.json"]
+    for name in mine:
+        (out / name).parent.mkdir(exist_ok=True)
+        (out / name).write_text("mine")
+    before = snapshot(out)
+    with pytest.raises(RunError, match=r"--force: .* holds files no run wrote: figures\.png, "):
+        run_leaderboard(suite, out_dir=out, workers=1, show_progress=False, force=True)
+    assert snapshot(out) == before  # nothing deleted
+    for name in mine:
+        (out / name).unlink()
+    (out / "figures.png").rmdir()
     rows = run_leaderboard(suite, out_dir=out, workers=1, show_progress=False, force=True)
-    assert not (out / "old_scenario.png").exists()
-    assert not (out / "trajectories" / "000099.npz").exists()
     assert len(read_episodes(out)) == 8 and read_run(out)["status"] == "complete"
     assert untimed(rows) == untimed(json.loads((clean_run / "leaderboard.json").read_text()))
-    # a file no run writes is never deleted: --force refuses to touch it
-    (out / "notes.txt").write_text("mine")
-    with pytest.raises(RunError, match=r"notes\.txt"):
+    # a folder written by no run of this version (no manifest) is refused, not guessed at
+    (out / "manifest.txt").unlink()
+    with pytest.raises(RunError, match=r"no manifest\.txt"):
         run_leaderboard(suite, out_dir=out, show_progress=False, force=True)
     assert (out / "run.json").is_file()
+
+
+def test_finding4_report_force_deletes_only_its_listed_outputs(
+    tmp_path: Path, clean_run: Path, capsys
+) -> None:
+    report = tmp_path / "report"
+    assert main(["report", str(clean_run), "--out", str(report), "--json"]) == 0
+    assert "report.json" in (report / "manifest.txt").read_text().splitlines()
+    (report / "trajectories").mkdir()
+    (report / "trajectories" / "mine.npz").write_text("mine")
+    assert main(["report", str(clean_run), "--out", str(report), "--force", "--json"]) == 2
+    assert "trajectories/mine.npz" in capsys.readouterr().err
+    assert (report / "leaderboard.json").is_file()
+    (report / "trajectories" / "mine.npz").unlink()
+    assert main(["report", str(clean_run), "--out", str(report), "--force", "--json"]) == 2
+    assert "holds files no run wrote: trajectories;" in capsys.readouterr().err  # their folder
+    (report / "trajectories").rmdir()
+    assert main(["report", str(clean_run), "--out", str(report), "--force", "--json"]) == 0
 
 
 def test_an_interrupted_run_resumes_to_the_clean_table(tmp_path: Path, clean_run: Path) -> None:
@@ -340,3 +373,159 @@ def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
     (out / "notes.txt").write_text("mine")
     with pytest.raises(RunError, match=r"notes\.txt"):
         train("ppo", out_dir=out, n_timesteps=64, progress=False, force=True)
+
+
+# --- issue 19, finding 2: episodes.jsonl is a set keyed by the episode key ----------------
+
+
+def copy_run(source: Path, target: Path) -> Path:
+    """A copy of a finished run folder (its record and episodes)."""
+    target.mkdir()
+    for name in ("run.json", "episodes.jsonl"):
+        (target / name).write_bytes((source / name).read_bytes())
+    return target
+
+
+def test_finding2_a_duplicated_line_counts_once_on_resume_and_report(
+    tmp_path: Path, clean_run: Path, capsys
+) -> None:
+    out = copy_run(clean_run, tmp_path / "out")
+    lines = (out / "episodes.jsonl").read_text().splitlines(keepends=True)
+    (out / "episodes.jsonl").write_text("".join(lines[:5]) + lines[0] + lines[2])  # 2 repeated
+    assert len(read_episodes(out)) == 5
+    ran: list[object] = []
+    rows = run_leaderboard(
+        write_suite(tmp_path),
+        out_dir=out,
+        workers=1,
+        show_progress=False,
+        resume=True,
+        on_episode=ran.append,
+    )
+    assert len(ran) == 3 and all(r["episodes"] == 2 for r in rows)
+    assert main(["report", str(out), "--out", str(tmp_path / "report"), "--json"]) == 0
+    assert [r["episodes"] for r in json.loads(capsys.readouterr().out)] == [2, 2, 2, 2]
+
+
+@pytest.mark.parametrize(
+    ("change", "problem"),
+    [
+        (
+            {"ace": 99.0},
+            'episode ["nominal", "pid_los", 10000, null] again, with other values than on line 1',
+        ),
+        ({"controller": "pid_vf"}, "controller 'pid_vf' is not in the run's suite"),
+        ({"scenario": "current_shift"}, "scenario 'current_shift' is not in the run's suite"),
+        ({"seed": 77}, "seed 77 is not one of the run's seeds"),
+        ({"training_seed": 3}, "training seed 3 is not one of 'pid_los''s in the run"),
+    ],
+)
+def test_finding2_an_other_duplicate_or_a_foreign_episode_is_an_error_naming_the_line(
+    tmp_path: Path, clean_run: Path, capsys, change: dict, problem: str
+) -> None:
+    out = copy_run(clean_run, tmp_path / "out")
+    first = json.loads((out / "episodes.jsonl").read_text().splitlines()[0])
+    with open(out / "episodes.jsonl", "a") as fh:
+        fh.write(json.dumps({**first, **change}) + "\n")
+    expected = f"{out / 'episodes.jsonl'}: line 9: {problem}"
+    suite = write_suite(tmp_path)
+    args = ["leaderboard", "--suite", suite, "--out", str(out), "--resume", "--no-progress"]
+    for argv, command in ((args, "leaderboard"), (["report", str(out)], "report")):
+        assert (
+            main([*argv, "--out", str(tmp_path / "report")] if command == "report" else argv) == 2
+        )
+        err = capsys.readouterr().err
+        assert err == f"shipgym {command}: error: {expected}\n"
+    assert not (tmp_path / "report").exists()
+
+
+@pytest.mark.parametrize(
+    ("line", "problem"),
+    [
+        (b"[1, 2]", "not an episode record (a JSON list)"),
+        (b"{}", "not an episode record (no scenario, controller, kind, seed, training_seed)"),
+        (b'{"scenario": "nominal", \xff\xfe}', "not UTF-8 text"),
+        (b"{not json", "not JSON"),
+        (None, 'metric ace is "fast", not a number'),
+        (None, 'seed "1" is not an integer'),
+    ],
+)
+def test_finding2_a_malformed_line_is_one_line_naming_file_and_line(
+    tmp_path: Path, clean_run: Path, capsys, line: bytes | None, problem: str
+) -> None:
+    out = copy_run(clean_run, tmp_path / "out")
+    if line is None:  # a record with one bad value
+        first = json.loads((out / "episodes.jsonl").read_text().splitlines()[0])
+        key = "ace" if "ace" in problem else "seed"
+        line = json.dumps({**first, key: "fast" if key == "ace" else "1"}).encode()
+    data = (out / "episodes.jsonl").read_bytes().splitlines(keepends=True)
+    (out / "episodes.jsonl").write_bytes(b"".join([*data[:3], line + b"\n", *data[3:]]))
+    assert main(["report", str(out), "--out", str(tmp_path / "report")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"shipgym report: error: {out / 'episodes.jsonl'}: line 4: {problem}\n"
+    with pytest.raises(RunError, match="line 4"):
+        run_leaderboard(write_suite(tmp_path), out_dir=out, show_progress=False, resume=True)
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        (b'{"suite": {"seeds": [1]', "line 1: not JSON (Expecting ',' delimiter)"),
+        (b"[1, 2]", "not a run record (no 'suite')"),
+        (b'{"suite": {}}', "not a run record (key 'suite.seeds' is null, not a list of integers)"),
+        (b'{\n"suite": "\xff"}', "line 2: not UTF-8 text"),
+    ],
+)
+def test_finding2_a_malformed_run_json_is_one_line_naming_the_file(
+    tmp_path: Path, clean_run: Path, capsys, text: bytes, problem: str
+) -> None:
+    out = copy_run(clean_run, tmp_path / "out")
+    (out / "run.json").write_bytes(text)
+    assert main(["report", str(out), "--out", str(tmp_path / "report")]) == 2
+    assert capsys.readouterr().err == f"shipgym report: error: {out / 'run.json'}: {problem}\n"
+    suite = write_suite(tmp_path)
+    args = ["leaderboard", "--suite", suite, "--out", str(out), "--resume", "--no-progress"]
+    assert main(args) == 2
+    assert capsys.readouterr().err == f"shipgym leaderboard: error: {out / 'run.json'}: {problem}\n"
+
+
+class _FillsUp(io.FileIO):
+    """A file on a disk that fills up: the first write stores half its bytes, then none."""
+
+    full = False
+
+    def write(self, data: bytes) -> int:  # type: ignore[override]
+        if self.full:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        self.full = True
+        return super().write(bytes(data)[: len(data) // 2])
+
+
+def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_run: Path) -> None:
+    """A full disk cuts an episode's line short: it is cut off again, so no partial line
+    stays between whole ones once there is room again."""
+    from baselines.runs import RunLog, episode_result
+
+    records = read_episodes(clean_run)
+    log = RunLog.open(
+        tmp_path / "out", command=["test"], suite=read_run(clean_run)["suite"], jobs=8
+    )
+    with pytest.raises(RunFailed, match=r"no room to write .*episodes\.jsonl"):
+        with log.recording():
+            log.append(episode_result(records[0], clean_run))
+            full = _FillsUp(log.episodes_file, "ab")
+            log._file, spare = full, log._file
+            spare.close()
+            log.append(episode_result(records[1], clean_run))
+    assert len((log.episodes_file).read_text().splitlines()) == 1
+    assert read_run(tmp_path / "out")["status"] == "failed"
+    ran: list[object] = []
+    run_leaderboard(
+        write_suite(tmp_path),
+        out_dir=tmp_path / "out",
+        workers=1,
+        show_progress=False,
+        resume=True,
+        on_episode=ran.append,
+    )
+    assert len(ran) == 7 and len(read_episodes(tmp_path / "out")) == 8

@@ -1,0 +1,135 @@
+"""One run per output folder: an exclusive lock on ``--out`` while a run writes there.
+
+``leaderboard``, ``evaluate`` and ``report`` hold :func:`out_lock` on their ``--out`` for
+the whole run.  The lock is a POSIX record lock (``fcntl.lockf``) on the file
+:data:`LOCK_FILE` in the folder, which holds the holder's process id, start time and
+command.  A second run on the folder is refused at once, in one line naming the holder.
+
+A stale lock cannot block anyone: the kernel releases a process's record locks when it
+dies, however it dies (kill -9 included), and record locks are not inherited by forked
+workers.  A lock file left by a killed run is therefore free; the next run takes it and
+writes its own holder into it.  The file is not a run's output: the "not empty" check and
+``--force`` ignore it, and a run that ends removes it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import fcntl
+import json
+import os
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+from baselines.errors import RunError
+
+#: the lock file a run keeps in its ``--out`` while it runs
+LOCK_FILE = ".shipgym.lock"
+
+#: folders this process holds (a second lock of one folder in one process is refused too:
+#: POSIX record locks do not exclude their own process)
+_HELD: set[Path] = set()
+
+
+def _holder(file: Path) -> str:
+    """Who holds the lock, from the lock file (pid and start time)."""
+    try:
+        holder = json.loads(file.read_text())
+        return f"process {holder['pid']}, started {holder['start_time']}"
+    except (OSError, ValueError, KeyError, TypeError):
+        return "a process that has not yet written its name"
+
+
+def in_use(folder: Path, holder: str) -> RunError:
+    """The refusal of a folder another run holds (``holder``: who)."""
+    return RunError(
+        f"--out {folder} is in use by another run ({holder}): wait for it to end, or choose "
+        "another --out"
+    )
+
+
+def _acquire(folder: Path, start_time: str) -> int:
+    """The descriptor of the locked lock file of ``folder``; a :class:`RunError` naming
+    the holder when another process holds it."""
+    file = folder / LOCK_FILE
+    while True:
+        fd = os.open(file, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno in (errno.EACCES, errno.EAGAIN):
+                raise in_use(folder, _holder(file)) from None
+            raise
+        try:  # the file may have been removed by its last holder meanwhile: lock the new one
+            same = os.path.samestat(os.fstat(fd), os.stat(file))
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    holder = {"pid": os.getpid(), "start_time": start_time, "command": sys.argv}
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, (json.dumps(holder) + "\n").encode(), 0)
+    return fd
+
+
+def lock_holder(folder: str | os.PathLike) -> str | None:
+    """Who holds the lock of ``folder`` (process id, start time), or None when nobody else
+    does (free, no lock file, or held by this process)."""
+    path = Path(folder)
+    file = path / LOCK_FILE
+    if path.resolve() in _HELD or not file.is_file():
+        return None
+    try:
+        fd = os.open(file, os.O_RDONLY)
+    except OSError:
+        return None
+    try:  # a shared lock conflicts with the holder's exclusive one; closing releases ours
+        fcntl.lockf(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError as exc:
+        if exc.errno in (errno.EACCES, errno.EAGAIN):
+            return _holder(file)
+        raise
+    finally:
+        os.close(fd)
+    return None
+
+
+@contextlib.contextmanager
+def out_lock(out: str | os.PathLike, start_time: str) -> Iterator[Path]:
+    """Hold the exclusive lock of the folder ``out`` (made if missing; removed again if
+    the run leaves it empty) for the ``with`` body; ``start_time``: the holder's, as the
+    refusal names it.  A :class:`RunError` if another run holds it."""
+    folder = Path(out)
+    key = folder.resolve()
+    if key in _HELD:
+        raise in_use(folder, f"process {os.getpid()}, this one")
+    made = not folder.exists()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RunError(f"--out {folder}: cannot create it ({exc.strerror})") from None
+    try:
+        fd = _acquire(folder, start_time)
+    except BaseException:
+        if made:
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
+    _HELD.add(key)
+    try:
+        yield folder
+    finally:
+        _HELD.discard(key)
+        with contextlib.suppress(OSError):
+            (folder / LOCK_FILE).unlink()  # while locked: the next holder finds a fresh file
+        os.close(fd)
+        if made:
+            with contextlib.suppress(OSError):
+                folder.rmdir()  # only if empty: a run refused before writing leaves nothing
+
+
+__all__ = ["LOCK_FILE", "in_use", "lock_holder", "out_lock"]

@@ -1,0 +1,36 @@
+"""Fixtures of the whole test suite."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+#: folders of the working directory that commands write into by default (``results/…``)
+DEFAULT_OUTPUTS = ("results",)
+
+
+def working_directory_listing(root: Path) -> set[str]:
+    """What a test could leave in the working directory: its entries (hidden ones, tool
+    caches such as ``.pytest_cache``, aside) and, two levels deep, what the commands'
+    default output folders hold."""
+    found = {p.name for p in root.iterdir() if not p.name.startswith(".")}
+    for name in DEFAULT_OUTPUTS:
+        folder = root / name
+        if folder.is_dir():
+            found |= {p.relative_to(root).as_posix() for p in folder.glob("*")}
+            found |= {p.relative_to(root).as_posix() for p in folder.glob("*/*")}
+    return found
+
+
+@pytest.fixture(autouse=True)
+def leaves_no_trace(request: pytest.FixtureRequest) -> Iterator[None]:
+    """Every test writes only into temporary folders (issue 19, finding 11): the working
+    directory (the checkout, where ``shipgym leaderboard`` writes ``results/``) is as it
+    was before the test."""
+    root = Path.cwd()
+    before = working_directory_listing(root)
+    yield
+    new = sorted(working_directory_listing(root) - before)
+    assert not new, f"{request.node.nodeid} wrote into the working directory {root}: {new}"
