@@ -42,6 +42,7 @@ def test_every_subcommand_is_listed() -> None:
         "manoeuvre",
         "scenarios",
         "bench",
+        "references",
     ]
 
 

@@ -238,3 +238,31 @@ def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:
         json.dump(data, f)
     assert ReferenceTable.load(file).lookup(sc, 1) is None
     assert table_path().name == "oracle.json.gz"
+
+
+def test_shipgym_references_fills_a_table_and_resumes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``shipgym references`` computes the trials a table lacks, and only those."""
+    import json
+
+    import yaml
+
+    from baselines.cli import main
+
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        yaml.safe_dump(
+            {"name": "tiny", "scenarios": ["nominal"], "controllers": ["oracle"], "seeds": 1}
+        )
+    )
+    table = tmp_path / "refs.json.gz"
+    args = ["references", "--suite", str(suite), "--table", str(table), "--workers", "1", "--json"]
+    assert main(args) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert (first["computed"], first["held"]) == (1, 0)
+    assert main(args) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert (again["computed"], again["held"]) == (0, 1)
+    (entry,) = ReferenceTable.load(table).entries.values()
+    assert entry["metrics"]["termination_reason"] == "goal" and entry["metrics"]["cost"] > 0
