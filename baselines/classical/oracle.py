@@ -18,9 +18,12 @@ over the control steps of the horizon:
     Σ_k  |e_k|/L + w_ψ|ψ̃_k| + w_δ (δc_k/δmax)² + w_Δ ((δc_k − δc_{k−1})/δmax)²
 
 with |·| smoothed as √(z² + ε²) (ε = ``smooth_abs``), e and ψ̃ measured as the env measures
-them: to the active leg, which switches to the next at the along-track point ℓ − R0 of the
-env's switching rule (smoothly, over ``switch_width_L``·L); a PCHIP route enters as its
-chords ahead of the closest point.
+them: to the active leg.  Legs switch as the env's tracker switches them (the acceptance
+circle R0 of Liu eq. (13) or the along-track rule of Borkowski eq. (27)), through latches
+q_j ∈ [0, 1] carried in the prediction's state (q_j⁺ = q_j + (1 − q_j)σ_j, σ_j the rule
+smoothed over ``switch_width_L``·L and set 2 widths inside its edge), so that a switch is
+permanent, as in the env; a PCHIP route enters as its chords ahead of the closest point.
+The goal bonus is not in the objective (it is not in the cost either).
 
 **Horizon rule.**  H = 2(T + (L + R0)/U) + δmax/δ̇max: two of the ship's yaw time constants T
 (its first-order Nomoto T of the nominal model, the one the classical controllers use) to
@@ -36,14 +39,20 @@ nomoto2 10.0 s (21 steps of 0.5 s), Esso Osaka (1:100) 32 s on its curved route,
 (the one applied); the horizon's rest is split into ``blocks`` equal intervals of m·Ts
 (m = ⌈(H/Ts − 1)/blocks⌉), one command each.  The stage cost is evaluated at every control
 step end, as the env does.  Prediction step h_p = Ts/n with n the smallest integer such that
-h_p·|λ_max| ≤ 1 (λ_max the fastest eigenvalue of the model linearised at cruise: RK4
-accurate and stable), never finer than the env's own h.
+h_p·|λ_max| ≤ 2 (λ_max the fastest eigenvalue of the nominal model linearised at cruise;
+RK4 is stable to 2.79 on the negative real axis), never finer than the env's own h.
 
 **Solver.**  Generalised Gauss–Newton SQP (Messerer, Baumgärtner & Diehl 2021): the cost
 is Σ φ_i(z_i(u)) with convex outer φ (smooth |·| or square) of a smooth inner z; each
-iteration solves the box QP with H = Jᵀ diag(φ'') J, g = Jᵀ φ' (:class:`BoxQP`), then a
-backtracking line search on the cost; warm-started from the shifted previous plan.  z and
-J = ∂z/∂u are one CasADi function compiled to C (cached, :mod:`shipgym.codegen`).
+iteration solves the box QP with H = Jᵀ diag(c) J, g = Jᵀ φ' (:class:`BoxQP`), c = φ'' for
+the squares and the curvature 1/√(z² + ε²) of the quadratic majoriser for the smooth |·|
+(iteratively reweighted least squares: φ'' itself vanishes away from 0), then a
+backtracking line search on the cost; stopped when an iteration gains less than
+``cost_tolerance`` (relative) or moves less than ``step_tolerance``; warm-started from the
+shifted previous plan.  z and J = ∂z/∂u come from one CasADi function compiled to C
+(cached, :mod:`shipgym.codegen`): the horizon is a ``mapaccum`` loop, and J is carried as
+forward sensitivities S = ∂x/∂u (S⁺ = A·S + B·e_jᵀ, A and B of one period in closed form),
+so the generated code stays small for horizons of hundreds of steps.
 """
 
 from __future__ import annotations
@@ -541,7 +550,8 @@ class Oracle:
         self.plan = np.zeros(self.solver.n_u)
         self.command = 0.0
         self.failures = 0
-        self.solve_times: list[float] = []
+        self.solve_times: list[float] = []  # wall clock [s]
+        self.solve_cpu_times: list[float] = []  # this thread's CPU time [s]
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         if self._truth is None:
@@ -568,9 +578,10 @@ class Oracle:
             truth.disturbance_forecast(mids),
         )
         guess = np.concatenate([[self.plan[1]], self.plan[1:]])  # shifted by one period
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         plan, ok, _ = self.solver.solve(p, guess)
         self.solve_times.append(time.perf_counter() - start)
+        self.solve_cpu_times.append(time.thread_time() - cpu)  # not inflated by a busy machine
         if ok:
             self.plan = plan
         else:
