@@ -55,16 +55,32 @@ SAMPLE_KEYS = ("psi", "delta", "delta_c")
 
 
 class PersistentExcitation:
-    """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad]."""
+    """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad].
 
-    def __init__(self, sigma: float, rng: np.random.Generator | None = None) -> None:
+    ``hold``: calls (control periods) each draw is held for (1: a new draw every call, the
+    paper's; a slower ship holds it longer, :mod:`baselines.classical.nmpc_ship`).
+    """
+
+    def __init__(
+        self, sigma: float, rng: np.random.Generator | None = None, hold: int = 1
+    ) -> None:
         if sigma < 0:
             raise ValueError(f"sigma must be ≥ 0, got {sigma}")
+        if hold < 1:
+            raise ValueError(f"hold must be ≥ 1, got {hold}")
         self.sigma = sigma
+        self.hold = hold
         self.rng = rng if rng is not None else np.random.default_rng()
+        self._calls = 0
+        self._noise = 0.0
 
     def __call__(self, u: float) -> float:
-        return u + self.sigma * float(self.rng.standard_normal()) if self.sigma else u
+        if not self.sigma:
+            return u
+        if self._calls % self.hold == 0:
+            self._noise = self.sigma * float(self.rng.standard_normal())
+        self._calls += 1
+        return u + self._noise
 
 
 @dataclasses.dataclass
