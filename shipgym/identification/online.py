@@ -61,9 +61,7 @@ class PersistentExcitation:
     paper's; a slower ship holds it longer, :mod:`baselines.classical.nmpc_ship`).
     """
 
-    def __init__(
-        self, sigma: float, rng: np.random.Generator | None = None, hold: int = 1
-    ) -> None:
+    def __init__(self, sigma: float, rng: np.random.Generator | None = None, hold: int = 1) -> None:
         if sigma < 0:
             raise ValueError(f"sigma must be ≥ 0, got {sigma}")
         if hold < 1:
