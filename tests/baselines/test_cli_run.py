@@ -91,7 +91,7 @@ def test_a_controller_that_does_not_apply_is_refused(
     from baselines.classical.reference import ZeroRudder
     from baselines.registry import register_controller
 
-    register_controller("nomoto2_only", ZeroRudder, applies_to=("nomoto2",))
+    register_controller("nomoto2_only", lambda: ZeroRudder(), applies_to=("nomoto2",))
     out = tmp_path / "out"
     assert main(["run", "mariner_track", "nomoto2_only", "--out", str(out)]) == 2
     err = capsys.readouterr().err
