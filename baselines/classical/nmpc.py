@@ -1,10 +1,17 @@
 """Nonlinear MPC path following with LOS reference (Liu et al. 2019 §2.2.3, Algorithm 1).
 
-Prediction model: the ship model's own right-hand side and RK4 step (the simulator's), in
+On every ship (issue 17): nomoto2 with the paper's numbers, every other ship with a Nomoto
+prediction model from its own zig-zag and numbers from its own time scales
+(:mod:`baselines.classical.nmpc_ship`, where each rule is stated).
+
+Prediction model: the nomoto2 model's right-hand side and RK4 step (the simulator's), in
 CasADi SX, with the model parameters as solver parameters, so that an online identifier
 can change them without rebuilding the solver.  States [x, y, ψ, r, ṙ, δ] are predicted
-with ``prediction_substeps`` RK4 steps per control period (one step per Ts = 0.5 s is
-unstable for T2 = 0.0247 s); the error states of eq. (14) are outputs of the prediction:
+with ``prediction_substeps`` RK4 steps per prediction interval of ``interval`` control
+periods (the paper: 1 period, 10 substeps; one step per Ts = 0.5 s is unstable for
+T2 = 0.0247 s; with ``interval`` > 1 each planned command is held for that many periods,
+move blocking, and the warm start is the previous plan unshifted); the error states of
+eq. (14) are outputs of the prediction:
 
     e = −(x − x_n) sin ψp + (y − y_n) cos ψp,   ψ̃ = wrap(ψ − ψp)
 
