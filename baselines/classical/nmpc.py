@@ -50,7 +50,13 @@ import casadi as ca
 import numpy as np
 
 from baselines.classical.box_qp import BoxQP
-from baselines.classical.nmpc_ship import ShipNMPCPlan, ship_plan
+from baselines.classical.nmpc_ship import (
+    PAPER_CONTROL_HORIZON,
+    PAPER_HORIZON,
+    PAPER_Q,
+    ShipNMPCPlan,
+    ship_plan,
+)
 from baselines.policy import check_action_mode
 from baselines.registry import register_controller
 from shipgym.codegen import compiled
@@ -64,9 +70,9 @@ from shipgym.models.nomoto2 import Nomoto2
 class NMPCSettings:
     """Liu et al. (2019) §4 defaults, plus the numerical choices (documented in the module)."""
 
-    horizon: int = 10  # N_p
-    control_horizon: int = 8  # N_c
-    Q: tuple[float, float, float, float, float] = (1.0, 1.0, 0.01, 0.01, 0.001)
+    horizon: int = PAPER_HORIZON  # N_p
+    control_horizon: int = PAPER_CONTROL_HORIZON  # N_c
+    Q: tuple[float, float, float, float, float] = PAPER_Q
     R: float = 0.01
     prediction_substeps: int = 10  # RK4 steps per prediction interval
     interval: int = 1  # control periods per prediction interval (move blocking; 1: the paper)

@@ -68,17 +68,17 @@ from typing import Any
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import first_order_nomoto
 from shipgym.identification.front_end import SVF_BANDWIDTH
+from shipgym.identification.online import PAPER_LAMBDA_C, PAPER_UPDATE_EVERY, PAPER_WINDOW
 from shipgym.identification.zigzag import ship_nomoto
 from shipgym.models.base import ParameterError
 from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params, nomoto2_first_order
 
-#: the paper's N_p, N_c, Q, N_w [samples], N_u [samples], λ_c¹, λ_c² (Liu et al. 2019 §4)
+#: the paper's N_p, N_c, Q (Liu et al. 2019 §4; ``NMPCSettings``' defaults)
 PAPER_HORIZON = 10
 PAPER_CONTROL_HORIZON = 8
 PAPER_Q = (1.0, 1.0, 0.01, 0.01, 0.001)
-PAPER_WINDOW = 1200
-PAPER_WINDOW_TO_UPDATE = 24  # N_w / N_u = 1200 / 50
-PAPER_LAMBDA_C = (1e-5, 1e-2)
+#: N_w / N_u of the paper's identifiers (1200 / 50)
+PAPER_WINDOW_TO_UPDATE = PAPER_WINDOW / PAPER_UPDATE_EVERY
 #: RK4 step per fastest time constant τ_f (|h·λ| ≤ 0.5)
 STEP_PER_FAST_TIME_CONSTANT = 0.5
 #: heading response settled (95 %) after 3 T

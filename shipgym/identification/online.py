@@ -50,6 +50,10 @@ from shipgym.identification.nomoto import (
 from shipgym.models.nomoto2 import Nomoto2Params
 
 RAD_TO_DEG = 180.0 / math.pi
+#: Liu et al. (2019) §4: window N_w and update period N_u [samples, at h = 0.01 s], λ_c¹, λ_c²
+PAPER_WINDOW = 1200
+PAPER_UPDATE_EVERY = 50
+PAPER_LAMBDA_C = (1e-5, 1e-2)
 #: the keys of ``info["samples"]`` an identifier reads
 SAMPLE_KEYS = ("psi", "delta", "delta_c")
 
@@ -101,8 +105,8 @@ class _SlidingWindowNomoto:
         self,
         h: float,
         initial: Nomoto2Params | None = None,
-        window: int = 1200,
-        update_every: int = 50,
+        window: int = PAPER_WINDOW,
+        update_every: int = PAPER_UPDATE_EVERY,
         gamma: float | None = None,
         servo_model: str = "forward",
         bias_penalty: bool = True,
@@ -289,11 +293,11 @@ class LambdaLSSVM(_SlidingWindowNomoto):
         self,
         h: float,
         initial: Nomoto2Params | None = None,
-        window: int = 1200,
-        update_every: int = 50,
+        window: int = PAPER_WINDOW,
+        update_every: int = PAPER_UPDATE_EVERY,
         gamma: float | None = None,
-        lambda_c1: float = 1e-5,
-        lambda_c2: float = 1e-2,
+        lambda_c1: float = PAPER_LAMBDA_C[0],
+        lambda_c2: float = PAPER_LAMBDA_C[1],
         c3: float = 0.01,
         c4: float = 0.99,
         index_unit: str = "deg",
