@@ -26,12 +26,17 @@ identifiers estimate online), with u0 = U and L of the ship:
   (:meth:`ShipNMPCPlan.prediction_params`): K, d0 and T = T1 + T2 − T3 adapt; an estimate
   with K ≤ 0 or T ≤ 0 keeps the previous model (no real plant has them; the weighted
   LS-SVM, which keeps a K < 0 on nomoto2 as the paper's Figure 7 shows, otherwise steered
-  the Esso Osaka and the Blanke ship out of their corridors); β, Tc stay nominal.  β is
-  not identifiable at the yaw rates of path following (Esso Osaka estimates range −4 …
-  140 s²), and these ships' steering gears are rate-limited, so the servo regression's Tc is
-  an amplitude-dependent fit (0.13 s on the Esso Osaka's small corrections against 0.88 s in
-  its zig-zag), not a parameter to adapt; taken into the prediction, it made RK4 diverge in
-  60 % of the steps.
+  the Esso Osaka and the Blanke ship out of their corridors), and K, T are clipped to
+  [x/2, 2x] around the nominal model (F = :data:`PROJECTION_FACTOR`, as the adaptive LQR's
+  projection): the training distribution changes a ship's rudder effectiveness by ×0.6–1.5;
+  on the Blanke ship the paper's differences front end estimates T anywhere in 0.11–27 s
+  (nominal 2.86 s), and a T of 0.16 s made the NMPC circle 300 m off the path (3 randomised
+  trials: ACE 91 m, no goal; with F = 3 one trial 48 m; with F = 2 all three 7.9–9.5 m, at
+  the goal, against 7.7 m for ``nmpc``); β, Tc stay nominal.  β is not identifiable at the
+  yaw rates of path following (Esso Osaka estimates range −4 … 140 s²), and these ships'
+  steering gears are rate-limited, so the servo regression's Tc is an amplitude-dependent
+  fit (0.13 s on the Esso Osaka's small corrections against 0.88 s in its zig-zag), not a
+  parameter to adapt; taken into the prediction, it made RK4 diverge in 60 % of the steps.
 
 **Numbers** (T, K: the nominal first-order Nomoto model; τ_f = min(T2, Tc) of the nominal
 prediction model; n = the scenario's ``los_radius_L``; subscript p: the paper ship):
@@ -83,6 +88,8 @@ PAPER_WINDOW_TO_UPDATE = PAPER_WINDOW / PAPER_UPDATE_EVERY
 STEP_PER_FAST_TIME_CONSTANT = 0.5
 #: heading response settled (95 %) after 3 T
 SETTLING_TIME_CONSTANTS = 3.0
+#: F: estimates of K and T reach the prediction clipped to [x/F, x·F] around the nominal
+PROJECTION_FACTOR = 2.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,7 +186,8 @@ class ShipNMPCPlan:
         return self.horizon * self.interval * self.scales.Ts
 
     def prediction_params(self, estimate: Nomoto2Params) -> Nomoto2Params | None:
-        """An identified model in the prediction model's structure (None: K ≤ 0 or T ≤ 0)."""
+        """An identified model in the prediction model's structure, K and T clipped to
+        [x/F, x·F] around the nominal (None: K ≤ 0 or T ≤ 0)."""
         if not self.reduce:
             return estimate
         try:
@@ -188,8 +196,10 @@ class ShipNMPCPlan:
             return None
         if not K > 0:  # a real plant steers the documented way (Nomoto2Params.plant_positive)
             return None
-        n = self.nominal
-        return estimate.replace(T1=T, T2=n.T2, T3=n.T3, beta=n.beta, Tc=n.Tc)
+        n, f = self.nominal, PROJECTION_FACTOR
+        K = min(max(K, self.scales.K / f), self.scales.K * f)
+        T = min(max(T, self.scales.T / f), self.scales.T * f)
+        return estimate.replace(K=K, T1=T, T2=n.T2, T3=n.T3, beta=n.beta, Tc=n.Tc)
 
     def identifier_options(self, lambda_thresholds: bool) -> dict[str, Any]:
         """Window, update period (and λ_c¹, λ_c² for λ-LS-SVM) of the online identifiers."""

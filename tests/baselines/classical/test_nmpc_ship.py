@@ -78,7 +78,8 @@ def test_other_ships_derive_their_numbers_from_their_time_scales(scenario: str) 
 
 
 def test_an_estimate_reaches_the_prediction_reduced_and_only_if_physical() -> None:
-    """K, d0 and T = T1 + T2 − T3 adapt; β, Tc stay nominal; K ≤ 0 or T ≤ 0 is refused."""
+    """K, d0 and T = T1 + T2 − T3 adapt, K and T within a factor 2 of the nominal; β, Tc
+    stay nominal; K ≤ 0 or T ≤ 0 is refused."""
     plan = ship_plan(context("mariner_track"))
     n = plan.nominal
     estimate = n.replace(K=2 * n.K, T1=50.0, T2=0.2, T3=0.3, d0=1e-3, beta=140.0, Tc=0.1)
@@ -86,6 +87,8 @@ def test_an_estimate_reaches_the_prediction_reduced_and_only_if_physical() -> No
     assert used is not None
     assert (used.K, used.T1, used.d0) == (2 * n.K, pytest.approx(49.9), 1e-3)
     assert (used.T2, used.T3, used.beta, used.Tc) == (n.T2, n.T3, n.beta, n.Tc)
+    wild = plan.prediction_params(estimate.replace(K=5 * n.K, T1=0.2, T3=0.3))
+    assert wild is not None and (wild.K, wild.T1) == (2 * n.K, n.T1 / 2)
     assert plan.prediction_params(estimate.replace(K=-n.K)) is None
     assert plan.prediction_params(estimate.replace(T1=0.5, T3=2.0)) is None
 
