@@ -1,10 +1,17 @@
 """Nonlinear MPC path following with LOS reference (Liu et al. 2019 §2.2.3, Algorithm 1).
 
-Prediction model: the ship model's own right-hand side and RK4 step (the simulator's), in
+On every ship (issue 17): nomoto2 with the paper's numbers, every other ship with a Nomoto
+prediction model from its own zig-zag and numbers from its own time scales
+(:mod:`baselines.classical.nmpc_ship`, where each rule is stated).
+
+Prediction model: the nomoto2 model's right-hand side and RK4 step (the simulator's), in
 CasADi SX, with the model parameters as solver parameters, so that an online identifier
 can change them without rebuilding the solver.  States [x, y, ψ, r, ṙ, δ] are predicted
-with ``prediction_substeps`` RK4 steps per control period (one step per Ts = 0.5 s is
-unstable for T2 = 0.0247 s); the error states of eq. (14) are outputs of the prediction:
+with ``prediction_substeps`` RK4 steps per prediction interval of ``interval`` control
+periods (the paper: 1 period, 10 substeps; one step per Ts = 0.5 s is unstable for
+T2 = 0.0247 s; with ``interval`` > 1 each planned command is held for that many periods,
+move blocking, and the warm start is the previous plan unshifted); the error states of
+eq. (14) are outputs of the prediction:
 
     e = −(x − x_n) sin ψp + (y − y_n) cos ψp,   ψ̃ = wrap(ψ − ψp)
 
@@ -36,29 +43,39 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+import zlib
 from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
 
 from baselines.classical.box_qp import BoxQP
+from baselines.classical.nmpc_ship import (
+    PAPER_CONTROL_HORIZON,
+    PAPER_HORIZON,
+    PAPER_Q,
+    ShipNMPCPlan,
+    ship_plan,
+)
 from baselines.policy import check_action_mode
 from baselines.registry import register_controller
 from shipgym.codegen import compiled
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
 from shipgym.models.base import ShipModel
+from shipgym.models.nomoto2 import Nomoto2
 
 
 @dataclasses.dataclass(frozen=True)
 class NMPCSettings:
     """Liu et al. (2019) §4 defaults, plus the numerical choices (documented in the module)."""
 
-    horizon: int = 10  # N_p
-    control_horizon: int = 8  # N_c
-    Q: tuple[float, float, float, float, float] = (1.0, 1.0, 0.01, 0.01, 0.001)
+    horizon: int = PAPER_HORIZON  # N_p
+    control_horizon: int = PAPER_CONTROL_HORIZON  # N_c
+    Q: tuple[float, float, float, float, float] = PAPER_Q
     R: float = 0.01
-    prediction_substeps: int = 10  # RK4 steps per control period in the prediction
+    prediction_substeps: int = 10  # RK4 steps per prediction interval
+    interval: int = 1  # control periods per prediction interval (move blocking; 1: the paper)
     max_iter: int = 10  # Gauss–Newton SQP iterations per control step (warm-started)
     step_tolerance: float = 1e-5  # rad: stop when the accepted step is smaller
     compile: bool = True  # compile residual + Jacobian to C (cached); VM otherwise
@@ -80,10 +97,12 @@ class NMPCSolver:
         s = settings
         if not 1 <= s.control_horizon <= s.horizon:
             raise ValueError("need 1 ≤ control_horizon ≤ horizon")
+        if s.interval < 1 or s.prediction_substeps < 1:
+            raise ValueError("need interval ≥ 1 and prediction_substeps ≥ 1")
         self.model, self.settings = model, settings
         self.rudder_limit = rudder_limit
         nx, npar = model.n_states, model.n_params
-        h = control_period / s.prediction_substeps
+        h = control_period * s.interval / s.prediction_substeps
         step = model.casadi_step(h)
         ix, iy, ipsi = (model.state_index(k) for k in ("x", "y", "psi"))
         ir, irdot, idelta = (model.state_index(k) for k in ("r", "r_dot", "delta"))
@@ -120,6 +139,8 @@ class NMPCSolver:
         self.n_residuals = rho.shape[0]
         self.predict_function = ca.Function("predict", [u, p], [ca.horzcat(*states)])
         tag = f"{model.name}_n{s.horizon}_c{s.control_horizon}_s{s.prediction_substeps}"
+        if (s.interval, s.Q, s.R) != (1, NMPCSettings.Q, NMPCSettings.R):  # another ship's
+            tag += f"_k{s.interval}_{zlib.crc32(repr((s.Q, s.R, length)).encode()):08x}"
         residual = ca.Function(f"nmpc_rho_{tag}", [u, p], [rho])
         # dense: the buffer interface writes only the structural nonzeros of an output
         jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.densify(ca.jacobian(rho, u))])
@@ -225,9 +246,13 @@ def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) 
     return float(t @ (values - values.mean()) / (t @ t))
 
 
-@register_controller("nmpc", applies_to=("nomoto2",))
+@register_controller("nmpc")
 class NMPC:
-    """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019)."""
+    """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019).
+
+    ``settings`` None: the numbers of the ship (:func:`ship_plan`; the paper's on nomoto2).
+    ``excitation_deg``: σ of eq. (45) [deg] (None: 0).
+    """
 
     name: ClassVar[str]  # set by the registration
     kind: ClassVar[str] = "classical"
@@ -238,38 +263,59 @@ class NMPC:
     def __init__(
         self, settings: NMPCSettings | None = None, excitation_deg: float | None = None
     ) -> None:
+        self._given_settings = settings
         self.settings = settings if settings is not None else NMPCSettings()
         # eq. (45) excitation (σ not given by the paper; 0 by default: see the README)
         default = 0.0
         self.excitation = math.radians(excitation_deg if excitation_deg is not None else default)
 
+    def _identifier(self, plan: ShipNMPCPlan) -> Any:
+        """The online identifier with the ship's window, update period, thresholds, SVF λ."""
+        if self.identifier_type is None:
+            return None
+        options = {
+            **plan.identifier_options(issubclass(self.identifier_type, LambdaLSSVM)),
+            **self.identifier_options,
+        }
+        if options.get("front_end") == "svf":
+            options.setdefault("svf_bandwidth", plan.svf_bandwidth)
+        return self.identifier_type(self.ctx.fine_step, plan.nominal, **options)
+
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
         self.ctx = context
-        self.solver = get_solver(
-            context.nominal_model, self.settings, context.control_period, context.rudder_limit
-        )
-        self.params = context.nominal_params
-        self.identifier = (
-            self.identifier_type(
-                context.fine_step, context.nominal_params, **self.identifier_options
+        self.ship_plan = plan = ship_plan(context)
+        if self._given_settings is None:
+            self.settings = NMPCSettings(
+                horizon=plan.horizon,
+                control_horizon=plan.control_horizon,
+                Q=plan.Q,
+                prediction_substeps=plan.substeps,
+                interval=plan.interval,
             )
-            if self.identifier_type is not None
-            else None
+        # nomoto2 predicts with its own model; another ship with its Nomoto model (module doc)
+        self.model = context.nominal_model if not plan.reduce else Nomoto2(plan.nominal)
+        self.solver = get_solver(
+            self.model, self.settings, context.control_period, context.rudder_limit
         )
-        self.pe = PersistentExcitation(self.excitation, np.random.default_rng(seed))
+        self.params = plan.nominal
+        self.identifier = self._identifier(plan)
+        self.pe = PersistentExcitation(
+            self.excitation, np.random.default_rng(seed), hold=plan.excitation_hold
+        )
         self.tracker = context.new_tracker()
         self._started = False
         self.plan = np.zeros(self.settings.control_horizon)
         self.failures = 0
         self.model_fallbacks = 0
-        self._good_params = context.nominal_params
+        self._good_params = plan.nominal
         self.solves = 0
-        self.solve_times: list[float] = []
+        self.solve_times: list[float] = []  # wall clock [s]
+        self.solve_cpu_times: list[float] = []  # this thread's CPU time [s] (load-proof)
         self.param_history: list[dict[str, float]] = []
 
     def _state(self, info: dict[str, Any]) -> np.ndarray:
-        model = self.ctx.nominal_model
+        model = self.model
         x0 = np.zeros(model.n_states)
         x0[model.state_index("x")], x0[model.state_index("y")] = info["position"]
         x0[model.state_index("psi")] = info["heading"]
@@ -280,10 +326,19 @@ class NMPC:
         x0[model.state_index("delta")] = info["rudder_angle"]
         return x0
 
+    def _warm_start(self) -> np.ndarray:
+        """The previous plan shifted by one control period: by one interval when an interval
+        is one period, else unchanged (a period is a fraction of the first interval)."""
+        if self.settings.interval == 1:
+            return np.append(self.plan[1:], self.plan[-1])
+        return self.plan.copy()
+
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         if self.identifier is not None and "samples" in info:
             self.identifier.update(info["samples"])
-            self.params = self.identifier.params
+            estimate = self.ship_plan.prediction_params(self.identifier.params)
+            if estimate is not None:
+                self.params = estimate
         x, y = info["position"]
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
         self._started = True
@@ -294,8 +349,8 @@ class NMPC:
         )
         radius = self.ctx.guidance.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
         x0 = self._state(info)
-        guess = np.append(self.plan[1:], self.plan[-1])  # shifted previous solution
-        start = time.perf_counter()
+        guess = self._warm_start()
+        start, start_cpu = time.perf_counter(), time.thread_time()
         plan, ok, _ = self.solver.solve(
             self.solver.parameters(
                 x0, leg_start, frame.path_angle, radius, self.params.to_vector()
@@ -316,6 +371,7 @@ class NMPC:
                 guess,
             )
         self.solve_times.append(time.perf_counter() - start)
+        self.solve_cpu_times.append(time.thread_time() - start_cpu)
         self.solves += 1
         if ok:
             self.plan = plan
@@ -336,21 +392,21 @@ class NMPC:
         }
 
 
-@register_controller("nmpc_wlssvm", applies_to=("nomoto2",))
+@register_controller("nmpc_wlssvm")
 class NMPCWeightedLSSVM(NMPC):
     """``nmpc_wlssvm``: NMPC with the model updated online by weighted LS-SVM."""
 
     identifier_type = WeightedLSSVMOnline
 
 
-@register_controller("nmpc_lambda_lssvm", applies_to=("nomoto2",))
+@register_controller("nmpc_lambda_lssvm")
 class NMPCLambdaLSSVM(NMPC):
     """``nmpc_lambda_lssvm``: NMPC with the model updated by λ-LS-SVM (Algorithm 2)."""
 
     identifier_type = LambdaLSSVM
 
 
-@register_controller("nmpc_wlssvm_svf", applies_to=("nomoto2",))
+@register_controller("nmpc_wlssvm_svf")
 class NMPCWeightedLSSVMSVF(NMPCWeightedLSSVM):
     """``nmpc_wlssvm_svf``: ``nmpc_wlssvm`` with the outlier + state-variable-filter front end
     (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019, issue 14)."""
@@ -358,7 +414,7 @@ class NMPCWeightedLSSVMSVF(NMPCWeightedLSSVM):
     identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}
 
 
-@register_controller("nmpc_lambda_lssvm_svf", applies_to=("nomoto2",))
+@register_controller("nmpc_lambda_lssvm_svf")
 class NMPCLambdaLSSVMSVF(NMPCLambdaLSSVM):
     """``nmpc_lambda_lssvm_svf``: ``nmpc_lambda_lssvm`` with the outlier + state-variable-filter
     front end (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019)."""

@@ -50,21 +50,39 @@ from shipgym.identification.nomoto import (
 from shipgym.models.nomoto2 import Nomoto2Params
 
 RAD_TO_DEG = 180.0 / math.pi
+#: Liu et al. (2019) §4: window N_w and update period N_u [samples, at h = 0.01 s], λ_c¹, λ_c²
+PAPER_WINDOW = 1200
+PAPER_UPDATE_EVERY = 50
+PAPER_LAMBDA_C = (1e-5, 1e-2)
 #: the keys of ``info["samples"]`` an identifier reads
 SAMPLE_KEYS = ("psi", "delta", "delta_c")
 
 
 class PersistentExcitation:
-    """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad]."""
+    """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad].
 
-    def __init__(self, sigma: float, rng: np.random.Generator | None = None) -> None:
+    ``hold``: calls (control periods) each draw is held for (1: a new draw every call, the
+    paper's; a slower ship holds it longer, :mod:`baselines.classical.nmpc_ship`).
+    """
+
+    def __init__(self, sigma: float, rng: np.random.Generator | None = None, hold: int = 1) -> None:
         if sigma < 0:
             raise ValueError(f"sigma must be ≥ 0, got {sigma}")
+        if hold < 1:
+            raise ValueError(f"hold must be ≥ 1, got {hold}")
         self.sigma = sigma
+        self.hold = hold
         self.rng = rng if rng is not None else np.random.default_rng()
+        self._calls = 0
+        self._noise = 0.0
 
     def __call__(self, u: float) -> float:
-        return u + self.sigma * float(self.rng.standard_normal()) if self.sigma else u
+        if not self.sigma:
+            return u
+        if self._calls % self.hold == 0:
+            self._noise = self.sigma * float(self.rng.standard_normal())
+        self._calls += 1
+        return u + self._noise
 
 
 @dataclasses.dataclass
@@ -87,8 +105,8 @@ class _SlidingWindowNomoto:
         self,
         h: float,
         initial: Nomoto2Params | None = None,
-        window: int = 1200,
-        update_every: int = 50,
+        window: int = PAPER_WINDOW,
+        update_every: int = PAPER_UPDATE_EVERY,
         gamma: float | None = None,
         servo_model: str = "forward",
         bias_penalty: bool = True,
@@ -275,11 +293,11 @@ class LambdaLSSVM(_SlidingWindowNomoto):
         self,
         h: float,
         initial: Nomoto2Params | None = None,
-        window: int = 1200,
-        update_every: int = 50,
+        window: int = PAPER_WINDOW,
+        update_every: int = PAPER_UPDATE_EVERY,
         gamma: float | None = None,
-        lambda_c1: float = 1e-5,
-        lambda_c2: float = 1e-2,
+        lambda_c1: float = PAPER_LAMBDA_C[0],
+        lambda_c2: float = PAPER_LAMBDA_C[1],
         c3: float = 0.01,
         c4: float = 0.99,
         index_unit: str = "deg",

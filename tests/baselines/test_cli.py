@@ -216,11 +216,25 @@ def test_cli_bench_identification_json(capsys) -> None:
     assert aging["lambda_lssvm"]["t_within_10pct"] <= aging["weighted_lssvm"]["t_within_10pct"]
 
 
-def test_cli_bench_nmpc_json(capsys) -> None:
+def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
+    """The nomoto2 figures, and per ship each family member's (here two, 40 steps: CI time)."""
+    from baselines import benchmarks
+
+    monkeypatch.setattr(benchmarks, "NMPC_FAMILY", ("nmpc", "nmpc_lambda_lssvm_svf"))
+    monkeypatch.setattr(benchmarks, "PER_SHIP_MAX_STEPS", 40)
     assert main(["bench", "nmpc", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)
     assert 0 < figures["nmpc_median_ms"] <= figures["nmpc_p99_ms"]
     assert figures["failures"] == 0 and figures["solves"] > 100
+    assert set(figures["per_ship"]) == {"nomoto2", "esso_osaka", "mariner", "blanke"}
+    for ship, entry in figures["per_ship"].items():
+        for name in ("nmpc", "nmpc_lambda_lssvm_svf"):
+            assert 0 < entry[f"{name}_median_ms"] <= entry[f"{name}_p99_ms"], ship
+            assert 0 < entry[f"{name}_cpu_median_ms"] <= entry[f"{name}_cpu_p99_ms"], ship
+        assert entry["nmpc_solves"] == (3 * 40 if ship == "nomoto2" else 40)
+        assert entry["family_p99_ms"] == max(
+            entry["nmpc_p99_ms"], entry["nmpc_lambda_lssvm_svf_p99_ms"]
+        )
 
 
 def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:

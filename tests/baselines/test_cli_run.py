@@ -86,13 +86,17 @@ def test_a_scenario_file_runs(tmp_path: Path, capsys: pytest.CaptureFixture[str]
 
 
 def test_a_controller_that_does_not_apply_is_refused(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], scratch_registry: None
 ) -> None:
+    from baselines.classical.reference import ZeroRudder
+    from baselines.registry import register_controller
+
+    register_controller("nomoto2_only", lambda: ZeroRudder(), applies_to=("nomoto2",))
     out = tmp_path / "out"
-    assert main(["run", "mariner_track", "nmpc", "--out", str(out)]) == 2
+    assert main(["run", "mariner_track", "nomoto2_only", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err == (
-        "shipgym run: error: controller 'nmpc' does not apply to the mariner ship of "
+        "shipgym run: error: controller 'nomoto2_only' does not apply to the mariner ship of "
         "scenario 'mariner_track'\n"
     )
     assert not out.exists()

@@ -33,11 +33,11 @@ BUILTINS = {
     "adaptive_lqr": ("rudder", None),
     "l1_backstepping": ("rudder", None),
     "adaptive_backstepping": ("rudder", None),
-    "nmpc": ("rudder", ("nomoto2",)),
-    "nmpc_wlssvm": ("rudder", ("nomoto2",)),
-    "nmpc_lambda_lssvm": ("rudder", ("nomoto2",)),
-    "nmpc_wlssvm_svf": ("rudder", ("nomoto2",)),
-    "nmpc_lambda_lssvm_svf": ("rudder", ("nomoto2",)),
+    "nmpc": ("rudder", None),
+    "nmpc_wlssvm": ("rudder", None),
+    "nmpc_lambda_lssvm": ("rudder", None),
+    "nmpc_wlssvm_svf": ("rudder", None),
+    "nmpc_lambda_lssvm_svf": ("rudder", None),
     "zero_rudder": ("rudder", None),
     "random": ("rudder", None),
     "oracle": ("rudder", None),
@@ -187,9 +187,8 @@ def test_unknown_controller_lists_valid_names() -> None:
 
 
 def test_applies_to_follows_the_registration(scratch_registry: None) -> None:
-    for name in ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"):
-        assert applies_to(name, "nomoto2")
-        assert not any(applies_to(name, ship) for ship in ("mariner", "blanke", "esso_osaka"))
+    for name in ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"):  # issue 17: every ship
+        assert all(applies_to(name, s) for s in ("nomoto2", "mariner", "blanke", "esso_osaka"))
     assert applies_to("pid_los", "mariner") and applies_to("ppo", "mariner")
     register_controller("test_mariner_only", lambda: ZeroRudder(), applies_to=["mariner"])
     assert CONTROLLERS["test_mariner_only"].applies_to == ("mariner",)
@@ -215,9 +214,10 @@ def test_the_long_form_renames_and_sets_a_registered_controller(scratch_registry
     theirs = run_episode(make_controller("pid_los")[0], "nominal", seed=0)
     assert (mine.controller, theirs.controller) == ("pid_stiff", "pid_los")
     assert mine.metrics["pid_kp"] > theirs.metrics["pid_kp"]
-    nmpc = resolve_controller(ControllerEntry(controller="nmpc", name="nmpc_2"))
-    assert nmpc.applies_to == ("nomoto2",) and controller_kind("nmpc_2") == "classical"
-    assert not applies_to("nmpc_2", "mariner")
+    register_controller("test_nomoto2_only", lambda: ZeroRudder(), applies_to=["nomoto2"])
+    alias = resolve_controller(ControllerEntry(controller="test_nomoto2_only", name="only_2"))
+    assert alias.applies_to == ("nomoto2",) and controller_kind("only_2") == "classical"
+    assert not applies_to("only_2", "mariner")
 
 
 def test_unknown_settings_are_named_before_anything_is_made() -> None:

@@ -168,12 +168,12 @@ def test_nmpc_refuses_guidance_mode() -> None:
         NMPC().reset(env.unwrapped.controller_context, 0)
 
 
-def test_svf_controllers_are_registered_for_the_nomoto2_ship() -> None:
+def test_svf_controllers_are_registered_for_every_ship() -> None:
     from baselines.registry import CONTROLLERS
 
     for name in ("nmpc_lambda_lssvm_svf", "nmpc_wlssvm_svf"):
         record = CONTROLLERS[name]
-        assert record.applies_to == ("nomoto2",) and record.action_mode == "rudder"
+        assert record.applies_to is None and record.action_mode == "rudder"
         policy = record.factory()
         assert policy.identifier_options == {"front_end": "svf"}
 

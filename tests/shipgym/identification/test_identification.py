@@ -279,6 +279,14 @@ def test_persistent_excitation_has_the_requested_spread() -> None:
     assert abs(np.mean(draws)) < 5 * 0.02 / math.sqrt(20000)
 
 
+def test_persistent_excitation_holds_each_draw_for_hold_calls() -> None:
+    """hold = 3 (a slower ship, issue 17): the paper's draws, each kept for three calls."""
+    paper = PersistentExcitation(0.02, np.random.default_rng(6))
+    held = PersistentExcitation(0.02, np.random.default_rng(6), hold=3)
+    draws = [paper(0.0) for _ in range(4)]
+    assert [held(0.0) for _ in range(12)] == [d for d in draws for _ in range(3)]
+
+
 # ----------------------------------------------------------------------------- continuous LS
 def test_continuous_least_squares_converges_from_wrong_guesses() -> None:
     """Borkowski (2018) §5: a0 = 0.02, c0 = 0.002 against the true a = 0.018, c = 0.001."""
