@@ -284,6 +284,8 @@ SHIP_SCENARIOS: dict[str, tuple[str, ...]] = {
 }
 #: per-ship episodes are cut after this many control steps (the bench's run time)
 PER_SHIP_MAX_STEPS = 1000
+#: the same for the oracle (``oracle_median_ms`` / ``oracle_p99_ms``; target median ≤ 20 ms)
+ORACLE_MAX_STEPS = 300
 
 
 def _percentiles_ms(times: list[float], prefix: str) -> dict[str, float]:
@@ -309,10 +311,12 @@ def solve_times_per_ship(
     ``solve_cpu_times`` (its thread's CPU time: not inflated by a loaded machine), and
     ``{controller}_solves``."""
     from baselines.evaluation import run_episode
+    from baselines.privileged import grants_truth
     from baselines.registry import make_controller
     from shipgym.scenarios import load_scenario
 
     max_steps = PER_SHIP_MAX_STEPS if max_steps is None else max_steps
+    privileged = grants_truth(controller)  # the oracle reads the truth, as in a run
     out: dict[str, dict[str, Any]] = {}
     for ship, names in (SHIP_SCENARIOS if ships is None else ships).items():
         wall: list[float] = []
@@ -322,7 +326,7 @@ def solve_times_per_ship(
             limit = min(scenario.config.time_limit, max_steps * scenario.control_period)
             scenario = scenario.with_overrides({"time_limit": limit})
             policy, _ = make_controller(controller)
-            run_episode(policy, scenario, seed=seed)
+            run_episode(policy, scenario, seed=seed, privileged=privileged)
             wall += policy.solve_times
             cpu += getattr(policy, "solve_cpu_times", [])
         entry = _percentiles_ms(wall, controller)
@@ -341,7 +345,9 @@ def bench_nmpc(
     """NMPC solve time in closed loop: median, p99, ratio to Ts (``nmpc`` on nomoto2's
     ``scenarios``), and ``per_ship``: every ``family`` member on each ship
     (:func:`solve_times_per_ship`) with ``family_median_ms`` / ``family_p99_ms``, the
-    largest over the members (targets ≤ 1 ms / ≤ 5 ms, issue 17); None: :data:`NMPC_FAMILY`,
+    largest over the members (targets ≤ 1 ms / ≤ 5 ms, issue 17), and the privileged
+    ``oracle``'s ``oracle_median_ms`` / ``oracle_p99_ms`` (target median ≤ 20 ms, its
+    episodes cut after ``max_steps`` or :data:`ORACLE_MAX_STEPS`); None: :data:`NMPC_FAMILY`,
     :data:`PER_SHIP_MAX_STEPS`."""
     from baselines.classical.nmpc import NMPC
     from baselines.evaluation import run_episode
@@ -359,11 +365,14 @@ def bench_nmpc(
     median = statistics.median(times)
     p99 = float(np.percentile(times, 99))
     family = NMPC_FAMILY if family is None else family
+    oracle_steps = ORACLE_MAX_STEPS if max_steps is None else max_steps
     max_steps = PER_SHIP_MAX_STEPS if max_steps is None else max_steps
     per_ship: dict[str, dict[str, Any]] = {ship: {} for ship in SHIP_SCENARIOS}
     for controller in family:
         for ship, entry in solve_times_per_ship(controller, max_steps=max_steps).items():
             per_ship[ship] |= entry
+    for ship, entry in solve_times_per_ship("oracle", max_steps=oracle_steps).items():
+        per_ship[ship] |= entry
     for entry in per_ship.values():
         for stat in ("median", "p99", "cpu_median", "cpu_p99"):
             values = [entry[f"{c}_{stat}_ms"] for c in family if f"{c}_{stat}_ms" in entry]
@@ -380,6 +389,7 @@ def bench_nmpc(
         "per_ship": per_ship,
         "per_ship_target_median_ms": 1.0,
         "per_ship_target_p99_ms": 5.0,
+        "oracle_target_median_ms": 20.0,
     }
 
 

@@ -222,6 +222,7 @@ def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
 
     monkeypatch.setattr(benchmarks, "NMPC_FAMILY", ("nmpc", "nmpc_lambda_lssvm_svf"))
     monkeypatch.setattr(benchmarks, "PER_SHIP_MAX_STEPS", 40)
+    monkeypatch.setattr(benchmarks, "ORACLE_MAX_STEPS", 30)  # past the jumps (12 s)
     assert main(["bench", "nmpc", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)
     assert 0 < figures["nmpc_median_ms"] <= figures["nmpc_p99_ms"]
@@ -235,6 +236,9 @@ def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
         assert entry["family_p99_ms"] == max(
             entry["nmpc_p99_ms"], entry["nmpc_lambda_lssvm_svf_p99_ms"]
         )
+        # the privileged oracle, through its channel as in a run (issue 17)
+        assert 0 < entry["oracle_median_ms"] <= entry["oracle_p99_ms"], ship
+        assert entry["oracle_solves"] == (3 * 30 if ship == "nomoto2" else 30)
 
 
 def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
