@@ -67,7 +67,9 @@ def step_costs(scenario: Scenario, controller: str, seed: int) -> tuple[np.ndarr
     """(start time of each control step [s], its cost) of one episode (module doc)."""
     policy, mode = make_controller(controller)
     logs: list[Any] = []
-    run_episode(policy, scenario, seed, mode, after_episode=lambda env: logs.append(env.episode_log()))
+    run_episode(
+        policy, scenario, seed, mode, after_episode=lambda env: logs.append(env.episode_log())
+    )
     log = logs[0]
     cost = -np.asarray(log.reward, dtype=float)
     if log.reached_goal:
@@ -143,7 +145,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
     seeds = [EVAL_SEED_OFFSET + i for i in range(args.seeds)]
-    rows = [change_effect(s, args.controller, seeds).row() for s in args.scenarios or matrix_scenarios()]
+    rows = [
+        change_effect(s, args.controller, seeds).row() for s in args.scenarios or matrix_scenarios()
+    ]
     if args.json:
         print(json.dumps(rows, indent=1))
         return
