@@ -34,7 +34,7 @@ V1_IDS = {
 #: the env ids of the ships (the -v1 ids; a scenario= keyword replaces the default)
 SHIP_ID = {ship: env_id for env_id, ship in V1_IDS.items()}
 #: draught ratio of each ship's manoeuvrability change (its YAML says why)
-DRAUGHT = {"esso_osaka": 0.45, "mariner": 1.3, "blanke": 1.25}
+DRAUGHT = {"esso_osaka": 0.4, "mariner": 1.3, "blanke": 1.35}
 
 
 def _route_length(name: str) -> float:
