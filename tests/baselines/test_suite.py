@@ -42,7 +42,7 @@ def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
     default = load_suite("default")
     matrix = matrix_scenarios() + [f"{s}_nominal" for s in ("esso_osaka", "mariner", "blanke")]
     assert set(matrix) <= set(default.scenarios)
-    assert len(default.scenarios) == 34 and default.heldout_scenarios == 16
+    assert len(default.scenarios) == 31 and default.heldout_scenarios == 16
     assert default.seeds == 10
 
 
