@@ -1,15 +1,16 @@
 """Randomised scenario distributions for training and held-out testing (SPEC §4).
 
 A *distribution* (YAML in ``configs/distributions/``) lists ships; each ship gives ranges
-for its nominal parameters, its own parameter jumps (which parameters, how large, when) or
-current shifts (a current appearing), its background current and wave disturbance, its
-guidance laws and the margin of its time limit.  The path (number of legs, leg lengths in
-ship lengths, turn angles, polyline or PCHIP; a ship may give its own) and the sensor noise
-are shared.  The time limit is ``time_factor · route length / (U − the largest current
-speed) + time_margin``.  :meth:`ScenarioDistribution.sample` turns a random generator into
-an ordinary :class:`~shipgym.scenarios.schema.ScenarioConfig`, so a sampled scenario runs
-through exactly the same loader, env and metrics as a catalogue one; its control period
-and fine step are the ship's own.
+for its nominal parameters, its own parameter jumps (which parameters, how large, when),
+loading-condition changes (a draught ratio, :mod:`shipgym.models.loading`), current shifts
+(a current appearing) or a combination of them at one time, its background current and wave
+disturbance, its guidance laws and the margin of its time limit.  The path (number of legs,
+leg lengths in ship lengths, turn angles, polyline or PCHIP; a ship may give its own) and
+the sensor noise are shared.  The time limit is ``time_factor · route length / (U − the
+largest current speed) + time_margin``.  :meth:`ScenarioDistribution.sample` turns a random
+generator into an ordinary :class:`~shipgym.scenarios.schema.ScenarioConfig`, so a sampled
+scenario runs through exactly the same loader, env and metrics as a catalogue one; its
+control period and fine step are the ship's own.
 
 Ships.  A train split draws the ship per scenario with probability ∝ its ``weight``; a test
 split lists ``count`` named scenarios per ship, interleaved round-robin in the order of
