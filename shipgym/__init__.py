@@ -11,12 +11,18 @@ from gymnasium.envs.registration import register, registry
 
 __version__ = "0.1.0"
 
-#: env id -> default scenario: one id per ship, same contract and keyword arguments (SPEC §5)
+#: env id -> default scenario: one id per ship, same contract and keyword arguments (SPEC §5).
+#: The per-ship ``-v1`` ids default to that ship's rudder aging (a changing plant, issue 18);
+#: their ``-v0`` ids keep the scenarios they always had (Gymnasium's versioning rule: a
+#: different default is a different env).
 ENV_IDS: dict[str, str] = {
     "ShipPathFollow-v0": "rudder_aging",
     "ShipPathFollow-EssoOsaka-v0": "osaka_stochastic_current",
     "ShipPathFollow-Mariner-v0": "mariner_track",
     "ShipPathFollow-Blanke-v0": "blanke_current_shift",
+    "ShipPathFollow-EssoOsaka-v1": "esso_osaka_rudder_aging",
+    "ShipPathFollow-Mariner-v1": "mariner_rudder_aging",
+    "ShipPathFollow-Blanke-v1": "blanke_rudder_aging",
 }
 
 for _env_id, _scenario in ENV_IDS.items():

@@ -90,6 +90,7 @@ from baselines.classical.adaptive.settings import (
 )
 from baselines.policy import check_action_mode
 from baselines.registry import register_controller
+from shipgym.angles import unwrap_floats
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
@@ -173,9 +174,9 @@ class L1Backstepping:
         samples = info.get("samples")
         if samples is not None and len(samples["psi"]) > 0:
             step = self.ctx.fine_step
-            psis = np.append(samples["psi"], psi)
-            rs = np.append(samples["r"], r)
-            deltas = np.append(samples["delta"], delta)
+            psis = [*samples["psi"].tolist(), psi]
+            rs = [*samples["r"].tolist(), r]
+            deltas = [*samples["delta"].tolist(), delta]
         else:  # no valid samples: the period's end points (module doc)
             last = self._last
             n = max(1, round(self.ctx.control_period / self.ctx.fine_step))
@@ -197,8 +198,8 @@ class L1Backstepping:
             return max(speed, 0.1 * self.ctx.nominal_speed), 0.0
         samples = info.get("samples")
         if samples is not None and len(samples["psi"]) > 0:
-            headings = np.unwrap(np.append(samples["psi"], info["heading"]))
-            mean_heading = float(np.mean(headings))
+            headings = unwrap_floats([*samples["psi"].tolist(), float(info["heading"])])
+            mean_heading = float(np.mean(np.array(headings)))
         else:
             h0 = self._last["psi"]
             mean_heading = h0 + 0.5 * wrap_angle(info["heading"] - h0)

@@ -1,15 +1,16 @@
 """Randomised scenario distributions for training and held-out testing (SPEC §4).
 
 A *distribution* (YAML in ``configs/distributions/``) lists ships; each ship gives ranges
-for its nominal parameters, its own parameter jumps (which parameters, how large, when) or
-current shifts (a current appearing), its background current and wave disturbance, its
-guidance laws and the margin of its time limit.  The path (number of legs, leg lengths in
-ship lengths, turn angles, polyline or PCHIP; a ship may give its own) and the sensor noise
-are shared.  The time limit is ``time_factor · route length / (U − the largest current
-speed) + time_margin``.  :meth:`ScenarioDistribution.sample` turns a random generator into
-an ordinary :class:`~shipgym.scenarios.schema.ScenarioConfig`, so a sampled scenario runs
-through exactly the same loader, env and metrics as a catalogue one; its control period
-and fine step are the ship's own.
+for its nominal parameters, its own parameter jumps (which parameters, how large, when),
+loading-condition changes (a draught ratio, :mod:`shipgym.models.loading`), current shifts
+(a current appearing) or a combination of them at one time, its background current and wave
+disturbance, its guidance laws and the margin of its time limit.  The path (number of legs,
+leg lengths in ship lengths, turn angles, polyline or PCHIP; a ship may give its own) and
+the sensor noise are shared.  The time limit is ``time_factor · route length / (U − the
+largest current speed) + time_margin``.  :meth:`ScenarioDistribution.sample` turns a random
+generator into an ordinary :class:`~shipgym.scenarios.schema.ScenarioConfig`, so a sampled
+scenario runs through exactly the same loader, env and metrics as a catalogue one; its
+control period and fine step are the ship's own.
 
 Ships.  A train split draws the ship per scenario with probability ∝ its ``weight``; a test
 split lists ``count`` named scenarios per ship, interleaved round-robin in the order of
@@ -51,6 +52,7 @@ from shipgym.config import (
     read_yaml,
     resolve,
 )
+from shipgym.models.loading import HULLS, loading_change
 from shipgym.scenarios.schema import ScenarioConfig
 
 #: salts of the two seed spaces: test scenarios come from SeedSequence([TEST_SALT, ·, j]),
@@ -86,21 +88,27 @@ class CurrentShift(StrictModel):
 
 
 class JumpKind(StrictModel):
-    """A named kind of event: a change of one or more parameters together (``params``) or
-    a current appearing (``current``).  ``linked``: one uniform draw places every parameter
-    at the same relative point of its range (e.g. both rudder derivatives by one factor)."""
+    """A named kind of event: a change of one or more parameters together (``params``), a
+    loading-condition change (``draught_ratio``: the draught × U(range), every parameter
+    it moves by :func:`shipgym.models.loading.loading_change`; 3-DOF ships), a current
+    appearing (``current``), or a combination of them at the same time (e.g. rudder aging
+    and a current).  ``linked``: one uniform draw places every parameter at the same
+    relative point of its range (e.g. both rudder derivatives by one factor)."""
 
     weight: float = Field(1.0, gt=0)
     params: dict[str, JumpSpec] = Field(default_factory=dict)
     linked: bool = False
+    draught_ratio: Range | None = None
     current: CurrentShift | None = None
     ramp_probability: float = Field(0.0, ge=0, le=1)
     ramp_duration: Range = (2.0, 10.0)  # s
 
     @model_validator(mode="after")
     def _changes_something(self) -> JumpKind:
-        if bool(self.params) == (self.current is not None):
-            raise ValueError("a jump kind gives exactly one of 'params' and 'current'")
+        if not (self.params or self.draught_ratio is not None or self.current is not None):
+            raise ValueError("a jump kind gives 'params', 'draught_ratio' or 'current'")
+        if self.draught_ratio is not None and self.draught_ratio[0] <= 0:
+            raise ValueError(f"draught_ratio: must be > 0, got {list(self.draught_ratio)}")
         return self
 
 
@@ -306,8 +314,15 @@ def _check_jumps(ship: ShipSampling, key: str, split: str, shortest: float) -> N
         raise ValueError(f"{key}.jumps.order: 'cycle' is for test splits (named scenarios)")
     for kind_name, kind in jumps.kinds.items():
         where = f"{key}.jumps.kinds.{kind_name}"
+        if kind.draught_ratio is not None and ship.model not in HULLS:
+            raise ValueError(
+                f"{where}.draught_ratio: no loading-condition model for {ship.model}; "
+                f"valid: {sorted(HULLS)}"
+            )
         for end in (0, 1):
             changed = dict(ship.params)
+            if kind.draught_ratio is not None:
+                changed.update(_loading(ship, changed, kind.draught_ratio[end]))
             for pname, spec in kind.params.items():
                 if spec.mode != "value":
                     _check_param(ship, f"{where}.params.{pname}", pname, f"{key}.params")
@@ -316,7 +331,8 @@ def _check_jumps(ship: ShipSampling, key: str, split: str, shortest: float) -> N
             try:
                 MODELS[ship.model].from_config(changed, ship.unit_reading, ship.variant)
             except ParameterError as exc:
-                raise ValueError(f"{where}.params: {exc}") from None
+                key_at_fault = "draught_ratio" if kind.draught_ratio is not None else "params"
+                raise ValueError(f"{where}.{key_at_fault}: {exc}") from None
 
 
 def _shortest_time_limit(path: PathSampling, ship: ShipSampling, model: Any) -> float:
@@ -357,6 +373,15 @@ def _nominal(ship: ShipSampling, pname: str) -> float | None:
     if len(model_cls.unit_readings) == 1:
         return _defaults(ship.model).get(pname)
     return None
+
+
+def _loading(ship: ShipSampling, params: dict[str, float], ratio: float) -> dict[str, float]:
+    """The parameters (config units = SI for the 3-DOF ships) a draught × ``ratio`` moves,
+    from the ship's parameters ``params`` before the change."""
+    from shipgym.models import MODELS
+
+    record = MODELS[ship.model].from_config(params, ship.unit_reading, ship.variant).params
+    return loading_change(ship.model, record, ratio)
 
 
 def _changed(spec: JumpSpec, base: float, x: float) -> float:
@@ -521,6 +546,8 @@ def _sample_jump(
         kind_index = int(rng.choice(len(kinds), p=weights / weights.sum()))
     kind = kinds[kind_index]
     changed = {}
+    if kind.draught_ratio is not None:
+        changed.update(_loading(ship, params, _uniform(rng, kind.draught_ratio)))
     u = rng.random() if kind.linked and kind.params else None
     for pname, spec in kind.params.items():
         lo, hi = spec.range
@@ -540,11 +567,12 @@ def _sample_jump(
     duration = round(_uniform(rng, kind.ramp_duration), 2) if ramp else 0.0
     if shift is not None:
         shift.update(switch_time=time, transition_time=duration)
+    if not changed:
         return [], shift
     event: dict[str, Any] = {"time": time, "params": changed}
     if ramp:
         event.update(kind="ramp", duration=duration)
-    return [event], None
+    return [event], shift
 
 
 def test_rng(distribution: str, index: int, ship: int = 0) -> np.random.Generator:

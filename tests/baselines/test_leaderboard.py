@@ -366,3 +366,24 @@ def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, worker
             recorded[controller]["steps"],
             recorded[controller]["ace"],
         )
+
+
+@pytest.mark.slow
+def test_quick_suite_finishes(tmp_path: Path) -> None:
+    """The quick suite (issue 18) runs to the end with every controller on its 12
+    scenarios (one evaluation seed here, to keep CI short; the suite's own is 3): a row per
+    controller and scenario, every applicable one with its episodes."""
+    from baselines.suite import load_suite
+
+    quick = load_suite("quick")
+    rows = run_leaderboard("quick", seeds=1, out_dir=tmp_path, workers=2, show_progress=False)
+    assert {r["scenario"] for r in rows} == set(quick.scenarios)
+    assert len(rows) == len(quick.scenarios) * len(quick.controllers)
+    applies = [r for r in rows if r["applies"]]
+    assert all(r["episodes"] == r["seeds"] * max(1, r["training_seeds"]) for r in applies)
+    assert {r["controller"] for r in applies if r["scenario"] == "blanke_rudder_aging"} >= {
+        "pid_los",
+        "l1_backstepping",
+        "ppo",
+    }
+    assert read_run(tmp_path)["status"] == "complete"

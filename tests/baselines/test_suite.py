@@ -20,7 +20,7 @@ def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
 
 
 def test_packaged_suites_load() -> None:
-    assert list_suites() == list_names("suites") == ["default", "smoke"]
+    assert list_suites() == list_names("suites") == ["default", "quick", "smoke"]
     smoke = load_suite("smoke")
     assert smoke == SuiteConfig(
         name="smoke",
@@ -32,6 +32,35 @@ def test_packaged_suites_load() -> None:
     )
     assert smoke.randomize is not None and smoke.randomize.heading_error_deg is not None
     assert smoke.all_scenarios() == ["rudder_aging", "mariner_track", "heldout:0"]
+
+
+def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
+    """The whole scenario matrix (issue 18) with the nomoto2 and papers' scenarios, and the
+    held-out scenarios up to heldout:15 (each 3-DOF ship's three families and a combination)."""
+    from baselines.change_effect import matrix_scenarios
+
+    default = load_suite("default")
+    matrix = matrix_scenarios() + [f"{s}_nominal" for s in ("esso_osaka", "mariner", "blanke")]
+    assert set(matrix) <= set(default.scenarios)
+    assert len(default.scenarios) == 31 and default.heldout_scenarios == 16
+    assert default.seeds == 10
+
+
+def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
+    """quick: 3 seeds, the default suite's controllers and trials, 12 scenarios = 4 ships ×
+    (rudder aging, current shift, manoeuvrability change)."""
+    from shipgym.scenarios import load_scenario
+
+    quick, default = load_suite("quick"), load_suite("default")
+    assert quick.seeds == 3 and quick.heldout_scenarios == 0
+    assert quick.controllers == default.controllers and quick.randomize == default.randomize
+    families = ("rudder_aging", "current_shift", "maneuverability_change")
+    cells = set()
+    for name in quick.scenarios:
+        ship = load_scenario(name).model.name
+        (family,) = [f for f in families if f in name]
+        cells.add((ship, family))
+    assert len(cells) == len(quick.scenarios) == 12
 
 
 def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
@@ -96,7 +125,7 @@ def test_unknown_scenario_names_suite_key_and_valid_names(tmp_path: Path) -> Non
 
 
 def test_unknown_suite_lists_the_suites() -> None:
-    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, smoke"):
+    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, quick, smoke"):
         load_suite("nope")
 
 

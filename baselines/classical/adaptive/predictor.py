@@ -26,6 +26,7 @@ import numpy as np
 
 from baselines.classical.adaptive.design_model import NonlinearNomoto
 from baselines.classical.adaptive.projection import projection
+from shipgym.angles import unwrap_floats
 
 #: the adaptive parameters, in the order of :attr:`StatePredictor.estimates`
 PARAMETERS = ("rho", "sigma", "b")
@@ -122,8 +123,9 @@ class StatePredictor:
         stages evaluate :meth:`_rhs` written out on local floats (the same operations in
         the same order, so the same bits; ≈ 4× faster than calling it, tested).
         """
-        psi = np.unwrap(np.asarray(psi, dtype=float))
-        psi = psi + 2.0 * math.pi * round((self.psi_hat - psi[0]) / (2.0 * math.pi))
+        psi_l = unwrap_floats(np.asarray(psi, dtype=float).tolist())  # numpy.unwrap's bits
+        shift = 2.0 * math.pi * round((self.psi_hat - psi_l[0]) / (2.0 * math.pi))
+        psi_l = [value + shift for value in psi_l]
         n_sub = max(1, math.ceil(self.gamma2 * step / 0.5))
         dt = step / n_sub
         half_dt, sixth_dt = 0.5 * dt, dt / 6.0
@@ -162,7 +164,6 @@ class StatePredictor:
 
         x0, x1, x2, x3 = self.r_hat, self.rho, self.sigma, self.b
         psi_hat = self.psi_hat
-        psi_l = psi.tolist()
         r_l = np.asarray(r, dtype=float).tolist()
         d_l = np.asarray(delta, dtype=float).tolist()
         for j in range(len(psi_l) - 1):

@@ -15,7 +15,8 @@ import yaml
 from baselines.evaluation import run_episode
 from baselines.registry import make_controller
 from shipgym.models import MODELS
-from shipgym.scenarios import load_scenario
+from shipgym.models.loading import loading_change
+from shipgym.scenarios import list_scenarios, load_scenario
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import (
     DistributionConfig,
@@ -76,10 +77,14 @@ def test_a_sampled_scenario_has_its_ships_timing_scale_and_jumps() -> None:
             kinds[config.ship.model].add(",".join(sorted(event.params)))
         if config.disturbances.current.kind == "two_phase":
             kinds[config.ship.model].add("current")
+    loading = {
+        ship: ",".join(sorted(loading_change(ship, MODELS[ship].params_type(), 0.8)))
+        for ship in SHIPS[1:]
+    }
     assert kinds["nomoto2"] == {"Tc", "d0", "K,T1"}
-    assert kinds["esso_osaka"] == {"T_servo", "Nd,Yd", "current"}
-    assert kinds["mariner"] == {"T_delta", "a3", "current"}
-    assert kinds["blanke"] == {"T_delta", "dCL", "current"}
+    assert kinds["esso_osaka"] == {"T_servo", "Nd,Yd", loading["esso_osaka"], "current"}
+    assert kinds["mariner"] == {"T_delta", "a3", loading["mariner"], "current"}
+    assert kinds["blanke"] == {"T_delta", "dCL", loading["blanke"], "current"}
 
 
 def test_a_current_shift_is_a_calm_then_appearing_current_within_the_time_limit() -> None:
@@ -129,10 +134,10 @@ def test_heldout_interleaves_the_ships_and_keeps_the_one_ship_scenarios() -> Non
     """heldout:0-3 are one scenario per ship; adding ships to a test split leaves the first
     ship's scenarios as they were (same seeds), only their names move."""
     heldout = load_distribution("heldout")
-    assert len(heldout) == 21
+    assert len(heldout) == 24
     assert [heldout.test_scenario(i).ship.model for i in range(4)] == list(SHIPS)
-    counts = collections.Counter(heldout.test_scenario(i).ship.model for i in range(21))
-    assert counts == {"nomoto2": 12, "esso_osaka": 3, "mariner": 3, "blanke": 3}
+    counts = collections.Counter(heldout.test_scenario(i).ship.model for i in range(24))
+    assert counts == {"nomoto2": 12, "esso_osaka": 4, "mariner": 4, "blanke": 4}
     raw = _raw("heldout")
     one_ship = {**raw, "ships": [{**raw["ships"][0], "count": 4}]}
     alone = _distribution(one_ship)
@@ -145,34 +150,120 @@ def test_heldout_interleaves_the_ships_and_keeps_the_one_ship_scenarios() -> Non
             assert {k for k in a if a[k] != b[k]} <= {"time_limit"}
 
 
-def test_heldout_other_ships_have_one_scenario_of_each_outside_kind() -> None:
-    """order: cycle — the three held-out scenarios of each other ship cover its three jump
-    kinds, each outside the training range."""
+#: per ship, the parameter whose factor measures each parameter family (issue 18): servo
+#: time constant (aging), the steering gain (gain), the loading change's key parameter
+#: (loading: Esso Osaka's draught T, Blanke's mass, the Mariner's a3)
+AGING = {"nomoto2": "Tc", "esso_osaka": "T_servo", "mariner": "T_delta", "blanke": "T_delta"}
+GAIN = {"nomoto2": "K", "esso_osaka": "Yd", "mariner": "a3", "blanke": "dCL"}
+LOADING = {"esso_osaka": "T", "mariner": "a3", "blanke": "m"}
+#: the suites' trial range of a current's speed factor (default and quick)
+CURRENT_FACTOR = (0.8, 1.2)
+
+
+def _base(config: Any, name: str) -> float:
+    return config.ship.params.get(name, MODELS[config.ship.model].params_type().as_dict()[name])
+
+
+def _families(config: Any) -> dict[str, tuple[float, float]]:
+    """A scenario's changes: family → the interval of sizes its trials can take (a factor of
+    the family's parameter; nomoto2's d0 shift in °/s; a current in m/s, × the trials'
+    speed factor)."""
+    ship = config.ship.model
+    out: dict[str, tuple[float, float]] = {}
+    for event in config.events:
+        changed = set(event.params)
+        if ship == "nomoto2" and changed == {"d0"}:
+            shift = event.params["d0"] - config.ship.params["d0"]
+            out["d0_shift"] = (shift, shift)
+            continue
+        if ship == "nomoto2" and len(changed) > 2:
+            family, name = "case3", GAIN[ship]  # Liu et al. (2019) Case 3: all parameters
+        elif AGING[ship] in changed:
+            family, name = "aging", AGING[ship]
+        elif ship in LOADING and (len(changed) > 2 or changed == {"a1", "a3"}):
+            family, name = "loading", LOADING[ship]
+        else:
+            family, name = "gain", GAIN[ship]
+        factor = event.params[name] / _base(config, name)
+        out[family] = (factor, factor)
+    current = config.disturbances.current
+    if getattr(current, "second_speed", 0.0):
+        lo, hi = CURRENT_FACTOR
+        out["current"] = (current.second_speed * lo, current.second_speed * hi)
+    return out
+
+
+def _training_ranges(ship: Any) -> dict[str, tuple[float, float]]:
+    """The documented (train.yaml) size range of each family of one ship, in the units of
+    :func:`_families`."""
+    kinds = ship.jumps.kinds
+    model = ship.model
+    out = {"aging": kinds["rudder_aging"].params[AGING[model]].range}
+    out["gain"] = kinds["gain_change"].params[GAIN[model]].range
+    if model == "nomoto2":
+        out["d0_shift"] = kinds["current_shift"].params["d0"].range
+        return out
+    out["current"] = kinds["current_shift"].current.speed
+    base = MODELS[model].params_type()
+    ends = [
+        loading_change(model, base, r)[LOADING[model]] / getattr(base, LOADING[model])
+        for r in kinds["loading_change"].draught_ratio
+    ]
+    out["loading"] = (min(ends), max(ends))
+    return out
+
+
+def _tested_scenarios() -> list[Any]:
+    """Every catalogue scenario with a change and every held-out scenario (configs)."""
+    heldout = load_distribution("heldout")
+    configs = [load_scenario(name).config for name in list_scenarios()]
+    configs += [heldout.test_scenario(i) for i in range(len(heldout))]
+    return [c for c in configs if _families(c)]
+
+
+def test_heldout_other_ships_have_each_family_outside_training_and_a_combination() -> None:
+    """order: cycle — the four held-out scenarios of each 3-DOF ship are rudder aging, a
+    current shift, a loading change (each outside the training range) and aging + current."""
     heldout, train = load_distribution("heldout"), load_distribution("train").config
-    by_ship: dict[str, list[Any]] = collections.defaultdict(list)
-    for i in range(len(heldout)):
-        config = heldout.test_scenario(i)
-        by_ship[config.ship.model].append(config)
     for ship in SHIPS[1:]:
-        trained = next(s for s in train.ships if s.model == ship).jumps.kinds
-        aging = next(iter(trained["rudder_aging"].params))
-        gain = next(iter(trained["gain_change"].params))
-        defaults = MODELS[ship].params_type().as_dict()
-        max_aging = max(trained["rudder_aging"].params[aging].range) * defaults[aging]
-        min_gain = min(trained["gain_change"].params[gain].range)
-        max_current = max(trained["current_shift"].current.speed)
-        outside = []
-        for config in by_ship[ship]:
-            if config.disturbances.current.kind == "two_phase":
-                outside.append(config.disturbances.current.second_speed > max_current)
-            else:
-                (event,) = config.events
-                if aging in event.params:
-                    outside.append(event.params[aging] > max_aging)
-                else:
-                    base = config.ship.params[gain]
-                    outside.append(event.params[gain] / base < min_gain)
-        assert outside == [True, True, True], ship
+        ranges = _training_ranges(next(s for s in train.ships if s.model == ship))
+        configs = [
+            heldout.test_scenario(i)
+            for i in range(len(heldout))
+            if heldout.test_scenario(i).ship.model == ship
+        ]
+        seen = sorted(",".join(sorted(_families(c))) for c in configs)
+        assert seen == ["aging", "aging,current", "current", "loading"], ship
+        for config in configs:
+            for family, (lo, hi) in _families(config).items():
+                low, high = ranges[family]
+                assert hi < low or lo > high, (ship, family)
+
+
+def test_training_never_draws_a_catalogue_or_heldout_trial() -> None:
+    """Every ship draws the three families within its documented training ranges, and
+    those ranges are disjoint from the sizes of every catalogue and held-out scenario of
+    that ship and family (a current × the suites' trial factor 0.8-1.2)."""
+    train = load_distribution("train").config
+    ranges = {ship.model: _training_ranges(ship) for ship in train.ships}
+    drawn: dict[str, set[str]] = collections.defaultdict(set)
+    for config in _train_draws(600):
+        families = _families(config)
+        assert len(families) <= 1, families  # one change per training episode
+        for family, (lo, hi) in families.items():
+            low, high = ranges[config.ship.model][family]
+            factor = CURRENT_FACTOR if family == "current" else (1.0, 1.0)
+            assert low * factor[0] - 1e-9 <= lo and hi <= high * factor[1] + 1e-9, family
+            drawn[config.ship.model].add(family)
+    assert drawn["nomoto2"] == {"aging", "d0_shift", "gain"}
+    for ship in SHIPS[1:]:
+        assert drawn[ship] == {"aging", "current", "gain", "loading"}, ship
+    tested = _tested_scenarios()
+    assert len(tested) > 40
+    for config in tested:
+        for family, (lo, hi) in _families(config).items():
+            low, high = ranges[config.ship.model].get(family, (math.inf, -math.inf))
+            assert hi < low or lo > high, (config.name, family, (lo, hi), (low, high))
 
 
 def test_validation_is_the_training_ranges_in_the_test_seed_space() -> None:
