@@ -56,6 +56,7 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
     controllers = [
         "pid_los",
         "zero_rudder",
+        "oracle",  # the ranking's denominator
         {"controller": "pid_vf", "name": MATHTEXT},
         {"controller": "pid_tvvf", "name": FORMULA},
     ]
@@ -68,7 +69,13 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
     args = ["leaderboard", "--suite", str(suite), "--out", str(out), "--workers", "1"]
     assert main([*args, "--no-progress", "--json"]) == 0, capsys.readouterr().err
     rows = json.loads(capsys.readouterr().out)
-    assert {r["controller"] for r in rows} == {"pid_los", "zero_rudder", MATHTEXT, FORMULA}
+    assert {r["controller"] for r in rows} == {
+        "pid_los",
+        "zero_rudder",
+        "oracle",
+        MATHTEXT,
+        FORMULA,
+    }
     figures = sorted(p.name for p in out.glob("*.png"))
     assert figures == [
         "profile_catalogue.png",
@@ -83,4 +90,4 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
         assert len(set(table)) == 1, table
     with open(out / "leaderboard.csv", newline="") as fh:
         names = {row["controller"] for row in csv.DictReader(fh)}
-    assert names == {"pid_los", "zero_rudder", MATHTEXT, "'" + FORMULA}
+    assert names == {"pid_los", "zero_rudder", "oracle", MATHTEXT, "'" + FORMULA}
