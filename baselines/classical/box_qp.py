@@ -1,4 +1,6 @@
-"""The box-constrained QP of a Gauss–Newton SQP step (CasADi's qrqp, buffers bound once).
+"""The box-constrained QP of a Gauss–Newton SQP step (CasADi's qrqp, buffers bound once), and
+the other pieces every shooting SQP here shares: numpy buffers bound to a compiled CasADi
+function (:func:`bind`) and the backtracking line search (:func:`backtrack`).
 
     min_Δ  ½ Δᵀ H Δ + gᵀ Δ    s.t.  lb ≤ Δ ≤ ub
 
@@ -10,8 +12,45 @@ allocates nothing.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import Any
+
 import casadi as ca
 import numpy as np
+
+
+def bind(
+    function: ca.Function, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+) -> tuple[Any, Callable[[], None]]:
+    """``function``'s buffer interface with numpy arrays as its inputs and outputs: calling
+    the returned evaluator reads the inputs and writes the outputs in place (no allocation).
+    Keep the returned buffer alive as long as the evaluator is used."""
+    buffer, evaluate = function.buffer()
+    for i, arg in enumerate(inputs):
+        buffer.set_arg(i, memoryview(arg))
+    for i, out in enumerate(outputs):
+        buffer.set_res(i, memoryview(out))
+    return buffer, evaluate
+
+
+def backtrack(
+    u: np.ndarray,
+    step: np.ndarray,
+    cost: float,
+    lb: np.ndarray,
+    ub: np.ndarray,
+    evaluate: Callable[[np.ndarray], float],
+) -> tuple[np.ndarray, float] | None:
+    """Backtracking line search: the first of u + αΔ (α = 1, ½, ¼, … > 10⁻³, clipped to
+    [lb, ub]) whose cost is not above ``cost``, with that cost; None if there is none."""
+    alpha = 1.0
+    while alpha > 1e-3:
+        trial = np.clip(u + alpha * step, lb, ub)
+        trial_cost = evaluate(trial)
+        if trial_cost <= cost:
+            return trial, trial_cost
+        alpha *= 0.5
+    return None
 
 
 class BoxQP:
@@ -32,11 +71,7 @@ class BoxQP:
         self.n = n
         self._in = {name: np.zeros(qp.sparsity_in(i).nnz()) for i, name in enumerate(qp.name_in())}
         self._out = [np.zeros(qp.sparsity_out(i).nnz()) for i in range(qp.n_out())]
-        buffer, self._eval = qp.buffer()
-        for i, name in enumerate(qp.name_in()):
-            buffer.set_arg(i, memoryview(self._in[name]))
-        for i, out in enumerate(self._out):
-            buffer.set_res(i, memoryview(out))
+        buffer, self._eval = bind(qp, [self._in[name] for name in qp.name_in()], self._out)
         self._keep = (qp, buffer)  # the buffers' owners stay alive
 
     def solve(self, h: np.ndarray, g: np.ndarray, lb: np.ndarray, ub: np.ndarray) -> np.ndarray:

@@ -49,7 +49,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP
+from baselines.classical.box_qp import BoxQP, backtrack, bind
 from baselines.classical.nmpc_ship import (
     PAPER_CONTROL_HORIZON,
     PAPER_HORIZON,
@@ -163,12 +163,7 @@ class NMPCSolver:
         return self._qp.solve(jac.T @ jac, jac.T @ rho, self.lb - u, self.ub - u)
 
     def _bind(self, function: ca.Function, outputs: list[np.ndarray]):
-        buffer, evaluate = function.buffer()
-        buffer.set_arg(0, memoryview(self._u))
-        buffer.set_arg(1, memoryview(self._p))
-        for i, out in enumerate(outputs):
-            buffer.set_res(i, memoryview(out))
-        return buffer, evaluate
+        return bind(function, [self._u, self._p], outputs)
 
     def parameters(
         self,
@@ -204,15 +199,10 @@ class NMPCSolver:
             if not (np.all(np.isfinite(rho)) and np.all(np.isfinite(jac))):
                 return u, False, iterations
             step = self._gauss_newton_step(u, rho, jac)
-            alpha = 1.0
-            while alpha > 1e-3:  # backtracking on the cost
-                trial = np.clip(u + alpha * step, self.lb, self.ub)
-                trial_cost = self.cost(trial, p)
-                if trial_cost <= cost:
-                    break
-                alpha *= 0.5
-            else:
+            found = backtrack(u, step, cost, self.lb, self.ub, lambda t: self.cost(t, p))
+            if found is None:
                 break  # no descent: converged as far as Gauss–Newton goes
+            trial, trial_cost = found
             moved = float(np.max(np.abs(trial - u)))
             u, cost = trial, trial_cost
             if moved < s.step_tolerance:

@@ -66,7 +66,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP
+from baselines.classical.box_qp import BoxQP, backtrack, bind
 from baselines.errors import ControllerError
 from baselines.registry import register_controller
 from shipgym.codegen import compiled
@@ -353,8 +353,8 @@ class OracleSolver:
         self._p = np.zeros(n_p)
         self._z = np.zeros(self.n_z)
         self._j = np.zeros((n_u, self.n_z))  # column-major J
-        self._value = _bind(value, self._u, self._p, [self._z])
-        self._both = _bind(both, self._u, self._p, [self._z, self._j])
+        self._value = bind(value, [self._u, self._p], [self._z])
+        self._both = bind(both, [self._u, self._p], [self._z, self._j])
         self._keep = (value, both)
         self.lb = np.full(n_u, -rudder_limit)
         self.ub = np.full(n_u, rudder_limit)
@@ -398,15 +398,10 @@ class OracleSolver:
                 return u, False, iterations
             _, d1, d2 = self._outer(z)
             step = self._qp.solve((jac.T * d2) @ jac, jac.T @ d1, self.lb - u, self.ub - u)
-            alpha = 1.0
-            while alpha > 1e-3:  # backtracking on the cost
-                trial = np.clip(u + alpha * step, self.lb, self.ub)
-                trial_cost = self.cost(trial, p)
-                if trial_cost <= cost:
-                    break
-                alpha *= 0.5
-            else:
+            found = backtrack(u, step, cost, self.lb, self.ub, lambda t: self.cost(t, p))
+            if found is None:
                 break  # no descent along the GGN step: converged as far as it goes
+            trial, trial_cost = found
             moved = float(np.max(np.abs(trial - u)))
             gain = cost - trial_cost
             u, cost = trial, trial_cost
@@ -436,15 +431,6 @@ class OracleSolver:
                 disturbances.ravel(),
             ]
         )
-
-
-def _bind(function: ca.Function, u: np.ndarray, p: np.ndarray, outputs: list[np.ndarray]):
-    buffer, evaluate = function.buffer()
-    buffer.set_arg(0, memoryview(u))
-    buffer.set_arg(1, memoryview(p))
-    for i, out in enumerate(outputs):
-        buffer.set_res(i, memoryview(out))
-    return buffer, evaluate
 
 
 _SOLVERS: dict[tuple, OracleSolver] = {}
