@@ -1,0 +1,52 @@
+"""The env's privileged truth (``plant_truth``): what only the oracle reference reads."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import shipgym  # noqa: F401  (registers the envs)
+from shipgym.scenarios import load_scenario
+
+
+def _run_to(env: gym.Env, t: float) -> None:
+    while env.unwrapped.time < t - 1e-9:
+        env.step(np.zeros(1, dtype=np.float32))
+
+
+def test_the_truth_carries_the_parameters_acting_now_never_the_schedule() -> None:
+    """Before a jump the truth is the nominal record; after it, the jumped one."""
+    sc = load_scenario("maneuverability_change")
+    (event,) = sc.config.events
+    env = gym.make("ShipPathFollow-v0", scenario=sc)
+    env.reset(seed=0)
+    before = env.unwrapped.plant_truth()
+    assert before.params == sc.nominal_params
+    assert before.t == 0.0
+    _run_to(env, event.time + 1.0)
+    after = env.unwrapped.plant_truth()
+    assert after.params == sc.schedule.record_at(after.t)
+    assert after.params != sc.nominal_params
+    assert np.array_equal(after.state, env.unwrapped._state)
+    after.state[0] += 1.0  # a copy: the oracle cannot move the plant
+    assert not np.array_equal(after.state, env.unwrapped._state)
+
+
+def test_the_disturbance_forecast_knows_the_scheduled_current_switch() -> None:
+    """A two-phase current (calm, then 0.5 m/s from 150 s, no fluctuation): the forecast is
+    the mean current at each future time, the mean rows equal the constant row before the
+    switch, and the second speed after it."""
+    env = gym.make("ShipPathFollow-v0", scenario="blanke_current_shift")
+    env.reset(seed=0)
+    dist = env.unwrapped._disturbances
+    truth = env.unwrapped.plant_truth()
+    times = np.array([0.0, 149.0, 151.0, 400.0])
+    forecast = truth.disturbance_forecast(times)
+    assert np.allclose(forecast[:2], dist.constant_row())
+    speed = np.hypot(forecast[:, 0], forecast[:, 1])
+    assert speed[2:] == pytest.approx([0.5, 0.5])
+    _run_to(env, 200.0)
+    late = env.unwrapped.plant_truth()
+    assert np.hypot(*late.disturbance_now[:2]) == pytest.approx(0.5)
+    assert np.allclose(late.disturbance_forecast(np.array([300.0])), late.disturbance_now)
