@@ -1,6 +1,7 @@
 """The box-constrained QP of a Gauss–Newton SQP step (CasADi's qrqp, buffers bound once), and
 the other pieces every shooting SQP here shares: numpy buffers bound to a compiled CasADi
-function (:func:`bind`) and the backtracking line search (:func:`backtrack`).
+function (:func:`bind`), the backtracking line search (:func:`backtrack`) and the SQP loop
+around them (:func:`sqp`).
 
     min_Δ  ½ Δᵀ H Δ + gᵀ Δ    s.t.  lb ≤ Δ ≤ ub
 
@@ -12,6 +13,7 @@ allocates nothing.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -83,3 +85,41 @@ class BoxQP:
         q["ubx"][:] = ub
         self._eval()
         return self._out[0].copy()
+
+
+def sqp(
+    guess: np.ndarray,
+    lb: np.ndarray,
+    ub: np.ndarray,
+    cost: Callable[[np.ndarray], float],
+    direction: Callable[[np.ndarray], np.ndarray | None],
+    max_iter: int,
+    step_tolerance: float,
+    cost_tolerance: float | None = None,
+) -> tuple[np.ndarray, bool, int]:
+    """The warm-started SQP of a shooting NMPC: from ``guess`` (clipped to [lb, ub]), at most
+    ``max_iter`` times a step Δ = ``direction(u)`` (None: the linearisation is not finite)
+    and a :func:`backtrack` on ``cost``; stopped when no descent is found, when the accepted
+    step moves less than ``step_tolerance`` or (``cost_tolerance`` given) when it lowers the
+    cost by less than that fraction.  Returns (plan, success, iterations)."""
+    u = np.clip(guess, lb, ub)
+    value = cost(u)
+    if not math.isfinite(value):
+        return u, False, 0
+    iterations = 0
+    for iterations in range(1, max_iter + 1):
+        step = direction(u)
+        if step is None:
+            return u, False, iterations
+        found = backtrack(u, step, value, lb, ub, cost)
+        if found is None:
+            break  # no descent: converged as far as the (generalised) Gauss–Newton goes
+        trial, trial_value = found
+        moved = float(np.max(np.abs(trial - u)))
+        gain = value - trial_value
+        u, value = trial, trial_value
+        if moved < step_tolerance:
+            break
+        if cost_tolerance is not None and gain <= cost_tolerance * value:
+            break
+    return u, bool(np.all(np.isfinite(u)) and math.isfinite(value)), iterations

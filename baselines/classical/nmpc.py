@@ -49,7 +49,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP, backtrack, bind
+from baselines.classical.box_qp import BoxQP, bind, sqp
 from baselines.classical.nmpc_ship import (
     PAPER_CONTROL_HORIZON,
     PAPER_HORIZON,
@@ -186,28 +186,25 @@ class NMPCSolver:
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""
         s = self.settings
-        u = np.clip(guess, self.lb, self.ub)
         self._p[:] = p
-        cost = self.cost(u, p)
-        if not math.isfinite(cost):
-            return u, False, 0
-        iterations = 0
-        for iterations in range(1, s.max_iter + 1):
+
+        def direction(u: np.ndarray) -> np.ndarray | None:
             self._u[:] = u
             self._jac_eval[1]()
             rho, jac = self._rho.copy(), self._jac.T
             if not (np.all(np.isfinite(rho)) and np.all(np.isfinite(jac))):
-                return u, False, iterations
-            step = self._gauss_newton_step(u, rho, jac)
-            found = backtrack(u, step, cost, self.lb, self.ub, lambda t: self.cost(t, p))
-            if found is None:
-                break  # no descent: converged as far as Gauss–Newton goes
-            trial, trial_cost = found
-            moved = float(np.max(np.abs(trial - u)))
-            u, cost = trial, trial_cost
-            if moved < s.step_tolerance:
-                break
-        return u, bool(np.all(np.isfinite(u)) and math.isfinite(cost)), iterations
+                return None
+            return self._gauss_newton_step(u, rho, jac)
+
+        return sqp(
+            guess,
+            self.lb,
+            self.ub,
+            lambda u: self.cost(u, p),
+            direction,
+            s.max_iter,
+            s.step_tolerance,
+        )
 
     def predict(self, plan: np.ndarray, p: np.ndarray) -> np.ndarray:
         """Predicted states (N_p, n_x) at the ends of the control periods."""

@@ -66,7 +66,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP, backtrack, bind
+from baselines.classical.box_qp import BoxQP, bind, sqp
 from baselines.errors import ControllerError
 from baselines.registry import register_controller
 from shipgym.codegen import compiled
@@ -359,7 +359,6 @@ class OracleSolver:
         self.lb = np.full(n_u, -rudder_limit)
         self.ub = np.full(n_u, rudder_limit)
         self._qp = BoxQP(n_u)
-        self.iterations: list[int] = []
 
     # ---------------------------------------------------------------- cost and SQP
     def _outer(self, z: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -384,31 +383,28 @@ class OracleSolver:
 
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Plan (one command per interval, rad), success flag, iterations."""
-        u = np.clip(guess, self.lb, self.ub)
         self._p[:] = p
-        cost = self.cost(u, p)
-        if not math.isfinite(cost):
-            return u, False, 0
-        iterations = 0
-        for iterations in range(1, self.settings.max_iter + 1):
+
+        def direction(u: np.ndarray) -> np.ndarray | None:
             self._u[:] = u
             self._both[1]()
             z, jac = self._z, self._j.T
             if not (np.all(np.isfinite(z)) and np.all(np.isfinite(jac))):
-                return u, False, iterations
+                return None
             _, d1, d2 = self._outer(z)
-            step = self._qp.solve((jac.T * d2) @ jac, jac.T @ d1, self.lb - u, self.ub - u)
-            found = backtrack(u, step, cost, self.lb, self.ub, lambda t: self.cost(t, p))
-            if found is None:
-                break  # no descent along the GGN step: converged as far as it goes
-            trial, trial_cost = found
-            moved = float(np.max(np.abs(trial - u)))
-            gain = cost - trial_cost
-            u, cost = trial, trial_cost
-            if moved < self.settings.step_tolerance or gain <= self.settings.cost_tolerance * cost:
-                break
-        self.iterations.append(iterations)
-        return u, math.isfinite(cost), iterations
+            return self._qp.solve((jac.T * d2) @ jac, jac.T @ d1, self.lb - u, self.ub - u)
+
+        s = self.settings
+        return sqp(
+            guess,
+            self.lb,
+            self.ub,
+            lambda u: self.cost(u, p),
+            direction,
+            s.max_iter,
+            s.step_tolerance,
+            s.cost_tolerance,
+        )
 
     def parameters(
         self,
