@@ -35,11 +35,11 @@ from pathlib import Path
 
 import gymnasium as gym
 
-import baselines
+import shipgym_baselines
 import shipgym
 
 root = Path(sys.argv[1]).resolve()
-for module in (shipgym, baselines):
+for module in (shipgym, shipgym_baselines):
     where = Path(module.__file__).resolve()
     assert root not in where.parents, f"{module.__name__} imported from the checkout: {where}"
 ids = sorted(i for i in gym.registry if i.startswith("ShipPathFollow"))

@@ -134,7 +134,7 @@ JUMP_CASES = {
 
 def _jump_case(name: str) -> Any:
     """A catalogue scenario, or ``<name>_noise_free``: the same without its sensor model."""
-    from baselines.variants import scenario_variant
+    from shipgym_baselines.variants import scenario_variant
 
     base = name.removesuffix("_noise_free")
     return scenario_variant(base, noise_free=name != base)
@@ -152,8 +152,8 @@ def identification_log(
     import gymnasium as gym
 
     import shipgym  # noqa: F401
-    from baselines.classical.pid import PIDLOS
     from shipgym.identification import PersistentExcitation
+    from shipgym_baselines.classical.pid import PIDLOS
 
     env = gym.make(
         "ShipPathFollow-v0",
@@ -310,10 +310,10 @@ def solve_times_per_ship(
     ``{controller}_cpu_median_ms`` / ``_cpu_p99_ms`` where the policy also records
     ``solve_cpu_times`` (its thread's CPU time: not inflated by a loaded machine), and
     ``{controller}_solves``."""
-    from baselines.evaluation import run_episode
-    from baselines.privileged import grants_truth
-    from baselines.registry import make_controller
     from shipgym.scenarios import load_scenario
+    from shipgym_baselines.evaluation import run_episode
+    from shipgym_baselines.privileged import grants_truth
+    from shipgym_baselines.registry import make_controller
 
     max_steps = PER_SHIP_MAX_STEPS if max_steps is None else max_steps
     privileged = grants_truth(controller)  # the oracle reads the truth, as in a run
@@ -349,8 +349,8 @@ def bench_nmpc(
     ``oracle``'s ``oracle_median_ms`` / ``oracle_p99_ms`` (target median ≤ 20 ms, its
     episodes cut after ``max_steps`` or :data:`ORACLE_MAX_STEPS`); None: :data:`NMPC_FAMILY`,
     :data:`PER_SHIP_MAX_STEPS`."""
-    from baselines.classical.nmpc import NMPC
-    from baselines.evaluation import run_episode
+    from shipgym_baselines.classical.nmpc import NMPC
+    from shipgym_baselines.evaluation import run_episode
 
     times: list[float] = []
     solves = failures = 0
@@ -406,7 +406,11 @@ def bench_training(
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from baselines.learned.agents import build_hyperparams, load_agent_config, make_training_env
+    from shipgym_baselines.learned.agents import (
+        build_hyperparams,
+        load_agent_config,
+        make_training_env,
+    )
 
     torch.set_num_threads(1)  # as `shipgym train`
     config = load_agent_config("ppo")

@@ -14,7 +14,7 @@ after-change cost is ≥ 1.3× the twin's over the same window (:data:`MATTERS`)
 with the twin rather than with the steps before t*, because what comes after t* on a route
 (its turns) differs from what comes before whatever the plant does.
 
-``python -m baselines.change_effect [SCENARIO …] [--controller C] [--seeds N] [--json]``
+``python -m shipgym_baselines.change_effect [SCENARIO …] [--controller C] [--seeds N] [--json]``
 prints the table (default: every matrix scenario with a change, ``pid_los``, 3 seeds of the
 default suite's trials).
 """
@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 
-from baselines.evaluation import EVAL_SEED_OFFSET, run_episode
-from baselines.registry import make_controller
-from baselines.suite import load_suite
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
+from shipgym_baselines.registry import make_controller
+from shipgym_baselines.suite import load_suite
 
 #: the factor by which a change must raise the after-change cost per step (issue 18)
 MATTERS = 1.3

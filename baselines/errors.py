@@ -26,7 +26,7 @@ class ControllerError(ShipgymError, KeyError):
 class UnsafeFileError(ControllerError):
     """A file that only unpickling can read (an SB3 zip's pickled parts a scoring run needs,
     a ``vecnormalize.pkl``): unpickling runs any code the file holds, so it is refused
-    unless the user passes ``--trust-pickle`` (:mod:`baselines.learned.trust`)."""
+    unless the user passes ``--trust-pickle`` (:mod:`shipgym_baselines.learned.trust`)."""
 
 
 class RunError(ShipgymError, ValueError):

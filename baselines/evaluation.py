@@ -15,11 +15,11 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
-from baselines.errors import ControllerError
-from baselines.plugins import ControllerEntry, ControllerSpec
-from baselines.policy import Policy
-from baselines.privileged import grants_truth, reset_with_truth
-from baselines.registry import make_controller
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
+from shipgym_baselines.policy import Policy
+from shipgym_baselines.privileged import grants_truth, reset_with_truth
+from shipgym_baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"
 #: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
@@ -109,7 +109,7 @@ def run_episode(
     Controller compute time is measured here, around each ``act`` call, never by the env:
     ``compute_ms`` [ms] is its mean per step and ``compute_ms_max`` [ms] its maximum.
     ``privileged``: set by :func:`evaluate` / :func:`evaluate_batch` for the built-in
-    ``oracle`` only (:mod:`baselines.privileged`): it then reads the true plant.
+    ``oracle`` only (:mod:`shipgym_baselines.privileged`): it then reads the true plant.
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
@@ -154,7 +154,7 @@ def evaluate_batch(
     :func:`run_episode` one by one (compute times aside).
 
     ``controller``: a name, spec or long form (made with ``training_seed``, one of
-    :func:`~baselines.registry.training_seeds`; None: a learned policy's first) or a Policy
+    :func:`~shipgym_baselines.registry.training_seeds`; None: a learned policy's first) or a Policy
     instance.  A :class:`BatchPolicy` (learned policies) runs all episodes in lockstep, one
     ``act_batch`` for the live envs per step; its ``compute_ms`` / ``compute_ms_max`` [ms]
     are the mean and maximum over an episode's steps of that call's time divided by the
@@ -250,7 +250,7 @@ def evaluate(
 ) -> list[EpisodeResult]:
     """Evaluate a controller on a scenario over seeds.
 
-    ``controller``: a name, spec or long form :func:`~baselines.registry.make_controller`
+    ``controller``: a name, spec or long form :func:`~shipgym_baselines.registry.make_controller`
     knows (made afresh per seed with ``settings``) or a Policy instance (``settings`` may
     give its ``action_mode``; default: the policy's own).
     """

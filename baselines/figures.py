@@ -1,19 +1,19 @@
 """The leaderboard's figures (issue 13): per-scenario small multiples and the rliable ranking.
 
-Every figure uses :func:`baselines.style.controller_style` (one colour and line style per
+Every figure uses :func:`shipgym_baselines.style.controller_style` (one colour and line style per
 controller, the same in every figure), labels its axes with units, keeps legends outside the
-data and is written twice: a PNG at :data:`~baselines.style.FIGURE_DPI` (200 dpi) and an SVG
+data and is written twice: a PNG at :data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi) and an SVG
 copy beside it (:func:`save_figure`).  Matplotlib runs on the Agg backend.
 
 What a run hands in:
 
 * ``drawn``: (scenario, controller) → :class:`DrawnEpisode` (or a plain ``(seed,
   trajectory)`` / ``(seed, trajectory, training_seed)`` tuple) — the episode to draw, its
-  trajectory as :attr:`baselines.evaluation.EpisodeResult.trajectory` keeps it (arrays ``t``
+  trajectory as :attr:`shipgym_baselines.evaluation.EpisodeResult.trajectory` keeps it (arrays ``t``
   [s], ``x``, ``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad], …).
   :func:`median_ace_episode` names the episode to keep (the median-ACE seed, and its training
   seed), :func:`episodes_to_draw` picks them from episode results.
-* ``aggregate``: the ``aggregate.json`` rows (:func:`baselines.ranking.aggregate_ranking`);
+* ``aggregate``: the ``aggregate.json`` rows (:func:`shipgym_baselines.ranking.aggregate_ranking`);
   ``episodes``: the ``episodes.jsonl`` records; ``splits``: scenario → split.
 
 Functions (each returns the written files, PNG then SVG):
@@ -49,9 +49,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from baselines.escaping import plain_text
-from baselines.ranking import ORACLE
-from baselines.style import FIGURE_DPI, controller_style
+from shipgym_baselines.escaping import plain_text
+from shipgym_baselines.ranking import ORACLE
+from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
@@ -145,7 +145,7 @@ def _seed_key(seed: int | None) -> tuple[bool, int]:
 
 def episodes_to_draw(results: Iterable[Any]) -> dict[tuple[str, str], DrawnEpisode]:
     """The median-ACE episode of each (scenario, controller) of ``results``
-    (:class:`~baselines.evaluation.EpisodeResult`), for :func:`plot_scenarios`; a pair whose
+    (:class:`~shipgym_baselines.evaluation.EpisodeResult`), for :func:`plot_scenarios`; a pair whose
     median episode has no kept trajectory is left out."""
     results = list(results)
     records = [
@@ -558,7 +558,7 @@ def plot_ranking(
     saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
     ratio from ``episodes``, one panel per family); see the module doc.  Returns every
     written file."""
-    from baselines.ranking import PARTIAL
+    from shipgym_baselines.ranking import PARTIAL
 
     files: list[Path] = []
     for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in aggregate):
@@ -650,7 +650,7 @@ def _plot_profiles(
 ) -> list[Path]:
     from rliable import plot_utils
 
-    from baselines.ranking import performance_profiles, scored_episodes
+    from shipgym_baselines.ranking import performance_profiles, scored_episodes
 
     plt = pyplot()
     in_split = {s for s, sp in splits.items() if sp == split}

@@ -3,18 +3,18 @@
 Each evaluation seed runs its own trial of a scenario: the suite's ``randomize`` ranges
 (:mod:`shipgym.scenarios.trials`) draw the start, the jump time and the current from the
 seed, and the sensor noise varies with it too.  A learned agent runs once per training seed
-(:func:`baselines.registry.training_seeds`), so its row aggregates training seeds ×
+(:func:`shipgym_baselines.registry.training_seeds`), so its row aggregates training seeds ×
 evaluation seeds.
 
 The work is cut into jobs (:class:`Job`, names and seeds only: the worker builds each
 seed's trial): a classical controller's job is one (scenario, seed) episode; a learned
 agent's is one training seed on one scenario for all the evaluation seeds, evaluated
-batched (:func:`baselines.evaluation.evaluate_batch`: one network forward per step for all
+batched (:func:`shipgym_baselines.evaluation.evaluate_batch`: one network forward per step for all
 seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
 ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
-The parent records each episode as it arrives (:mod:`baselines.runs`: ``run.json``,
+The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
-``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`baselines.ranking`: cost over
+``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`shipgym_baselines.ranking`: cost over
 the oracle's), ``scenario_scores.json``, the figures.
 """
 
@@ -37,15 +37,20 @@ from typing import Any, NamedTuple
 import numpy as np
 from tqdm import tqdm
 
-from baselines import evaluation
-from baselines.errors import BackendError, RunError, check_seeds
-from baselines.escaping import csv_cell, md_cell, plain_text
-from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
-from baselines.figures import median_ace_episode
-from baselines.jsonout import dumps
-from baselines.plugins import ControllerSpec
-from baselines.privileged import grants_truth
-from baselines.ranking import (
+from shipgym.config import is_path
+from shipgym.limits import worker_count
+from shipgym.metrics import aggregate
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines import evaluation
+from shipgym_baselines.errors import BackendError, RunError, check_seeds
+from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
+from shipgym_baselines.figures import median_ace_episode
+from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.plugins import ControllerSpec
+from shipgym_baselines.privileged import grants_truth
+from shipgym_baselines.ranking import (
     BASELINE,
     NO_RANKING,
     ORACLE,
@@ -56,10 +61,10 @@ from baselines.ranking import (
     resolution_lines,
     row_intervals,
 )
-from baselines.ranking import scenario_scores as score_table
-from baselines.references import result_from_entry, shipped_table
-from baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from baselines.runs import (
+from shipgym_baselines.ranking import scenario_scores as score_table
+from shipgym_baselines.references import result_from_entry, shipped_table
+from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
+from shipgym_baselines.runs import (
     BACKENDS,
     RunLog,
     check_out_dir,
@@ -67,14 +72,9 @@ from baselines.runs import (
     episode_result,
     read_episodes,
 )
-from baselines.signals import worker_init
-from baselines.style import FIGURE_DPI, controller_style
-from baselines.suite import load_suite
-from shipgym.config import is_path
-from shipgym.limits import worker_count
-from shipgym.metrics import aggregate
-from shipgym.scenarios import Scenario, load_scenario
-from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines.signals import worker_init
+from shipgym_baselines.style import FIGURE_DPI, controller_style
+from shipgym_baselines.suite import load_suite
 
 #: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
 COLUMNS = (
@@ -196,7 +196,7 @@ def run_job(job: tuple) -> EpisodeResult:
 
 
 def run_batch(job: Job) -> list[EpisodeResult]:
-    """The job's episodes, all seeds at once (:func:`baselines.evaluation.evaluate_batch`),
+    """The job's episodes, all seeds at once (:func:`shipgym_baselines.evaluation.evaluate_batch`),
     in the order of ``job.seeds``."""
     results = evaluation.evaluate_batch(
         job.controller, trials(job), list(job.seeds), training_seed=job.training_seed
@@ -206,7 +206,7 @@ def run_batch(job: Job) -> list[EpisodeResult]:
 
 def reference_work(job: Job) -> list[EpisodeResult]:
     """The oracle's episodes of ``job``: each trial's entry of the shipped reference table
-    (:mod:`baselines.references`), the oracle run for a trial the table lacks."""
+    (:mod:`shipgym_baselines.references`), the oracle run for a trial the table lacks."""
     table = shipped_table()
     out = []
     for seed, trial in zip(job.seeds, trials(job), strict=True):
@@ -230,7 +230,7 @@ def work(job: Job) -> list[EpisodeResult]:
 
 def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
     """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes,
-    :func:`baselines.signals.worker_init`)."""
+    :func:`shipgym_baselines.signals.worker_init`)."""
     if workers <= 1:
         for job in jobs:
             yield work(job)
@@ -243,7 +243,7 @@ def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
         workers_running = list((pool._processes or {}).values())  # shutdown forgets them
         pool.shutdown(wait=False, cancel_futures=True)
         for process in workers_running:
-            process.kill()  # workers ignore SIGTERM (baselines.signals)
+            process.kill()  # workers ignore SIGTERM (shipgym_baselines.signals)
         raise
     pool.shutdown()
 
@@ -382,9 +382,9 @@ def run_leaderboard(
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
-    its shipped reference table (:mod:`baselines.references`).  ``workers``: local processes
+    its shipped reference table (:mod:`shipgym_baselines.references`).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
-    :class:`~baselines.runs.RunInterrupted`.
+    :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
     check_out_usable(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
@@ -457,7 +457,7 @@ def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
 
 def keep_drawn(log: RunLog, rows: Mapping[tuple[str, str], set[tuple]], row: tuple) -> None:
     """Once every episode of ``row`` is recorded: keep the trajectory of the episode its
-    figure draws (:func:`baselines.figures.median_ace_episode`), remove the others'."""
+    figure draws (:func:`shipgym_baselines.figures.median_ace_episode`), remove the others'."""
     keys = rows[row]
     if not keys <= log.done:
         return
@@ -495,16 +495,16 @@ def write_results(
 
     ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
     controller × scenario cost ratios, then the rows), ``generalisation.json``,
-    ``aggregate.json`` (:func:`baselines.ranking.aggregate_ranking`),
+    ``aggregate.json`` (:func:`shipgym_baselines.ranking.aggregate_ranking`),
     ``scenario_scores.json`` and the figures
-    (:mod:`baselines.figures`: per scenario the small multiples of each controller's
+    (:mod:`shipgym_baselines.figures`: per scenario the small multiples of each controller's
     median-ACE episode, per split the ranking's interval estimates and performance
-    profiles) and ``leaderboard.html`` (:mod:`baselines.pages`: all of it on one page).  The
+    profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.pages`: all of it on one page).  The
     ranking of each split and each figure are independent tasks, run in a
     pool of ``workers`` processes (default: the cores) when there are
     :data:`POOLED_FIGURES` scenario figures or more.
     """
-    from baselines import figures, pages
+    from shipgym_baselines import figures, pages
 
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
     results = sorted(results, key=_order)
@@ -614,7 +614,7 @@ def aggregate_results(
 ) -> list[dict[str, Any]]:
     """One row per (scenario, controller) over its episodes (training seeds × evaluation
     seeds): means, ``*_std`` and 95 % ``*_ci95`` intervals ``[low, high]`` (bootstrap,
-    stratified over training seeds: :func:`baselines.ranking.row_intervals`; None where a
+    stratified over training seeds: :func:`shipgym_baselines.ranking.row_intervals`; None where a
     metric is not finite in every episode, e.g. t_c when a seed never converged), or "does
     not apply".  ``seeds``: the evaluation seeds; ``training_seeds``: how many training
     seeds (0 for a controller that is not trained), ``training_seed_list`` which;
@@ -816,7 +816,7 @@ def terminal_summary(folder: str | os.PathLike) -> str:
     """What ``leaderboard``, ``evaluate`` and ``report`` print: the ranking of the run
     folder's ``aggregate.json`` (or why there is none), its resolution, and the path of
     ``leaderboard.html``."""
-    from baselines.pages import PAGE_FILE
+    from shipgym_baselines.pages import PAGE_FILE
 
     board = json.loads((Path(folder) / AGGREGATE_FILE).read_text())
     lines = ["## Ranking (cost over the oracle's; lower is better)", ""]

@@ -23,7 +23,7 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-from baselines.errors import RunError
+from shipgym_baselines.errors import RunError
 
 #: the lock file a run keeps in its ``--out`` while it runs
 LOCK_FILE = ".shipgym.lock"

@@ -6,7 +6,7 @@ written, so a run killed while writing a file still lists it; the tables and fig
 whose names the drawing code chooses, are listed as they appear).  ``--force`` deletes
 exactly the listed paths and refuses, before deleting anything, a folder that holds
 anything else: a user's file, a directory of their own, a file of an earlier shipgym
-version that kept no manifest.  The lock file (:mod:`baselines.locking`) is never listed
+version that kept no manifest.  The lock file (:mod:`shipgym_baselines.locking`) is never listed
 and never deleted.
 """
 
@@ -17,8 +17,8 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
-from baselines.errors import RunError
-from baselines.locking import LOCK_FILE
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.locking import LOCK_FILE
 
 #: the list of paths the runs in a folder wrote
 MANIFEST_FILE = "manifest.txt"

@@ -6,10 +6,10 @@ data URI (the SVG copy where there is one, else the PNG).  The page holds, in or
 1. the **ranking** per split (``aggregate.json`` rows: IQM and geometric mean of the cost
    ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
    rate, 95 % intervals; a split's partial table below it), the resolution of each split
-   and the figures (``ranking_*`` / ``profile_*`` of :mod:`baselines.figures`);
+   and the figures (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.figures`);
 2. the **controller × scenario table**: the oracle's mean cost, then each controller's
    geometric-mean cost ratio with its interval (``scenario_scores.json``,
-   :func:`baselines.ranking.scenario_scores`), shaded from 1 (the oracle, green) to ≥ 4
+   :func:`shipgym_baselines.ranking.scenario_scores`), shaded from 1 (the oracle, green) to ≥ 4
    (red);
 3. the **scenario figures** (``scenario_*``), one per scenario;
 4. the **long per-row table** (``leaderboard.json`` rows), collapsed.
@@ -35,8 +35,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from baselines.figures import figure_stem
-from baselines.ranking import (
+from shipgym_baselines.figures import figure_stem
+from shipgym_baselines.ranking import (
     NO_RANKING,
     ORACLE,
     PARTIAL,
@@ -44,7 +44,7 @@ from baselines.ranking import (
     is_partial,
     resolution_lines,
 )
-from baselines.style import controller_style
+from shipgym_baselines.style import controller_style
 
 PAGE_FILE = "leaderboard.html"
 SPLIT_TITLES = {"catalogue": "Catalogue scenarios", "heldout": "Held-out scenarios"}
@@ -378,7 +378,7 @@ def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
 
 # ------------------------------------------------------------------------------ figures
 def _anchor(name: str) -> str:
-    """The id of a scenario's figure (the stem :func:`baselines.figures.plot_scenario` gives
+    """The id of a scenario's figure (the stem :func:`shipgym_baselines.figures.plot_scenario` gives
     its files)."""
     return "scenario_" + figure_stem(name)
 
@@ -479,8 +479,9 @@ def write_html(
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
-    :func:`baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
-    :mod:`baselines.figures`; ``subtitle``: a line under the title (e.g. the suite and seeds).
+    :func:`shipgym_baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
+    :mod:`shipgym_baselines.figures`; ``subtitle``: a line under the title (e.g. the suite
+    and seeds).
     Returns the page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -11,7 +11,7 @@ A controller that is not built in enters the benchmark by one of
   (``{controller: SPEC, name: DISPLAY_NAME, settings: {keyword: value}}``), so that one
   controller can enter twice under two names with different settings.
 
-This module only finds and loads the objects; :mod:`baselines.registry` turns them into
+This module only finds and loads the objects; :mod:`shipgym_baselines.registry` turns them into
 controller records.  A run passes the spec *string* to its worker processes, never the
 loaded object, and each process resolves it again.
 """
@@ -32,8 +32,8 @@ from typing import Any
 
 from pydantic import Field
 
-from baselines.errors import ControllerError
 from shipgym.config import StrictModel
+from shipgym_baselines.errors import ControllerError
 
 #: the entry-point group an installed package declares its controllers in
 ENTRY_POINT_GROUP = "shipgym.controllers"

@@ -1,7 +1,7 @@
 """The one privileged channel: the true plant, for the built-in ``oracle`` reference only.
 
 The evaluation loop gives every controller the observation, ``info`` and the controller
-context, nothing else.  The ``oracle`` reference (:mod:`baselines.classical.oracle`) is the
+context, nothing else.  The ``oracle`` reference (:mod:`shipgym_baselines.classical.oracle`) is the
 one exception: when, and only when, a run names the registered ``oracle`` itself (not an
 instance, a spec, a renamed long form or one with settings), the loop hands it the env's
 :meth:`~shipgym.envs.path_follow.ShipPathFollowEnv.plant_truth` through
@@ -13,9 +13,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from baselines.errors import ControllerError
-from baselines.plugins import ControllerEntry, as_entry
-from baselines.registry import CONTROLLERS
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.plugins import ControllerEntry, as_entry
+from shipgym_baselines.registry import CONTROLLERS
 
 ORACLE = "oracle"
 
@@ -27,7 +27,7 @@ def grants_truth(controller: Any) -> bool:
     entry = as_entry(controller)
     if entry.controller != ORACLE or entry.settings or entry.name not in (None, ORACLE):
         return False
-    from baselines.classical.oracle import Oracle
+    from shipgym_baselines.classical.oracle import Oracle
 
     record = CONTROLLERS.get(ORACLE)
     return record is not None and record.factory is Oracle
@@ -35,7 +35,7 @@ def grants_truth(controller: Any) -> bool:
 
 def reset_with_truth(policy: Any, context: Any, env: Any, seed: int | None) -> None:
     """Start the oracle's episode with the env's truth (the caller checked the grant)."""
-    from baselines.classical.oracle import Oracle
+    from shipgym_baselines.classical.oracle import Oracle
 
     if type(policy) is not Oracle:
         raise ControllerError(f"only the built-in oracle reads the true plant, not {policy!r}")

@@ -1,6 +1,6 @@
 """Reference data: the ``oracle``'s episodes, computed once and shipped (as D4RL's scores).
 
-The oracle (:mod:`baselines.classical.oracle`) is the denominator of the leaderboard's cost
+The oracle (:mod:`shipgym_baselines.classical.oracle`) is the denominator of the leaderboard's cost
 ratio on every scenario trial.  Its episodes are deterministic given the trial (the resolved
 scenario a suite's seed draws) and the env seed, so they are computed once per trial, frozen
 per env revision (:data:`shipgym.envs.core.ENV_REVISION`), oracle revision and settings, and
@@ -34,12 +34,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from baselines.runs import _number, _plain
 from shipgym.envs.core import ENV_REVISION
 from shipgym.scenarios import Scenario
+from shipgym_baselines.runs import _number, _plain
 
 if TYPE_CHECKING:
-    from baselines.evaluation import EpisodeResult
+    from shipgym_baselines.evaluation import EpisodeResult
 
 TABLE_FILE = "oracle.json.gz"
 FORMAT = 1
@@ -69,7 +69,7 @@ def entry_key(scenario: Scenario, seed: int) -> str:
 
 def oracle_header() -> dict[str, Any]:
     """The header a table must carry to be valid now (env revision, oracle settings)."""
-    from baselines.classical.oracle import ORACLE_REVISION, OracleSettings
+    from shipgym_baselines.classical.oracle import ORACLE_REVISION, OracleSettings
 
     return {
         "format": FORMAT,
@@ -141,7 +141,7 @@ def shipped_table() -> ReferenceTable:
 
 def result_from_entry(entry: Mapping[str, Any], scenario: str, seed: int) -> EpisodeResult:
     """The oracle's :class:`EpisodeResult` of a table entry (its trajectory: the trace)."""
-    from baselines.evaluation import EpisodeResult
+    from shipgym_baselines.evaluation import EpisodeResult
 
     metrics = {k: _number(v) for k, v in entry["metrics"].items()}
     return EpisodeResult(

@@ -12,12 +12,12 @@ and the ships it applies to; the instances made by :func:`make_controller` carry
 and action mode (a class as class attributes, a factory function's policy as attributes
 set on it).
 The built-in controllers register when their modules are imported, which this module does
-(so the registry is full once ``baselines.registry`` is imported).
+(so the registry is full once ``shipgym_baselines.registry`` is imported).
 
 Every other controller is found by :func:`resolve_controller` (all that :func:`make_controller`
 accepts): an installed plug-in's entry point, a spec ``module.path:Attr`` or
-``path/to/file.py:Attr`` (:mod:`baselines.plugins`), the long form of a suite (a display
-name and settings), a learned policy or SB3 model zip (:mod:`baselines.learned.policy`).  A
+``path/to/file.py:Attr`` (:mod:`shipgym_baselines.plugins`), the long form of a suite (a display
+name and settings), a learned policy or SB3 model zip (:mod:`shipgym_baselines.learned.policy`).  A
 controller only ever gets ``reset(context, seed)`` and ``act(obs, info)`` from the
 evaluation loop, whatever its origin.
 """
@@ -35,8 +35,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TypeVar, overload
 
-from baselines.errors import ControllerError
-from baselines.plugins import (
+from shipgym.envs.core import ACTION_MODES
+from shipgym.models import MODELS
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.plugins import (
     ControllerEntry,
     ControllerSpec,
     as_entry,
@@ -47,18 +49,16 @@ from baselines.plugins import (
     looks_like_path,
     parse_spec,
 )
-from baselines.policy import Policy
-from shipgym.envs.core import ACTION_MODES
-from shipgym.models import MODELS
+from shipgym_baselines.policy import Policy
 
 #: modules whose controllers register themselves on import
 BUILTIN_MODULES = (
-    "baselines.classical.pid",
-    "baselines.classical.lqr",
-    "baselines.classical.l1_backstepping",
-    "baselines.classical.nmpc",
-    "baselines.classical.reference",
-    "baselines.classical.oracle",
+    "shipgym_baselines.classical.pid",
+    "shipgym_baselines.classical.lqr",
+    "shipgym_baselines.classical.l1_backstepping",
+    "shipgym_baselines.classical.nmpc",
+    "shipgym_baselines.classical.reference",
+    "shipgym_baselines.classical.oracle",
 )
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])
@@ -72,7 +72,7 @@ KINDS = ("classical", "learned", "reference")
 class ControllerRecord:
     """One registered controller.
 
-    ``factory(**settings)`` makes a fresh :class:`~baselines.policy.Policy`;
+    ``factory(**settings)`` makes a fresh :class:`~shipgym_baselines.policy.Policy`;
     ``action_mode`` is the env mode it drives; ``applies_to`` the ship ids it runs on
     (None: every ship); ``kind`` is ``"classical"`` unless the factory says otherwise;
     ``training_seeds``: a learned policy's (the factory takes ``training_seed=k``), else
@@ -235,7 +235,7 @@ def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
 
 def _record_of(text: str) -> ControllerRecord:
     """The record a controller string means (see :func:`resolve_controller`)."""
-    from baselines.learned.policy import shipped_policies
+    from shipgym_baselines.learned.policy import shipped_policies
 
     record = _RECORDS.get(text)
     if record is not None:
@@ -264,8 +264,8 @@ def _record_of(text: str) -> ControllerRecord:
 def _learned_record(name_or_path: str) -> ControllerRecord:
     """A shipped policy, trained agent's folder or model zip, the files of every training
     seed checked now (one action mode for all)."""
-    from baselines.learned.policy import LearnedPolicy, policy_label, read_policy
-    from baselines.learned.policy import training_seeds as policy_seeds
+    from shipgym_baselines.learned.policy import LearnedPolicy, policy_label, read_policy
+    from shipgym_baselines.learned.policy import training_seeds as policy_seeds
 
     seeds = policy_seeds(name_or_path)
     files = [read_policy(name_or_path, seed) for seed in seeds]
@@ -459,7 +459,7 @@ def is_controller(name: ControllerSpec) -> bool:
 
 def unknown_controller(name: str) -> str:
     """The error message for a name :func:`is_controller` rejects: the valid names."""
-    from baselines.learned.policy import shipped_policies
+    from shipgym_baselines.learned.policy import shipped_policies
 
     plugins = [n for n in entry_point_names() if n not in _RECORDS]
     installed = f", the installed plug-ins {', '.join(plugins)}" if plugins else ""

@@ -1,7 +1,8 @@
 """``shipgym report``: the tables and plots rebuilt from one or more run folders.
 
 Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.jsonl``,
-:mod:`baselines.runs`); several merge into one table (separate ``evaluate`` runs of different
+:mod:`shipgym_baselines.runs`); several merge into one table (separate ``evaluate`` runs of
+different
 policies on the same suite give the leaderboard of those policies).  Runs that give the same
 scenario name different settings, draw their trials differently (``randomize``), or hold the
 same (scenario, controller, seed, training_seed) episode, are refused.  The output folder
@@ -17,10 +18,10 @@ from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from baselines.errors import RunError, RunFailed
-from baselines.locking import out_lock
-from baselines.manifest import Manifest, clear_listed
-from baselines.runs import (
+from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.locking import out_lock
+from shipgym_baselines.manifest import Manifest, clear_listed
+from shipgym_baselines.runs import (
     Key,
     check_out_dir,
     check_out_usable,
@@ -38,7 +39,7 @@ from baselines.runs import (
 )
 
 if TYPE_CHECKING:
-    from baselines.evaluation import EpisodeResult
+    from shipgym_baselines.evaluation import EpisodeResult
 
 REPORT_FILE = "report.json"
 
@@ -154,7 +155,7 @@ def _write(
     command: Sequence[str],
 ) -> list[dict[str, Any]]:
     """The report's files in the locked ``target``, each listed in its manifest."""
-    from baselines.leaderboard import write_results
+    from shipgym_baselines.leaderboard import write_results
 
     manifest = Manifest(target)
     with manifest.claiming():

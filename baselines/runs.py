@@ -18,8 +18,8 @@
                      row (scenario, controller) is complete only the episode its figure
                      draws is kept (:meth:`RunLog.drop_trajectories`)
 
-A run holds an exclusive lock on its folder (:mod:`baselines.locking`) and lists every path
-it writes in ``manifest.txt`` (:mod:`baselines.manifest`).  A folder that is not empty is
+A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.locking`) and lists every path
+it writes in ``manifest.txt`` (:mod:`shipgym_baselines.manifest`).  A folder that is not empty is
 refused before any work unless ``resume`` (run the episodes missing from ``episodes.jsonl``;
 the resolved suite must equal ``run.json``'s) or ``force`` (delete what the manifest lists
 first; a folder holding anything else is refused).  ``episodes.jsonl`` is read as a set
@@ -55,13 +55,13 @@ from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from baselines.errors import RunError, RunFailed
-from baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
-from baselines.manifest import Manifest, clear_listed
-from baselines.signals import signal_number
+from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
+from shipgym_baselines.manifest import Manifest, clear_listed
+from shipgym_baselines.signals import signal_number
 
 if TYPE_CHECKING:
-    from baselines.evaluation import EpisodeResult
+    from shipgym_baselines.evaluation import EpisodeResult
 
 RUN_FILE = "run.json"
 EPISODES_FILE = "episodes.jsonl"
@@ -130,7 +130,7 @@ def check_out_dir(
 ) -> Path:
     """``out`` as a Path once it can hold this run; a :class:`RunError` before any work when
     it cannot: unusable (:func:`check_out_usable`), in use by another run (its lock:
-    :mod:`baselines.locking`), or not empty without ``resume`` / ``force`` (``note`` is
+    :mod:`shipgym_baselines.locking`), or not empty without ``resume`` / ``force`` (``note`` is
     added to that message, e.g. where a default folder came from)."""
     path = check_out_usable(out, resume=resume, force=force)
     holder = lock_holder(path)
@@ -281,7 +281,7 @@ def _read_json(file: Path) -> Any:
 
 def write_json(file: Path, document: Any) -> None:
     """Write atomically (a temporary file renamed over ``file``)."""
-    from baselines.jsonout import dumps
+    from shipgym_baselines.jsonout import dumps
 
     tmp = temporary_file(file)
     try:
@@ -299,7 +299,7 @@ def temporary_file(file: Path) -> Path:
 
 def as_json(document: Any) -> Any:
     """``document`` as it reads back from JSON (tuples → lists, numpy → Python)."""
-    from baselines.jsonout import dumps
+    from shipgym_baselines.jsonout import dumps
 
     return json.loads(dumps(document))
 
@@ -538,10 +538,10 @@ def _inside(folder: Path, name: Any) -> Path:
 
 
 def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> EpisodeResult:
-    """An :class:`~baselines.evaluation.EpisodeResult` from a record of ``folder``'s
+    """An :class:`~shipgym_baselines.evaluation.EpisodeResult` from a record of ``folder``'s
     ``episodes.jsonl`` (its trajectory read if it was kept, else empty; a record of an
     earlier version names its file as ``trajectory``)."""
-    from baselines.evaluation import EpisodeResult
+    from shipgym_baselines.evaluation import EpisodeResult
 
     trajectory: dict[str, np.ndarray] = {}
     name = record.get("trajectory") or trajectory_file(episode_key(record))
@@ -566,7 +566,8 @@ def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> Epis
 
 class RunLog:
     """An open run folder: its ``run.json`` record, the ``episodes.jsonl`` it appends to,
-    its manifest (:mod:`baselines.manifest`) and its lock (:mod:`baselines.locking`).
+    its manifest (:mod:`shipgym_baselines.manifest`) and its lock
+    (:mod:`shipgym_baselines.locking`).
 
     :meth:`open` locks the folder and starts (or resumes) the run, :meth:`append` records
     each finished episode, :meth:`recording` sets the final status and releases the lock.
@@ -750,7 +751,7 @@ class RunLog:
         """The run's body: status "complete" when it ends, "failed" (with ``error``) on an
         error, and on Ctrl-C or SIGTERM "interrupted" and a :class:`RunInterrupted` saying
         what was kept.  A worker that died or a full disk: "failed" and a
-        :class:`~baselines.errors.RunFailed` saying what was kept.  (A killed run keeps
+        :class:`~shipgym_baselines.errors.RunFailed` saying what was kept.  (A killed run keeps
         "running" and every episode it finished.)  Releases the folder's lock."""
         with self._lock:
             try:
@@ -786,7 +787,7 @@ class RunLog:
         except OSError as exc:
             if not (in_place and exc.errno in NO_ROOM and file.is_file()):
                 raise
-            from baselines.jsonout import dumps
+            from shipgym_baselines.jsonout import dumps
 
             data = (dumps(self.record) + "\n").encode()
             if len(data) <= file.stat().st_size:

@@ -9,11 +9,11 @@ from typing import Annotated, Any
 
 from pydantic import Discriminator, Field, Tag, model_validator
 
-from baselines.errors import ConfigError
-from baselines.plugins import ControllerEntry, ControllerSpec, anchored
 from shipgym.config import ConfigFile, StrictModel, is_path, list_names, load_yaml_model, resolve
 from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_SEEDS
 from shipgym.scenarios.trials import TrialRandomization
+from shipgym_baselines.errors import ConfigError
+from shipgym_baselines.plugins import ControllerEntry, ControllerSpec, anchored
 
 
 def _controller_form(value: Any) -> str:
@@ -36,7 +36,7 @@ class SuiteConfig(StrictModel):
     (registered controllers, installed plug-ins, specs ``module.path:Attr`` /
     ``path/to/file.py:Attr``, shipped learned policies, trained agents' folders, SB3 model
     zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
-    {keyword: value}}`` (:class:`~baselines.plugins.ControllerEntry`); a relative file path
+    {keyword: value}}`` (:class:`~shipgym_baselines.plugins.ControllerEntry`); a relative file path
     among them is read against the suite file's folder.  ``seeds``: evaluation seeds per
     (controller, scenario, training seed).  ``randomize``: what each evaluation seed draws
     for its trial of a scenario (:class:`~shipgym.scenarios.trials.TrialRandomization`:

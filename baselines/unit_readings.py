@@ -1,6 +1,6 @@
 """Evidence for the nomoto2 unit reading: pid_los on each scenario under each reading.
 
-``python -m baselines.unit_readings [--json]`` prints ACE, t_c and how the episode ended for
+``python -m shipgym_baselines.unit_readings [--json]`` prints ACE, t_c and how the episode ended for
 every catalogue nomoto2 scenario with ``ship.unit_reading`` set to each reading (README,
 "Units of the nomoto2 ship").
 """
@@ -10,9 +10,9 @@ from __future__ import annotations
 import argparse
 import json
 
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from baselines.variants import scenario_variant
 from shipgym.models.nomoto2 import UnitReading
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from shipgym_baselines.variants import scenario_variant
 
 SCENARIOS = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
 

@@ -5,7 +5,7 @@ around them (:func:`sqp`).
 
     min_Δ  ½ Δᵀ H Δ + gᵀ Δ    s.t.  lb ≤ Δ ≤ ub
 
-Used by every shooting NMPC here (:mod:`baselines.classical.nmpc`, the oracle): H = JᵀWJ is
+Used by every shooting NMPC here (:mod:`shipgym_baselines.classical.nmpc`, the oracle): H = JᵀWJ is
 the (generalised) Gauss–Newton Hessian, g = Jᵀ∇φ.  The solver is built once per size; its
 inputs and outputs are numpy buffers bound through CasADi's buffer interface, so a solve
 allocates nothing.

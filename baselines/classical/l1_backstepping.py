@@ -3,23 +3,24 @@
 Xu, Oliveira & Guedes Soares (2021), §2–3 and §5.2, as two controllers:
 ``l1_backstepping`` (low-pass filter C(s) on, the paper's L1 controller) and
 ``adaptive_backstepping`` (filter off: "a typical adaptive backstepping controller", §5.2).
-The pieces live in :mod:`baselines.classical.adaptive`, one module per idea:
+The pieces live in :mod:`shipgym_baselines.classical.adaptive`, one module per idea:
 
 * design model, eqs. (15)–(17): T·ṙ + σ·H(r)·r = ρ·K·δ + b, H(r) = 1 + a2·r², K, T, a2 of
-  the ship from the identification pipeline (:mod:`~baselines.classical.adaptive.design_model`);
+  the ship from the identification pipeline
+  (:mod:`~shipgym_baselines.classical.adaptive.design_model`);
 * state predictor, eq. (20), with the adaptation laws (24)–(25) and their projection
-  operator (:mod:`~baselines.classical.adaptive.predictor`,
-  :mod:`~baselines.classical.adaptive.projection`);
-* backstepping law, eqs. (27)–(35) (:mod:`~baselines.classical.adaptive.backstepping`);
+  operator (:mod:`~shipgym_baselines.classical.adaptive.predictor`,
+  :mod:`~shipgym_baselines.classical.adaptive.projection`);
+* backstepping law, eqs. (27)–(35) (:mod:`~shipgym_baselines.classical.adaptive.backstepping`);
 * low-pass filter, eq. (39): δ_ctrl = C(s)δ, C(s) = ω²/(s² + 2ζωs + ω²)
-  (:mod:`~baselines.classical.adaptive.lowpass`);
+  (:mod:`~shipgym_baselines.classical.adaptive.lowpass`);
 * guidance, eq. (48): ψd = γp − sgn(ye)·atan(|ye|^θ/Δ) − β, θ = 0.05|ye| + 1, Δ = 2L, and
   its derivatives in ye (:func:`shipgym.guidance.tvvf_heading`,
   :func:`shipgym.guidance.tvvf_heading_derivatives`; Δ, θ and the error unit from the
   scenario's guidance settings, ``context.guidance.tvvf_*``, whose defaults are the paper's);
 * the §5.2 gains and their transfer to another ship
-  (:mod:`~baselines.classical.adaptive.settings`); the linearised loop
-  (:mod:`~baselines.classical.adaptive.loop_analysis`); the rudder's high-frequency content
+  (:mod:`~shipgym_baselines.classical.adaptive.settings`); the linearised loop
+  (:mod:`~shipgym_baselines.classical.adaptive.loop_analysis`); the rudder's high-frequency content
   (:func:`shipgym.metrics.high_frequency_power`).
 
 Choices of this module, where the paper is silent or ambiguous (options of
@@ -75,27 +76,27 @@ from typing import Any
 
 import numpy as np
 
-from baselines.classical.adaptive.backstepping import backstepping_rudder
-from baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
-from baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
-from baselines.classical.adaptive.lowpass import SecondOrderLowPass
-from baselines.classical.adaptive.predictor import StatePredictor
-from baselines.classical.adaptive.projection import projection
-from baselines.classical.adaptive.settings import (
-    FILTER_PLACEMENTS,
-    PAPER_SHIP_LENGTH,
-    PAPER_SHIP_SPEED,
-    Gains,
-    L1BacksteppingSettings,
-)
-from baselines.policy import check_action_mode
-from baselines.registry import register_controller
 from shipgym.angles import unwrap_floats
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.metrics import high_frequency_power
 from shipgym.paths import wrap_angle
+from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
+from shipgym_baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
+from shipgym_baselines.classical.adaptive.lowpass import SecondOrderLowPass
+from shipgym_baselines.classical.adaptive.predictor import StatePredictor
+from shipgym_baselines.classical.adaptive.projection import projection
+from shipgym_baselines.classical.adaptive.settings import (
+    FILTER_PLACEMENTS,
+    PAPER_SHIP_LENGTH,
+    PAPER_SHIP_SPEED,
+    Gains,
+    L1BacksteppingSettings,
+)
+from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.registry import register_controller
 
 #: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
 cubic_damping_from_zigzag = ship_cubic_damping

@@ -65,11 +65,11 @@ from typing import Any
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
-from baselines.policy import check_action_mode
-from baselines.registry import register_controller
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
+from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.registry import register_controller
 
 #: Borkowski (2018) §5: initial estimates on the Mariner (a0 [1/s], c0 [1/s²])
 PAPER_INITIAL_GUESS = {"mariner": (0.02, 0.002)}

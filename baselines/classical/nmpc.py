@@ -2,7 +2,7 @@
 
 On every ship (issue 17): nomoto2 with the paper's numbers, every other ship with a Nomoto
 prediction model from its own zig-zag and numbers from its own time scales
-(:mod:`baselines.classical.nmpc_ship`, where each rule is stated).
+(:mod:`shipgym_baselines.classical.nmpc_ship`, where each rule is stated).
 
 Prediction model: the nomoto2 model's right-hand side and RK4 step (the simulator's), in
 CasADi SX, with the model parameters as solver parameters, so that an online identifier
@@ -49,21 +49,21 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP, bind, sqp
-from baselines.classical.nmpc_ship import (
+from shipgym.codegen import compiled
+from shipgym.envs.context import ControllerContext
+from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
+from shipgym.models.base import ShipModel
+from shipgym.models.nomoto2 import Nomoto2
+from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
+from shipgym_baselines.classical.nmpc_ship import (
     PAPER_CONTROL_HORIZON,
     PAPER_HORIZON,
     PAPER_Q,
     ShipNMPCPlan,
     ship_plan,
 )
-from baselines.policy import check_action_mode
-from baselines.registry import register_controller
-from shipgym.codegen import compiled
-from shipgym.envs.context import ControllerContext
-from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
-from shipgym.models.base import ShipModel
-from shipgym.models.nomoto2 import Nomoto2
+from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.registry import register_controller
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """``oracle``: the privileged reference — NMPC on the true plant (issue 17).
 
 What is achievable on a scenario when the plant is known.  At every control step the oracle
-reads, through the evaluation loop's privileged channel (:mod:`baselines.privileged`; no
+reads, through the evaluation loop's privileged channel (:mod:`shipgym_baselines.privileged`; no
 other controller can reach it), the true state, the true parameters acting now (after every
 jump so far, never the future schedule) and the disturbance forecast of
 :class:`shipgym.envs.truth.PlantTruth` (the deterministic current ahead, the present
@@ -66,14 +66,14 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from baselines.classical.box_qp import BoxQP, bind, sqp
-from baselines.errors import ControllerError
-from baselines.registry import register_controller
 from shipgym.codegen import compiled
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
 from shipgym.identification import first_order_nomoto
 from shipgym.models.base import ShipModel
+from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers

@@ -48,8 +48,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from baselines.policy import check_action_mode
-from baselines.registry import register_controller
 from shipgym.autopilot import (
     VYSHNEGRADSKY_AB_STATED,
     HeadingPID,
@@ -60,6 +58,8 @@ from shipgym.envs.context import ControllerContext
 from shipgym.guidance import desired_heading
 from shipgym.identification import first_order_nomoto, second_order_nomoto
 from shipgym.models.base import ShipModel
+from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.registry import register_controller
 
 TUNINGS = ("pole_placement", "vyshnegradsky")
 

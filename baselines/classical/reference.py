@@ -6,8 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from baselines.registry import register_controller
 from shipgym.envs.context import ControllerContext
+from shipgym_baselines.registry import register_controller
 
 
 @register_controller("zero_rudder")

@@ -10,7 +10,8 @@ import signal
 import sys
 from collections.abc import Callable
 
-from baselines.cli import (
+from shipgym.errors import ShipgymError
+from shipgym_baselines.cli import (
     bench,
     leaderboard,
     manoeuvre,
@@ -21,9 +22,8 @@ from baselines.cli import (
     scenarios,
     train,
 )
-from baselines.errors import RunFailed
-from baselines.signals import Terminated, signal_number, terminate_as_interrupt
-from shipgym.errors import ShipgymError
+from shipgym_baselines.errors import RunFailed
+from shipgym_baselines.signals import Terminated, signal_number, terminate_as_interrupt
 
 #: the subcommands' parser builders, in the order ``shipgym --help`` lists them
 SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
@@ -59,13 +59,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one subcommand; a :class:`ShipgymError` (bad input) prints one line and exits 2,
-    a :class:`~baselines.errors.RunFailed` one line and exit 1, Ctrl-C or SIGTERM one line
+    a :class:`~shipgym_baselines.errors.RunFailed` one line and exit 1, Ctrl-C or SIGTERM one line
     and 128 + the signal's number; any other exception is a bug and keeps its
     traceback."""
     parser = build_parser()
     args = parser.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)  # a run's record keeps it
-    from baselines.learned.trust import trusting_pickle
+    from shipgym_baselines.learned.trust import trusting_pickle
 
     try:
         # SIGTERM ends a run as Ctrl-C does
@@ -77,7 +77,8 @@ def main(argv: list[str] | None = None) -> int:
     except ShipgymError as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return EXIT_USAGE
-    except KeyboardInterrupt as exc:  # a run says what it kept (baselines.runs.RunInterrupted)
+    # a run says what it kept (shipgym_baselines.runs.RunInterrupted)
+    except KeyboardInterrupt as exc:
         signum = signal_number(exc)
         by = "" if signum == signal.SIGINT else f" by {signal.Signals(signum).name}"
         detail = f": {exc}" if str(exc) and not isinstance(exc, Terminated) else ""

@@ -1,7 +1,7 @@
-"""``python -m baselines.cli``: the ``shipgym`` console script."""
+"""``python -m shipgym_baselines.cli``: the ``shipgym`` console script."""
 
 import sys
 
-from baselines.cli import main
+from shipgym_baselines.cli import main
 
 sys.exit(main())

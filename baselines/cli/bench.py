@@ -6,9 +6,9 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
-from baselines import benchmarks
-from baselines.cli.options import add_json_option, emit
-from baselines.errors import check_count
+from shipgym_baselines import benchmarks
+from shipgym_baselines.cli.options import add_json_option, emit
+from shipgym_baselines.errors import check_count
 
 #: bench target -> the benchmark run with the parsed options (``--repeats``)
 BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {

@@ -1,7 +1,7 @@
 """``shipgym leaderboard`` (the suite's controllers) and ``shipgym evaluate`` (one policy).
 
 Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
-:mod:`baselines.runs`); a folder that is not empty is refused before any work unless
+:mod:`shipgym_baselines.runs`); a folder that is not empty is refused before any work unless
 ``--resume`` or ``--force``.
 """
 
@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from baselines.cli.options import add_run_options, command_line, emit
+from shipgym_baselines.cli.options import add_run_options, command_line, emit
 
 #: ``evaluate`` writes to ``EVALUATE_ROOT/<policy>`` unless given ``--out``
 EVALUATE_ROOT = Path("results/evaluate")
@@ -56,7 +56,7 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
 
 def evaluate_folder(policy: str) -> Path:
     """``evaluate``'s default folder for ``policy``: one per table name."""
-    from baselines.registry import controller_label
+    from shipgym_baselines.registry import controller_label
 
     label = controller_label(policy)
     return EVALUATE_ROOT / "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
@@ -65,8 +65,8 @@ def evaluate_folder(policy: str) -> Path:
 def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
     the rows)."""
-    from baselines.runs import check_out_dir, check_out_usable
-    from baselines.suite import load_suite
+    from shipgym_baselines.runs import check_out_dir, check_out_usable
+    from shipgym_baselines.suite import load_suite
 
     policy = getattr(args, "policy", None)
     out, note = args.out, ""
@@ -77,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     check_out_usable(out, resume=args.resume, force=args.force)
     load_suite(args.suite)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
-    from baselines.leaderboard import run_leaderboard, terminal_summary
+    from shipgym_baselines.leaderboard import run_leaderboard, terminal_summary
 
     rows = run_leaderboard(
         suite=args.suite,

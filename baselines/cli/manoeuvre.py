@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from baselines.cli.options import add_json_option, emit
-from baselines.errors import RunError
 from shipgym.manoeuvres import ManoeuvreLog, plot_manoeuvre, turning_circle, zigzag
 from shipgym.models import MODELS, ShipModel
+from shipgym_baselines.cli.options import add_json_option, emit
+from shipgym_baselines.errors import RunError
 
 Manoeuvre = Callable[[ShipModel, argparse.Namespace], tuple[ManoeuvreLog, dict[str, float]]]
 
@@ -45,7 +45,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the ship and ``--out`` (a writable folder; its plot of the same manoeuvre is
     replaced), run the manoeuvre, save its plot, print the figures."""
-    from baselines.runs import check_out_dir
+    from shipgym_baselines.runs import check_out_dir
 
     if args.ship not in MODELS:
         raise RunError(f"unknown ship {args.ship!r}; valid: {', '.join(sorted(MODELS))}")

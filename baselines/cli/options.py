@@ -6,8 +6,8 @@ import argparse
 import sys
 from typing import Any
 
-from baselines.jsonout import dumps
-from baselines.runs import BACKENDS
+from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.runs import BACKENDS
 
 
 def add_json_option(parser: argparse.ArgumentParser, help: str) -> None:
@@ -22,7 +22,7 @@ def add_progress_option(parser: argparse.ArgumentParser, help: str | None = None
 
 def add_trust_pickle_option(parser: argparse.ArgumentParser) -> None:
     """``--trust-pickle``: read model files that only unpickling can read (it runs any code
-    they hold; :mod:`baselines.learned.trust`)."""
+    they hold; :mod:`shipgym_baselines.learned.trust`)."""
     parser.add_argument(
         "--trust-pickle",
         action="store_true",

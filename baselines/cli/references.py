@@ -1,6 +1,6 @@
 """``shipgym references``: fill the oracle's reference table for suites' trials.
 
-The table (:mod:`baselines.references`) ships with the package; the leaderboard reads it and
+The table (:mod:`shipgym_baselines.references`) ships with the package; the leaderboard reads it and
 runs the oracle only for a trial it lacks.  This command runs the oracle on every trial of
 the given suites (scenarios × the suite's seeds, drawn with its ``randomize`` ranges) that
 the table does not hold yet, and writes the table after every episode, so an interrupted
@@ -15,7 +15,7 @@ import sys
 import time
 from contextlib import closing
 
-from baselines.cli.options import add_json_option, emit
+from shipgym_baselines.cli.options import add_json_option, emit
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -31,12 +31,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import os
 
-    from baselines.errors import check_seeds
-    from baselines.evaluation import EVAL_SEED_OFFSET
-    from baselines.leaderboard import Job, iter_results, suite_scenario, trials
-    from baselines.privileged import ORACLE
-    from baselines.references import ReferenceTable
-    from baselines.suite import load_suite
+    from shipgym_baselines.errors import check_seeds
+    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+    from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
+    from shipgym_baselines.privileged import ORACLE
+    from shipgym_baselines.references import ReferenceTable
+    from shipgym_baselines.suite import load_suite
 
     table = ReferenceTable.load(args.table)
     jobs, trial_of, held = [], {}, 0

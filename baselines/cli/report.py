@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from baselines.cli.options import add_json_option, add_out_options, command_line, emit
+from shipgym_baselines.cli.options import add_json_option, add_out_options, command_line, emit
 
 #: where ``report`` writes unless given ``--out``
 REPORT_OUT = "results/report"
@@ -30,10 +30,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Merge the runs, write the report, print the table (or rows); say which runs were
     incomplete."""
-    from baselines.report import write_report
+    from shipgym_baselines.report import write_report
 
     rows, sources = write_report(args.runs, args.out, force=args.force, command=command_line(args))
-    from baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard import terminal_summary
 
     for source in sources:
         if source["status"] != "complete":

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from baselines.cli.options import add_json_option, add_progress_option, emit
-from baselines.errors import check_seeds
-from baselines.reproduce import PAPERS
+from shipgym_baselines.cli.options import add_json_option, add_progress_option, emit
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.reproduce import PAPERS
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> int:
     (or the rows with ``--json``).  The report's files in ``--out`` are replaced."""
     from tqdm import tqdm
 
-    from baselines.runs import check_out_dir
+    from shipgym_baselines.runs import check_out_dir
 
     check_seeds(args.seeds, "--seeds")
     out = args.out or f"results/reproduce/{args.paper}"

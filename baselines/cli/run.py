@@ -13,14 +13,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from baselines.cli.options import (
+from shipgym_baselines.cli.options import (
     add_json_option,
     add_out_options,
     add_trust_pickle_option,
     emit,
 )
-from baselines.errors import RunError
-from baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 
 #: the default ``--out`` is ``RUN_ROOT/<scenario>_<controller>_<seed>``
 RUN_ROOT = Path("results/run")
@@ -70,13 +70,13 @@ def _file_name(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Check the scenario, the controller and ``--out`` (in that order, before any work),
     run the episode, write its files, print its metrics."""
-    from baselines.evaluation import evaluate
-    from baselines.jsonout import dumps
-    from baselines.leaderboard import check_controllers, plot_results
-    from baselines.registry import applies_to
-    from baselines.runs import check_out_dir, clear_outputs
     from shipgym.config import is_path
     from shipgym.scenarios import load_scenario
+    from shipgym_baselines.evaluation import evaluate
+    from shipgym_baselines.jsonout import dumps
+    from shipgym_baselines.leaderboard import check_controllers, plot_results
+    from shipgym_baselines.registry import applies_to
+    from shipgym_baselines.runs import check_out_dir, clear_outputs
 
     scenario = load_scenario(args.scenario)
     (label,) = check_controllers([args.controller])

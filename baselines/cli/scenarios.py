@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from baselines.cli.options import add_json_option, emit
+from shipgym_baselines.cli.options import add_json_option, emit
 
 #: exit code when a validated file is bad (as a bad input elsewhere)
 EXIT_BAD_FILE = 2

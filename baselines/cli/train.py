@@ -11,14 +11,14 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from baselines.cli.options import (
+from shipgym_baselines.cli.options import (
     add_backend_option,
     add_json_option,
     add_out_options,
     add_progress_option,
     emit,
 )
-from baselines.errors import RunError, check_count
+from shipgym_baselines.errors import RunError, check_count
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -61,8 +61,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
     """One job per (agent, seed) with its output directory (``train_sweep``'s input)."""
-    from baselines.learned.agents import list_agent_configs, load_agent_config
-    from baselines.learned.train import check_agent_folder
+    from shipgym_baselines.learned.agents import list_agent_configs, load_agent_config
+    from shipgym_baselines.learned.train import check_agent_folder
 
     if args.timesteps is not None:
         check_count(args.timesteps, "--timesteps")
@@ -101,7 +101,7 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
 
 def run(args: argparse.Namespace) -> int:
     """Train every job, print one line per run (or the meta(s) with ``--json``)."""
-    from baselines.learned.train import train_sweep
+    from shipgym_baselines.learned.train import train_sweep
 
     metas = train_sweep(training_jobs(args), backend=args.backend, workers=args.workers)
     text = "\n".join(

@@ -16,8 +16,8 @@ from typing import Any, Literal
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from baselines.errors import ConfigError
 from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
+from shipgym_baselines.errors import ConfigError
 
 ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
 
@@ -179,8 +179,8 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
 
     if config.vec_env == "batched":
-        from baselines.learned.vec_env import SB3BatchedVecEnv
         from shipgym.envs.vector import ShipPathFollowVectorEnv
+        from shipgym_baselines.learned.vec_env import SB3BatchedVecEnv
 
         venv = SB3BatchedVecEnv(
             ShipPathFollowVectorEnv(config.n_envs, config.scenario, config.action_mode)

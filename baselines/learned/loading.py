@@ -14,8 +14,8 @@ from what is data:
   :func:`~shipgym.envs.core.action_space`), checked against the bounds the zip records;
 * the weights, ``policy.pth``, with ``torch.load(weights_only=True)``.
 
-A zip that needs more is an :class:`~baselines.errors.UnsafeFileError` naming
-``--trust-pickle`` (:mod:`baselines.learned.trust`).  The shipped agents act exactly as
+A zip that needs more is an :class:`~shipgym_baselines.errors.UnsafeFileError` naming
+``--trust-pickle`` (:mod:`shipgym_baselines.learned.trust`).  The shipped agents act exactly as
 through SB3's load (tests/golden/shipped_policy_actions.npz).
 """
 
@@ -31,9 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from baselines.errors import ControllerError
-from baselines.learned.trust import refuse_unpickling
 from shipgym.envs.core import action_space, observation_space
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.learned.trust import refuse_unpickling
 
 #: where SB3 marks a value it pickled
 PICKLED = ":serialized:"

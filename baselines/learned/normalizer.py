@@ -6,7 +6,7 @@ statistics, so they live in JSON: ``norm_obs``, ``mean`` and ``var`` (one number
 observation entry, float64), ``epsilon`` and ``clip_obs``; :meth:`ObsNormalizer.normalize_obs`
 is SB3's ``VecNormalize.normalize_obs`` on them, bit for bit (tested).
 
-``python -m baselines.learned.normalizer FILE.pkl`` converts a ``vecnormalize.pkl`` you
+``python -m shipgym_baselines.learned.normalizer FILE.pkl`` converts a ``vecnormalize.pkl`` you
 trust into ``vecnormalize.json`` beside it (that one unpickling is yours to allow).
 """
 
@@ -22,10 +22,10 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from baselines.errors import ControllerError
-from baselines.learned.trust import pickle_trusted, refuse_unpickling
 from shipgym.config import validate_model
 from shipgym.envs.core import OBS_NAMES
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.learned.trust import pickle_trusted, refuse_unpickling
 
 #: the data file of the statistics, and the pickle SB3 writes (read only when trusted)
 NORMALIZER_FILE = "vecnormalize.json"
@@ -103,7 +103,7 @@ def unpickle_normalizer(file: Path) -> ObsNormalizer:
         raise refuse_unpickling(
             file,
             f"a pickled VecNormalize (convert it to {NORMALIZER_FILE}: python -m "
-            "baselines.learned.normalizer FILE)",
+            "shipgym_baselines.learned.normalizer FILE)",
         )
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -136,7 +136,7 @@ def load_normalizer(file: Path) -> ObsNormalizer:
 
 def main(argv: list[str] | None = None) -> int:
     """Convert each ``vecnormalize.pkl`` named into ``vecnormalize.json`` beside it."""
-    from baselines.learned.trust import trusting_pickle
+    from shipgym_baselines.learned.trust import trusting_pickle
 
     for name in sys.argv[1:] if argv is None else argv:
         file = Path(name)

@@ -5,10 +5,11 @@ wrote it: the algorithm is read from the zip (:func:`detect_algorithm`), the act
 its action space (shape (1,): rudder, (2,): guidance), and the observation statistics beside
 it (``vecnormalize.json``; a ``vecnormalize.pkl`` only with ``--trust-pickle``) normalise
 the observation as in training.  Nothing is unpickled unless the command trusts pickles
-(:mod:`baselines.learned.loading`, :mod:`baselines.learned.trust`).  A ``meta.json`` beside
+(:mod:`shipgym_baselines.learned.loading`, :mod:`shipgym_baselines.learned.trust`).
+A ``meta.json`` beside
 it (what ``shipgym train`` writes) is optional; its keys are checked (:class:`PolicyMeta`)
 and its training cost becomes leaderboard columns.  Every unreadable file is a
-:class:`~baselines.errors.ControllerError` naming the file (and the key).
+:class:`~shipgym_baselines.errors.ControllerError` naming the file (and the key).
 
 A policy trained with several seeds is a folder of ``seed_<k>/`` folders, each a policy
 folder as above (``policies/<name>/seed_<k>/model.zip``; a ``shipgym train --seeds …`` run
@@ -46,14 +47,14 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from baselines.errors import ControllerError, UnsafeFileError
-from baselines.learned.loading import load_data_only
-from baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
-from baselines.learned.trust import pickle_trusted
-from baselines.policy import check_action_mode
 from shipgym.config import validate_model
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.core import OBS_NAMES
+from shipgym_baselines.errors import ControllerError, UnsafeFileError
+from shipgym_baselines.learned.loading import load_data_only
+from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
+from shipgym_baselines.learned.trust import pickle_trusted
+from shipgym_baselines.policy import check_action_mode
 
 POLICY_DIR = Path(__file__).resolve().parent / "policies"
 
@@ -162,7 +163,7 @@ class SavedModel:
 class PolicyFiles:
     """A learned policy's files: the model, its checked ``meta.json`` (``meta``: as written,
     empty without one), the observation statistics beside it, if any
-    (:func:`~baselines.learned.normalizer.normalizer_file`), and the training seed
+    (:func:`~shipgym_baselines.learned.normalizer.normalizer_file`), and the training seed
     (its ``seed_<k>`` folder's, else the meta's; None when neither says)."""
 
     model: SavedModel

@@ -13,9 +13,10 @@ normalisation and the wall-time counter) up to the config's ``n_timesteps``; a f
 Otherwise an output directory that is not empty is refused, unless ``force=True`` (its
 earlier outputs, :data:`TRAINING_OUTPUTS`, are removed first).
 
-:func:`export_policy` copies what :class:`~baselines.learned.policy.LearnedPolicy` needs (the
+:func:`export_policy` copies what
+:class:`~shipgym_baselines.learned.policy.LearnedPolicy` needs (the
 best model, its meta, the observation statistics ``vecnormalize.json`` if the run
-normalises observations (data, not a pickle: :mod:`baselines.learned.normalizer`); no
+normalises observations (data, not a pickle: :mod:`shipgym_baselines.learned.normalizer`); no
 checkpoints, replay buffers or logs) into a policy directory; :func:`ship_policy` into the
 shipped layout
 ``baselines/learned/policies/<name>/seed_<k>/``.  So ``shipgym train all --seeds 0 1 2
@@ -32,9 +33,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from baselines.errors import BackendError, RunError
-from baselines.evaluation import EVAL_SEED_OFFSET
-from baselines.learned.agents import (
+from shipgym.limits import worker_count
+from shipgym_baselines.errors import BackendError, RunError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.learned.agents import (
     AgentConfig,
     algo_class,
     build_hyperparams,
@@ -42,8 +44,7 @@ from baselines.learned.agents import (
     make_eval_env,
     make_training_env,
 )
-from baselines.runs import check_out_dir, clear_outputs
-from shipgym.limits import worker_count
+from shipgym_baselines.runs import check_out_dir, clear_outputs
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 #: what a training run writes into its directory (``force`` clears these, and only these)
@@ -279,11 +280,11 @@ def train(
 
 def save_obs_statistics(venv: Any, out: Path) -> Path | None:
     """Write the observation statistics of a training env that normalises observations as
-    ``out/vecnormalize.json`` (data: :class:`~baselines.learned.normalizer.ObsNormalizer`);
+    ``out/vecnormalize.json`` (data: :class:`~shipgym_baselines.learned.normalizer.ObsNormalizer`);
     None (and no file) for one that does not."""
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer
+    from shipgym_baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer
 
     (out / NORMALIZER_FILE).unlink(missing_ok=True)  # not a stale one
     if not (isinstance(venv, VecNormalize) and venv.norm_obs):
@@ -339,7 +340,7 @@ def ship_policy(out_dir: str | Path, root: str | Path | None = None) -> Path:
     (name and seed from its ``meta.json``; ``root``: default ``baselines/learned/policies``).
     A single-model policy folder of that name (the layout before training seeds) has its
     files removed: the agent is its ``seed_<k>`` folders from now on."""
-    from baselines.learned.policy import POLICY_DIR
+    from shipgym_baselines.learned.policy import POLICY_DIR
 
     meta_file = Path(out_dir) / "meta.json"
     if not meta_file.is_file():

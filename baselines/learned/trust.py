@@ -3,8 +3,9 @@
 A stable-baselines3 zip keeps cloudpickled values beside its JSON, and a
 ``vecnormalize.pkl`` is a pickle: unpickling either runs any code its author put in it.
 Scoring third-party agents is this product's purpose, so a model is read as data only
-(:mod:`baselines.learned.loading`, :mod:`baselines.learned.normalizer`) and a file that
-needs unpickling is an :class:`~baselines.errors.UnsafeFileError` unless the user trusts
+(:mod:`shipgym_baselines.learned.loading`, :mod:`shipgym_baselines.learned.normalizer`)
+and a file that
+needs unpickling is an :class:`~shipgym_baselines.errors.UnsafeFileError` unless the user trusts
 it: ``--trust-pickle`` on ``evaluate``, ``run`` and ``leaderboard``.
 
 The choice travels in the environment variable :data:`TRUST_PICKLE_ENV`, so the worker
@@ -18,7 +19,7 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
-from baselines.errors import UnsafeFileError
+from shipgym_baselines.errors import UnsafeFileError
 
 #: set to "1" while a command runs with ``--trust-pickle``
 TRUST_PICKLE_ENV = "SHIPGYM_TRUST_PICKLE"

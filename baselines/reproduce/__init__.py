@@ -1,16 +1,16 @@
 """Re-runs of the source papers' experiments (``shipgym reproduce PAPER``, SPEC §11).
 
-One package per paper, each with the parts of :mod:`baselines.reproduce.protocol` (the
+One package per paper, each with the parts of :mod:`shipgym_baselines.reproduce.protocol` (the
 experiment, its claims, the markdown report, the figures) joined in its ``REPRODUCTION``;
-the rows are :func:`baselines.reproduce.rows.reproduction_row`'s, the tables
-:mod:`baselines.reproduce.report`'s.
+the rows are :func:`shipgym_baselines.reproduce.rows.reproduction_row`'s, the tables
+:mod:`shipgym_baselines.reproduce.report`'s.
 """
 
-from baselines.reproduce import borkowski2018, liu2019, morenosalinas2013, xu2020, xu2021
-from baselines.reproduce.protocol import Outcome, Reproduction
+from shipgym_baselines.reproduce import borkowski2018, liu2019, morenosalinas2013, xu2020, xu2021
+from shipgym_baselines.reproduce.protocol import Outcome, Reproduction
 
 #: paper id -> its package: ``REPRODUCTION`` (a :class:`Reproduction`) and, what
-#: :mod:`baselines.cli` calls, ``run(out_dir, seeds, progress) -> rows`` (writes the report)
+#: :mod:`shipgym_baselines.cli` calls, ``run(out_dir, seeds, progress) -> rows`` (writes the report)
 #: and ``markdown(rows) -> str``
 PAPERS = {
     "liu2019": liu2019,

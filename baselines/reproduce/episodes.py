@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
-from baselines.reproduce.protocol import Progress
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
+from shipgym_baselines.reproduce.protocol import Progress
 
 
 def seeded_episodes(
@@ -17,7 +17,7 @@ def seeded_episodes(
     **run_options: Any,
 ) -> list[tuple[EpisodeResult, Any]]:
     """(result, policy) of a fresh ``make_policy()`` on seeds ``EVAL_SEED_OFFSET + i``,
-    i < ``seeds`` (:func:`baselines.evaluation.run_episode` with ``run_options``), calling
+    i < ``seeds`` (:func:`shipgym_baselines.evaluation.run_episode` with ``run_options``), calling
     ``progress`` after each."""
     out = []
     for i in range(seeds):

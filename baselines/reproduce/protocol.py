@@ -1,18 +1,18 @@
 """The common shape of a paper reproduction (``shipgym reproduce PAPER``, SPEC §11).
 
-Every paper is a package ``baselines.reproduce.<paper>`` with the same parts:
+Every paper is a package ``shipgym_baselines.reproduce.<paper>`` with the same parts:
 
 * ``experiment.run_experiment(seeds, progress, **options) -> Outcome``: the episodes and the
-  rows of SPEC §9b (:func:`baselines.reproduce.rows.reproduction_row`); no files;
+  rows of SPEC §9b (:func:`shipgym_baselines.reproduce.rows.reproduction_row`); no files;
 * ``claims`` where the paper states something checkable: rows whose ``paper`` is the claim;
 * ``tables.report(rows) -> str``: the markdown report, its tables made by
-  :func:`baselines.reproduce.report.table`;
+  :func:`shipgym_baselines.reproduce.report.table`;
 * ``figures.plots(outcome, out_dir)``: the figures, from the outcome's episodes;
 
 joined by one :class:`Reproduction` (the package's ``REPRODUCTION``), whose :meth:`run`
 writes ``<name>.json``, ``<name>.md``, the outcome's extra documents and the figures.  The
-package also exposes ``run`` and ``markdown``: what :mod:`baselines.cli` calls through
-:data:`baselines.reproduce.PAPERS`.
+package also exposes ``run`` and ``markdown``: what :mod:`shipgym_baselines.cli` calls through
+:data:`shipgym_baselines.reproduce.PAPERS`.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from baselines.jsonout import dumps
+from shipgym_baselines.jsonout import dumps
 
 #: the rows of SPEC §9b: ``{case, controller, metric, ours, paper, …}``
 Rows = list[dict[str, Any]]

@@ -6,7 +6,7 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from baselines.reproduce.protocol import Rows
+from shipgym_baselines.reproduce.protocol import Rows
 
 
 def cell(value: Any, spec: str = ".4g", inf: str = "inf") -> str:

@@ -44,7 +44,7 @@ from shipgym.tracking import PathTracker, TrackFrame
 ACTION_MODES = ("rudder", "guidance")
 
 #: revision of the step core's numbers (dynamics, reward, termination): reference data
-#: computed with the env (the oracle's costs, ``baselines.references``) is valid for one
+#: computed with the env (the oracle's costs, ``shipgym_baselines.references``) is valid for one
 #: revision; bump it whenever a change moves an episode's numbers
 ENV_REVISION = 1
 

@@ -2,7 +2,7 @@
 
 No controller sees any of this (the controller context holds the nominal model, ``info``
 the measurements).  The evaluation loop hands it, through one explicit channel, to the
-built-in ``oracle`` reference alone (``baselines.privileged``), so that the leaderboard can
+built-in ``oracle`` reference alone (``shipgym_baselines.privileged``), so that the leaderboard can
 say what is achievable on a scenario when the plant is known.
 
 * ``params``: the true parameters acting now (after every jump so far; never the future

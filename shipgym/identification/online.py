@@ -62,7 +62,7 @@ class PersistentExcitation:
     """Liu et al. (2019) eq. (45): add i.i.d. N(0, σ²) noise to a control input [rad].
 
     ``hold``: calls (control periods) each draw is held for (1: a new draw every call, the
-    paper's; a slower ship holds it longer, :mod:`baselines.classical.nmpc_ship`).
+    paper's; a slower ship holds it longer, :mod:`shipgym_baselines.classical.nmpc_ship`).
     """
 
     def __init__(self, sigma: float, rng: np.random.Generator | None = None, hold: int = 1) -> None:

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from baselines import registry
+from shipgym_baselines import registry
 
 
 @pytest.fixture

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from baselines.cli import main
+from shipgym_baselines.cli import main
 
 #: a scenario file's text with one ``{line}`` to fill in (nomoto2, 30 s)
 SCENARIO = """\

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from baselines.classical.pid import PIDLOS
-from baselines.evaluation import evaluate, run_episode
-from baselines.leaderboard import run_leaderboard
 from shipgym.autopilot import HeadingPID, PIDGains
+from shipgym_baselines.classical.pid import PIDLOS
+from shipgym_baselines.evaluation import evaluate, run_episode
+from shipgym_baselines.leaderboard import run_leaderboard
 
 
 def test_pid_gains_place_closed_loop_poles() -> None:
@@ -99,10 +99,10 @@ def assert_equals_golden(rows: list[dict], golden: Path) -> None:
 
 def test_default_suite_has_every_controller_and_learned_agent() -> None:
     """Every classical controller on main and every shipped policy is on the board."""
-    from baselines.leaderboard import load_suite
-    from baselines.learned.policy import shipped_policies
-    from baselines.registry import CONTROLLERS
     from shipgym.scenarios import list_scenarios
+    from shipgym_baselines.leaderboard import load_suite
+    from shipgym_baselines.learned.policy import shipped_policies
+    from shipgym_baselines.registry import CONTROLLERS
 
     suite = load_suite("default")
     assert set(CONTROLLERS) | set(shipped_policies()) <= set(suite.controllers)

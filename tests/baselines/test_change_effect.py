@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from baselines.change_effect import (
+from shipgym.scenarios import load_scenario
+from shipgym_baselines.change_effect import (
     MATTERS,
     change_effect,
     change_time,
@@ -15,9 +16,8 @@ from baselines.change_effect import (
     step_costs,
     twin,
 )
-from baselines.evaluation import EVAL_SEED_OFFSET, run_episode
-from baselines.registry import make_controller
-from shipgym.scenarios import load_scenario
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
+from shipgym_baselines.registry import make_controller
 
 
 def test_matrix_scenarios_are_the_three_ships_times_three_families_times_two_routes() -> None:

@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from baselines.cli import build_parser, main
-from baselines.errors import ControllerError
 from shipgym.scenarios import ScenarioError
+from shipgym_baselines.cli import build_parser, main
+from shipgym_baselines.errors import ControllerError
 
 
 def _subcommands() -> list[str]:
@@ -57,10 +57,10 @@ def test_help_of_every_subcommand(command: str, capsys: pytest.CaptureFixture[st
 
 
 def test_choices_come_from_the_registries() -> None:
-    from baselines.cli.bench import BENCHES
-    from baselines.cli.manoeuvre import MANOEUVRES
-    from baselines.reproduce import PAPERS
     from shipgym.models import MODELS
+    from shipgym_baselines.cli.bench import BENCHES
+    from shipgym_baselines.cli.manoeuvre import MANOEUVRES
+    from shipgym_baselines.reproduce import PAPERS
 
     parser = build_parser()
     assert parser.parse_args(["reproduce", "xu2021"]).paper == "xu2021"
@@ -76,7 +76,7 @@ def test_choices_come_from_the_registries() -> None:
 
 def test_python_dash_m_runs_the_cli() -> None:
     done = subprocess.run(
-        [sys.executable, "-m", "baselines.cli", "scenarios", "--json"],
+        [sys.executable, "-m", "shipgym_baselines.cli", "scenarios", "--json"],
         capture_output=True,
         text=True,
         check=True,
@@ -218,7 +218,7 @@ def test_cli_bench_identification_json(capsys) -> None:
 
 def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
     """The nomoto2 figures, and per ship each family member's (here two, 40 steps: CI time)."""
-    from baselines import benchmarks
+    from shipgym_baselines import benchmarks
 
     monkeypatch.setattr(benchmarks, "NMPC_FAMILY", ("nmpc", "nmpc_lambda_lssvm_svf"))
     monkeypatch.setattr(benchmarks, "PER_SHIP_MAX_STEPS", 40)

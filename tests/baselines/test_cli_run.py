@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from baselines.cli import main
-from baselines.cli.run import default_out
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from shipgym_baselines.cli import main
+from shipgym_baselines.cli.run import default_out
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
 
 #: wall-clock figures differ between two runs of the same episode
 TIMING = ("compute_ms", "compute_ms_max")
@@ -88,8 +88,8 @@ def test_a_scenario_file_runs(tmp_path: Path, capsys: pytest.CaptureFixture[str]
 def test_a_controller_that_does_not_apply_is_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], scratch_registry: None
 ) -> None:
-    from baselines.classical.reference import ZeroRudder
-    from baselines.registry import register_controller
+    from shipgym_baselines.classical.reference import ZeroRudder
+    from shipgym_baselines.registry import register_controller
 
     register_controller("nomoto2_only", lambda: ZeroRudder(), applies_to=("nomoto2",))
     out = tmp_path / "out"

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import yaml
 
-from baselines.cli import main
-from baselines.escaping import csv_cell, md_cell, plain_text
+from shipgym_baselines.cli import main
+from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 
 ROOT = Path(__file__).resolve().parents[2]
 MATHTEXT = r"$\undefinedmacro{x}$"

@@ -10,11 +10,12 @@ from typing import Any
 import numpy as np
 import pytest
 
-from baselines import evaluation
-from baselines.classical.pid import PIDLOS
-from baselines.classical.reference import ZeroRudder
-from baselines.errors import ControllerError
-from baselines.evaluation import (
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym_baselines import evaluation
+from shipgym_baselines.classical.pid import PIDLOS
+from shipgym_baselines.classical.reference import ZeroRudder
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.evaluation import (
     EVAL_SEED_OFFSET,
     EpisodeResult,
     compute_time_metrics,
@@ -22,8 +23,7 @@ from baselines.evaluation import (
     evaluate_batch,
     run_episode,
 )
-from baselines.registry import make_controller, training_seeds
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym_baselines.registry import make_controller, training_seeds
 
 SLEEP_S = 0.002
 
@@ -168,7 +168,7 @@ def test_batched_recurrent_evaluation_spans_several_forward_chunks() -> None:
     """More episodes than one forward's rows (BATCH_ROWS): LSTM states stay with their
     episodes across chunks, as episodes end and the rows shift."""
     pytest.importorskip("sb3_contrib")
-    from baselines.learned.policy import BATCH_ROWS
+    from shipgym_baselines.learned.policy import BATCH_ROWS
 
     n = BATCH_ROWS + 2
     seeds = [EVAL_SEED_OFFSET + i for i in range(n)]

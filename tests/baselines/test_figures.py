@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from baselines import figures
-from baselines.figures import (
+from shipgym_baselines import figures
+from shipgym_baselines.figures import (
     DrawnEpisode,
     episodes_to_draw,
     family_panels,
@@ -19,8 +19,8 @@ from baselines.figures import (
     plot_ranking,
     plot_scenario,
 )
-from baselines.ranking import aggregate_ranking
-from baselines.style import FIGURE_DPI, controller_style
+from shipgym_baselines.ranking import aggregate_ranking
+from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 SVG = "{http://www.w3.org/2000/svg}"
 

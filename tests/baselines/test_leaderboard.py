@@ -8,10 +8,17 @@ from pathlib import Path
 
 import pytest
 
-from baselines.errors import RunError
-from baselines.leaderboard import COLUMNS, Job, plan_jobs, run_batch, run_job, run_leaderboard
-from baselines.learned.policy import model_zip
-from baselines.runs import read_episodes, read_run
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.leaderboard import (
+    COLUMNS,
+    Job,
+    plan_jobs,
+    run_batch,
+    run_job,
+    run_leaderboard,
+)
+from shipgym_baselines.learned.policy import model_zip
+from shipgym_baselines.runs import read_episodes, read_run
 from tests.baselines.test_runs import TIMING, untimed, write_suite
 
 RANDOMIZE = {
@@ -48,7 +55,7 @@ def with_stand_in_oracle(run_folder: Path, out: Path) -> Path:
     """A copy of a run record (``run.json``, ``episodes.jsonl``) with a stand-in ``oracle``
     (kind reference): each pid_los episode again, its cost × :data:`STAND_IN`; then the
     report of it in ``out / "report"``, whose folder is returned."""
-    from baselines.report import write_report
+    from shipgym_baselines.report import write_report
 
     record = json.loads((run_folder / "run.json").read_text())
     entry = {"name": "oracle", "controller": "oracle", "kind": "reference"}
@@ -126,7 +133,7 @@ def test_rows_carry_an_interval_for_every_metric(randomised: Path) -> None:
 
 
 def test_without_the_oracle_the_ranking_says_what_it_needs(randomised: Path) -> None:
-    from baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard import terminal_summary
 
     assert json.loads((randomised / "aggregate.json").read_text()) == []
     assert json.loads((randomised / "scenario_scores.json").read_text()) == []
@@ -320,7 +327,7 @@ def test_the_terminal_ends_with_the_ranking_and_the_page(
 ) -> None:
     """``report`` (like ``leaderboard``) prints the ranking and where the page is, not the
     long rows."""
-    from baselines.cli import main
+    from shipgym_baselines.cli import main
 
     out = tmp_path / "again"
     assert main(["report", str(ranked.parent / "record"), "--out", str(out)]) == 0
@@ -373,7 +380,7 @@ def test_quick_suite_finishes(tmp_path: Path) -> None:
     """The quick suite (issue 18) runs to the end with every controller on its 12
     scenarios (one evaluation seed here, to keep CI short; the suite's own is 3): a row per
     controller and scenario, every applicable one with its episodes."""
-    from baselines.suite import load_suite
+    from shipgym_baselines.suite import load_suite
 
     quick = load_suite("quick")
     rows = run_leaderboard("quick", seeds=1, out_dir=tmp_path, workers=2, show_progress=False)

@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-import baselines.leaderboard
-from baselines.cli import main
-from baselines.learned.train import train_sweep
+import shipgym_baselines.leaderboard
 from shipgym.limits import MAX_SEEDS, LimitError
+from shipgym_baselines.cli import main
+from shipgym_baselines.learned.train import train_sweep
 
 ONE_JOB = {"name": "one", "scenarios": ["nominal"], "controllers": ["zero_rudder"], "seeds": 1}
 
@@ -60,13 +60,13 @@ def test_finding8_workers_below_one_are_refused(tmp_path: Path, capsys) -> None:
 
 def test_finding8_workers_beyond_the_jobs_are_clamped(tmp_path: Path, monkeypatch) -> None:
     started = []
-    real = baselines.leaderboard.iter_results
+    real = shipgym_baselines.leaderboard.iter_results
 
     def spy(jobs, backend, workers):
         started.append(workers)
         return real(jobs, backend, workers)
 
-    monkeypatch.setattr(baselines.leaderboard, "iter_results", spy)
+    monkeypatch.setattr(shipgym_baselines.leaderboard, "iter_results", spy)
     argv = [
         "leaderboard",
         "--suite",

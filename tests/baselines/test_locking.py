@@ -10,17 +10,17 @@ from pathlib import Path
 
 import pytest
 
-from baselines.cli import main
-from baselines.errors import RunError
-from baselines.leaderboard import run_leaderboard
-from baselines.locking import LOCK_FILE, out_lock
-from baselines.runs import read_episodes, read_run
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.locking import LOCK_FILE, out_lock
+from shipgym_baselines.runs import read_episodes, read_run
 from tests.baselines.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 HOLD = """
 import sys, time
-from baselines.locking import out_lock
+from shipgym_baselines.locking import out_lock
 with out_lock(sys.argv[1], "2026-01-02T03:04:05+00:00"):
     print("locked", flush=True)
     time.sleep(600)
@@ -85,7 +85,7 @@ def test_finding1_two_runs_started_together_on_one_folder(tmp_path: Path) -> Non
     """The probe: two ``shipgym leaderboard`` processes on one folder.  One runs, the other
     is refused in one line naming it; every episode is recorded once."""
     out, suite = tmp_path / "out", write_suite(tmp_path, seeds=3)
-    command = [sys.executable, "-m", "baselines.cli", "leaderboard", "--suite", suite]
+    command = [sys.executable, "-m", "shipgym_baselines.cli", "leaderboard", "--suite", suite]
     command += ["--out", str(out), "--workers", "1", "--no-progress", "--json"]
     runs = [
         subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)

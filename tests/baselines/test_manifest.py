@@ -6,9 +6,15 @@ from pathlib import Path
 
 import pytest
 
-from baselines.errors import RunError
-from baselines.locking import LOCK_FILE
-from baselines.manifest import MANIFEST_FILE, Manifest, clear_listed, read_manifest, snapshot
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.locking import LOCK_FILE
+from shipgym_baselines.manifest import (
+    MANIFEST_FILE,
+    Manifest,
+    clear_listed,
+    read_manifest,
+    snapshot,
+)
 
 
 def test_finding4_claimed_paths_are_listed_once_before_they_exist(tmp_path: Path) -> None:

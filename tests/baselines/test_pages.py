@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from baselines.figures import DrawnEpisode, plot_scenario
-from baselines.pages import PAGE_FILE, page, write_html
+from shipgym_baselines.figures import DrawnEpisode, plot_scenario
+from shipgym_baselines.pages import PAGE_FILE, page, write_html
 
 CONTROLLERS = [
     "pid_los",

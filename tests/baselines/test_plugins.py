@@ -19,12 +19,13 @@ import numpy as np
 import pytest
 import yaml
 
-from baselines.cli import main
-from baselines.errors import ConfigError, ControllerError, RunError
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate, run_episode
-from baselines.leaderboard import check_controllers, run_job, run_leaderboard
-from baselines.plugins import ControllerEntry, anchored, entry_point_names, parse_spec
-from baselines.registry import (
+from shipgym.envs.context import ControllerContext
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import ConfigError, ControllerError, RunError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, run_episode
+from shipgym_baselines.leaderboard import check_controllers, run_job, run_leaderboard
+from shipgym_baselines.plugins import ControllerEntry, anchored, entry_point_names, parse_spec
+from shipgym_baselines.registry import (
     CONTROLLERS,
     applies_to,
     controller_kind,
@@ -32,8 +33,7 @@ from baselines.registry import (
     make_controller,
     unknown_controller,
 )
-from baselines.suite import load_suite
-from shipgym.envs.context import ControllerContext
+from shipgym_baselines.suite import load_suite
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -233,8 +233,8 @@ def test_a_registered_class_named_by_a_spec_keeps_its_registration(
 ) -> None:
     file = tmp_path / "decorated.py"
     file.write_text(
-        "from baselines import register_controller\n"
-        "from baselines.classical.reference import ZeroRudder\n\n"
+        "from shipgym_baselines import register_controller\n"
+        "from shipgym_baselines.classical.reference import ZeroRudder\n\n"
         "@register_controller('test_decorated_zero', applies_to=['mariner'])\n"
         "class Zero(ZeroRudder):\n"
         "    pass\n"
@@ -339,8 +339,8 @@ def test_an_entry_point_is_listed_then_loaded_when_asked_for(site: Path) -> None
 
 def test_an_entry_point_module_may_register_itself(site: Path) -> None:
     module = (
-        "from baselines import register_controller\n"
-        "from baselines.classical.reference import ZeroRudder\n\n"
+        "from shipgym_baselines import register_controller\n"
+        "from shipgym_baselines.classical.reference import ZeroRudder\n\n"
         "@register_controller('test_ep_self', action_mode='guidance')\n"
         "class SelfRegistered(ZeroRudder):\n"
         "    pass\n"

@@ -9,7 +9,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from baselines.ranking import (
+from shipgym_baselines.ranking import (
     AGGREGATE_FIELDS,
     aggregate_ranking,
     performance_profiles,
@@ -281,7 +281,7 @@ def test_the_fast_metrics_give_rliables_bits() -> None:
     aggregate_iqm and probability_of_improvement exactly, ties and equal columns included."""
     from rliable import metrics as rmetrics
 
-    from baselines.ranking import interquartile_mean, probability_of_improvement
+    from shipgym_baselines.ranking import interquartile_mean, probability_of_improvement
 
     rng = np.random.default_rng(3)
     for trial in range(200):

@@ -7,13 +7,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-import baselines
-from baselines.classical.pid import PIDLOS
-from baselines.classical.reference import ZeroRudder
-from baselines.errors import ControllerError
-from baselines.evaluation import run_episode
-from baselines.plugins import ControllerEntry
-from baselines.registry import (
+import shipgym_baselines
+from shipgym.envs.context import ControllerContext
+from shipgym_baselines.classical.pid import PIDLOS
+from shipgym_baselines.classical.reference import ZeroRudder
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.plugins import ControllerEntry
+from shipgym_baselines.registry import (
     CONTROLLERS,
     applies_to,
     controller_kind,
@@ -21,7 +22,6 @@ from baselines.registry import (
     register_controller,
     resolve_controller,
 )
-from shipgym.envs.context import ControllerContext
 
 #: the contract: every built-in controller's name, action mode and ships (None: all)
 BUILTINS = {
@@ -70,7 +70,7 @@ def test_the_registry_is_read_only() -> None:
 
 
 def test_register_controller_is_exported_from_baselines() -> None:
-    assert baselines.register_controller is register_controller
+    assert shipgym_baselines.register_controller is register_controller
 
 
 def test_decorator_registers_a_class_and_gives_it_the_name(scratch_registry: None) -> None:

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from baselines.cli import main
-from baselines.errors import RunError
-from baselines.report import write_report
-from baselines.runs import read_run
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.report import write_report
+from shipgym_baselines.runs import read_run
 from tests.baselines.test_runs import untimed, write_suite
 
 

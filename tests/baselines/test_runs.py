@@ -17,13 +17,13 @@ from pathlib import Path
 import pytest
 import yaml
 
-import baselines.leaderboard
-from baselines.cli import main
-from baselines.errors import RunError, RunFailed
-from baselines.jsonout import dumps
-from baselines.leaderboard import run_leaderboard
-from baselines.manifest import snapshot
-from baselines.runs import (
+import shipgym_baselines.leaderboard
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.manifest import snapshot
+from shipgym_baselines.runs import (
     RunInterrupted,
     check_out_dir,
     clear_outputs,
@@ -101,8 +101,8 @@ def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) ->
 
 def test_a_learned_episode_records_its_training_seed(tmp_path: Path) -> None:
     """One episode per shipped training seed, each with its own (its meta's) seed."""
-    from baselines.learned.policy import model_zip
-    from baselines.registry import training_seeds
+    from shipgym_baselines.learned.policy import model_zip
+    from shipgym_baselines.registry import training_seeds
 
     suite = write_suite(tmp_path, scenarios=["nominal"], controllers=["ppo"], seeds=1)
     run_leaderboard(suite, out_dir=tmp_path / "out", workers=1, show_progress=False)
@@ -277,7 +277,7 @@ def test_a_killed_run_keeps_its_episodes_and_resumes(tmp_path: Path, clean_run: 
 
 def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> None:
     calls: list[object] = []
-    real = baselines.leaderboard.run_job
+    real = shipgym_baselines.leaderboard.run_job
 
     def third_is_interrupted(job: tuple) -> object:
         calls.append(job)
@@ -285,7 +285,7 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
             raise KeyboardInterrupt
         return real(job)
 
-    monkeypatch.setattr(baselines.leaderboard, "run_job", third_is_interrupted)
+    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_job", third_is_interrupted)
     out = tmp_path / "out"
     args = ["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out), "--workers", "1"]
     assert main([*args, "--no-progress"]) == 130
@@ -311,7 +311,7 @@ def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
 
 def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> None:
     calls: list[object] = []
-    real = baselines.leaderboard.run_job
+    real = shipgym_baselines.leaderboard.run_job
 
     def second_fails(job: tuple) -> object:
         calls.append(job)
@@ -319,7 +319,7 @@ def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> Non
             raise RuntimeError("a bug in a controller")
         return real(job)
 
-    monkeypatch.setattr(baselines.leaderboard, "run_job", second_fails)
+    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_job", second_fails)
     out = tmp_path / "out"
     with pytest.raises(RuntimeError, match="a bug"):  # a bug keeps its traceback
         run_leaderboard(write_suite(tmp_path), out_dir=out, workers=1, show_progress=False)
@@ -331,7 +331,7 @@ def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> Non
 def test_sigint_stops_the_workers_without_tracebacks(tmp_path: Path) -> None:
     """A real Ctrl-C (SIGINT to the process group, as a terminal sends it) with 2 workers."""
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "baselines.cli", "leaderboard", "--suite", "smoke"]
+    command = [sys.executable, "-m", "shipgym_baselines.cli", "leaderboard", "--suite", "smoke"]
     command += ["--seeds", "1", "--out", str(out), "--workers", "2", "--no-progress"]
     process = subprocess.Popen(
         command,
@@ -355,7 +355,7 @@ def test_sigint_stops_the_workers_without_tracebacks(tmp_path: Path) -> None:
 
 
 def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
-    from baselines.learned.train import TRAINING_OUTPUTS, train
+    from shipgym_baselines.learned.train import TRAINING_OUTPUTS, train
 
     out = tmp_path / "agent"
     out.mkdir()
@@ -504,7 +504,7 @@ class _FillsUp(io.FileIO):
 def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_run: Path) -> None:
     """A full disk cuts an episode's line short: it is cut off again, so no partial line
     stays between whole ones once there is room again."""
-    from baselines.runs import RunLog, episode_result
+    from shipgym_baselines.runs import RunLog, episode_result
 
     records = read_episodes(clean_run)
     log = RunLog.open(

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from baselines.runs import read_episodes, read_run
+from shipgym_baselines.runs import read_episodes, read_run
 from tests.baselines.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def leaderboard(out: Path, suite: str = "smoke") -> list[str]:
     """The command of ``shipgym leaderboard`` with 2 workers, one seed."""
-    command = [sys.executable, "-m", "baselines.cli", "leaderboard", "--suite", suite]
+    command = [sys.executable, "-m", "shipgym_baselines.cli", "leaderboard", "--suite", suite]
     return [*command, "--seeds", "1", "--out", str(out), "--workers", "2", "--no-progress"]
 
 
@@ -161,7 +161,15 @@ def test_finding6_a_full_disk_under_report_is_one_line(tmp_path: Path) -> None:
         resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
 
     report = tmp_path / "report"
-    command = [sys.executable, "-m", "baselines.cli", "report", str(out), "--out", str(report)]
+    command = [
+        sys.executable,
+        "-m",
+        "shipgym_baselines.cli",
+        "report",
+        str(out),
+        "--out",
+        str(report),
+    ]
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, preexec_fn=small_files)
     assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
     assert done.stderr.startswith("shipgym report: failed: no room to write ")

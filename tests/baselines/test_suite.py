@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from baselines.errors import ConfigError
-from baselines.suite import SuiteConfig, list_suites, load_suite
 from shipgym.config import list_names
+from shipgym_baselines.errors import ConfigError
+from shipgym_baselines.suite import SuiteConfig, list_suites, load_suite
 
 
 def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
@@ -37,7 +37,7 @@ def test_packaged_suites_load() -> None:
 def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
     """The whole scenario matrix (issue 18) with the nomoto2 and papers' scenarios, and the
     held-out scenarios up to heldout:15 (each 3-DOF ship's three families and a combination)."""
-    from baselines.change_effect import matrix_scenarios
+    from shipgym_baselines.change_effect import matrix_scenarios
 
     default = load_suite("default")
     matrix = matrix_scenarios() + [f"{s}_nominal" for s in ("esso_osaka", "mariner", "blanke")]

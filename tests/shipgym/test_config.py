@@ -218,11 +218,22 @@ def _files(folder: Path, pattern: str = "*") -> list[Path]:
 def test_the_wheel_holds_every_module(wheel_files: set[str]) -> None:
     """Subpackages are found on disk (setup.py): none is left out of the wheel."""
     modules = [
-        p.relative_to(REPO).as_posix()
-        for top in ("shipgym", "baselines")
+        f"{package}/{p.relative_to(REPO / top).as_posix()}"
+        for package, top in (("shipgym", "shipgym"), ("shipgym_baselines", "baselines"))
         for p in _files(REPO / top, "*.py")
     ]
     assert modules and set(modules) <= wheel_files
+
+
+def test_the_wheel_installs_only_our_top_level_names(wheel_files: set[str]) -> None:
+    """No top-level import package that could collide with another distribution's
+    (``baselines`` is OpenAI Baselines'): only shipgym and shipgym_baselines."""
+    tops = {
+        name.split("/")[0]
+        for name in wheel_files
+        if not name.split("/")[0].endswith((".dist-info", ".data"))
+    }
+    assert tops == {"shipgym", "shipgym_baselines"}, tops
 
 
 def test_the_wheel_holds_configs_as_package_data(wheel_files: set[str]) -> None:
@@ -232,7 +243,9 @@ def test_the_wheel_holds_configs_as_package_data(wheel_files: set[str]) -> None:
 
 
 def test_the_wheel_holds_the_shipped_policies(wheel_files: set[str]) -> None:
+    folder = REPO / "baselines"
     policies = [
-        p.relative_to(REPO).as_posix() for p in _files(REPO / "baselines" / "learned" / "policies")
+        f"shipgym_baselines/{p.relative_to(folder).as_posix()}"
+        for p in _files(folder / "learned" / "policies")
     ]
     assert policies and set(policies) <= wheel_files

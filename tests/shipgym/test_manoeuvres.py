@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from baselines.cli import main
 from shipgym.manoeuvres import ManoeuvreError, turning_circle, zigzag
 from shipgym.models import Nomoto2, Nomoto2Params
+from shipgym_baselines.cli import main
 
 
 def test_nomoto2_steady_turn_matches_the_closed_form() -> None:

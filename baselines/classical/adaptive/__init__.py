@@ -1,5 +1,5 @@
 """Parts of the adaptive backstepping heading controllers of Xu, Oliveira & Guedes Soares
-(2021), one module per idea, for :mod:`baselines.classical.l1_backstepping`.
+(2021), one module per idea, for :mod:`shipgym_baselines.classical.l1_backstepping`.
 
 * :mod:`.design_model` — the design model T·ṙ + H(r)·r = K·δ + b, eq. (15), and its nominal
   values for a ship;

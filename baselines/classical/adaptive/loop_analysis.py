@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from baselines.classical.adaptive.design_model import NonlinearNomoto
-from baselines.classical.adaptive.lowpass import low_pass_transfer_function
-from baselines.classical.adaptive.settings import Gains
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto
+from shipgym_baselines.classical.adaptive.lowpass import low_pass_transfer_function
+from shipgym_baselines.classical.adaptive.settings import Gains
 
 
 def linearised_pd_gains(model: NonlinearNomoto, gains: Gains) -> tuple[float, float]:

@@ -24,9 +24,9 @@ import math
 
 import numpy as np
 
-from baselines.classical.adaptive.design_model import NonlinearNomoto
-from baselines.classical.adaptive.projection import projection
 from shipgym.angles import unwrap_floats
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto
+from shipgym_baselines.classical.adaptive.projection import projection
 
 #: the adaptive parameters, in the order of :attr:`StatePredictor.estimates`
 PARAMETERS = ("rho", "sigma", "b")

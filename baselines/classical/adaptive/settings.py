@@ -34,7 +34,7 @@ import dataclasses
 
 from shipgym.guidance import TVVF_PAPER_SHIP_LENGTH
 
-#: where the low-pass filter C(s) acts (:mod:`baselines.classical.l1_backstepping`,
+#: where the low-pass filter C(s) acts (:mod:`shipgym_baselines.classical.l1_backstepping`,
 #: "Filter placement")
 FILTER_PLACEMENTS = ("command", "adaptive")
 #: how the §5.2 gains carry to another ship (module doc, "Gain transfer")
@@ -71,7 +71,7 @@ class L1BacksteppingSettings:
     projection_epsilon: float = 0.1
     filter_frequency: float = 0.25  # ω [rad/s]
     filter_damping: float = 1.0  # ζ
-    #: where C(s) acts (:mod:`baselines.classical.l1_backstepping`, "Filter placement"):
+    #: where C(s) acts (:mod:`shipgym_baselines.classical.l1_backstepping`, "Filter placement"):
     #: "command" (eq. (39) as printed: the whole law) or "adaptive" (only the estimates'
     #: share of it, the standard L1 structure)
     filter_placement: str = "command"

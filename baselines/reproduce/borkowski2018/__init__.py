@@ -6,7 +6,7 @@ with R = 500 m, 1000 s, and the scenario's wind-wave yaw disturbance, our stand-
 paper's unspecified "signal characteristic of wind-induced sea waves") under ``lqr`` (the
 gain of the initial guess, fixed) and ``adaptive_lqr`` (the gain re-solved from the
 continuous-LS estimates), both with λy = 1/2000, λψ = 1, λδ = 5
-(:mod:`baselines.classical.lqr`), from several initial guesses (a0, c0): the paper's
+(:mod:`shipgym_baselines.classical.lqr`), from several initial guesses (a0, c0): the paper's
 (0.02, 0.002) against the plant's linear part a1 = 0.018 1/s, a3 = 0.001 1/s², and our
 choices around it (both ×½, ×1.5, ×⅓, ×3; c0 alone ×½ (= the truth) and ×3).
 
@@ -21,13 +21,13 @@ is the mean over ``seeds`` episodes (``ours_std`` the population spread; the rat
 of the means).  Writes ``borkowski2018.md`` / ``.json`` and ``borkowski2018.png`` (track,
 J(t), e(t), δ(t) for the paper's guess; â(t), ĉ(t) for every guess, against the truth).
 
-Parts (:mod:`baselines.reproduce.protocol`): :mod:`.experiment` (the runs and rows),
+Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the runs and rows),
 :mod:`.claims` (J lower, the largest reduction), :mod:`.quality_index` (J(t) of eq. (29)),
 :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from baselines.reproduce.borkowski2018.claims import PAPER_MAX_REDUCTION
-from baselines.reproduce.borkowski2018.experiment import (
+from shipgym_baselines.reproduce.borkowski2018.claims import PAPER_MAX_REDUCTION
+from shipgym_baselines.reproduce.borkowski2018.experiment import (
     CONTROLLERS,
     GUESSES,
     PAPER_GUESS,
@@ -37,10 +37,10 @@ from baselines.reproduce.borkowski2018.experiment import (
     case_name,
     run_experiment,
 )
-from baselines.reproduce.borkowski2018.figures import plot_runs, plots
-from baselines.reproduce.borkowski2018.quality_index import cumulative_J
-from baselines.reproduce.borkowski2018.tables import report
-from baselines.reproduce.protocol import Reproduction
+from shipgym_baselines.reproduce.borkowski2018.figures import plot_runs, plots
+from shipgym_baselines.reproduce.borkowski2018.quality_index import cumulative_J
+from shipgym_baselines.reproduce.borkowski2018.tables import report
+from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("borkowski2018", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from baselines.reproduce.rows import reproduction_row
+from shipgym_baselines.reproduce.rows import reproduction_row
 
 #: Borkowski (2018) §5: "reduction of the control quality indicator value to 15 %"
 PAPER_MAX_REDUCTION = 0.15

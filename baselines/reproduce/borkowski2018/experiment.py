@@ -7,13 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from baselines.classical.lqr import LQR, AdaptiveLQR
-from baselines.errors import check_seeds
-from baselines.reproduce.borkowski2018.claims import case_claims, summary_claims
-from baselines.reproduce.episodes import seeded_episodes
-from baselines.reproduce.protocol import Outcome, Progress
-from baselines.reproduce.rows import reproduction_row
 from shipgym.scenarios import load_scenario
+from shipgym_baselines.classical.lqr import LQR, AdaptiveLQR
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.reproduce.borkowski2018.claims import case_claims, summary_claims
+from shipgym_baselines.reproduce.episodes import seeded_episodes
+from shipgym_baselines.reproduce.protocol import Outcome, Progress
+from shipgym_baselines.reproduce.rows import reproduction_row
 
 SCENARIO = "mariner_track"
 #: Borkowski (2018) §5: the plant's linear part (a1 [1/s], a3 [1/s²]) and the initial guess

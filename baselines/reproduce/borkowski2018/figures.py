@@ -7,11 +7,11 @@ from typing import Any
 
 import numpy as np
 
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.borkowski2018.experiment import TRUTH
-from baselines.reproduce.borkowski2018.quality_index import cumulative_J
-from baselines.reproduce.plotting import pyplot, save
-from baselines.reproduce.protocol import Outcome
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.borkowski2018.experiment import TRUTH
+from shipgym_baselines.reproduce.borkowski2018.quality_index import cumulative_J
+from shipgym_baselines.reproduce.plotting import pyplot, save
+from shipgym_baselines.reproduce.protocol import Outcome
 
 
 def plots(outcome: Outcome, out_dir: Path) -> None:

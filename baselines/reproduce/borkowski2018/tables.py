@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from baselines.reproduce.borkowski2018.experiment import PAPER_GUESS, case_name
-from baselines.reproduce.protocol import Rows
-from baselines.reproduce.report import cell, index, seeds_of, table
+from shipgym_baselines.reproduce.borkowski2018.experiment import PAPER_GUESS, case_name
+from shipgym_baselines.reproduce.protocol import Rows
+from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
 
 
 def report(rows: Rows) -> str:

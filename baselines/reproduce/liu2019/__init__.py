@@ -6,20 +6,20 @@ convergence times) this runs the catalogue scenario and reports our ACE and t_c 
 published ones (SPEC §11), writes ``liu2019.md`` / ``.json`` and, per case and reading, a
 figure with the tracks, e(t), the identified parameters against the truth and λ_k.
 
-Parts (:mod:`baselines.reproduce.protocol`): :mod:`.experiment` (the runs and rows),
+Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the runs and rows),
 :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from baselines.reproduce.liu2019.experiment import (
+from shipgym_baselines.reproduce.liu2019.experiment import (
     CASES,
     CONTROLLERS,
     PUBLISHED,
     READINGS,
     run_experiment,
 )
-from baselines.reproduce.liu2019.figures import plot_case, plots
-from baselines.reproduce.liu2019.tables import report
-from baselines.reproduce.protocol import Reproduction
+from shipgym_baselines.reproduce.liu2019.figures import plot_case, plots
+from shipgym_baselines.reproduce.liu2019.tables import report
+from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("liu2019", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown

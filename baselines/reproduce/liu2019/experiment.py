@@ -14,18 +14,18 @@ from typing import Any
 
 import numpy as np
 
-from baselines.classical.nmpc import (
+from shipgym_baselines.classical.nmpc import (
     NMPC,
     NMPCLambdaLSSVM,
     NMPCLambdaLSSVMSVF,
     NMPCWeightedLSSVM,
     NMPCWeightedLSSVMSVF,
 )
-from baselines.errors import check_seeds
-from baselines.reproduce.episodes import seeded_episodes
-from baselines.reproduce.protocol import Outcome, Progress
-from baselines.reproduce.rows import reproduction_row
-from baselines.variants import scenario_variant
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.reproduce.episodes import seeded_episodes
+from shipgym_baselines.reproduce.protocol import Outcome, Progress
+from shipgym_baselines.reproduce.rows import reproduction_row
+from shipgym_baselines.variants import scenario_variant
 
 CASES = {  # scenario -> (paper's case, parameters that change)
     "rudder_aging": ("Case 1", ("Tc",)),

@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.liu2019.experiment import CASES
-from baselines.reproduce.plotting import pyplot, save
-from baselines.reproduce.protocol import Outcome
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.liu2019.experiment import CASES
+from shipgym_baselines.reproduce.plotting import pyplot, save
+from shipgym_baselines.reproduce.protocol import Outcome
 
 
 def plots(outcome: Outcome, out_dir: Path) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from baselines.reproduce.liu2019.experiment import (
+from shipgym_baselines.reproduce.liu2019.experiment import (
     CASES,
     CONTROLLERS,
     IDENTIFIED,
@@ -10,8 +10,8 @@ from baselines.reproduce.liu2019.experiment import (
     SCORED,
     SVF_CONTROLLERS,
 )
-from baselines.reproduce.protocol import Rows
-from baselines.reproduce.report import cell, index, seeds_of, table
+from shipgym_baselines.reproduce.protocol import Rows
+from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
 
 NOTE = (
     "\nACE: mean |e| [m] after the change (Liu et al. 2019 eq. 46); t_c: the moment [s] "

@@ -25,11 +25,11 @@ regression.  Writes ``morenosalinas2013.md`` / ``.json``, the identified coeffic
 the plant's (linearised) ones in ``morenosalinas2013_coefficients.json`` and a figure of the
 time series (measured, plant, identified).
 
-Parts (:mod:`baselines.reproduce.protocol`): :mod:`.experiment` (the fits, replays and
+Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the fits, replays and
 rows), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from baselines.reproduce.morenosalinas2013.experiment import (
+from shipgym_baselines.reproduce.morenosalinas2013.experiment import (
     CASES,
     CONTROLLERS,
     HEADING_NOISE,
@@ -42,9 +42,9 @@ from baselines.reproduce.morenosalinas2013.experiment import (
     ZIGZAG_DURATION,
     run_experiment,
 )
-from baselines.reproduce.morenosalinas2013.figures import plot_series, plots
-from baselines.reproduce.morenosalinas2013.tables import report
-from baselines.reproduce.protocol import Reproduction
+from shipgym_baselines.reproduce.morenosalinas2013.figures import plot_series, plots
+from shipgym_baselines.reproduce.morenosalinas2013.tables import report
+from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("morenosalinas2013", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown

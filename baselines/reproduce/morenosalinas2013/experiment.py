@@ -8,12 +8,12 @@ from typing import Any
 import numpy as np
 from scipy.signal import butter, filtfilt
 
-from baselines.errors import check_seeds
-from baselines.reproduce.protocol import Outcome, Progress
-from baselines.reproduce.rows import reproduction_row
 from shipgym.identification.blanke import BlankeFit, fit_blanke, simulate_commands
 from shipgym.manoeuvres import turning_circle, zigzag
 from shipgym.models.blanke import Blanke, regression_coefficients
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.reproduce.protocol import Outcome, Progress
+from shipgym_baselines.reproduce.rows import reproduction_row
 
 DEG = math.pi / 180.0
 
@@ -100,7 +100,7 @@ def run_experiment(
     ``yaw_rate_noise`` [rad/s] one-sigma gyro noise (the paper gives none);
     ``duration_scale`` shortens the manoeuvres (e.g. 0.5 for a quick run).  ``episodes``:
     (plant, noise-free states per case, seed-0 measurements and predictions, samples per
-    IMU period) for :func:`~baselines.reproduce.morenosalinas2013.figures.plot_series`;
+    IMU period) for :func:`~shipgym_baselines.reproduce.morenosalinas2013.figures.plot_series`;
     ``documents``: the identified coefficients (seed 0) beside the plant's.
     """
     check_seeds(seeds)

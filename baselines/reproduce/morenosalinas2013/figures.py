@@ -7,15 +7,15 @@ from typing import Any
 
 import numpy as np
 
-from baselines.reproduce.morenosalinas2013.experiment import (
+from shipgym.models.blanke import Blanke
+from shipgym_baselines.reproduce.morenosalinas2013.experiment import (
     CASES,
     CONTROLLERS,
     DEG,
     SAMPLING_TIME,
 )
-from baselines.reproduce.plotting import pyplot, save
-from baselines.reproduce.protocol import Outcome
-from shipgym.models.blanke import Blanke
+from shipgym_baselines.reproduce.plotting import pyplot, save
+from shipgym_baselines.reproduce.protocol import Outcome
 
 
 def plots(outcome: Outcome, out_dir: Path) -> None:

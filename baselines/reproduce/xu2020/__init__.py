@@ -17,7 +17,7 @@ The experiment, on the ``esso_osaka`` plant (1:100 model, L = 3.25 m, U0 = 0.41 
    to 0.41 m/s; ``None`` starts at cruise speed);
 
 each under ``pid_lookahead_los`` (eq. (6), Δ = 2L) and ``pid_vf`` (Algorithm 1, τ = 2L,
-χe = 90°, k = 1) of :mod:`baselines.classical.pid`, both with the Vyshnegradsky gains.
+χe = 90°, k = 1) of :mod:`shipgym_baselines.classical.pid`, both with the Vyshnegradsky gains.
 
 The paper's Figure 8 (the waypoints) is lost: both cases use ``osaka_curved``'s assumed
 route (20, 0), (120, 40), (220, 10), (320, 50) m and its constant current (0.03 m/s towards
@@ -51,21 +51,25 @@ extra seeds repeat the same episode.
 Writes ``xu2020.md`` / ``.json`` and, per case, ``xu2020_{case}.png`` (track, ψ and ψd,
 e(t), δ(t) of both controllers for each setting, first gains design).
 
-Parts (:mod:`baselines.reproduce.protocol`): :mod:`.scenarios` (cases and plant settings),
+Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.scenarios` (cases and plant settings),
 :mod:`.published` (the paper's numbers), :mod:`.controllers` (the laws, logging ψd, and the
 gain designs), :mod:`.identification` (§5), :mod:`.metrics` (one episode's figures),
 :mod:`.experiment` (the runs and rows), :mod:`.claims` (VF against LOS as the tables
 order them), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from baselines.reproduce.protocol import Reproduction
-from baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS
-from baselines.reproduce.xu2020.experiment import run_experiment
-from baselines.reproduce.xu2020.figures import plot_case, plots
-from baselines.reproduce.xu2020.identification import identification_rows
-from baselines.reproduce.xu2020.metrics import EPISODE_METRICS, episode_figures
-from baselines.reproduce.xu2020.published import PUBLISHED, PUBLISHED_GAINS, PUBLISHED_NOMOTO
-from baselines.reproduce.xu2020.scenarios import (
+from shipgym_baselines.reproduce.protocol import Reproduction
+from shipgym_baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS
+from shipgym_baselines.reproduce.xu2020.experiment import run_experiment
+from shipgym_baselines.reproduce.xu2020.figures import plot_case, plots
+from shipgym_baselines.reproduce.xu2020.identification import identification_rows
+from shipgym_baselines.reproduce.xu2020.metrics import EPISODE_METRICS, episode_figures
+from shipgym_baselines.reproduce.xu2020.published import (
+    PUBLISHED,
+    PUBLISHED_GAINS,
+    PUBLISHED_NOMOTO,
+)
+from shipgym_baselines.reproduce.xu2020.scenarios import (
     BASE_SCENARIO,
     CASES,
     CURVED_INITIAL_SPEED,
@@ -73,7 +77,7 @@ from baselines.reproduce.xu2020.scenarios import (
     SETTINGS,
     build_scenario,
 )
-from baselines.reproduce.xu2020.tables import report
+from shipgym_baselines.reproduce.xu2020.tables import report
 
 REPRODUCTION = Reproduction("xu2020", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from baselines.reproduce.xu2020.published import TABLE_LINES
+from shipgym_baselines.reproduce.xu2020.published import TABLE_LINES
 
 Index = dict[tuple[Any, ...], dict[str, Any]]  # (case, controller, metric, setting, gains)
 VF, LOS = "pid_vf", "pid_lookahead_los"

@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from baselines.classical.pid import PIDVF, PIDLookaheadLOS
 from shipgym.autopilot import VYSHNEGRADSKY_AB_PRINTED, VYSHNEGRADSKY_AB_STATED
 from shipgym.envs.context import ControllerContext
+from shipgym_baselines.classical.pid import PIDVF, PIDLookaheadLOS
 
 #: gain design -> (A, B) of the Vyshnegradsky diagram (§5.1 states 4, 4; 3, 3 gives the
 #: printed gains, :mod:`shipgym.autopilot`)

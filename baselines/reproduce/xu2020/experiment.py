@@ -7,15 +7,15 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from baselines.errors import check_seeds
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.episodes import seeded_episodes
-from baselines.reproduce.protocol import Outcome, Progress
-from baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS
-from baselines.reproduce.xu2020.identification import identification_rows, setting_row
-from baselines.reproduce.xu2020.metrics import EPISODE_METRICS, episode_figures
-from baselines.reproduce.xu2020.published import PUBLISHED
-from baselines.reproduce.xu2020.scenarios import (
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.episodes import seeded_episodes
+from shipgym_baselines.reproduce.protocol import Outcome, Progress
+from shipgym_baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS
+from shipgym_baselines.reproduce.xu2020.identification import identification_rows, setting_row
+from shipgym_baselines.reproduce.xu2020.metrics import EPISODE_METRICS, episode_figures
+from shipgym_baselines.reproduce.xu2020.published import PUBLISHED
+from shipgym_baselines.reproduce.xu2020.scenarios import (
     CASES,
     CURVED_INITIAL_SPEED,
     SETTINGS,

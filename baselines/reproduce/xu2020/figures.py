@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.plotting import pyplot, save
-from baselines.reproduce.protocol import Outcome
-from baselines.reproduce.xu2020.experiment import FirstRuns
-from baselines.reproduce.xu2020.scenarios import CASES
-from baselines.reproduce.xu2020.tables import LAW_NAMES
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.plotting import pyplot, save
+from shipgym_baselines.reproduce.protocol import Outcome
+from shipgym_baselines.reproduce.xu2020.experiment import FirstRuns
+from shipgym_baselines.reproduce.xu2020.scenarios import CASES
+from shipgym_baselines.reproduce.xu2020.tables import LAW_NAMES
 
 
 def plots(outcome: Outcome, out_dir: Path) -> None:

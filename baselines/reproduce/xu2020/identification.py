@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from baselines.reproduce.rows import reproduction_row
-from baselines.reproduce.xu2020.controllers import GAINS
-from baselines.reproduce.xu2020.published import PUBLISHED_GAINS, PUBLISHED_NOMOTO
-from baselines.reproduce.xu2020.scenarios import build_scenario
 from shipgym.autopilot import vyshnegradsky_gains
 from shipgym.identification.zigzag import ship_nomoto
+from shipgym_baselines.reproduce.rows import reproduction_row
+from shipgym_baselines.reproduce.xu2020.controllers import GAINS
+from shipgym_baselines.reproduce.xu2020.published import PUBLISHED_GAINS, PUBLISHED_NOMOTO
+from shipgym_baselines.reproduce.xu2020.scenarios import build_scenario
 
 
 def setting_row(

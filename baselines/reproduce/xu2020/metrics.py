@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from baselines.evaluation import EpisodeResult
 from shipgym.angles import wrap_angle
+from shipgym_baselines.evaluation import EpisodeResult
 
 #: per-episode figures: metric -> (quantity of PUBLISHED or None, statistic, unit)
 EPISODE_METRICS = {

@@ -6,11 +6,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from baselines.reproduce.protocol import Rows
-from baselines.reproduce.report import cell, index, seeds_of, table
-from baselines.reproduce.xu2020.claims import Index, our_relations, paper_relations
-from baselines.reproduce.xu2020.published import PUBLISHED_GAINS, PUBLISHED_NOMOTO, TABLE_LINES
-from baselines.reproduce.xu2020.scenarios import CASES
+from shipgym_baselines.reproduce.protocol import Rows
+from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
+from shipgym_baselines.reproduce.xu2020.claims import Index, our_relations, paper_relations
+from shipgym_baselines.reproduce.xu2020.published import (
+    PUBLISHED_GAINS,
+    PUBLISHED_NOMOTO,
+    TABLE_LINES,
+)
+from shipgym_baselines.reproduce.xu2020.scenarios import CASES
 
 #: the guidance laws' short names in the tables
 LAW_NAMES = {"pid_lookahead_los": "LOS", "pid_vf": "VF"}
@@ -116,7 +120,7 @@ def _paper_table(by_key: Index, case: str, settings: list[str], gains: str) -> l
 
 def _orderings(by_key: Index, case: str, settings: list[str], gains: list[str]) -> list[str]:
     """VF against LOS for every statistic of Tables 2–3, ours vs the paper's
-    (:mod:`~baselines.reproduce.xu2020.claims`)."""
+    (:mod:`~shipgym_baselines.reproduce.xu2020.claims`)."""
     checks = paper_relations(by_key, case, settings[0], gains[0])
     if not checks:
         return []

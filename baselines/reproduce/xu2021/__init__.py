@@ -7,7 +7,7 @@ t = 1000 s; the paper gives neither the switch time nor the fluctuation, see
 :mod:`shipgym.disturbances`) under four controllers:
 
 * ``l1_backstepping`` — the paper's L1 controller, C(s) of eq. (39) on the whole command
-  (:mod:`baselines.classical.l1_backstepping`, §5.2 gains, ω = 0.25 rad/s, ζ = 1);
+  (:mod:`shipgym_baselines.classical.l1_backstepping`, §5.2 gains, ω = 0.25 rad/s, ζ = 1);
 * ``l1_backstepping_adaptive_filter`` — the same with C(s) only on the estimates' share of
   the command (``filter_placement="adaptive"``, the standard L1 structure u = u_nom +
   C(s)·u_ad; our alternative reading of Fig. 4 / eq. (39));
@@ -24,7 +24,7 @@ them.  Rows (SPEC §9b, plus ``seeds`` and ``ours_std``) therefore hold:
   the heading error to the path (the leaderboard's ψ̃) and to the controller's own reference
   ψ − ψd; the rudder angle (mean |δ|, RMS, mean |δ̇|); the RMS above ω = 0.25 rad/s (the
   filter corner) and above 1 rad/s of the rudder *command* and of the rudder *angle*
-  (Welch PSD, :func:`~baselines.classical.l1_backstepping.high_frequency_power`, the figure
+  (Welch PSD, :func:`~shipgym_baselines.classical.l1_backstepping.high_frequency_power`, the figure
   the controllers' ``episode_stats`` report); the drift angle over ground (course −
   heading, the paper's β with earth-fixed u, v) spread and HF RMS; the settling after each
   waypoint switch (time until |e| stays below the leaderboard's convergence threshold
@@ -36,12 +36,12 @@ them.  Rows (SPEC §9b, plus ``seeds`` and ``ours_std``) therefore hold:
   comparison holds when ours is at least ``CLAIM_MARGIN`` = 10 % lower (the ``ratio`` is in
   the row); "cross-track errors nearly same" is the ACE ratio against the paper's 1.0;
 * ``linearised``: the law (35) with exact estimates on its design model, linearised at
-  r = 0 (:func:`~baselines.classical.l1_backstepping.linearised_closed_loop_poles`): the
+  r = 0 (:func:`~shipgym_baselines.classical.l1_backstepping.linearised_closed_loop_poles`): the
   largest closed-loop pole real part and the loop's crossover and phase margin, against
   the paper's UGAS claim (§3–4) as "stable: True".  Continuous time: the 0.5-s sampling
   (≈ 27° more lag at 1.9 rad/s) and the rudder servo are left out.
 
-Episode metrics come from :func:`baselines.evaluation.run_episode` (the leaderboard's);
+Episode metrics come from :func:`shipgym_baselines.evaluation.run_episode` (the leaderboard's);
 per-phase figures are computed from the same trajectory (rows after the reset sample, as
 :func:`shipgym.metrics.compute_metrics` counts them), so the ``episode`` ACE equals the
 leaderboard's ``ace``.  Seeds are ``EVAL_SEED_OFFSET + i``; ``ours`` is the mean over
@@ -77,16 +77,16 @@ Findings (3 seeds, ``shipgym reproduce xu2021 --seeds 3``), each gap from the mo
   (≈ 64 s, outer gain K1 = 0.02 1/s).  "L1 better than PID" (Fig. 15) holds for the stable
   readings (ACE 0.58×), not for the printed one (2.65×).
 
-Parts (:mod:`baselines.reproduce.protocol`): :mod:`.scenario` (the two-phase current),
+Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.scenario` (the two-phase current),
 :mod:`.controllers` (the four laws, recorded), :mod:`.metrics` (one episode's figures per
 phase), :mod:`.linearised` (the loop at r = 0), :mod:`.claims` (§5.2's statements),
 :mod:`.experiment` (the runs and rows), :mod:`.current` (the true current from the env's
 log), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from baselines.reproduce.protocol import Reproduction
-from baselines.reproduce.xu2021.claims import CLAIM_MARGIN, CLAIMS, FILTER_CLAIMS, claims
-from baselines.reproduce.xu2021.controllers import (
+from shipgym_baselines.reproduce.protocol import Reproduction
+from shipgym_baselines.reproduce.xu2021.claims import CLAIM_MARGIN, CLAIMS, FILTER_CLAIMS, claims
+from shipgym_baselines.reproduce.xu2021.controllers import (
     AB,
     CONTROLLERS,
     L1,
@@ -95,19 +95,19 @@ from baselines.reproduce.xu2021.controllers import (
     PID,
     Recorded,
 )
-from baselines.reproduce.xu2021.current import DisturbanceLog, current_speed
-from baselines.reproduce.xu2021.experiment import run_experiment
-from baselines.reproduce.xu2021.figures import plot_runs, plots
-from baselines.reproduce.xu2021.linearised import linear_analysis, loop_margins
-from baselines.reproduce.xu2021.metrics import (
+from shipgym_baselines.reproduce.xu2021.current import DisturbanceLog, current_speed
+from shipgym_baselines.reproduce.xu2021.experiment import run_experiment
+from shipgym_baselines.reproduce.xu2021.figures import plot_runs, plots
+from shipgym_baselines.reproduce.xu2021.linearised import linear_analysis, loop_margins
+from shipgym_baselines.reproduce.xu2021.metrics import (
     CUTOFF,
     CUTOFF_HIGH,
     METRICS,
     PHASES,
     episode_figures,
 )
-from baselines.reproduce.xu2021.scenario import SCENARIO, build_scenario, switch_time
-from baselines.reproduce.xu2021.tables import report
+from shipgym_baselines.reproduce.xu2021.scenario import SCENARIO, build_scenario, switch_time
+from shipgym_baselines.reproduce.xu2021.tables import report
 
 REPRODUCTION = Reproduction("xu2021", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from baselines.reproduce.rows import reproduction_row as _row
-from baselines.reproduce.xu2021.controllers import AB, L1_VARIANTS, PID
+from shipgym_baselines.reproduce.rows import reproduction_row as _row
+from shipgym_baselines.reproduce.xu2021.controllers import AB, L1_VARIANTS, PID
 
 #: a comparative claim holds when ours is at least this much lower (a difference that a
 #: figure shows; smaller ones are within the seed-to-seed spread of these runs)

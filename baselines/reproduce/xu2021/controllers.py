@@ -8,9 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
-from baselines.classical.pid import PIDTVVF
 from shipgym.angles import wrap_angle
+from shipgym_baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
+from shipgym_baselines.classical.pid import PIDTVVF
 
 L1 = "l1_backstepping"
 L1_ADAPTIVE = "l1_backstepping_adaptive_filter"

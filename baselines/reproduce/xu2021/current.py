@@ -14,7 +14,7 @@ import numpy as np
 
 
 class DisturbanceLog:
-    """``after_episode`` hook of :func:`baselines.evaluation.run_episode`: keeps, per
+    """``after_episode`` hook of :func:`shipgym_baselines.evaluation.run_episode`: keeps, per
     episode, the disturbances the plant saw (name -> values at ``"t"`` [s])."""
 
     def __init__(self) -> None:

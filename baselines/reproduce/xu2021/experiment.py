@@ -6,18 +6,18 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from baselines.errors import check_seeds
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.episodes import seeded_episodes
-from baselines.reproduce.protocol import Outcome, Progress
-from baselines.reproduce.rows import reproduction_row as _row
-from baselines.reproduce.xu2021.claims import claims
-from baselines.reproduce.xu2021.controllers import CONTROLLERS, PID, Recorded
-from baselines.reproduce.xu2021.current import DisturbanceLog
-from baselines.reproduce.xu2021.linearised import linear_analysis
-from baselines.reproduce.xu2021.metrics import PHASES, episode_figures
-from baselines.reproduce.xu2021.scenario import build_scenario
 from shipgym.models import MODELS
+from shipgym_baselines.errors import check_seeds
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.episodes import seeded_episodes
+from shipgym_baselines.reproduce.protocol import Outcome, Progress
+from shipgym_baselines.reproduce.rows import reproduction_row as _row
+from shipgym_baselines.reproduce.xu2021.claims import claims
+from shipgym_baselines.reproduce.xu2021.controllers import CONTROLLERS, PID, Recorded
+from shipgym_baselines.reproduce.xu2021.current import DisturbanceLog
+from shipgym_baselines.reproduce.xu2021.linearised import linear_analysis
+from shipgym_baselines.reproduce.xu2021.metrics import PHASES, episode_figures
+from shipgym_baselines.reproduce.xu2021.scenario import build_scenario
 
 
 class FirstRuns(NamedTuple):

@@ -9,14 +9,14 @@ from typing import Any
 import numpy as np
 import scipy.signal
 
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.plotting import pyplot, save
-from baselines.reproduce.protocol import Outcome
-from baselines.reproduce.xu2021.controllers import Recorded
-from baselines.reproduce.xu2021.current import current_speed
-from baselines.reproduce.xu2021.experiment import FirstRuns
-from baselines.reproduce.xu2021.metrics import CUTOFF, DEG
-from baselines.reproduce.xu2021.scenario import switch_time
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.plotting import pyplot, save
+from shipgym_baselines.reproduce.protocol import Outcome
+from shipgym_baselines.reproduce.xu2021.controllers import Recorded
+from shipgym_baselines.reproduce.xu2021.current import current_speed
+from shipgym_baselines.reproduce.xu2021.experiment import FirstRuns
+from shipgym_baselines.reproduce.xu2021.metrics import CUTOFF, DEG
+from shipgym_baselines.reproduce.xu2021.scenario import switch_time
 
 
 def plots(outcome: Outcome, out_dir: Path) -> None:

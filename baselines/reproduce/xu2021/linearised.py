@@ -9,15 +9,15 @@ import gymnasium as gym
 import numpy as np
 import scipy.optimize
 
-from baselines.classical.l1_backstepping import (
+from shipgym.identification import first_order_nomoto
+from shipgym_baselines.classical.l1_backstepping import (
     Gains,
     L1BacksteppingSettings,
     linearised_closed_loop_poles,
     nominal_design_model,
 )
-from baselines.classical.pid import PIDTVVF
-from baselines.reproduce.xu2021.controllers import AB, L1, L1_ADAPTIVE, PID
-from shipgym.identification import first_order_nomoto
+from shipgym_baselines.classical.pid import PIDTVVF
+from shipgym_baselines.reproduce.xu2021.controllers import AB, L1, L1_ADAPTIVE, PID
 
 
 def loop_margins(num: np.ndarray, den: np.ndarray) -> tuple[float, float]:

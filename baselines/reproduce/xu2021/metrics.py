@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 
-from baselines.classical.l1_backstepping import high_frequency_power
-from baselines.evaluation import EpisodeResult
-from baselines.reproduce.xu2021.controllers import Recorded
-from baselines.reproduce.xu2021.scenario import switch_time
 from shipgym.angles import wrap_angle
 from shipgym.tracking import PathTracker
+from shipgym_baselines.classical.l1_backstepping import high_frequency_power
+from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.reproduce.xu2021.controllers import Recorded
+from shipgym_baselines.reproduce.xu2021.scenario import switch_time
 
 #: the HF band: above the filter corner ω = 0.25 rad/s of eq. (39) (Xu et al. 2021 §5.2)
 CUTOFF = 0.25  # [rad/s]

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from baselines.reproduce.protocol import Rows
-from baselines.reproduce.report import cell, index, seeds_of, table
-from baselines.reproduce.xu2021.claims import CLAIMS
-from baselines.reproduce.xu2021.metrics import METRICS, PHASES
+from shipgym_baselines.reproduce.protocol import Rows
+from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
+from shipgym_baselines.reproduce.xu2021.claims import CLAIMS
+from shipgym_baselines.reproduce.xu2021.metrics import METRICS, PHASES
 
 #: table text of the episode-only metrics
 EPISODE_TEXT = {

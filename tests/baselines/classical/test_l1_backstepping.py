@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 import yaml
 
-import baselines.classical.l1_backstepping as l1
-from baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
-from baselines.evaluation import run_episode
+import shipgym_baselines.classical.l1_backstepping as l1
 from shipgym.envs.context import ControllerContext
 from shipgym.metrics import high_frequency_power
 from shipgym.scenarios import catalogue_dir, scenario_from_dict
+from shipgym_baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
+from shipgym_baselines.evaluation import run_episode
 
 TS = 0.5  # control period of the nomoto2 scenarios [s]
 
@@ -30,7 +30,9 @@ def _context(scenario: str, **make_kwargs: object) -> ControllerContext:
 
 def test_the_parts_stay_importable_from_the_controller_module() -> None:
     """The names the reproduction code imports from l1_backstepping are the parts' own."""
-    from baselines.classical.adaptive import (
+    from shipgym import guidance, metrics
+    from shipgym.identification import cubic_damping
+    from shipgym_baselines.classical.adaptive import (
         design_model,
         loop_analysis,
         lowpass,
@@ -38,8 +40,6 @@ def test_the_parts_stay_importable_from_the_controller_module() -> None:
         projection,
         settings,
     )
-    from shipgym import guidance, metrics
-    from shipgym.identification import cubic_damping
 
     assert l1.Gains is settings.Gains
     assert l1.L1BacksteppingSettings is settings.L1BacksteppingSettings

@@ -10,7 +10,11 @@ import numpy as np
 import pytest
 from scipy.linalg import solve_continuous_are
 
-from baselines.classical.lqr import (
+from shipgym.envs.context import ControllerContext
+from shipgym.identification import first_order_nomoto
+from shipgym.models.mariner import MarinerParams
+from shipgym.scenarios import load_scenario, scenario_from_dict
+from shipgym_baselines.classical.lqr import (
     LQR,
     AdaptiveLQR,
     LQRWeights,
@@ -19,13 +23,9 @@ from baselines.classical.lqr import (
     lqr_gain,
     track_model,
 )
-from baselines.cli import build_parser
-from baselines.evaluation import run_episode
-from baselines.reproduce import PAPERS, borkowski2018
-from shipgym.envs.context import ControllerContext
-from shipgym.identification import first_order_nomoto
-from shipgym.models.mariner import MarinerParams
-from shipgym.scenarios import load_scenario, scenario_from_dict
+from shipgym_baselines.cli import build_parser
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.reproduce import PAPERS, borkowski2018
 
 PAPER = LQRWeights()  # λy = 1/2000, λψ = 1, λδ = 5 (Borkowski 2018 §5)
 MARINER = MarinerParams()
@@ -245,7 +245,7 @@ def test_fast_riccati_solution_equals_scipy_and_solves_the_care() -> None:
     track model of the four ships' (a, c, U) ranges."""
     from scipy.linalg import solve_continuous_are
 
-    from baselines.classical.lqr import LQRWeights, solve_care, track_model
+    from shipgym_baselines.classical.lqr import LQRWeights, solve_care, track_model
 
     rng = np.random.default_rng(0)
     for _ in range(50):

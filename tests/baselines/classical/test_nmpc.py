@@ -8,10 +8,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCSettings, NMPCSolver
-from baselines.evaluation import evaluate, run_episode
 from shipgym.models import Nomoto2, Nomoto2Params
 from shipgym.scenarios import scenario_from_dict
+from shipgym_baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCSettings, NMPCSolver
+from shipgym_baselines.evaluation import evaluate, run_episode
 
 DEG = math.pi / 180.0
 
@@ -169,7 +169,7 @@ def test_nmpc_refuses_guidance_mode() -> None:
 
 
 def test_svf_controllers_are_registered_for_every_ship() -> None:
-    from baselines.registry import CONTROLLERS
+    from shipgym_baselines.registry import CONTROLLERS
 
     for name in ("nmpc_lambda_lssvm_svf", "nmpc_wlssvm_svf"):
         record = CONTROLLERS[name]
@@ -182,8 +182,8 @@ def test_svf_front_end_restores_the_adaptive_advantage_in_case3() -> None:
     """Issue 14: Case 3 (heading noise σ = 0.2° and outliers), 3 seeds: the mean ACE of each
     ``*_svf`` controller is below half that of non-adaptive ``nmpc`` (measured 0.53 and
     0.80 m against 3.53 m), where the paper's differences leave λ-LS-SVM worse than ``nmpc``."""
-    from baselines.classical.nmpc import NMPCLambdaLSSVMSVF, NMPCWeightedLSSVMSVF
-    from baselines.evaluation import EVAL_SEED_OFFSET
+    from shipgym_baselines.classical.nmpc import NMPCLambdaLSSVMSVF, NMPCWeightedLSSVMSVF
+    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 
     def mean_ace(cls) -> float:
         return float(

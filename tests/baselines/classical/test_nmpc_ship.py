@@ -5,19 +5,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from baselines.classical.nmpc import NMPC, NMPCSettings
-from baselines.classical.nmpc_ship import (
+from shipgym.envs.context import ControllerContext
+from shipgym.identification import first_order_nomoto
+from shipgym.models.nomoto2 import nomoto2_first_order
+from shipgym.scenarios import load_scenario
+from shipgym_baselines.classical.nmpc import NMPC, NMPCSettings
+from shipgym_baselines.classical.nmpc_ship import (
     PAPER_Q,
     nominal_prediction_params,
     paper_ship,
     ship_plan,
 )
-from baselines.evaluation import run_episode
-from baselines.registry import applies_to, make_controller
-from shipgym.envs.context import ControllerContext
-from shipgym.identification import first_order_nomoto
-from shipgym.models.nomoto2 import nomoto2_first_order
-from shipgym.scenarios import load_scenario
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.registry import applies_to, make_controller
 
 FAMILY = ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm", "nmpc_wlssvm_svf", "nmpc_lambda_lssvm_svf")
 #: each other ship's catalogue scenario, and the part of it a test runs [s]: past its first

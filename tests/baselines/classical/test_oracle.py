@@ -12,7 +12,9 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from baselines.classical.oracle import (
+from shipgym.envs.context import ControllerContext
+from shipgym.scenarios import load_scenario
+from shipgym_baselines.classical.oracle import (
     LAST_LEG,
     Oracle,
     OracleSettings,
@@ -20,15 +22,13 @@ from baselines.classical.oracle import (
     horizon_seconds,
     oracle_grid,
 )
-from baselines.errors import ControllerError
-from baselines.evaluation import evaluate, run_episode
-from baselines.leaderboard import Job, trials, work
-from baselines.plugins import ControllerEntry
-from baselines.privileged import grants_truth
-from baselines.references import ReferenceTable, entry_key, shipped_table, table_path
-from baselines.suite import load_suite
-from shipgym.envs.context import ControllerContext
-from shipgym.scenarios import load_scenario
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.evaluation import evaluate, run_episode
+from shipgym_baselines.leaderboard import Job, trials, work
+from shipgym_baselines.plugins import ControllerEntry
+from shipgym_baselines.privileged import grants_truth
+from shipgym_baselines.references import ReferenceTable, entry_key, shipped_table, table_path
+from shipgym_baselines.suite import load_suite
 
 
 # ------------------------------------------------------------------ the optimiser
@@ -114,7 +114,7 @@ def test_the_horizon_rule_by_ship() -> None:
 # ------------------------------------------------------------------ the privileged channel
 SPY = """
 import numpy as np
-from baselines.classical.oracle import Oracle
+from shipgym_baselines.classical.oracle import Oracle
 
 class Spy:
     name = "spy"
@@ -159,7 +159,7 @@ def test_the_privileged_channel_is_unreachable_from_a_plugin(spy_module: Path) -
     for spec in (
         f"{spy_module}:Imitator",
         f"{spy_module}:borrowed",
-        "baselines.classical.oracle:Oracle",
+        "shipgym_baselines.classical.oracle:Oracle",
         ControllerEntry(controller="oracle", name="my_oracle"),
         ControllerEntry(controller="oracle", settings={"settings": OracleSettings(blocks=5)}),
     ):
@@ -248,7 +248,7 @@ def test_shipgym_references_fills_a_table_and_resumes(
 
     import yaml
 
-    from baselines.cli import main
+    from shipgym_baselines.cli import main
 
     suite = tmp_path / "tiny.yaml"
     suite.write_text(

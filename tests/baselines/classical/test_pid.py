@@ -10,14 +10,6 @@ import numpy as np
 import pytest
 import yaml
 
-from baselines.classical.pid import (
-    PIDLOS,
-    PIDTVVF,
-    PIDVF,
-    PIDLookaheadLOS,
-    design_gains,
-)
-from baselines.evaluation import evaluate
 from shipgym.autopilot import (
     VYSHNEGRADSKY_AB_PRINTED,
     PIDGains,
@@ -30,6 +22,14 @@ from shipgym.guidance import tvvf_heading, vector_field_heading
 from shipgym.identification import first_order_nomoto, second_order_nomoto
 from shipgym.models import Mariner, Nomoto2
 from shipgym.scenarios import scenario_from_dict
+from shipgym_baselines.classical.pid import (
+    PIDLOS,
+    PIDTVVF,
+    PIDVF,
+    PIDLookaheadLOS,
+    design_gains,
+)
+from shipgym_baselines.evaluation import evaluate
 
 #: Esso Osaka 2nd-order Nomoto model identified by Xu & Guedes Soares (2020) §5.2
 ESSO = {"K": 0.185, "T1": 7.8569, "T2": 0.3815, "T3": 0.5297}

@@ -12,11 +12,6 @@ import pytest
 import yaml
 
 import shipgym
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from baselines.leaderboard import run_job, run_leaderboard
-from baselines.learned.agents import AgentConfig, load_agent_config
-from baselines.learned.policy import LearnedPolicy
-from baselines.learned.train import export_policy, latest_checkpoint, train
 from shipgym.scenarios import ScenarioError, load_scenario
 from shipgym.scenarios.sampling import (
     DistributionError,
@@ -24,6 +19,11 @@ from shipgym.scenarios.sampling import (
     train_rng,
     train_scenario_seed,
 )
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+from shipgym_baselines.leaderboard import run_job, run_leaderboard
+from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
+from shipgym_baselines.learned.policy import LearnedPolicy
+from shipgym_baselines.learned.train import export_policy, latest_checkpoint, train
 
 pytest.importorskip("stable_baselines3")
 
@@ -243,7 +243,7 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
     local = run_leaderboard(
         str(suite), seeds=2, out_dir=tmp_path / "a", workers=2, show_progress=False
     )
-    from baselines.learned.train import train_sweep
+    from shipgym_baselines.learned.train import train_sweep
 
     job = {"config": _tiny_config(), "seed": 3, "n_timesteps": 128, "tensorboard": False}
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
@@ -272,7 +272,7 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
 
 def test_training_sweep_gives_the_same_runs_in_a_process_pool(tmp_path: Path) -> None:
     """Two seeds trained in a local process pool equal the same runs trained in turn."""
-    from baselines.learned.train import train_sweep
+    from shipgym_baselines.learned.train import train_sweep
 
     def jobs(root: Path) -> list[dict]:
         return [
@@ -307,11 +307,11 @@ def test_train_seeds_ship_lays_out_a_folder_per_training_seed(
     """``train --seeds 1 2`` trains a run per seed; ``--ship --resume`` on the finished runs
     exports them (without training again) into ``policies/<name>/seed_<k>`` — what
     LearnedPolicy reads, nothing else — and the agent's single-model files are removed."""
-    from baselines.cli import main
-    from baselines.registry import training_seeds
+    from shipgym_baselines.cli import main
+    from shipgym_baselines.registry import training_seeds
 
     policies = tmp_path / "policies"
-    monkeypatch.setattr("baselines.learned.policy.POLICY_DIR", policies)
+    monkeypatch.setattr("shipgym_baselines.learned.policy.POLICY_DIR", policies)
     (policies / "ppo_tiny").mkdir(parents=True)
     for old in ("model.zip", "meta.json"):  # the layout before training seeds
         (policies / "ppo_tiny" / old).write_text("old")
@@ -341,7 +341,7 @@ def test_train_seeds_ship_lays_out_a_folder_per_training_seed(
 
 
 def test_train_takes_seed_as_an_alias_of_seeds() -> None:
-    from baselines.cli import build_parser
+    from shipgym_baselines.cli import build_parser
 
     parser = build_parser()
     assert parser.parse_args(["train", "ppo", "--seed", "3"]).seeds == [3]

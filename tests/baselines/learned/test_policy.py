@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 import shipgym  # noqa: F401  (registers the envs)
-from baselines.cli import main
-from baselines.errors import ControllerError
-from baselines.evaluation import EVAL_SEED_OFFSET, evaluate, evaluate_batch
-from baselines.learned.policy import (
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, evaluate_batch
+from shipgym_baselines.learned.policy import (
     ALGORITHMS,
     BATCH_ROWS,
     LearnedPolicy,
@@ -27,9 +27,9 @@ from baselines.learned.policy import (
     read_policy,
     shipped_policies,
 )
-from baselines.learned.trust import trusting_pickle
-from baselines.plugins import ControllerEntry
-from baselines.registry import (
+from shipgym_baselines.learned.trust import trusting_pickle
+from shipgym_baselines.plugins import ControllerEntry
+from shipgym_baselines.registry import (
     controller_kind,
     controller_label,
     make_controller,

@@ -17,12 +17,12 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines.cli import main
-from baselines.errors import UnsafeFileError
-from baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer, read_normalizer
-from baselines.learned.policy import POLICY_DIR, LearnedPolicy
-from baselines.learned.trust import TRUST_PICKLE_ENV, pickle_trusted, trusting_pickle
-from baselines.registry import make_controller
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import UnsafeFileError
+from shipgym_baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer, read_normalizer
+from shipgym_baselines.learned.policy import POLICY_DIR, LearnedPolicy
+from shipgym_baselines.learned.trust import TRUST_PICKLE_ENV, pickle_trusted, trusting_pickle
+from shipgym_baselines.registry import make_controller
 
 sb3 = pytest.importorskip("stable_baselines3")
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "shipped_policy_actions.npz"
@@ -157,7 +157,7 @@ def test_finding7_a_pickled_vecnormalize_is_refused_unless_trusted(tmp_path: Pat
     venv.save(str(folder / "vecnormalize.pkl"))
     with trusting_pickle(True):
         trusted = LearnedPolicy(folder)
-    from baselines.learned.normalizer import main as convert
+    from shipgym_baselines.learned.normalizer import main as convert
 
     assert convert([str(folder / "vecnormalize.pkl")]) == 0
     data = LearnedPolicy(folder)  # the JSON beside it: no unpickling
@@ -194,7 +194,7 @@ def test_finding7_trust_pickle_reads_a_zip_sb3_alone_can(tmp_path: Path, capsys)
 def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-    from baselines.learned.train import export_policy, save_obs_statistics
+    from shipgym_baselines.learned.train import export_policy, save_obs_statistics
 
     env = DummyVecEnv([lambda: gym.make("ShipPathFollow-v0")])
     assert save_obs_statistics(VecNormalize(env, norm_obs=False), tmp_path) is None

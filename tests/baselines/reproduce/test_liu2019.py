@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from baselines.reproduce.liu2019 import markdown, run_experiment
-from baselines.reproduce.liu2019.experiment import IDENTIFIED
+from shipgym_baselines.reproduce.liu2019 import markdown, run_experiment
+from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED
 
 #: the paper-literal ACE [m] (si reading, 1 seed) as recorded before the SVF front end:
 #: the extension must not move them by one bit

@@ -8,11 +8,11 @@ import math
 
 import pytest
 
-from baselines.cli import build_parser
-from baselines.reproduce import PAPERS, Outcome, Reproduction, borkowski2018
-from baselines.reproduce.borkowski2018.claims import case_claims
-from baselines.reproduce.report import cell, index, seeds_of, table
-from baselines.reproduce.rows import reproduction_row
+from shipgym_baselines.cli import build_parser
+from shipgym_baselines.reproduce import PAPERS, Outcome, Reproduction, borkowski2018
+from shipgym_baselines.reproduce.borkowski2018.claims import case_claims
+from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
+from shipgym_baselines.reproduce.rows import reproduction_row
 
 
 @pytest.mark.parametrize("name", sorted(PAPERS))
@@ -20,7 +20,7 @@ def test_every_paper_is_a_reproduction_the_cli_can_run(name: str) -> None:
     package = PAPERS[name]
     paper = package.REPRODUCTION
     assert isinstance(paper, Reproduction) and paper.name == name
-    # what baselines.cli calls: run(out_dir=, seeds=, progress=) and markdown(rows)
+    # what shipgym_baselines.cli calls: run(out_dir=, seeds=, progress=) and markdown(rows)
     assert package.run == paper.run and package.markdown == paper.markdown
     params = inspect.signature(paper.run_experiment).parameters
     assert list(params)[:2] == ["seeds", "progress"]

@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from baselines.cli import build_parser
-from baselines.evaluation import run_episode
-from baselines.reproduce import PAPERS, xu2020
 from shipgym.identification.zigzag import ship_nomoto
 from shipgym.models import MODELS
+from shipgym_baselines.cli import build_parser
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.reproduce import PAPERS, xu2020
 
 pytestmark = pytest.mark.skipif("esso_osaka" not in MODELS, reason="esso_osaka not registered")
 

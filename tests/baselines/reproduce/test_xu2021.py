@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
-from baselines.cli import build_parser
-from baselines.evaluation import run_episode
-from baselines.jsonout import finite_or_none
-from baselines.reproduce import PAPERS, xu2021
 from shipgym.models import MODELS
+from shipgym_baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
+from shipgym_baselines.cli import build_parser
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.jsonout import finite_or_none
+from shipgym_baselines.reproduce import PAPERS, xu2021
 
 pytestmark = pytest.mark.skipif("esso_osaka" not in MODELS, reason="esso_osaka not registered")
 

@@ -126,7 +126,7 @@ def test_sb3_adapter_trains_ppo_and_autoresets_same_step() -> None:
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
-    from baselines.learned.vec_env import SB3BatchedVecEnv
+    from shipgym_baselines.learned.vec_env import SB3BatchedVecEnv
 
     env = SB3BatchedVecEnv(ShipPathFollowVectorEnv(N, "nominal"))
     assert isinstance(env, VecEnv)
@@ -209,7 +209,7 @@ def test_make_vec_takes_max_episode_steps_like_the_time_limit_wrapper() -> None:
 def test_sb3_adapter_gives_each_env_the_single_env_info_keys() -> None:
     from stable_baselines3.common.vec_env import VecMonitor
 
-    from baselines.learned.vec_env import SB3BatchedVecEnv
+    from shipgym_baselines.learned.vec_env import SB3BatchedVecEnv
 
     env = VecMonitor(
         SB3BatchedVecEnv(ShipPathFollowVectorEnv(N, "nominal")),

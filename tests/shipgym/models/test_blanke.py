@@ -256,9 +256,9 @@ def test_fit_rejects_bad_data():
 
 
 def test_reproduce_returns_the_documented_rows(tmp_path):
-    from baselines.cli import build_parser
-    from baselines.reproduce import PAPERS
-    from baselines.reproduce.morenosalinas2013 import PUBLISHED, SIGNALS
+    from shipgym_baselines.cli import build_parser
+    from shipgym_baselines.reproduce import PAPERS
+    from shipgym_baselines.reproduce.morenosalinas2013 import PUBLISHED, SIGNALS
 
     module = PAPERS["morenosalinas2013"]
     assert build_parser().parse_args(["reproduce", "morenosalinas2013"]).paper == (

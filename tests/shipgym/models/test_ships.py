@@ -108,8 +108,8 @@ CLASSICAL = [
 def test_every_classical_controller_keeps_the_error_bounded_on_every_ship(ship: str) -> None:
     """Short fixed-seed runs (60 control steps) of each classical controller (each applies
     to every ship): the ship stays inside the corridor and every number is finite."""
-    from baselines.evaluation import evaluate
-    from baselines.registry import applies_to
+    from shipgym_baselines.evaluation import evaluate
+    from shipgym_baselines.registry import applies_to
 
     config = load_scenario(gym.spec(SHIP_IDS[ship]).kwargs["scenario"]).config
     data = config.model_dump(exclude_none=True)

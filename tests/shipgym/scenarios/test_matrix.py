@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 import shipgym
-from baselines.evaluation import EVAL_SEED_OFFSET, run_episode
-from baselines.registry import make_controller
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
 from shipgym.scenarios import list_scenarios, load_scenario
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
+from shipgym_baselines.registry import make_controller
 
 SHIPS = ("esso_osaka", "mariner", "blanke")
 FAMILIES = ("rudder_aging", "current_shift", "maneuverability_change")

@@ -12,8 +12,6 @@ import numpy as np
 import pytest
 import yaml
 
-from baselines.evaluation import run_episode
-from baselines.registry import make_controller
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
 from shipgym.scenarios import list_scenarios, load_scenario
@@ -25,6 +23,8 @@ from shipgym.scenarios.sampling import (
     load_distribution,
     train_rng,
 )
+from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.registry import make_controller
 
 SHIPS = ("nomoto2", "esso_osaka", "mariner", "blanke")
 DISTRIBUTIONS = Path(__file__).resolve().parents[3] / "configs/distributions"

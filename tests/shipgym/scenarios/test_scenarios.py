@@ -491,7 +491,7 @@ def test_unknown_initial_state_name_is_a_load_error_naming_the_key() -> None:
 @pytest.mark.parametrize("controller", ["pid_los", "adaptive_backstepping"])
 def test_mariner_track_can_be_finished_in_its_time_limit(controller: str) -> None:
     """The 11 km route fits the limit (it did not in Borkowski's 1000 s: 7.9 km at 7.86 m/s)."""
-    from baselines.evaluation import evaluate
+    from shipgym_baselines.evaluation import evaluate
 
     (result,) = evaluate(controller, "mariner_track", seeds=[0])
     assert result.metrics["termination_reason"] == "goal"

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from baselines.classical.adaptive.backstepping import backstepping_rudder
-from baselines.classical.adaptive.design_model import NonlinearNomoto
-from baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
+from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto
+from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 
 MODEL = NonlinearNomoto(K=0.506, T=1.4483, a2=0.0081)
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
 from shipgym.identification import first_order_nomoto
 from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.models import MODELS, Nomoto2, Nomoto2Params
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
 
 
 def test_nomoto2_design_model_is_the_first_order_reduction_with_beta() -> None:

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from baselines.classical.adaptive.backstepping import backstepping_rudder
-from baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
-from baselines.classical.adaptive.loop_analysis import (
+from shipgym.models import MODELS
+from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
+from shipgym_baselines.classical.adaptive.loop_analysis import (
     linearised_closed_loop_poles,
     linearised_pd_gains,
 )
-from baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
-from shipgym.models import MODELS
+from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 
 
 def _paper_design() -> tuple[NonlinearNomoto, Gains]:

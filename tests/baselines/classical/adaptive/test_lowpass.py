@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from baselines.classical.adaptive.lowpass import SecondOrderLowPass, low_pass_transfer_function
+from shipgym_baselines.classical.adaptive.lowpass import (
+    SecondOrderLowPass,
+    low_pass_transfer_function,
+)
 
 TS = 0.5  # [s]
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from baselines.classical.adaptive.design_model import NonlinearNomoto
-from baselines.classical.adaptive.predictor import StatePredictor
+from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto
+from shipgym_baselines.classical.adaptive.predictor import StatePredictor
 
 #: nomoto2's first-order design model (K, T1 + T2 − T3, β)
 MODEL = NonlinearNomoto(K=0.506, T=1.4483, a2=0.0081)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from baselines.classical.adaptive.projection import projection
+from shipgym_baselines.classical.adaptive.projection import projection
 
 LO, HI, EPS = 0.1, 10.0, 0.1
 CENTRE, W0 = 0.5 * (LO + HI), 0.5 * (HI - LO) / math.sqrt(1 + EPS)

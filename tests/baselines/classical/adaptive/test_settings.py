@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
+from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 
 
 def test_similarity_transfer_keeps_the_printed_gains_on_the_paper_ship() -> None:
