@@ -1,4 +1,5 @@
-"""The ``shipgym`` console script (SPEC §9b).
+"""The ``shipgym`` console script: leaderboard, evaluation, training, reproduction of the papers,
+manoeuvres and benchmarks (documentation: the docs site, page "Packages and commands").
 
 ``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
 """
