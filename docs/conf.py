@@ -33,7 +33,8 @@ source_suffix = {".md": "myst-nb", ".ipynb": "myst-nb"}
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints", "_generated/ships"]
 myst_enable_extensions = ["colon_fence", "dollarmath", "deflist"]
 myst_heading_anchors = 3
-suppress_warnings = ["myst.header"]
+# ref.python: a name documented in two modules (a re-export) is an ambiguous target
+suppress_warnings = ["myst.header", "ref.python"]
 
 # the notebooks are executed by the tests (tests/test_notebooks.py), rendered here as stored
 nb_execution_mode = "off"
@@ -42,10 +43,13 @@ bibtex_bibfiles = ["references.bib"]
 bibtex_default_style = "plain"
 bibtex_reference_style = "author_year"
 
-autodoc_default_options = {"members": True, "show-inheritance": True}
+autodoc_default_options = {"members": True, "show-inheritance": True, "ignore-module-all": True}
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
 autodoc_mock_imports: list[str] = []
+
+# -D shipgym_docs_api=0 leaves the API reference out (a quicker build)
+shipgym_docs_api = True
 
 html_theme = "furo"
 html_title = f"shipgym {release}"

@@ -82,33 +82,77 @@ class ShipPathFollowEnv(gym.Env):
 
     .. rubric:: Observation space
 
-    ``Box(low, high, (9,), float32)``, from measurements (sensor noise included) only:
+    ``Box(low, high, (9,), float32)``, from measurements (sensor noise included) only; ψ̃ is
+    the heading error, the path angle minus the measured heading:
 
-    ===  ======================  ==============================  ============  =======
-    idx  name                    quantity / scaling              unit before   bounds
-    ===  ======================  ==============================  ============  =======
-    0    ``cross_track``         e / e_max                       m             [-1, 1]
-    1    ``sin_heading_error``   sin ψ̃ (ψ̃ = path angle − ψ)      rad           [-1, 1]
-    2    ``cos_heading_error``   cos ψ̃                           rad           [-1, 1]
-    3    ``yaw_rate``            r / (2 u0 / L), clipped          rad/s         [-1, 1]
-    4    ``rudder_angle``        δ / δmax                        rad           [-1, 1]
-    5    ``last_rudder_command`` δc_prev / δmax                  rad           [-1, 1]
-    6    ``speed``               U / U0, clipped                 m/s           [0, 2]
-    7    ``next_angle_change``   Δψ_next / π (next leg)          rad           [-1, 1]
-    8    ``next_distance``       d_next / (d_next + 10 L)        m             [0, 1)
-    ===  ======================  ==============================  ============  =======
+    .. list-table::
+       :header-rows: 1
+
+       * - index
+         - name
+         - quantity and scaling
+         - unit before scaling
+         - bounds
+       * - 0
+         - ``cross_track``
+         - ``e / e_max``
+         - m
+         - [-1, 1]
+       * - 1
+         - ``sin_heading_error``
+         - ``sin ψ̃``
+         - rad
+         - [-1, 1]
+       * - 2
+         - ``cos_heading_error``
+         - ``cos ψ̃``
+         - rad
+         - [-1, 1]
+       * - 3
+         - ``yaw_rate``
+         - ``r / (2 u0 / L)``, clipped
+         - rad/s
+         - [-1, 1]
+       * - 4
+         - ``rudder_angle``
+         - ``δ / δmax``
+         - rad
+         - [-1, 1]
+       * - 5
+         - ``last_rudder_command``
+         - ``δc_prev / δmax``
+         - rad
+         - [-1, 1]
+       * - 6
+         - ``speed``
+         - ``U / U0``, clipped
+         - m/s
+         - [0, 2]
+       * - 7
+         - ``next_angle_change``
+         - ``Δψ_next / π``, path-angle change to the next leg
+         - rad
+         - [-1, 1]
+       * - 8
+         - ``next_distance``
+         - ``d_next / (d_next + 10 L)``, distance to the next waypoint
+         - m
+         - [0, 1)
 
     .. rubric:: Reward
 
-    Per step, from the true state (the score, the same for every controller):
-    r = −(|e|/L + w_ψ·|ψ̃| + w_δ·(δc/δmax)² + w_Δ·(Δδc/δmax)²), defaults w_ψ = 0.1,
-    w_δ = 0.01, w_Δ = 0.05 (the scenario's ``reward:``).  While the ship is inside the
-    corridor each term is bounded: 0 ≤ |e|/L ≤ e_max/L (10 by default), 0 ≤ w_ψ|ψ̃| ≤ w_ψπ,
-    0 ≤ w_δ(δc/δmax)² ≤ w_δ, 0 ≤ w_Δ(Δδc/δmax)² ≤ 4w_Δ, so r ∈ [−(e_max/L + w_ψπ + w_δ +
-    4w_Δ), 0].  Reaching the last waypoint adds ``goal_bonus`` (+10).  Leaving the corridor
-    adds a penalty equal to staying at its edge for the rest of the time limit,
-    −(e_max/L)·(steps left), so that leaving is never cheaper than staying; a non-finite
-    plant state is charged the same from the step before.
+    Per step, from the true state (the score, the same for every controller)::
+
+        r = −(|e|/L + w_ψ·|ψ̃| + w_δ·(δc/δmax)² + w_Δ·(Δδc/δmax)²)
+
+    with defaults w_ψ = 0.1, w_δ = 0.01, w_Δ = 0.05 (the scenario's ``reward:``).  While the
+    ship is inside the corridor each term is bounded: ``0 ≤ |e|/L ≤ e_max/L`` (10 by
+    default), ``0 ≤ w_ψ·|ψ̃| ≤ w_ψ·π``, ``0 ≤ w_δ·(δc/δmax)² ≤ w_δ``,
+    ``0 ≤ w_Δ·(Δδc/δmax)² ≤ 4·w_Δ``, so ``r ∈ [−(e_max/L + w_ψ·π + w_δ + 4·w_Δ), 0]``.
+    Reaching the last waypoint adds ``goal_bonus`` (+10).  Leaving the corridor adds a
+    penalty equal to staying at its edge for the rest of the time limit,
+    ``−(e_max/L)·(steps left)``, so that leaving is never cheaper than staying; a
+    non-finite plant state is charged the same from the step before.
 
     .. rubric:: Starting state
 
@@ -120,7 +164,7 @@ class ShipPathFollowEnv(gym.Env):
     .. rubric:: Episode end
 
     Terminated: the last waypoint is reached (``termination_reason = "goal"``), the ship
-    leaves the corridor |e| > e_max (``"corridor"``, e_max = 10 L by default), or the
+    leaves the corridor ``|e| > e_max`` (``"corridor"``, e_max = 10 L by default), or the
     plant state is not finite (``"non_finite_state"``).  Truncated: the scenario's
     ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last step ``info``
     also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).

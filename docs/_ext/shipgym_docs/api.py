@@ -44,3 +44,13 @@ def write(root: Path) -> list[Path]:
     out = [write_text(folder / "index.md", index)]
     out += [write_text(folder / f"{m}.md", page(m)) for m in modules]
     return out
+
+
+def write_placeholder(root: Path) -> list[Path]:
+    """The API index of a build without the API reference (``-D shipgym_docs_api=0``)."""
+    text = (
+        "# API reference\n\n"
+        "Left out of this build (`-D shipgym_docs_api=0`); the full build documents every "
+        "public module of `shipgym` and `shipgym_baselines`.\n"
+    )
+    return [write_text(root / "api" / "index.md", text)]

@@ -44,7 +44,7 @@ def _scenario_rows(name: str) -> list[tuple[str, str]]:
     model = sc.model
     steps = math.ceil(sc.config.time_limit / sc.control_period - 1e-9)
     rows = [
-        ("ship", f"[`{model.name}`](../ships.md#{model.name.replace('_', '-')})"),
+        ("ship", f"{{ref}}`{model.name} <ship-{model.name}>`"),
         ("default scenario", f"[`{name}`](../scenarios/{name}.md)"),
         ("control period Ts", f"{sc.control_period:g} s"),
         ("fine step h (RK4)", f"{sc.fine_step:g} s ({sc.substeps} substeps)"),

@@ -96,7 +96,7 @@ def page(name: str, used: list[str]) -> str:
     text = yaml_text(name)
     route, limit, steps = size(sc)
     rows = [
-        ("ship", f"[`{sc.model.name}`](../ships.md#{sc.model.name.replace('_', '-')})"),
+        ("ship", f"{{ref}}`{sc.model.name} <ship-{sc.model.name}>`"),
         ("what changes, when", changes(sc)),
         ("path", f"{sc.config.path.type}, {len(sc.config.path.waypoints)} waypoints"),
         ("route length", route),

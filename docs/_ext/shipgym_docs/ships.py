@@ -58,7 +58,7 @@ def section(name: str) -> str:
     record = model.params_type
     return "\n".join(
         [
-            f"### `{name}` parameters\n",
+            f"(ship-{name})=\n### `{name}` parameters\n",
             f"`{record.__module__}.{record.__name__}` — {source}\n",
             f"Control period Ts = {model.control_period:g} s, fine step h = "
             f"{model.fine_step:g} s; states `{', '.join(model.state_names)}`; disturbances "
