@@ -18,7 +18,10 @@ EVALUATE_ROOT = Path("results/evaluate")
 
 
 def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("leaderboard", help="run every controller on a suite (docs: 'The leaderboard and its statistics')")
+    p = sub.add_parser(
+        "leaderboard",
+        help="run every controller on a suite (docs: 'The leaderboard and its statistics')",
+    )
     add_run_options(p, out="results/leaderboard", progress_help="no progress bar on stderr")
     p.add_argument(
         "--controllers",

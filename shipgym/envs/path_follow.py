@@ -157,17 +157,18 @@ class ShipPathFollowEnv(gym.Env):
     .. rubric:: Starting state
 
     The scenario's ``initial_state`` (x, y [m], heading [deg], other states SI; default: the
-    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.  A suite's ``randomize:``
-    block (:class:`shipgym.scenarios.trials.TrialRandomization`) moves it per evaluation
-    seed; the env's seed draws sensor noise and stochastic currents and waves.
+    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.  A
+    suite's ``randomize:`` block (:class:`shipgym.scenarios.trials.TrialRandomization`) moves
+    it per evaluation seed; the env's seed draws sensor noise and stochastic currents and
+    waves.
 
     .. rubric:: Episode end
 
     Terminated: the last waypoint is reached (``termination_reason = "goal"``), the ship
     leaves the corridor ``|e| > e_max`` (``"corridor"``, e_max = 10 L by default), or the
     plant state is not finite (``"non_finite_state"``).  Truncated: the scenario's
-    ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last step ``info``
-    also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).
+    ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last
+    step ``info`` also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).
 
     .. rubric:: Arguments
 

@@ -82,11 +82,7 @@ def page(record: ControllerRecord) -> str:
         f"# {record.name}\n",
         table(["", ""], rows),
         "\n## Settings\n",
-        (
-            table(["keyword", "default"], settings(record))
-            if settings(record)
-            else "No settings.\n"
-        ),
+        (table(["keyword", "default"], settings(record)) if settings(record) else "No settings.\n"),
         "\nA suite passes them in its long form: "
         f"`{{controller: {record.name}, name: DISPLAY_NAME, settings: {{keyword: value}}}}`.\n",
         "\n## Description\n",
@@ -127,12 +123,12 @@ def learned_page(name: str) -> str:
 
 def index(names: list[str], learned: list[str]) -> str:
     rows = [
-        (f"[{n}]({n}.md)", CONTROLLERS[n].kind, CONTROLLERS[n].action_mode,
-         _ships(CONTROLLERS[n]))
+        (f"[{n}]({n}.md)", CONTROLLERS[n].kind, CONTROLLERS[n].action_mode, _ships(CONTROLLERS[n]))
         for n in names
     ]
-    rows += [(f"[{n}]({n}.md)", "learned", "", ", ".join(f"`{s}`" for s in MODELS))
-             for n in learned]
+    rows += [
+        (f"[{n}]({n}.md)", "learned", "", ", ".join(f"`{s}`" for s in MODELS)) for n in learned
+    ]
     return (
         "# Controllers\n\n"
         "Every registered controller (`shipgym_baselines.registry`) and every shipped learned "

@@ -15,14 +15,14 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import yaml  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import yaml
 
-from shipgym.config import catalogue, list_names  # noqa: E402
-from shipgym.scenarios import load_scenario  # noqa: E402
-from shipgym.scenarios.loader import Scenario, list_scenarios  # noqa: E402
-from shipgym_docs.pages import cell, table, write_bytes, write_text  # noqa: E402
+from shipgym.config import catalogue, list_names
+from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import Scenario, list_scenarios
+from shipgym_docs.pages import cell, table, write_bytes, write_text
 
 
 def yaml_text(name: str) -> str:
@@ -70,8 +70,13 @@ def route_png(sc: Scenario) -> bytes:
     # north-east axes: x north (up), y east (right)
     ax.plot(xy[:, 1], xy[:, 0], "-", color="C0", lw=1.5, label="path")
     ax.plot(wp[:, 1], wp[:, 0], "o", color="C0", ms=3)
-    ax.plot([x0[sc.model.state_index("y")]], [x0[sc.model.state_index("x")]], "^", color="C3",
-            label="start")
+    ax.plot(
+        [x0[sc.model.state_index("y")]],
+        [x0[sc.model.state_index("x")]],
+        "^",
+        color="C3",
+        label="start",
+    )
     ax.set_xlabel("east y [m]")
     ax.set_ylabel("north x [m]")
     ax.set_aspect("equal", adjustable="datalim")
@@ -117,7 +122,7 @@ def page(name: str, used: list[str]) -> str:
             f"\n## `configs/scenarios/{name}.yaml`\n",
             "```yaml\n" + text.rstrip() + "\n```\n",
             f"\nRun it: `shipgym run {name} pid_los`, or "
-            f"`gym.make(\"ShipPathFollow-v0\", scenario={name!r})`.\n",
+            f'`gym.make("ShipPathFollow-v0", scenario={name!r})`.\n',
         ]
     )
 
