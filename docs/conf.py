@@ -46,6 +46,8 @@ bibtex_reference_style = "author_year"
 autodoc_default_options = {"members": True, "show-inheritance": True, "ignore-module-all": True}
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
+# an override without a docstring shows none (not Gymnasium's own Env.step text)
+autodoc_inherit_docstrings = False
 autodoc_mock_imports: list[str] = []
 
 # -D shipgym_docs_api=0 leaves the API reference out (a quicker build)

@@ -17,7 +17,7 @@ from typing import Any
 
 from sphinx.application import Sphinx
 
-from shipgym_docs import api, controllers, envs, scenarios, ships, tutorials
+from shipgym_docs import api, controllers, docstrings, envs, scenarios, ships, tutorials
 
 GENERATED = "_generated"
 GENERATORS = (envs, scenarios, controllers, ships, tutorials, api)
@@ -42,4 +42,6 @@ def generate(app: Sphinx) -> None:
 def setup(app: Sphinx) -> dict[str, Any]:
     app.add_config_value("shipgym_docs_api", True, "env", bool)
     app.connect("builder-inited", generate)
+    app.connect("autodoc-process-docstring", docstrings.process_docstring)
+    app.connect("autodoc-skip-member", docstrings.skip_foreign)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -40,5 +40,5 @@ def rst_block(text: str) -> str:
 
 
 def number(value: float) -> str:
-    """A parameter value as written in the code (shortest round-trip repr)."""
-    return repr(float(value)) if not float(value).is_integer() else f"{value:g}"
+    """A parameter value to 6 significant digits."""
+    return f"{float(value):.6g}"

@@ -31,9 +31,21 @@ def yaml_text(name: str) -> str:
 
 
 def comments(text: str) -> list[str]:
-    """The YAML's comment lines, without the ``#``."""
-    lines = [line.strip() for line in text.splitlines()]
-    return [line.lstrip("#").strip() for line in lines if line.startswith("#")]
+    """The YAML's comments as paragraphs: wrapped comment lines joined; a paragraph ends at a
+    line ending with a full stop or at a line that is not a comment."""
+    paragraphs: list[str] = []
+    current: list[str] = []
+    for line in (raw.strip() for raw in text.splitlines()):
+        if line.startswith("#"):
+            current.append(line.lstrip("#").strip())
+            if not current[-1].endswith("."):
+                continue
+        if current:
+            paragraphs.append(" ".join(current))
+            current = []
+    if current:
+        paragraphs.append(" ".join(current))
+    return [p for p in paragraphs if p]
 
 
 def suites_using() -> dict[str, list[str]]:

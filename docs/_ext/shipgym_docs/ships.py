@@ -20,7 +20,8 @@ from shipgym.models import MODELS
 from shipgym.models.base import ParameterRecord
 from shipgym_docs.pages import number, table, write_text
 
-UNIT = re.compile(r"\[([^\]]*)\]\s*$")
+#: the unit of a field comment: its first ``[...]``
+UNIT = re.compile(r"\s*\[([^\]]*)\]")
 
 
 def field_comments(record: type[ParameterRecord]) -> dict[str, str]:
@@ -46,7 +47,7 @@ def rows(record: type[ParameterRecord]) -> list[tuple[str, str, str, str]]:
         comment = comments.get(field.name, "")
         match = UNIT.search(comment)
         unit = match.group(1) if match else ""
-        meaning = UNIT.sub("", comment).strip() if match else comment
+        meaning = UNIT.sub("", comment, count=1).strip() if match else comment
         out.append((f"`{field.name}`", unit, number(getattr(defaults, field.name)), meaning))
     return out
 
