@@ -1,9 +1,11 @@
-"""Docstrings as the API reference reads them.
+"""Docstrings as the API reference shows them: as written.
 
-The package's docstrings are written as plain text with reStructuredText roles: ``|e|`` is an
-absolute value, not a substitution.  :func:`escape_bars` escapes every ``|`` outside inline
-literals and literal blocks before autodoc parses a docstring; :func:`skip_foreign` leaves out
-module attributes that are not the package's (``numerics.min`` is ``builtins.min``).
+The package's docstrings are plain text with aligned equations (``|e|`` is an absolute value,
+``X_|u|u`` a coefficient's name), not reStructuredText; parsed as reST they would break into
+substitutions, hyperlink targets and block quotes.  :func:`as_written` shows each one as a
+literal block, with the roles' markup reduced to their targets; a docstring written as reST
+on purpose (one with a ``.. rubric::`` or ``.. list-table::``: the env classes, whose docstring
+is their page) is left to reST.
 """
 
 from __future__ import annotations
@@ -13,61 +15,21 @@ from typing import Any
 
 from sphinx.application import Sphinx
 
-LITERAL = re.compile(r"(``.*?``)")
-ROLE = re.compile(r"(:[\w:.-]+:`[^`]*`)")
+#: ``:role:`~a.b.C``` or ``:role:`text <target>``` → the name a reader looks for
+ROLE = re.compile(r":[\w:.-]+:`~?([^`<]*?)\s*(?:<[^>]*>)?`")
+#: what marks a docstring written as reStructuredText on purpose
+REST = (".. rubric::", ".. list-table::")
 
 
-def _escape(text: str) -> str:
-    """``|`` → ``\\|`` outside ``inline literals`` and role targets."""
-    parts = []
-    for piece in LITERAL.split(text):
-        if piece.startswith("``") and piece.endswith("``") and len(piece) >= 4:
-            parts.append(piece)
-            continue
-        parts.append(
-            "".join(
-                p if ROLE.fullmatch(p) else re.sub(r"(?<!\\)\|", r"\\|", p)
-                for p in ROLE.split(piece)
-            )
-        )
-    return "".join(parts)
-
-
-def escape_bars(lines: list[str]) -> list[str]:
-    """The docstring's lines with bars escaped, except in literal blocks (after ``::``) and
-    in table rows (lines starting with ``|`` or ``+``)."""
-    out = []
-    block_indent: int | None = None  # indentation of the line that opened a literal block
-    for line in lines:
-        stripped = line.lstrip()
-        indent = len(line) - len(stripped)
-        if block_indent is not None and stripped and indent <= block_indent:
-            block_indent = None
-        if (
-            block_indent is not None
-            or stripped.startswith(("|", "+"))
-            or ".. " in line[: indent + 3]
-        ):
-            out.append(line)
-        else:
-            out.append(_escape(line))
-        if block_indent is None and line.rstrip().endswith("::"):
-            block_indent = indent
-    return out
+def as_written(lines: list[str]) -> list[str]:
+    """The docstring's lines as a literal block (unless it is reST on purpose)."""
+    if not any(line.strip() for line in lines) or any(m in "\n".join(lines) for m in REST):
+        return lines
+    body = [("    " + ROLE.sub(r"\1", line)).rstrip() for line in lines]
+    return ["::", "", *body, ""]
 
 
 def process_docstring(
     app: Sphinx, what: str, name: str, obj: Any, options: Any, lines: list[str]
 ) -> None:
-    lines[:] = escape_bars(lines)
-
-
-def skip_foreign(
-    app: Sphinx, what: str, name: str, obj: Any, skip: bool, options: Any
-) -> bool | None:
-    """Skip a module's attribute defined outside the package (an alias of a builtin)."""
-    module = getattr(obj, "__module__", None)
-    if what == "module" and callable(obj) and isinstance(module, str):
-        if not module.startswith(("shipgym", "shipgym_baselines")):
-            return True
-    return None
+    lines[:] = as_written(lines)
