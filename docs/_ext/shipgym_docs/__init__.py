@@ -43,4 +43,5 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.add_config_value("shipgym_docs_api", True, "env", bool)
     app.connect("builder-inited", generate)
     app.connect("autodoc-process-docstring", docstrings.process_docstring)
+    app.connect("autodoc-skip-member", docstrings.skip_foreign)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -5,7 +5,8 @@ The package's docstrings are plain text with aligned equations (``|e|`` is an ab
 substitutions, hyperlink targets and block quotes.  :func:`as_written` shows each one as a
 literal block, with the roles' markup reduced to their targets; a docstring written as reST
 on purpose (one with a ``.. rubric::`` or ``.. list-table::``: the env classes, whose docstring
-is their page) is left to reST.
+is their page) is left to reST.  :func:`skip_foreign` leaves out module attributes that are
+not the package's (``numerics.any`` is ``numpy.any``).
 """
 
 from __future__ import annotations
@@ -33,3 +34,13 @@ def process_docstring(
     app: Sphinx, what: str, name: str, obj: Any, options: Any, lines: list[str]
 ) -> None:
     lines[:] = as_written(lines)
+
+
+def skip_foreign(
+    app: Sphinx, what: str, name: str, obj: Any, skip: bool, options: Any
+) -> bool | None:
+    """Skip a member defined outside the package (``numerics.any`` is ``numpy.any``)."""
+    module = getattr(obj, "__module__", None)
+    if callable(obj) and isinstance(module, str) and not module.startswith("shipgym"):
+        return True
+    return None
