@@ -11,7 +11,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 DOCS = REPO / "docs"
-PAGES = sorted(p for p in DOCS.glob("*.md") if ">>>" in p.read_text(encoding="utf-8"))
+PAGES = sorted(p for p in DOCS.glob("*.md") if "\n>>> " in p.read_text(encoding="utf-8"))
 
 
 def test_there_are_examples() -> None:
