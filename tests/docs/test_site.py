@@ -49,7 +49,7 @@ def test_every_env_id_has_a_page(site: Path) -> None:
     assert len(ids) >= 8
     for env_id in ids:
         page = site / "_generated" / "envs" / f"{env_id}.html"
-        text = page.read_text(encoding="utf-8")
+        text = page.read_text(encoding="utf-8").lower()
         for heading in (
             "Action space",
             "Observation space",
@@ -59,7 +59,7 @@ def test_every_env_id_has_a_page(site: Path) -> None:
             "Arguments",
             "Version history",
         ):
-            assert heading in text, (env_id, heading)
+            assert heading.lower() in text, (env_id, heading)
 
 
 def test_every_catalogue_scenario_has_a_page_and_a_route_figure(site: Path) -> None:
