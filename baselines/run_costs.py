@@ -42,6 +42,7 @@ def profile_suite(
     seeds: int = 1,
     controllers: Iterable[ControllerSpec] | None = None,
     scenarios: Iterable[str] | None = None,
+    show_progress: bool = False,
 ) -> dict[str, Any]:
     """CPU seconds of ``suite``'s jobs with ``seeds`` evaluation seeds (the suite's first
     ones), optionally only ``controllers`` / ``scenarios`` (names as the suite gives them).
@@ -53,8 +54,12 @@ def profile_suite(
     ``episodes``, ``steps``, ``cpu_s``, ``act_cpu_s`` (the controller's ``act`` calls),
     ``suite_cpu_s``, ``us_per_step``, ``act_us_per_step`` and ``other_us_per_step`` (env,
     setup) [µs], and the machine's ``load_average`` (1 min) at the start and the end.
+    ``show_progress``: a progress bar of the jobs on stderr.
     """
+    import sys
+
     import torch
+    from tqdm import tqdm
 
     from shipgym_baselines.errors import check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
@@ -85,7 +90,7 @@ def profile_suite(
     ship_of = {s: sc.model.name for s, sc in loaded.items()}
     load_start = os.getloadavg()[0]
     cells: dict[tuple[str, str], dict[str, float]] = defaultdict(_entry)
-    for job in jobs:
+    for job in tqdm(jobs, desc="profile", file=sys.stderr, disable=not show_progress):
         start = time.process_time()
         with evaluation.act_clock(time.process_time):
             results = work(job)

@@ -24,7 +24,11 @@ def _profile(args: argparse.Namespace) -> dict[str, Any]:
     from shipgym_baselines.run_costs import profile_suite
 
     return profile_suite(
-        args.suite, seeds=args.seeds, controllers=args.controllers, scenarios=args.scenarios
+        args.suite,
+        seeds=args.seeds,
+        controllers=args.controllers,
+        scenarios=args.scenarios,
+        show_progress=True,
     )
 
 
