@@ -6,9 +6,10 @@ policy's in lockstep, one network forward per step for all, with the same bits).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
@@ -24,6 +25,21 @@ from shipgym_baselines.registry import make_controller
 ENV_ID = "ShipPathFollow-v0"
 #: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
 EVAL_SEED_OFFSET = 10_000
+
+#: the clock [s] that times each ``act`` call (``compute_ms``): wall time, unless
+#: :func:`act_clock` swaps it (the run-cost profile reads CPU time)
+_clock: Callable[[], float] = time.perf_counter
+
+
+@contextlib.contextmanager
+def act_clock(clock: Callable[[], float]) -> Iterator[None]:
+    """Time the ``act`` calls with ``clock`` [s] (e.g. :func:`time.process_time`) inside."""
+    global _clock
+    saved, _clock = _clock, clock
+    try:
+        yield
+    finally:
+        _clock = saved
 
 
 @dataclasses.dataclass
@@ -120,9 +136,9 @@ def run_episode(
         else:
             policy.reset(episode.base.controller_context, seed=seed)
         while not episode.done:
-            start = time.perf_counter()
+            start = _clock()
             action = policy.act(episode.obs, episode.info)
-            episode.step(action, time.perf_counter() - start)
+            episode.step(action, _clock() - start)
         result = episode.result(policy)
         if after_episode is not None:
             after_episode(episode.base)
@@ -199,9 +215,9 @@ def _run_lockstep(
         live = [i for i, e in enumerate(episodes) if not e.done]
         while live:
             obs = np.stack([episodes[i].obs for i in live])
-            start = time.perf_counter()
+            start = _clock()
             actions = policy.act_batch(obs, live)
-            share = (time.perf_counter() - start) / len(live)
+            share = (_clock() - start) / len(live)
             for i, action in zip(live, actions, strict=True):
                 episodes[i].step(action, share)
             live = [i for i in live if not episodes[i].done]

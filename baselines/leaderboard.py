@@ -349,6 +349,18 @@ def plan_jobs(
     return jobs
 
 
+def longest_first(jobs: list[Job], scenarios: Mapping[str, Scenario]) -> list[Job]:
+    """``jobs`` ordered by their most control steps (the scenario's time limit over its
+    control period, × the job's seeds), longest first: the pool's workers then end
+    together instead of one finishing a long job alone (what a run computes is the same)."""
+
+    def steps(job: Job) -> float:
+        sc = scenarios[job.scenario]
+        return sc.config.time_limit / sc.control_period * len(job.seeds)
+
+    return sorted(jobs, key=steps, reverse=True)  # stable: ties keep the plan's order
+
+
 def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
     """The jobs with the seeds whose episodes ``done`` (episode keys) does not hold."""
     todo = []
@@ -415,7 +427,7 @@ def run_leaderboard(
         force=force,
     )
     with log.recording():  # holds out_dir's lock to the end
-        todo = missing(jobs, log.done)
+        todo = longest_first(missing(jobs, log.done), scenarios)
         rows = row_keys(jobs)
         bar = tqdm(
             total=n_episodes,

@@ -6,7 +6,9 @@
                      their training seeds, each scenario's settings), versions, git commit,
                      start/end time (ISO 8601 UTC), status ("running" → "complete" |
                      "interrupted" | "failed"), jobs (the episodes the run holds when
-                     complete), episodes
+                     complete), episodes, wall_s and cpu_s (wall-clock and CPU seconds
+                     of the run, tables and figures included, its process and its
+                     workers; a resumed run adds each invocation's)
     episodes.jsonl   one JSON object per finished episode (scenario, controller, kind, seed,
                      training_seed and every metric), appended and flushed by the parent
                      process as each episode ends: Ctrl-C or a kill keeps them; fsync'd at
@@ -590,6 +592,10 @@ class RunLog:
         self._file: IO[bytes] | None = None
         self._synced = time.monotonic()
         self._lock = contextlib.ExitStack()
+        #: this invocation's start: wall clock [s] and CPU time [s] (:func:`cpu_seconds`)
+        self._started = (time.perf_counter(), cpu_seconds())
+        #: ``wall_s`` / ``cpu_s`` of earlier invocations (a resumed run adds to them)
+        self._earlier = (float(record.get("wall_s") or 0.0), float(record.get("cpu_s") or 0.0))
 
     @property
     def episodes_file(self) -> Path:
@@ -736,8 +742,20 @@ class RunLog:
                 os.fsync(file.fileno())
             file.close()
         self._count = len(read_episodes(self.folder))  # the file's count: Ctrl-C may cut in
-        self.record.update(status=status, end_time=now(), episodes=self._count)
+        wall, cpu = self.elapsed()
+        self.record.update(
+            status=status,
+            end_time=now(),
+            episodes=self._count,
+            wall_s=self._earlier[0] + wall,
+            cpu_s=self._earlier[1] + cpu,
+        )
         self._write_record(in_place=status != "complete")
+
+    def elapsed(self) -> tuple[float, float]:
+        """Wall-clock and CPU seconds of this invocation so far (:func:`cpu_seconds`)."""
+        wall0, cpu0 = self._started
+        return time.perf_counter() - wall0, cpu_seconds() - cpu0
 
     def kept(self) -> str:
         """What the run kept, and how to finish it."""
@@ -794,6 +812,13 @@ class RunLog:
                 with contextlib.suppress(OSError), open(file, "r+b") as fh:
                     fh.write(data)
                     fh.truncate()
+
+
+def cpu_seconds() -> float:
+    """CPU seconds [s] of this process and of its finished child processes (a process
+    pool's workers count once the pool has shut down), user and system."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
 
 
 def outside_problem(exc: BaseException) -> str | None:

@@ -96,6 +96,12 @@ def run(args: argparse.Namespace) -> int:
         recompute_references=getattr(args, "recompute_references", False),
     )
     if not args.json:
-        sys.stderr.write(f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes\n")
+        from shipgym_baselines.runs import read_run
+
+        record = read_run(out)
+        sys.stderr.write(
+            f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes "
+            f"({record['wall_s']:.0f} s wall, {record['cpu_s']:.0f} s CPU)\n"
+        )
     emit(args, rows, terminal_summary(out))  # ends with the ranking and the page's path
     return 0

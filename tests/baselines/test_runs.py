@@ -82,6 +82,9 @@ def test_run_json_records_command_suite_versions_times_and_status(clean_run: Pat
     assert start.utcoffset() == datetime.timedelta(0) and start <= end
     assert record["status"] == "complete"
     assert record["jobs"] == record["episodes"] == 8
+    # the run's own wall-clock and CPU seconds (tables and figures included)
+    assert 0 < record["wall_s"] <= (end - start).total_seconds() + 1.0
+    assert record["cpu_s"] > 0
 
 
 def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) -> None:
