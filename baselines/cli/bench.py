@@ -24,7 +24,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "target",
         choices=list(BENCHES),
-        help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv)",
+        help="what to benchmark (training: the shipped PPO config through the per-ship batched "
+        "envs, DummyVecEnv and SubprocVecEnv)",
     )
     p.add_argument("--repeats", type=int, default=5, help="timed repetitions (≥ 1)")
     add_json_option(p, "print the figures as a JSON object")
