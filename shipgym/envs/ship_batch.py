@@ -42,7 +42,7 @@ from shipgym.envs import core
 from shipgym.envs.core import OBS_HIGH, OBS_LOW
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY, SCALAR
-from shipgym.scenarios import Scenario
+from shipgym.scenarios import Scenario, ScenarioConfig
 from shipgym.scenarios.loader import build_scenario, nominal_nomoto
 from shipgym.scenarios.sampling import (
     DistributionError,
@@ -51,7 +51,6 @@ from shipgym.scenarios.sampling import (
     train_rng,
     train_scenario_seed,
 )
-from shipgym.scenarios.schema import ScenarioConfig
 from shipgym.tracking import PathTracker, TrackFrame
 
 #: the constants every trial of a ship shares (the time limit, max_steps, differs)
