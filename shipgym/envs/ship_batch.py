@@ -28,6 +28,7 @@ metrics (a training env).  ``gym.make`` is not involved: build it directly, or t
 from __future__ import annotations
 
 import dataclasses
+import operator
 from typing import Any, ClassVar
 
 import numpy as np
@@ -53,6 +54,9 @@ from shipgym.scenarios.sampling import (
 )
 from shipgym.tracking import PathTracker, TrackFrame
 
+#: a TrackFrame's fields as a tuple, in declaration order
+_FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
+
 #: the constants every trial of a ship shares (the time limit, max_steps, differs)
 _SHARED = ("ship_length", "rudder_limit", "control_period", "fine_step", "substeps")
 
@@ -69,7 +73,6 @@ class Trial:
     autopilot_gains: PIDGains | None  # guidance mode (core.guidance_command reads it)
     context_row: np.ndarray | None
     rng: np.random.Generator  # the episode's generator (disturbance and sensor noise)
-    p_dirty: bool = False
 
 
 def ship_index_of(distribution: ScenarioDistribution, ship: int | str) -> int:
@@ -140,6 +143,12 @@ class ShipTrialsVectorEnv(VectorEnv):
         #: the config of each env's current trial (names ``<distribution>:train-<seed>``)
         self.trial_configs: list[ScenarioConfig | None] = [None] * num_envs
         self._max_steps = np.zeros(num_envs, dtype=np.int64)
+        #: the constants with each env's own time limit (max_steps, updated in place)
+        self._kk = dataclasses.replace(k, max_steps=self._max_steps)
+        self._p_dirty = np.zeros(num_envs, dtype=bool)
+        self._event_start = np.full(num_envs, np.inf)  # first event time [s]
+        self._event_end = np.full(num_envs, -np.inf)  # last event end [s]
+        self._time_varying = np.zeros(num_envs, dtype=bool)
         self._state = np.zeros((num_envs, first.model.n_states))
         self._steps = np.zeros(num_envs, dtype=np.int64)
         self._t = np.zeros(num_envs)
@@ -179,7 +188,8 @@ class ShipTrialsVectorEnv(VectorEnv):
         self._reset_envs(mask)
         self._autoreset[mask] = False
         self._started = True
-        return self._observation(), {}
+        self._obs = self._observation()
+        return self._obs, {}
 
     def reset_finished(self) -> tuple[np.ndarray, np.ndarray]:
         """Reset now the envs whose episode ended at the last step; returns (observations
@@ -188,7 +198,8 @@ class ShipTrialsVectorEnv(VectorEnv):
         if np.any(mask):
             self._reset_envs(mask)
             self._autoreset[:] = False
-        return self._observation(), mask
+            self._obs = self._observation()
+        return self._obs, mask
 
     def step(
         self, actions: Any
@@ -228,42 +239,47 @@ class ShipTrialsVectorEnv(VectorEnv):
         delta_c = np.where(live, delta_c, self._delta_c)
         prev_delta_c = self._delta_c.copy()
         t0 = self._t.copy()
-        for i in rows:  # true parameters and disturbances of the period, per trial
+        # true parameters of the period: only for envs whose event acts on it (or just did)
+        t1 = t0 + k.control_period
+        changing = live & (self._event_end >= t0 - 1e-9) & (self._event_start <= t1 + 1e-9)
+        for i in np.flatnonzero(changing | (live & self._p_dirty)).tolist():
             tr = trials[i]
-            if tr.scenario.schedule.events:
-                tr.p_dirty = core.refresh_parameters(
-                    tr.scenario.schedule, float(t0[i]), tr.constants, self._p_block[i], tr.p_dirty
-                )
-            if tr.disturbances.time_varying:
-                tr.disturbances.fill_one(self._w_block[i], float(t0[i]), tr.rng)
+            self._p_dirty[i] = core.refresh_parameters(
+                tr.scenario.schedule,
+                float(t0[i]),
+                tr.constants,
+                self._p_block[i],
+                bool(self._p_dirty[i]),
+            )
+        for i in np.flatnonzero(live & self._time_varying).tolist():  # disturbances
+            trials[i].disturbances.fill_one(self._w_block[i], float(t0[i]), trials[i].rng)
         traj = self._integrator.substep_states(self._state, delta_c, self._w_block, self._p_block)
         steps = np.where(live, self._steps + 1, self._steps)
-        finite = np.all(np.isfinite(traj[:, -1]), axis=1)
+        last = traj[:, -1]
+        finite = np.all(np.isfinite(last), axis=1)
         advance = live & finite
         self._steps = steps
         self._t = np.where(live, steps * k.control_period, self._t)
         self._delta_c = delta_c
-        self._state = np.where(advance[:, None], traj[:, -1], self._state)
-        for i in np.flatnonzero(advance):
+        self._state = np.where(advance[:, None], last, self._state)
+        if k.substeps > 1:
+            dx = last[:, k.ix] - traj[:, -2, k.ix]
+            dy = last[:, k.iy] - traj[:, -2, k.iy]
+            self._speed = np.where(advance, core.speed_over_ground(dx, dy, k, ARRAY), self._speed)
+        psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
+        r_m = np.where(advance, last[:, k.ir], self._r_m)
+        xs, ys = self._state[:, k.ix].tolist(), self._state[:, k.iy].tolist()
+        for i in np.flatnonzero(advance).tolist():
             tr = trials[i]
-            if tr.sensor.ideal:
-                self._psi_m[i], self._r_m[i] = traj[i, -1, k.ipsi], traj[i, -1, k.ir]
-            else:
+            if not tr.sensor.ideal:
                 p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
-                self._psi_m[i], self._r_m[i] = p_i[-1], r_i[-1]
-            if k.substeps > 1:
-                self._speed[i] = core.speed_over_ground(
-                    float(traj[i, -1, k.ix] - traj[i, -2, k.ix]),
-                    float(traj[i, -1, k.iy] - traj[i, -2, k.iy]),
-                    k,
-                    SCALAR,
-                )
-            x = self._state[i]
-            self._frames[i] = tr.tracker.update(float(x[k.ix]), float(x[k.iy]))
+                psi_m[i], r_m[i] = p_i[-1], r_i[-1]
+            self._frames[i] = tr.tracker.update(xs[i], ys[i])
+        self._psi_m, self._r_m = psi_m, r_m
         frame = self._stacked_frames()
         heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
         reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
-        kk = dataclasses.replace(k, max_steps=self._max_steps)
+        kk = self._kk  # the constants with each env's own max_steps
         reward, goal, corridor, truncated = core.terminate(reward, frame, steps, kk, ARRAY)
         goal, corridor, truncated = goal & advance, corridor & advance, truncated & advance
         diverged = live & ~finite
@@ -281,7 +297,8 @@ class ShipTrialsVectorEnv(VectorEnv):
             info["termination_reason"] = reasons
             info["_termination_reason"] = done
         self._autoreset = done
-        return self._observation(), rewards, terminated, truncated, info
+        self._obs = self._observation(frame)
+        return self._obs, rewards, terminated, truncated, info
 
     # ------------------------------------------------------------------ pieces
     def _new_trial(self, i: int) -> Trial:
@@ -327,6 +344,11 @@ class ShipTrialsVectorEnv(VectorEnv):
             sc = tr.scenario
             x = self._state[i] = sc.initial_state()
             self._max_steps[i] = tr.constants.max_steps
+            events = sc.schedule.events
+            self._event_start[i] = min((e.time for e in events), default=np.inf)
+            self._event_end[i] = max((e.end_time() for e in events), default=-np.inf)
+            self._p_dirty[i] = False
+            self._time_varying[i] = tr.disturbances.time_varying
             self._steps[i] = 0
             self._t[i] = 0.0
             self._delta_c[i] = 0.0
@@ -343,18 +365,17 @@ class ShipTrialsVectorEnv(VectorEnv):
                 self._context[i] = tr.context_row
 
     def _stacked_frames(self) -> TrackFrame:
-        frames = self._frames
+        """The envs' frames as one TrackFrame of arrays."""
+        table = np.array([_FRAME_ROW(f) for f in self._frames], dtype=float)
+        cols = table.T
         return TrackFrame(
-            *(
-                np.array([getattr(f, field.name) for f in frames])
-                for field in dataclasses.fields(TrackFrame)
-            )
+            cols[0], cols[1], cols[2], cols[3].astype(np.int64), cols[4], cols[5], cols[6] > 0.5
         )
 
-    def _observation(self) -> np.ndarray:
+    def _observation(self, frame: TrackFrame | None = None) -> np.ndarray:
         k = self._k0
         columns = core.observation_columns(
-            self._stacked_frames(),
+            self._stacked_frames() if frame is None else frame,
             self._psi_m,
             self._r_m,
             self._state[:, k.idelta],
