@@ -404,6 +404,7 @@ def bench_training(
     scenario: str | None = None,
     repeats: int = 1,
     kinds: tuple[str, ...] = ("batched", "dummy", "subproc"),
+    wide_envs: int | None = 64,
 ) -> dict[str, Any]:
     """PPO training throughput (env steps/s, learning included) of the shipped PPO
     configuration (configs/agents/ppo.yaml: the training distribution, its n_envs and
@@ -412,7 +413,11 @@ def bench_training(
     env: same config, env steps and machine, measured in the same run, one torch thread.
     ``scenario``: one fixed scenario instead of the distribution.
 
-    The first rollout of each run (process start-up, torch warm-up, compile) is excluded.
+    ``wide_envs``: also the batched path with that many envs (``batched_wide``; n_steps
+    scaled so that a rollout has the config's n_steps·n_envs env steps: the same
+    gradient updates per env step), since the batched envs' per-call cost is spread over
+    more envs.  The first rollout of each run (process start-up, torch warm-up, compile) is
+    excluded.
     Besides the wall-clock rate, ``…_cpu_s`` is this process's CPU time of the timed part
     (subprocess workers not counted), for loaded machines.
     """
@@ -437,8 +442,15 @@ def bench_training(
         "timesteps": timesteps,
         "torch_threads": torch.get_num_threads(),
     }
-    for kind in kinds:
-        env_config = config.env.model_copy(update={"vec_env": kind, "n_envs": n_envs, **source})
+    runs = [(kind, kind, n_envs) for kind in kinds]
+    if wide_envs and "batched" in kinds:
+        runs.append(("batched_wide", "batched", wide_envs))
+        figures["wide_envs"] = wide_envs
+    rollout = int(config.hyperparams.get("n_steps", 2048)) * n_envs
+    for label, kind, count in runs:
+        env_config = config.env.model_copy(update={"vec_env": kind, "n_envs": count, **source})
+        hyper = build_hyperparams(config, 1)
+        hyper["n_steps"] = max(rollout // count, 1)
         rates, cpu = [], []
         for rep in range(repeats):
             venv = VecNormalize(
@@ -446,25 +458,26 @@ def bench_training(
                 norm_obs=False,
                 norm_reward=config.env.normalize_reward,
             )
-            model = PPO(
-                config.policy,
-                venv,
-                seed=rep,
-                device="cpu",
-                **build_hyperparams(config, venv.action_space.shape[0]),
-            )
-            warm = model.n_steps * n_envs
+            model = PPO(config.policy, venv, seed=rep, device="cpu", **hyper)
+            warm = model.n_steps * count
             model.learn(warm)
             done, start, start_cpu = model.num_timesteps, time.perf_counter(), time.process_time()
             model.learn(timesteps, reset_num_timesteps=False)
             rates.append((model.num_timesteps - done) / (time.perf_counter() - start))
             cpu.append(time.process_time() - start_cpu)
             venv.close()
-        figures[f"ppo_{kind}_env_steps_per_s"] = statistics.median(rates)
-        figures[f"ppo_{kind}_cpu_s"] = statistics.median(cpu)
+        figures[f"ppo_{label}_env_steps_per_s"] = statistics.median(rates)
+        figures[f"ppo_{label}_cpu_s"] = statistics.median(cpu)
+        figures[f"ppo_{label}_env_steps_per_cpu_s"] = timesteps / statistics.median(cpu)
     if "batched" in kinds and "dummy" in kinds:
-        ratio = figures["ppo_batched_env_steps_per_s"] / figures["ppo_dummy_env_steps_per_s"]
-        figures["batched_over_dummy"] = ratio
+        for label in ("batched", "batched_wide"):
+            if f"ppo_{label}_cpu_s" in figures:
+                figures[f"{label}_over_dummy"] = (
+                    figures[f"ppo_{label}_env_steps_per_s"] / figures["ppo_dummy_env_steps_per_s"]
+                )
+                figures[f"{label}_over_dummy_cpu"] = (
+                    figures["ppo_dummy_cpu_s"] / figures[f"ppo_{label}_cpu_s"]
+                )
         figures["batched_over_dummy_target"] = BATCHED_OVER_DUMMY_TARGET
     if "batched" in kinds and "subproc" in kinds:
         figures["batched_over_subproc"] = (

@@ -16,13 +16,14 @@ parameters and disturbances are per-row inputs); reward, observation and termina
 the step core's functions (:mod:`shipgym.envs.core`) on arrays.  Per env, in Python, remain
 what differs between trials: the path tracker, the parameter schedule, the disturbance
 processes and the sensors.  A reset builds the trial's scenario (no integrator, no
-compile), which is what makes it cheaper than the randomised single env.
+compile).  Its per-call cost is spread over the envs of the call: it pays off with many
+envs per ship (docs/training.md gives the measured rates).
 
 Autoreset as :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (NEXT_STEP, plus
-:meth:`reset_finished` for same-step adapters such as stable-baselines3's).  ``info`` has the
-step's ``t`` and, at episode ends, ``termination_reason`` (with its ``_`` mask); no episode
-metrics (a training env).  ``gym.make`` is not involved: build it directly, or through
-``shipgym_baselines.learned`` (one env per ship, combined).
+:meth:`reset_finished` for same-step adapters such as stable-baselines3's).  ``info``
+holds, at episode ends only, ``termination_reason`` (with its ``_`` mask): no per-step
+keys and no episode metrics (a training env).  Not registered with ``gym.make``: build it
+directly, or through ``shipgym_baselines.learned.agents`` (one per ship, combined).
 """
 
 from __future__ import annotations
@@ -287,7 +288,7 @@ class ShipTrialsVectorEnv(VectorEnv):
         terminated = goal | corridor | diverged
         rewards = np.where(live, reward, 0.0)
         done = terminated | truncated
-        info: dict[str, Any] = {"t": self._t.copy()}
+        info: dict[str, Any] = {}
         if np.any(done):
             reasons = np.full(self.num_envs, None, dtype=object)
             reasons[goal] = "goal"
