@@ -113,3 +113,18 @@ class PlateauRule(StrictModel):
         """True when :meth:`gain` is known and below ``min_gain``."""
         g = self.gain(env_steps, values)
         return g is not None and g < self.min_gain
+
+
+def agent_curves(name: str, root: str | Path | None = None) -> list[dict[str, Any]]:
+    """The learning curves of a shipped agent ``name`` (``root/<name>/seed_<k>/``, root:
+    the shipped policies), each with its ``"seed"``; [] when it ships none."""
+    from shipgym_baselines.learned.policy import POLICY_DIR
+
+    agent = Path(root if root is not None else POLICY_DIR) / name
+    found = []
+    for folder in sorted(agent.glob("seed_*")):
+        curve = load_curve(folder)
+        suffix = folder.name.removeprefix("seed_")
+        if curve is not None and suffix.isdigit():
+            found.append({**curve, "seed": int(suffix)})
+    return sorted(found, key=lambda c: c["seed"])

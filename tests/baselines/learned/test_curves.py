@@ -79,3 +79,24 @@ def test_validation_trials_are_fixed_and_never_heldout() -> None:
         validation_trials("train", 4)
     with pytest.raises(RunError, match="scenarios"):
         validation_trials("validation", 10_000)
+
+
+def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
+    from shipgym_baselines.figures import LEARNING_CURVES_STEM, plot_learning_curves
+    from shipgym_baselines.learned.curves import agent_curves
+    from shipgym_baselines.pages import figure_sections
+
+    root = tmp_path / "policies"
+    for seed in (1, 0):
+        folder = root / "ppo" / f"seed_{seed}"
+        folder.mkdir(parents=True)
+        write_curve(folder, [100, 200], [[-3.0, -1.0], [-2.0, -1.0 - seed]])
+    curves = agent_curves("ppo", root)
+    assert [c["seed"] for c in curves] == [0, 1]
+    assert agent_curves("sac", root) == []
+    figures = tmp_path / "figures"
+    files = plot_learning_curves(figures, {"ppo": curves, "sac": []})
+    assert {f.name for f in files} == {f"{LEARNING_CURVES_STEM}.png", f"{LEARNING_CURVES_STEM}.svg"}
+    assert plot_learning_curves(figures, {"sac": []}) == []
+    ranking_html, scenario_html = figure_sections(files)
+    assert "learning curves" in ranking_html and scenario_html == ""
