@@ -75,3 +75,23 @@ def test_batched_context_relative_cost_and_plateau(tmp_path: Path) -> None:
     assert refs["trials"] == [["validation:0", 10_000]]
     assert refs["references"][0]["reference"] in ("oracle", "pid_los")
     assert (out / "best_model.zip").is_file()
+
+
+def test_a_context_feature_agent_is_evaluated_with_its_features(tmp_path: Path) -> None:
+    """An agent trained with context features loads as a LearnedPolicy that appends the
+    features from the controller context: on the leaderboard's env (9 observations) it acts
+    as the model does on the env with context_features=True."""
+    import pytest
+
+    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
+    from shipgym_baselines.learned.policy import LearnedPolicy
+    from shipgym_baselines.learned.selection import run_agent_episode
+
+    out = tmp_path / "run"
+    train(_tiny(env={"context_features": True}), out_dir=out, progress=False, tensorboard=False)
+    policy = LearnedPolicy(export_policy(out, tmp_path / "policy"))
+    assert policy.context_features
+    seed = EVAL_SEED_OFFSET
+    on_board = evaluate(policy, "nominal", [seed])[0].metrics
+    _, direct_cost = run_agent_episode(policy.model, "nominal", seed, "rudder", True)
+    assert on_board["cost"] == pytest.approx(direct_cost, rel=1e-6)
