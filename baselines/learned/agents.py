@@ -60,6 +60,8 @@ class AgentEnvConfig(StrictModel):
                     f"env.distribution {self.distribution!r} is a test split: agents train on "
                     "a train split only"
                 )
+            if self.vec_env == "batched":
+                ship_env_counts(self.n_envs, len(load_distribution(self.distribution).config.ships))
         if self.scenario is not None and ":" in self.scenario:
             raise ValueError(f"env.scenario {self.scenario!r}: never train on test scenarios")
         return self
@@ -214,10 +216,10 @@ def _single_env_factory(source: dict[str, Any], action_mode: str, context_featur
 
 def ship_env_counts(n_envs: int, n_ships: int) -> list[int]:
     """Envs per ship when ``n_envs`` are split over ``n_ships`` batched envs: equal shares
-    (each ship then gets the same share of env steps); a :class:`ConfigError` unless
-    ``n_envs`` is a positive multiple of ``n_ships``."""
+    (each ship then gets the same share of env steps); a ValueError (in a config: its
+    ConfigError naming the key) unless ``n_envs`` is a positive multiple of ``n_ships``."""
     if n_envs < n_ships or n_envs % n_ships:
-        raise ConfigError(
+        raise ValueError(
             f"env.n_envs {n_envs}: vec_env 'batched' on a distribution of {n_ships} ships "
             f"needs a multiple of {n_ships} (one batched env per ship, equal shares)"
         )

@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.learned.agents import (
     AgentConfig,
     load_agent_config,
@@ -30,8 +29,12 @@ def test_ship_gamma_is_a_horizon_in_seconds() -> None:
 
 def test_ship_env_counts() -> None:
     assert ship_env_counts(8, 4) == [2, 2, 2, 2]
-    with pytest.raises(ConfigError, match="multiple of 4"):
+    with pytest.raises(ValueError, match="multiple of 4"):
         ship_env_counts(6, 4)
+    data = load_agent_config("ppo").model_dump()
+    data["env"].update(vec_env="batched", n_envs=6)
+    with pytest.raises(ValueError, match="n_envs 6"):
+        AgentConfig.model_validate(data)
 
 
 def _batched_config(**env: object) -> AgentConfig:
