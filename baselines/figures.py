@@ -702,3 +702,40 @@ def _plot_profiles(
         va="top",
     )
     return save_figure(fig, out_dir, "profile_" + figure_stem(split))
+
+
+# ------------------------------------------------------------------ learning curves
+#: stem of the learning-curve figure (the page places it with the ranking figures)
+LEARNING_CURVES_STEM = "learning_curves"
+
+
+def plot_learning_curves(
+    out_dir: str | Path, curves: Mapping[str, Sequence[Mapping[str, Any]]]
+) -> list[Path]:
+    """``learning_curves``: one panel per learned agent, its validation mean return over
+    env steps for each training seed (a band of ± one std over the validation episodes).
+    ``curves``: agent → its seeds' curves (:func:`shipgym_baselines.learned.curves.
+    agent_curves`); agents without curves are left out, nothing is drawn without any."""
+    drawn = {name: cs for name, cs in curves.items() if cs}
+    if not drawn:
+        return []
+    plt = pyplot()
+    n = len(drawn)
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.0 * rows), squeeze=False)
+    for ax, (name, cs) in zip(axes.flat, drawn.items(), strict=False):
+        for curve in cs:
+            steps = np.asarray(curve["env_steps"], dtype=float)
+            mean = np.asarray(curve["mean_return"], dtype=float)
+            std = np.asarray(curve["std_return"], dtype=float)
+            (line,) = ax.plot(steps, mean, marker=".", label=f"seed {curve.get('seed', '?')}")
+            ax.fill_between(steps, mean - std, mean + std, color=line.get_color(), alpha=0.15)
+        ax.set_title(name)
+        ax.set_xlabel("env steps")
+        ax.set_ylabel("validation mean return")
+        ax.legend(fontsize="small")
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    return save_figure(fig, out_dir, LEARNING_CURVES_STEM)

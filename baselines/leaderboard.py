@@ -574,8 +574,16 @@ def write_results(
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
+        files += figures.plot_learning_curves(out, learned_curves(kinds))
     pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
     return rows
+
+
+def learned_curves(kinds: Mapping[str, str]) -> dict[str, list[dict[str, Any]]]:
+    """The shipped learning curves of the suite's learned controllers (by name)."""
+    from shipgym_baselines.learned.curves import agent_curves
+
+    return {name: agent_curves(name) for name, kind in kinds.items() if kind == "learned"}
 
 
 def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:

@@ -35,7 +35,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.figures import figure_stem
+from shipgym_baselines.figures import LEARNING_CURVES_STEM, figure_stem
 from shipgym_baselines.ranking import (
     NO_RANKING,
     ORACLE,
@@ -418,7 +418,10 @@ def figure_sections(
     drawn = []
     for stem, (uri, file) in embedded_figures(figures).items():
         kind, _, split = stem.partition("_")
-        if kind in ("ranking", "profile"):
+        if stem == LEARNING_CURVES_STEM:  # after the ranking figures of every split
+            caption = "learning curves of the learned agents (validation return per seed)"
+            ranking.append(("~", True, _figure(stem, uri, file, caption)))
+        elif kind in ("ranking", "profile"):
             what = "interval estimates" if kind == "ranking" else "performance profiles"
             html_ = _figure(stem, uri, file, f"{what}, {split}")
             ranking.append((split, kind == "profile", html_))

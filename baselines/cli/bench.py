@@ -37,8 +37,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "target",
         choices=list(BENCHES),
-        help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv; "
-        "leaderboard: CPU seconds of a suite per controller, ship and step)",
+        help="what to benchmark (training: the shipped PPO config through the per-ship batched "
+        "envs, DummyVecEnv and SubprocVecEnv; leaderboard: CPU seconds of a suite per "
+        "controller, ship and step)",
     )
     p.add_argument("--repeats", type=int, default=5, help="timed repetitions (≥ 1)")
     p.add_argument(

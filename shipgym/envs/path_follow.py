@@ -17,6 +17,11 @@ Observation (float32, 9 entries, each within its documented bound):
     7  Δψ_next / π                     path-angle change to the next leg
     8  d_next / (d_next + 10 L)        distance to the next waypoint, squashed to [0, 1)
 
+With ``context_features=True`` (a ``gym.make`` argument, default off) 7 entries follow: the
+controller context a classical controller is designed from (the nominal model's first-order
+Nomoto K and T, L, U0, Ts, δmax; :func:`shipgym.envs.core.context_columns`, table in
+docs/observation.md), constant over an episode, never the true parameters or the schedule.
+
 Reward, termination, observation and info are the step core of :mod:`shipgym.envs.core`
 (the same functions as the batched env); its docstring gives the reward.
 
@@ -207,6 +212,7 @@ class ShipPathFollowEnv(gym.Env):
         action_mode: str = "rudder",
         render_mode: str | None = None,
         compile: bool = True,
+        context_features: bool = False,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
@@ -214,8 +220,12 @@ class ShipPathFollowEnv(gym.Env):
                 f"got {render_mode!r}"
             )
         self.scenario: Scenario = load_scenario(scenario)
-        parts = core.EnvParts.build(self.scenario, action_mode, compile)
+        parts = core.EnvParts.build(
+            self.scenario, action_mode, compile, context_features=context_features
+        )
         self._parts = parts
+        #: the observation ends with the controller-context features (core.CONTEXT_NAMES)
+        self.context_features = context_features
         self.action_mode = action_mode
         self.render_mode = render_mode
         self.model = self.scenario.model
@@ -373,7 +383,10 @@ class ShipPathFollowEnv(gym.Env):
             ),
             dtype=np.float32,
         )
-        return np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        if self.context_features:
+            return np.concatenate([obs, self._parts.context_row])
+        return obs
 
     def _info(self, frame: Any) -> dict[str, Any]:
         x, k = self._state, self._k

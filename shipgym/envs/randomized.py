@@ -69,6 +69,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         action_mode: str = "rudder",
         render_mode: str | None = None,
         compile: bool = True,
+        context_features: bool = False,
     ) -> None:
         self.distribution = (
             distribution
@@ -78,6 +79,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         self.action_mode = action_mode
         self.render_mode = render_mode
         self._compile = compile
+        self.context_features = context_features
         self._next_test_index = 0
         self._env = self._make_env(self._first_config())
         self.action_space = self._env.action_space
@@ -94,6 +96,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             action_mode=self.action_mode,
             render_mode=self.render_mode,
             compile=self._compile,
+            context_features=self.context_features,
         )
 
     def reset(

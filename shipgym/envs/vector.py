@@ -58,6 +58,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         render_mode: str | None = None,
         episode_metrics: bool = True,
         max_episode_steps: int | None = None,
+        context_features: bool = False,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be ≥ 1, got {num_envs}")
@@ -68,8 +69,12 @@ class ShipPathFollowVectorEnv(VectorEnv):
         if render_mode is not None:
             raise ValueError("the batched env does not render; use a single env for that")
         sc = load_scenario(scenario)
-        parts = core.EnvParts.build(sc, action_mode, compile, batch=num_envs)
+        parts = core.EnvParts.build(
+            sc, action_mode, compile, batch=num_envs, context_features=context_features
+        )
         self._parts = parts
+        #: the observation ends with the controller-context features (as the single env)
+        self.context_features = context_features
         self.num_envs = num_envs
         self.scenario = sc
         self.action_mode = action_mode
@@ -298,7 +303,11 @@ class ShipPathFollowVectorEnv(VectorEnv):
             ARRAY,
         )
         obs = np.stack(columns, axis=1).astype(np.float32)
-        return np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        if self.context_features:
+            row = self._parts.context_row
+            return np.concatenate([obs, np.broadcast_to(row, (self.num_envs, row.size))], axis=1)
+        return obs
 
     def _info(self) -> dict[str, Any]:
         k = self._k
