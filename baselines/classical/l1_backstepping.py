@@ -82,6 +82,7 @@ from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.metrics import high_frequency_power
 from shipgym.paths import wrap_angle
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
 from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
 from shipgym_baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
@@ -189,22 +190,13 @@ class L1Backstepping:
 
     def _course(self, info: dict[str, Any]) -> tuple[float, float]:
         """(speed over ground U [m/s], drift angle β [rad]) over the last period."""
-        if not self._started:
-            return self.ctx.nominal_speed, 0.0
-        x, y = info["position"]
-        x0, y0 = self._last["position"]
-        dx, dy = x - x0, y - y0
-        speed = math.hypot(dx, dy) / self.ctx.control_period
-        if not self.settings.drift_compensation or speed < 0.1 * self.ctx.nominal_speed:
-            return max(speed, 0.1 * self.ctx.nominal_speed), 0.0
-        samples = info.get("samples")
-        if samples is not None and len(samples["psi"]) > 0:
-            headings = unwrap_floats([*samples["psi"].tolist(), float(info["heading"])])
-            mean_heading = float(np.mean(np.array(headings)))
-        else:
-            h0 = self._last["psi"]
-            mean_heading = h0 + 0.5 * wrap_angle(info["heading"] - h0)
-        return speed, float(wrap_angle(math.atan2(dy, dx) - mean_heading))
+        return course_and_drift(
+            info,
+            self._last if self._started else None,
+            self.ctx.control_period,
+            self.ctx.nominal_speed,
+            self.settings.drift_compensation,
+        )
 
     def _reference(
         self, ye: float, path_angle: float, psi: float, r: float, speed: float, drift: float

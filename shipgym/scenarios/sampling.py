@@ -185,6 +185,9 @@ class DistributionConfig(StrictModel):
     #: in the test seed space), ``count_per_ship`` named scenarios of each ship
     ranges_of: str | None = None
     count_per_ship: int | None = Field(None, ge=1)
+    #: with ``ranges_of``: every ship's ``jumps.order`` (``cycle``: the named scenarios step
+    #: through the change kinds, so that a few cover every family; None: the train split's)
+    jump_order: Literal["random", "cycle"] | None = None
     ships: list[ShipSampling] = Field(default_factory=lambda: [ShipSampling()])
     path: PathSampling = PathSampling()
     sensors: SensorSampling = SensorSampling()
@@ -212,6 +215,9 @@ class DistributionConfig(StrictModel):
             {**ship.model_dump(exclude={"weight", "count"}), "count": data["count_per_ship"]}
             for ship in base.ships
         ]
+        if data.get("jump_order") is not None:
+            for ship in ships:
+                ship["jumps"] = {**ship["jumps"], "order": data["jump_order"]}
         return {
             **data,
             "ships": ships,
@@ -237,6 +243,8 @@ class DistributionConfig(StrictModel):
     def _check_split(self) -> None:
         if self.count_per_ship is not None and self.ranges_of is None:
             raise ValueError("count_per_ship: only with ranges_of (else each ship's 'count')")
+        if self.jump_order is not None and self.ranges_of is None:
+            raise ValueError("jump_order: only with ranges_of (else each ship's jumps.order)")
         if self.split == "train":
             for i, ship in enumerate(self.ships):
                 if ship.count is not None:

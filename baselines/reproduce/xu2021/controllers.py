@@ -18,12 +18,12 @@ AB = "adaptive_backstepping"
 PID = "pid_tvvf"
 
 
-#: label -> factory
+#: label -> factory (the PID: the paper's design, never the tuned settings)
 CONTROLLERS: dict[str, Callable[[], Any]] = {
     L1: L1Backstepping,
     L1_ADAPTIVE: lambda: L1Backstepping(filter_placement="adaptive"),
     AB: AdaptiveBackstepping,
-    PID: PIDTVVF,
+    PID: lambda: PIDTVVF(preset="paper"),
 }
 L1_VARIANTS = (L1, L1_ADAPTIVE)
 
