@@ -76,13 +76,11 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.angles import unwrap_floats
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.metrics import high_frequency_power
 from shipgym.paths import wrap_angle
-from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
 from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
 from shipgym_baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
@@ -96,6 +94,7 @@ from shipgym_baselines.classical.adaptive.settings import (
     Gains,
     L1BacksteppingSettings,
 )
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
 

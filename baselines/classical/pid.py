@@ -61,13 +61,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from shipgym.angles import wrap_angle
 from shipgym.autopilot import (
     VYSHNEGRADSKY_AB_STATED,
     HeadingPID,
     PIDGains,
     vyshnegradsky_gains,
 )
-from shipgym.angles import wrap_angle
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import desired_heading
 from shipgym.identification import first_order_nomoto, second_order_nomoto
@@ -125,7 +125,27 @@ class _GuidedPID:
     default_tuning: ClassVar[str]
     default_preset: ClassVar[str] = "tuned"
 
-    def __init__(self, preset: str | None = None, **settings: Any) -> None:
+    def __init__(
+        self,
+        preset: str | None = None,
+        *,
+        tuning: str | None = None,
+        natural_frequency: float | None = None,
+        natural_frequency_T: float | None = None,
+        damping: float | None = None,
+        vyshnegradsky_ab: tuple[float, float] | None = None,
+        ki_ratio: float | None = None,
+        drift_compensation: bool | None = None,
+        los_radius_L: float | None = None,
+        lookahead_L: float | None = None,
+        vf_tau_L: float | None = None,
+        vf_chi_e_deg: float | None = None,
+        vf_k: float | None = None,
+        tvvf_delta_L: float | None = None,
+        tvvf_theta_slope: float | None = None,
+        tvvf_theta_offset: float | None = None,
+        tvvf_error_unit: str | None = None,
+    ) -> None:
         """``preset``: "tuned" (the registry's default: the ship's section of
         ``configs/tuning/chosen/<name>.yaml`` under the explicit ``settings``, the paper's
         where the file has none) or "paper" (the paper-literal design only); None: the
@@ -136,18 +156,16 @@ class _GuidedPID:
         per-ship bandwidth); vyshnegradsky_ab (A, B) and ki_ratio (Ki/Kp [1/s]) for the
         Vyshnegradsky design; any guidance parameter of
         :class:`~shipgym.scenarios.schema.GuidanceConfig` (e.g. ``los_radius_L``) replaces
-        the scenario's for this controller's own heading reference."""
+        the scenario's for this controller's own heading reference (None: not given)."""
         preset = self.default_preset if preset is None else preset
         if preset not in PRESETS:
             raise ValueError(f"{self.name}: preset must be one of {PRESETS}, got {preset!r}")
-        unknown = sorted(set(settings) - set(SETTINGS) - set(GUIDANCE_SETTINGS))
-        if unknown:
-            raise ValueError(
-                f"{self.name}: unknown setting(s) {unknown}; valid: "
-                f"{sorted(SETTINGS) + sorted(GUIDANCE_SETTINGS)}"
-            )
+        given = dict(locals())
         self.preset = preset
-        self.explicit = dict(settings)
+        #: the settings given here (None: not given), over the chosen ones at reset
+        self.explicit = {
+            k: given[k] for k in (*SETTINGS, *GUIDANCE_SETTINGS) if given[k] is not None
+        }
         self._configure(self.explicit)
 
     def _configure(self, settings: dict[str, Any]) -> None:

@@ -48,7 +48,7 @@ def read_chosen(controller: str, folder: str | os.PathLike | None = None) -> dic
     return data
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _packaged(controller: str) -> dict[str, Any]:
     return read_chosen(controller)
 

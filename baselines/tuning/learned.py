@@ -47,9 +47,12 @@ def apply_overrides(agent: Any, overrides: dict[str, Any]) -> Any:
             updates[block] = current.model_copy(update=values)
         else:
             updates[block] = {**current, **values}
-    return agent.model_validate({**agent.model_dump(), **{
-        k: (v.model_dump() if hasattr(v, "model_dump") else v) for k, v in updates.items()
-    }})
+    return agent.model_validate(
+        {
+            **agent.model_dump(),
+            **{k: (v.model_dump() if hasattr(v, "model_dump") else v) for k, v in updates.items()},
+        }
+    )
 
 
 def train_and_score(
@@ -79,8 +82,7 @@ def train_and_score(
         steps = part * k if k < spec.evaluations else spec.n_timesteps
         latest = latest_checkpoint(folder) if k > 1 else None
         if latest is None or latest[1] < steps:  # a part a long rollout already covered: skip
-            train(agent, folder, n_timesteps=steps, resume=k > 1, progress=False,
-                  tensorboard=False)
+            train(agent, folder, n_timesteps=steps, resume=k > 1, progress=False, tensorboard=False)
         ratios = controller_ratios(str(folder / "model.zip"), {}, trials, oracle)
         if report is not None:
             report(geometric_mean(ratios), steps)

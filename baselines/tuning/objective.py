@@ -52,9 +52,7 @@ def controller_ratios(
 
     entry = ControllerEntry(controller=controller, settings=settings)
     results = evaluate_batch(entry, [t.scenario for t in trials], [t.seed for t in trials])
-    return [
-        cost_ratio(r.metrics.get("cost"), c) for r, c in zip(results, oracle, strict=True)
-    ]
+    return [cost_ratio(r.metrics.get("cost"), c) for r, c in zip(results, oracle, strict=True)]
 
 
 def chunked_ratios(

@@ -140,8 +140,9 @@ class Scorer:
         self.run_name: str | None = None  # a learned trial's run folder name
         self.trials = plan_trials(plan)
         plan.folder.mkdir(parents=True, exist_ok=True)
-        self.oracle = oracle_costs(self.trials, plan.folder.parent if plan.ship else plan.folder,
-                                   progress)
+        self.oracle = oracle_costs(
+            self.trials, plan.folder.parent if plan.ship else plan.folder, progress
+        )
 
     def score(
         self, settings: dict[str, Any], report: Callable[[float, int], None] | None = None
@@ -301,13 +302,23 @@ def write_report(
         "study": plan.study_name,
         "storage": plan.storage,
         "objective": config.objective,
-        "sampler": {"type": "TPESampler", "seed": config.sampler_seed,
-                    "n_startup_trials": config.startup_trials},
-        "pruner": {"type": "MedianPruner", "n_startup_trials": config.startup_trials,
-                   "report_every_trials": config.chunk},
+        "sampler": {
+            "type": "TPESampler",
+            "seed": config.sampler_seed,
+            "n_startup_trials": config.startup_trials,
+        },
+        "pruner": {
+            "type": "MedianPruner",
+            "n_startup_trials": config.startup_trials,
+            "report_every_trials": config.chunk,
+        },
         "budget": config.budget,
-        "validation": {"distribution": config.validation.distribution, "trials": names,
-                       "seeds": [t.seed for t in trials], "oracle_costs": oracle},
+        "validation": {
+            "distribution": config.validation.distribution,
+            "trials": names,
+            "seeds": [t.seed for t in trials],
+            "oracle_costs": oracle,
+        },
         "fixed": dict(config.fixed),
         "default_settings": dict(config.default),
         "search_space": {k: v.model_dump(exclude_none=True) for k, v in config.params.items()},
@@ -330,7 +341,7 @@ def write_report(
         )
         summary = {
             "study": plan.study_name,
-            "report": str((plan.folder / REPORT_FILE)),
+            "report": str(plan.folder / REPORT_FILE),
             "best_value": best.value,
             "default_value": report["default_value"],
             "trials": len(study.trials),

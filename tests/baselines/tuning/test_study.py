@@ -179,8 +179,13 @@ def test_bad_tuning_configs_name_the_key(tmp_path: Path) -> None:
     for edit, match in [
         ({"params": {"x": {"low": 2.0, "high": 1.0}}}, "low < high"),
         ({"kind": "learned"}, "training"),
-        ({"fixed": {"los_radius_L": 3.0}, "params": TINY["params"] | {"los_radius_L": {
-            "low": 1.0, "high": 2.0}}}, "tuned"),
+        (
+            {
+                "fixed": {"los_radius_L": 3.0},
+                "params": TINY["params"] | {"los_radius_L": {"low": 1.0, "high": 2.0}},
+            },
+            "tuned",
+        ),
     ]:
         file = tmp_path / "bad.yaml"
         file.write_text(yaml.safe_dump({**TINY, **edit}))
