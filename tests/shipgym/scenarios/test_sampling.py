@@ -275,7 +275,10 @@ def test_validation_is_the_training_ranges_in_the_test_seed_space() -> None:
         assert v.model_dump(exclude={"weight", "count", "jumps"}) == t.model_dump(
             exclude={"weight", "count", "jumps"}
         )
-        assert v.jumps.model_dump(exclude={"order"}) == t.jumps.model_dump(exclude={"order"})
+        assert v.jumps.probability == 1.0
+        assert v.jumps.model_dump(exclude={"order", "probability"}) == t.jumps.model_dump(
+            exclude={"order", "probability"}
+        )
     assert [validation.test_scenario(i).ship.model for i in range(4)] == list(SHIPS)
 
 
