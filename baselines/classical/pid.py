@@ -189,7 +189,7 @@ class _GuidedPID:
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
         if self.preset == "tuned":  # the ship's chosen settings under the explicit ones
-            chosen = tuned_settings(self.name, context.ship)
+            chosen = tuned_settings(type(self).name, context.ship)  # the registered name
             if "natural_frequency" in self.explicit:  # an explicit ωn wins over a chosen ωn·T
                 chosen.pop("natural_frequency_T", None)
             self._configure({**chosen, **self.explicit})

@@ -256,3 +256,21 @@ def test_ray_tasks_share_the_study_storage(tiny: Path, tmp_path: Path) -> None:
     finished = [t for t in report["trials"] if t["state"] in ("COMPLETE", "PRUNED")]
     assert 3 <= len(finished) <= 4  # each task stops at the budget (one may overshoot by 1)
     assert report["best_value"] == min(t["value"] for t in finished if t["state"] == "COMPLETE")
+
+
+@pytest.mark.parametrize(
+    ("argv", "match"),
+    [
+        (["tune", "no_such_space"], "unknown tuning space 'no_such_space'"),
+        (["tune", "pid_los", "--ship", "titanic"], "--ship 'titanic'"),
+        (["tune", "ppo", "--ship", "mariner"], "--ship"),
+        (["tune", "pid_los", "--storage", "sqlite:///x.db"], "--storage"),
+        (["tune", "pid_los", "--ship", "nomoto2", "--trials", "0"], "--trials 0"),
+    ],
+)
+def test_bad_tune_input_is_one_line_naming_it(
+    argv: list[str], match: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main([*argv, "--out", str(tmp_path / "out"), "--chosen-dir", str(tmp_path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and match in err[0], err
