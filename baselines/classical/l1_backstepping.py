@@ -97,6 +97,7 @@ from shipgym_baselines.classical.adaptive.settings import (
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
+from shipgym_baselines.tuning.chosen import tuned_settings
 
 #: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
 cubic_damping_from_zigzag = ship_cubic_damping
@@ -130,13 +131,29 @@ class L1Backstepping:
     #: C(s) of eq. (39) on the command (off: plain adaptive backstepping)
     low_pass = True
 
-    def __init__(self, settings: L1BacksteppingSettings | None = None, **overrides: Any) -> None:
-        base = settings if settings is not None else L1BacksteppingSettings()
+    def __init__(
+        self,
+        settings: L1BacksteppingSettings | None = None,
+        preset: str = "tuned",
+        **overrides: Any,
+    ) -> None:
+        """``settings`` (default: the paper's) with ``overrides``; ``preset``: "tuned" adds
+        the ship's section of ``configs/tuning/chosen/<name>.yaml`` (``shipgym tune``,
+        docs/tuning.md) under the overrides at reset, "paper" does not."""
+        if preset not in ("tuned", "paper"):
+            raise ValueError(f"preset must be 'tuned' or 'paper', got {preset!r}")
+        self.preset = preset
+        self._base = settings if settings is not None else L1BacksteppingSettings()
+        self._overrides = dict(overrides)
         # L1BacksteppingSettings validates itself, also when replaced with overrides
-        self.settings = dataclasses.replace(base, **overrides) if overrides else base
+        self.settings = dataclasses.replace(self._base, **overrides) if overrides else self._base
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
+        if self.preset == "tuned":  # the ship's chosen settings under the overrides
+            chosen = tuned_settings(type(self).name, context.ship)
+            if chosen:
+                self.settings = dataclasses.replace(self._base, **{**chosen, **self._overrides})
         s = self.settings
         self.ctx = context
         self.model = nominal_design_model(context.nominal_model)

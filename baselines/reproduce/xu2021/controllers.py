@@ -18,11 +18,11 @@ AB = "adaptive_backstepping"
 PID = "pid_tvvf"
 
 
-#: label -> factory (the PID: the paper's design, never the tuned settings)
+#: label -> factory (the papers' designs, never the tuned settings)
 CONTROLLERS: dict[str, Callable[[], Any]] = {
-    L1: L1Backstepping,
-    L1_ADAPTIVE: lambda: L1Backstepping(filter_placement="adaptive"),
-    AB: AdaptiveBackstepping,
+    L1: lambda: L1Backstepping(preset="paper"),
+    L1_ADAPTIVE: lambda: L1Backstepping(preset="paper", filter_placement="adaptive"),
+    AB: lambda: AdaptiveBackstepping(preset="paper"),
     PID: lambda: PIDTVVF(preset="paper"),
 }
 L1_VARIANTS = (L1, L1_ADAPTIVE)

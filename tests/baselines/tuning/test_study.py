@@ -146,8 +146,9 @@ def test_a_study_reports_resumes_and_refuses_to_overwrite(tiny: Path, tmp_path: 
 def test_chosen_settings_reach_the_default_construction(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """PIDLOS() reads the ship's chosen section at reset; preset='paper' ignores it; the
-    ship without a section keeps the paper's design."""
+    """PIDLOS() and L1Backstepping() read the ship's chosen section at reset (explicit
+    settings win); preset='paper' ignores it; a ship without a section keeps the paper's
+    design."""
     from shipgym.envs.context import ControllerContext
     from shipgym.scenarios import load_scenario
 
@@ -169,6 +170,20 @@ def test_chosen_settings_reach_the_default_construction(
         other = PIDLOS()
         other.reset(ControllerContext.of(load_scenario("blanke_nominal"), "rudder"))
         assert other.natural_frequency_T is None  # no blanke section: the paper's ωn
+        from shipgym_baselines.classical.l1_backstepping import L1Backstepping
+
+        chosen.write_chosen("l1_backstepping", "nomoto2", {"K2": 30.0, "K1": 0.05}, {}, tmp_path)
+        chosen._packaged.cache_clear()
+        l1, l1_paper, l1_given = (
+            L1Backstepping(),
+            L1Backstepping(preset="paper"),
+            L1Backstepping(K1=0.01),
+        )
+        for policy in (l1, l1_paper, l1_given):
+            policy.reset(ctx)
+        assert (l1.settings.K1, l1.settings.K2) == (0.05, 30.0)
+        assert (l1_paper.settings.K1, l1_paper.settings.K2) == (0.02, 15.0)
+        assert (l1_given.settings.K1, l1_given.settings.K2) == (0.01, 30.0)
     finally:
         chosen._packaged.cache_clear()
 
