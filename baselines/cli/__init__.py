@@ -22,6 +22,7 @@ from shipgym_baselines.cli import (
     run,
     scenarios,
     train,
+    tune,
 )
 from shipgym_baselines.errors import RunFailed
 from shipgym_baselines.signals import Terminated, signal_number, terminate_as_interrupt
@@ -31,6 +32,7 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     leaderboard.add_leaderboard_parser,
     reproduce.add_parser,
     train.add_parser,
+    tune.add_parser,
     leaderboard.add_evaluate_parser,
     run.add_parser,
     report.add_parser,

@@ -111,10 +111,11 @@ def test_default_suite_has_every_controller_and_learned_agent() -> None:
 
 
 def test_guidance_mode_with_zero_action_is_pid_los() -> None:
-    """The env's autopilot (guidance mode, a = 0) is the pid_los baseline, step for step."""
+    """The env's autopilot (guidance mode, a = 0) is the pid_los baseline's paper design,
+    step for step."""
     import gymnasium as gym
 
-    pid = run_episode(PIDLOS(), "rudder_aging", seed=3)
+    pid = run_episode(PIDLOS(preset="paper"), "rudder_aging", seed=3)
     env = gym.make("ShipPathFollow-v0", scenario="rudder_aging", action_mode="guidance")
     env.reset(seed=3)
     commands = []

@@ -36,6 +36,7 @@ def test_every_subcommand_is_listed() -> None:
         "leaderboard",
         "reproduce",
         "train",
+        "tune",
         "evaluate",
         "run",
         "report",
