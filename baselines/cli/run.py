@@ -2,9 +2,10 @@
 
 Writes ``metrics.json`` (the episode's row: scenario, controller, kind, seed and every
 metric, as ``--json`` prints it) and the leaderboard's figure of the episode (path and
-track, cross-track error, rudder angle) into ``--out``.  The default seed is the
-leaderboard's first evaluation seed, so the episode is that of the leaderboard's first
-seed.
+track, cross-track error, rudder angle) into ``--out``.  The episode is the trial that
+``--seed`` draws with ``--suite``'s randomisation (default suite ``default``), so it equals
+that suite's leaderboard episode of the scenario and seed; the default seed is the
+leaderboard's first evaluation seed.
 """
 
 from __future__ import annotations
@@ -43,7 +44,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--seed",
         type=int,
         default=EVAL_SEED_OFFSET,
-        help=f"env seed (default {EVAL_SEED_OFFSET}, the leaderboard's first)",
+        help=f"evaluation seed (default {EVAL_SEED_OFFSET}, the leaderboard's first; its "
+        f"i-th seed is {EVAL_SEED_OFFSET} + i)",
+    )
+    p.add_argument(
+        "--suite",
+        default="default",
+        help="replay this suite's trial of the scenario and seed (its randomize: block: start "
+        "offset, heading, jump time, current), as its leaderboard ran it; a name in "
+        "configs/suites or a YAML path (default: default)",
     )
     add_out_options(
         p,
@@ -72,12 +81,15 @@ def run(args: argparse.Namespace) -> int:
     run the episode, write its files, print its metrics."""
     from shipgym.config import is_path
     from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.trials import trial_scenario
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.registry import applies_to
     from shipgym_baselines.runs import check_out_dir, clear_outputs
+    from shipgym_baselines.suite import load_suite
 
+    suite = load_suite(args.suite)
     scenario = load_scenario(args.scenario)
     (label,) = check_controllers([args.controller])
     ship = scenario.model.name
@@ -89,16 +101,22 @@ def run(args: argparse.Namespace) -> int:
     out = check_out_dir(args.out or default_out(name, label, args.seed), force=args.force)
     if args.force:
         clear_outputs(out, OUTPUTS)
-    result = evaluate(args.controller, scenario, [args.seed])[0]
+    # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
+    trial = trial_scenario(scenario, suite.randomize, args.seed)
+    result = evaluate(args.controller, trial, [args.seed])[0]
     result.controller, result.scenario = label, args.scenario  # as the leaderboard names them
     row = result.row()
     out.mkdir(parents=True, exist_ok=True)
     (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
-    plot_results([result], out, {args.scenario: scenario})
+    randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
+    plot_results([result], out, {args.scenario: scenario}, randomize)
     plots = sorted(p.name for p in out.glob("*.png"))
     text = "\n".join(f"{k:24s} {_cell(v)}" for k, v in row.items())
     emit(args, row, text)
-    sys.stderr.write(f"wrote {out}: {METRICS_FILE}, {', '.join(plots)}\n")
+    sys.stderr.write(
+        f"wrote {out}: {METRICS_FILE}, {', '.join(plots)} (suite {suite.name!r}'s trial of "
+        f"seed {args.seed})\n"
+    )
     return 0
 
 
