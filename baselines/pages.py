@@ -384,13 +384,14 @@ def _anchor(name: str) -> str:
 
 
 def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
-    """stem → (data URI, file name) of each figure, the SVG where a stem has one, else the
-    PNG; in the order of ``figures``."""
+    """stem → (data URI, file name) of each figure, the PNG where a stem has one (a
+    palette PNG, :func:`shipgym_baselines.figures.write_compressed_png`: the page stays
+    light; issue 20), else the SVG; in the order of ``figures``."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
         if f.suffix.lower() not in (".svg", ".png"):
             continue
-        if f.stem not in by_stem or f.suffix.lower() == ".svg":
+        if f.stem not in by_stem or f.suffix.lower() == ".png":
             by_stem[f.stem] = f
     out = {}
     for stem, f in by_stem.items():
