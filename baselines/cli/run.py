@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
+from typing import Any
 
 from shipgym_baselines.cli.options import (
     add_json_option,
@@ -61,6 +63,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "empty: see --force)",
         resume_help=None,
     )
+    p.add_argument(
+        "--video",
+        default=None,
+        metavar="FILE",
+        help="also write an animation of the episode: FILE.gif (Pillow) or FILE.mp4 (needs "
+        "ffmpeg: pip install 'shipgym[video]')",
+    )
     add_trust_pickle_option(p)
     add_json_option(p, "print the episode's metrics as one JSON object")
     p.set_defaults(func=run)
@@ -79,6 +88,7 @@ def _file_name(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Check the scenario, the controller and ``--out`` (in that order, before any work),
     run the episode, write its files, print its metrics."""
+    from shipgym.animation import check_video_file
     from shipgym.config import is_path
     from shipgym.scenarios import load_scenario
     from shipgym.scenarios.trials import trial_scenario
@@ -91,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
 
     suite = load_suite(args.suite)
     scenario = load_scenario(args.scenario)
+    video = None if args.video is None else check_video_file(args.video)
     (label,) = check_controllers([args.controller])
     ship = scenario.model.name
     if not applies_to(label, ship):
@@ -111,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
     randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
     plot_results([result], out, {args.scenario: scenario}, randomize)
     plots = sorted(p.name for p in out.glob("*.png"))
+    if video is not None:
+        _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}")
     text = "\n".join(f"{k:24s} {_cell(v)}" for k, v in row.items())
     emit(args, row, text)
     sys.stderr.write(
@@ -118,6 +131,19 @@ def run(args: argparse.Namespace) -> int:
         f"seed {args.seed})\n"
     )
     return 0
+
+
+def _write_video(file: Path, result: Any, trial: Any, title: str) -> None:
+    """The episode's animation as ``file``; its CPU time per frame on stderr."""
+    import numpy as np
+
+    from shipgym.animation import animate_episode
+
+    start = time.process_time()
+    path_xy = trial.path.point(np.linspace(0.0, trial.path.length, 400))
+    frames = animate_episode(result.trajectory, path_xy, trial.ship_length, file, title)
+    cpu = time.process_time() - start
+    sys.stderr.write(f"wrote {file}: {frames} frames, {1000 * cpu / frames:.0f} ms CPU a frame\n")
 
 
 def _cell(value: object) -> str:
