@@ -1,4 +1,5 @@
-"""The ``shipgym`` console script (SPEC §9b).
+"""The ``shipgym`` console script: leaderboards, training, evaluation, single runs, reports,
+manoeuvres, the scenario catalogue, benchmarks and the papers' experiments.
 
 ``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
 """

@@ -1,4 +1,4 @@
-"""``shipgym bench TARGET``: the benchmarks of SPEC §10."""
+"""``shipgym bench TARGET``: speed benchmarks (env steps, NMPC, identification, training)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("bench", help="benchmarks of SPEC §10")
+    p = sub.add_parser("bench", help="speed benchmarks: env steps, NMPC solves, identification, training throughput")
     p.add_argument(
         "target",
         choices=list(BENCHES),
