@@ -20,7 +20,10 @@ BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("bench", help="speed benchmarks: env steps, NMPC solves, identification, training throughput")
+    p = sub.add_parser(
+        "bench",
+        help="speed benchmarks: env steps, NMPC solves, identification, training throughput",
+    )
     p.add_argument(
         "target",
         choices=list(BENCHES),

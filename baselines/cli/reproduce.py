@@ -11,7 +11,10 @@ from shipgym_baselines.reproduce import PAPERS
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("reproduce", help="re-run a source paper's experiment and compare with its published numbers")
+    p = sub.add_parser(
+        "reproduce",
+        help="re-run a source paper's experiment and compare with its published numbers",
+    )
     p.add_argument("paper", choices=list(PAPERS), help="which paper")
     p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")
