@@ -57,9 +57,11 @@ def ffmpeg_exe() -> str:
 
 
 def frame_indices(n_steps: int, max_frames: int = MAX_FRAMES) -> np.ndarray:
-    """The samples shown: every k-th of ``n_steps`` (k the smallest giving ≤ ``max_frames``),
-    the last always."""
-    stride = max(1, math.ceil(n_steps / max_frames))
+    """The samples shown: every k-th of ``n_steps`` and the last (k the smallest giving
+    at most ``max_frames`` ≥ 2 in all)."""
+    if max_frames < 2:
+        raise VideoError(f"an animation has at least 2 frames, got max_frames={max_frames}")
+    stride = max(1, math.ceil((n_steps - 1) / (max_frames - 1)))
     idx = np.arange(0, n_steps, stride)
     return idx if idx[-1] == n_steps - 1 else np.append(idx, n_steps - 1)
 
