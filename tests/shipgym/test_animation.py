@@ -70,10 +70,10 @@ def test_record_video_works_with_the_video_extra(tmp_path: Path) -> None:
     import shipgym  # noqa: F401  (registers the envs)
 
     env = gym.make("ShipPathFollow-v0", render_mode="rgb_array")
-    env = gym.wrappers.RecordVideo(env, str(tmp_path), episode_trigger=lambda e: True)
+    env = gym.wrappers.RecordVideo(env, str(tmp_path / "videos"), episode_trigger=lambda e: True)
     env.reset(seed=0)
     for _ in range(5):
         env.step(np.zeros(env.action_space.shape, dtype=np.float32))
     env.close()
-    (video,) = tmp_path.glob("*.mp4")
+    (video,) = (tmp_path / "videos").glob("*.mp4")
     assert video.stat().st_size > 0
