@@ -2,8 +2,11 @@
 
 Every figure uses :func:`shipgym_baselines.style.controller_style` (one colour and line style per
 controller, the same in every figure), labels its axes with units, keeps legends outside the
-data and is written twice: a PNG at :data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi) and an SVG
-copy beside it (:func:`save_figure`).  Matplotlib runs on the Agg backend.
+data and is written twice (:func:`save_figure`): drawn at
+:data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi), as a palette PNG of at most
+:data:`PAGE_WIDTH` pixels (the page's image), and as a vector copy beside it (SVG; the
+scenario figures, which hold the long trajectories, as gzip-compressed SVGZ).  Matplotlib runs
+on the Agg backend.
 
 What a run hands in:
 
@@ -41,6 +44,8 @@ Functions (each returns the written files, PNG then SVG):
 
 from __future__ import annotations
 
+import gzip
+import io
 import math
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
@@ -60,6 +65,21 @@ MAX_POINTS = 2000
 #: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
 #: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)
 PROFILE_REPS = 200
+#: the figures' files: text kept as text in the SVG, a fixed hash salt (reproducible ids),
+#: and lines simplified to 0.5 px (matplotlib drops a vertex that moves its line by less
+#: than this fraction of a pixel; default 1/9): lighter files that look the same
+LIGHT_FIGURES = {
+    "svg.fonttype": "none",
+    "svg.hashsalt": "shipgym",
+    "path.simplify": True,
+    "path.simplify_threshold": 0.5,
+}
+#: widest PNG [px]: a figure drawn at FIGURE_DPI is written at 1/2, 1/3, … of its pixels,
+#: the first that fits (a 200-dpi figure at 100 dpi or less: the page shows no more; the
+#: vector copy keeps every detail)
+PAGE_WIDTH = 1400
+#: colours of a PNG's palette (lines, their antialiasing and the text)
+PAGE_COLOURS = 64
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
 REFERENCES = ("zero_rudder", "random", ORACLE)
@@ -97,21 +117,50 @@ def figure_stem(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
 
 
-def save_figure(fig: Any, out_dir: str | Path, stem: str, tight: bool = False) -> list[Path]:
-    """Write ``fig`` as ``<stem>.png`` (200 dpi) and ``<stem>.svg`` into ``out_dir`` (made if
-    missing), close it and return both paths.  ``tight``: crop to what is drawn (for a
-    figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
-    layout is computed once (the PNG) and kept for the SVG."""
+def save_figure(
+    fig: Any, out_dir: str | Path, stem: str, tight: bool = False, vector: str = ".svg"
+) -> list[Path]:
+    """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and its
+    vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for a figure
+    of long trajectories) into ``out_dir`` (made if missing), close it and return both
+    paths.  ``tight``: crop to what is drawn (for a figure drawn outside its canvas, as
+    rliable's interval plot is); a layout engine's layout is computed once (the PNG) and
+    kept for the SVG."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    paths = [out / f"{stem}.png", out / f"{stem}{vector}"]
     bbox = "tight" if tight else None
-    with pyplot().rc_context({"svg.fonttype": "none", "svg.hashsalt": "shipgym"}):
-        fig.savefig(paths[0], dpi=FIGURE_DPI, bbox_inches=bbox)
+    with pyplot().rc_context(LIGHT_FIGURES):
+        png = io.BytesIO()
+        fig.savefig(png, format="png", dpi=FIGURE_DPI, bbox_inches=bbox)
+        write_page_png(png.getvalue(), paths[0])
         fig.set_layout_engine("none")
-        fig.savefig(paths[1], bbox_inches=bbox, metadata={"Date": None})
+        svg = io.BytesIO()
+        fig.savefig(svg, format="svg", bbox_inches=bbox, metadata={"Date": None})
+    if vector == ".svgz":  # mtime 0: the same figure gives the same bytes
+        paths[1].write_bytes(gzip.compress(svg.getvalue(), compresslevel=9, mtime=0))
+    else:
+        paths[1].write_bytes(svg.getvalue())
     pyplot().close(fig)
     return paths
+
+
+def write_page_png(png: bytes, path: Path) -> None:
+    """``png`` (matplotlib's RGBA at :data:`FIGURE_DPI`, opaque) written as the page shows
+    it (issue 20: the page's weight): reduced by the smallest whole factor that makes it at
+    most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the dpi recorded
+    accordingly), a :data:`PAGE_COLOURS`-colour palette without dithering (a line figure
+    has few colours beyond its antialiasing), deflated at the highest level."""
+    from PIL import Image
+
+    with Image.open(io.BytesIO(png)) as image:
+        rgb = image.convert("RGB")
+        dpi = image.info.get("dpi", (FIGURE_DPI, FIGURE_DPI))
+    factor = math.ceil(rgb.width / PAGE_WIDTH)
+    if factor > 1:
+        rgb = rgb.reduce(factor)
+    palette = rgb.quantize(PAGE_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    palette.save(path, format="PNG", optimize=True, dpi=(dpi[0] / factor, dpi[1] / factor))
 
 
 # ------------------------------------------------------------------ which episode to draw
@@ -463,7 +512,7 @@ def plot_scenario(
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
     )
-    return save_figure(fig, out_dir, "scenario_" + figure_stem(scenario))
+    return save_figure(fig, out_dir, "scenario_" + figure_stem(scenario), vector=".svgz")
 
 
 def _scenario_title(

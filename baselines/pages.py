@@ -384,17 +384,19 @@ def _anchor(name: str) -> str:
 
 
 def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
-    """stem → (data URI, file name) of each figure, the SVG where a stem has one, else the
-    PNG; in the order of ``figures``."""
+    """stem → (data URI, file name) of each figure, the PNG where a stem has one (a
+    page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`: the page stays
+    light, issue 20), else the SVG; in the order of ``figures``."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
         if f.suffix.lower() not in (".svg", ".png"):
             continue
-        if f.stem not in by_stem or f.suffix.lower() == ".svg":
+        if f.stem not in by_stem or f.suffix.lower() == ".png":
             by_stem[f.stem] = f
     out = {}
     for stem, f in by_stem.items():
-        mime = "image/svg+xml" if f.suffix.lower() == ".svg" else "image/png"
+        png = f.suffix.lower() == ".png"
+        mime = "image/png" if png else "image/svg+xml"
         data = base64.b64encode(f.read_bytes()).decode("ascii")
         out[stem] = (f"data:{mime};base64,{data}", f.name)
     return out

@@ -1,5 +1,6 @@
-"""The ``shipgym`` console script: leaderboard, evaluation, training, reproduction of the papers,
-manoeuvres and benchmarks (documentation: the docs site, page "Packages and commands").
+"""The ``shipgym`` console script: leaderboards, training, evaluation, single runs, reports,
+manoeuvres, the scenario catalogue, benchmarks and the papers' experiments (documentation:
+the docs site, page "Packages and commands").
 
 ``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
 """

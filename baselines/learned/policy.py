@@ -245,15 +245,20 @@ def _folder_model(path: Path) -> Path:
 
 def policy_label(name_or_path: str | Path) -> str:
     """The table name of a learned policy: a shipped policy's name; a folder's name (a
-    ``seed_<k>`` folder with its parent's: ``ppo/seed_1``); for a zip the folder holding it,
-    plus the zip's stem unless it is ``model``."""
+    ``seed_<k>`` folder with its parent's: ``ppo/seed_1``); for an SB3 zip its file's stem
+    (``work/ppo_ship.zip`` → ``ppo_ship``), except a trained agent's own model file
+    (``model.zip``, ``best_model.zip``), which is named as its folder.  ``--name`` (the long
+    form's ``name``) gives any other."""
     path = Path(name_or_path).expanduser()
     if path.suffix == ".zip":
-        stem = "" if path.stem == "model" else f"/{path.stem}"
-        return f"{path.resolve().parent.name}{stem}"
+        return _folder_label(path.resolve().parent) if path.name in MODEL_FILES else path.stem
     if not path.exists():
         return str(name_or_path)
-    path = path.resolve()
+    return _folder_label(path.resolve())
+
+
+def _folder_label(path: Path) -> str:
+    """A trained agent's folder's name (a ``seed_<k>`` folder with its parent's)."""
     return f"{path.parent.name}/{path.name}" if SEED_FOLDER.fullmatch(path.name) else path.name
 
 
