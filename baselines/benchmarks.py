@@ -161,7 +161,7 @@ def identification_log(
     )
     obs, info = env.reset(seed=seed)
     ctx = env.unwrapped.controller_context
-    pid = PIDLOS()
+    pid = PIDLOS(preset="paper")  # the papers' experiment: the paper-literal design
     pid.reset(ctx, seed)
     excite = PersistentExcitation(math.radians(excitation_deg), np.random.default_rng(seed))
     log = []

@@ -56,6 +56,7 @@ import numpy as np
 
 from shipgym_baselines.escaping import plain_text
 from shipgym_baselines.ranking import ORACLE
+from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
@@ -138,9 +139,9 @@ def save_figure(
         svg = io.BytesIO()
         fig.savefig(svg, format="svg", bbox_inches=bbox, metadata={"Date": None})
     if vector == ".svgz":  # mtime 0: the same figure gives the same bytes
-        paths[1].write_bytes(gzip.compress(svg.getvalue(), compresslevel=9, mtime=0))
+        write_bytes(paths[1], gzip.compress(svg.getvalue(), compresslevel=9, mtime=0))
     else:
-        paths[1].write_bytes(svg.getvalue())
+        write_bytes(paths[1], svg.getvalue())
     pyplot().close(fig)
     return paths
 
@@ -160,7 +161,9 @@ def write_page_png(png: bytes, path: Path) -> None:
     if factor > 1:
         rgb = rgb.reduce(factor)
     palette = rgb.quantize(PAGE_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
-    palette.save(path, format="PNG", optimize=True, dpi=(dpi[0] / factor, dpi[1] / factor))
+    page = io.BytesIO()
+    palette.save(page, format="PNG", optimize=True, dpi=(dpi[0] / factor, dpi[1] / factor))
+    write_bytes(path, page.getvalue())
 
 
 # ------------------------------------------------------------------ which episode to draw

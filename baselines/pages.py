@@ -44,6 +44,7 @@ from shipgym_baselines.ranking import (
     is_partial,
     resolution_lines,
 )
+from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import controller_style
 
 PAGE_FILE = "leaderboard.html"
@@ -491,5 +492,5 @@ def write_html(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
-    path.write_text(page(rows, aggregate, scores, figures, title, subtitle), encoding="utf-8")
+    write_bytes(path, page(rows, aggregate, scores, figures, title, subtitle).encode("utf-8"))
     return path

@@ -285,12 +285,20 @@ def write_json(file: Path, document: Any) -> None:
     """Write atomically (a temporary file renamed over ``file``)."""
     from shipgym_baselines.jsonout import dumps
 
+    write_bytes(file, (dumps(document, indent=2) + "\n").encode())
+
+
+def write_bytes(file: Path, data: bytes) -> None:
+    """Write ``data`` atomically (a temporary file renamed over ``file``): a full disk leaves
+    neither a half-written ``file`` nor its temporary, and its error names ``file``."""
     tmp = temporary_file(file)
     try:
-        tmp.write_text(dumps(document, indent=2) + "\n")
+        tmp.write_bytes(data)
         os.replace(tmp, file)
-    except BaseException:  # no half-written temporary left behind (a full disk)
+    except BaseException as exc:  # no half-written temporary left behind (a full disk)
         tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(file)  # the one-line message names it
         raise
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import time
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -211,16 +210,15 @@ class _ClockedZero(ZeroRudder):
         return np.zeros((len(obs), 1), dtype=np.float32)
 
 
-def test_batched_compute_time_divides_each_forward_among_the_live_envs(monkeypatch) -> None:
+def test_batched_compute_time_divides_each_forward_among_the_live_envs() -> None:
     """The loop's clock reads 1 s more at every call, so each ``act_batch`` takes 1 s: while
     two episodes are live each step costs each 500 ms; once the short one has ended, the
     long one pays the whole second."""
     ticks = iter(range(10**6))
-    clock = SimpleNamespace(perf_counter=lambda: float(next(ticks)))
-    monkeypatch.setattr(evaluation, "time", clock)
     long = load_scenario("nominal")
     short = long.with_overrides({"time_limit": 20.0})
-    a, b = evaluate_batch(_ClockedZero(), [long, short], [0, 0])
+    with evaluation.act_clock(lambda: float(next(ticks))):
+        a, b = evaluate_batch(_ClockedZero(), [long, short], [0, 0])
     n_long, n_short = len(a.trajectory["t"]) - 1, len(b.trajectory["t"]) - 1
     assert n_short < n_long
     assert (b.metrics["compute_ms"], b.metrics["compute_ms_max"]) == (500.0, 500.0)
