@@ -18,6 +18,21 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 from shipgym.envs.vector import ShipPathFollowVectorEnv
 
 
+def sb3_step(env: Any, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
+    """One step of a batched env (``reset_finished`` after an episode end) in SB3's terms:
+    (observations, rewards, dones, per-env infos with ``terminal_observation`` and
+    ``TimeLimit.truncated``); the envs that ended are reset at once, as SB3 expects."""
+    obs, rewards, terminated, truncated, info = env.step(actions)
+    dones = terminated | truncated
+    infos = per_env_infos(info, env.num_envs)
+    for i in np.flatnonzero(dones):
+        infos[i]["terminal_observation"] = obs[i].copy()
+        infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+    if np.any(dones):
+        obs, _ = env.reset_finished()
+    return obs, rewards, dones, infos
+
+
 def per_env_infos(info: dict[str, Any], n: int) -> list[dict[str, Any]]:
     """A Gymnasium vector ``info`` (arrays with ``_key`` masks) as n per-env dicts."""
     infos: list[dict[str, Any]] = [{} for _ in range(n)]
@@ -59,14 +74,7 @@ class SB3BatchedVecEnv(VecEnv):
         self._actions = np.asarray(actions, dtype=np.float32).reshape(self.env.action_space.shape)
 
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
-        obs, rewards, terminated, truncated, info = self.env.step(self._actions)
-        dones = terminated | truncated
-        infos = per_env_infos(info, self.num_envs)
-        for i in np.flatnonzero(dones):
-            infos[i]["terminal_observation"] = obs[i].copy()
-            infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-        if np.any(dones):
-            obs, _ = self.env.reset_finished()
+        obs, rewards, dones, infos = sb3_step(self.env, self._actions)
         return obs, rewards.astype(np.float32), dones, infos
 
     def seed(self, seed: int | None = None) -> list[int | None]:
@@ -142,14 +150,7 @@ class SB3ShipsVecEnv(VecEnv):
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         all_obs, all_rewards, all_dones, all_infos = [], [], [], []
         for env, lo, hi in zip(self.envs, self._bounds[:-1], self._bounds[1:], strict=False):
-            obs, rewards, terminated, truncated, info = env.step(self._actions[lo:hi])
-            dones = terminated | truncated
-            infos = per_env_infos(info, env.num_envs)
-            for i in np.flatnonzero(dones):
-                infos[i]["terminal_observation"] = obs[i].copy()
-                infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-            if np.any(dones):
-                obs, _ = env.reset_finished()
+            obs, rewards, dones, infos = sb3_step(env, self._actions[lo:hi])
             all_obs.append(obs)
             all_rewards.append(rewards)
             all_dones.append(dones)

@@ -427,3 +427,16 @@ def episode_log(
         goal_bonus=scenario.config.reward.goal_bonus,
         dt=scenario.control_period,
     )
+
+
+def batch_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """A batched env's actions (n_envs, n_act) as float64, clipped to [-1, 1]; NaN or inf
+    in any env's row is an error naming those envs (before anything steps)."""
+    a = np.asarray(actions, dtype=np.float64).reshape(shape)
+    bad = ~np.all(np.isfinite(a), axis=1)
+    if np.any(bad):
+        raise ValueError(
+            f"actions of envs {np.flatnonzero(bad).tolist()} contain NaN or inf; "
+            "the env state is unchanged"
+        )
+    return np.clip(a, -1.0, 1.0)

@@ -144,14 +144,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        a = np.asarray(actions, dtype=np.float64).reshape(self.action_space.shape)
-        bad = ~np.all(np.isfinite(a), axis=1)
-        if np.any(bad):
-            raise ValueError(
-                f"actions of envs {np.flatnonzero(bad).tolist()} contain NaN or inf; "
-                "the env state is unchanged"
-            )
-        a = np.clip(a, -1.0, 1.0)
+        a = core.batch_actions(actions, self.action_space.shape)
         k = self._k
         n = self.num_envs
         reasons = np.full(n, None, dtype=object)
