@@ -47,7 +47,9 @@ def backtrack(
     [lb, ub]) whose cost is not above ``cost``, with that cost; None if there is none."""
     alpha = 1.0
     while alpha > 1e-3:
-        trial = np.clip(u + alpha * step, lb, ub)
+        trial = u + alpha * step
+        np.maximum(trial, lb, out=trial)  # np.clip(·, lb, ub), without its wrappers
+        np.minimum(trial, ub, out=trial)
         trial_cost = evaluate(trial)
         if trial_cost <= cost:
             return trial, trial_cost
@@ -102,7 +104,7 @@ def sqp(
     and a :func:`backtrack` on ``cost``; stopped when no descent is found, when the accepted
     step moves less than ``step_tolerance`` or (``cost_tolerance`` given) when it lowers the
     cost by less than that fraction.  Returns (plan, success, iterations)."""
-    u = np.clip(guess, lb, ub)
+    u = np.minimum(np.maximum(guess, lb), ub)  # np.clip(guess, lb, ub)
     value = cost(u)
     if not math.isfinite(value):
         return u, False, 0
@@ -115,11 +117,11 @@ def sqp(
         if found is None:
             break  # no descent: converged as far as the (generalised) Gauss–Newton goes
         trial, trial_value = found
-        moved = float(np.max(np.abs(trial - u)))
+        moved = float(np.abs(trial - u).max())
         gain = value - trial_value
         u, value = trial, trial_value
         if moved < step_tolerance:
             break
         if cost_tolerance is not None and gain <= cost_tolerance * value:
             break
-    return u, bool(np.all(np.isfinite(u)) and math.isfinite(value)), iterations
+    return u, bool(np.isfinite(u).all() and math.isfinite(value)), iterations

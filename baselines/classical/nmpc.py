@@ -179,14 +179,15 @@ class NMPCSolver:
     def cost(self, plan: np.ndarray, p: np.ndarray) -> float:
         """Cost (16) of a plan; inf when the prediction diverges (e.g. absurd parameters)."""
         self._p[:] = p
-        return self._plan_cost(plan)
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self._plan_cost(plan)
 
     def _plan_cost(self, plan: np.ndarray) -> float:
-        """:meth:`cost` with the parameters already in the buffer (inside :meth:`solve`)."""
+        """:meth:`cost` with the parameters already in the buffer, inside :meth:`solve`'s
+        ``errstate`` (an overflowing ρ·ρ is inf, not a warning)."""
         self._u[:] = plan
         self._rho_eval[1]()
-        with np.errstate(over="ignore", invalid="ignore"):
-            value = float(self._rho @ self._rho)
+        value = float(self._rho @ self._rho)
         return value if math.isfinite(value) else math.inf
 
     def _direction(self, u: np.ndarray) -> np.ndarray | None:
@@ -202,15 +203,17 @@ class NMPCSolver:
         """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""
         s = self.settings
         self._p[:] = p  # constant over the solve: written once, not per evaluation
-        return sqp(
-            guess,
-            self.lb,
-            self.ub,
-            self._plan_cost,
-            self._direction,
-            s.max_iter,
-            s.step_tolerance,
-        )
+        # a diverging prediction is handled, not warned about: inf cost, no direction
+        with np.errstate(over="ignore", invalid="ignore"):
+            return sqp(
+                guess,
+                self.lb,
+                self.ub,
+                self._plan_cost,
+                self._direction,
+                s.max_iter,
+                s.step_tolerance,
+            )
 
     def predict(self, plan: np.ndarray, p: np.ndarray) -> np.ndarray:
         """Predicted states (N_p, n_x) at the ends of the control periods."""
@@ -416,7 +419,8 @@ class NMPC:
             self.plan = guess
         self.param_history.append({"t": info["t"], **self._as_dict(used)})
         delta_c = self.pe(float(self.plan[0]))
-        return np.array([np.clip(delta_c / self.ctx.rudder_limit, -1.0, 1.0)], dtype=np.float32)
+        command = min(max(delta_c / self.ctx.rudder_limit, -1.0), 1.0)  # np.clip's value
+        return np.array([command], dtype=np.float32)
 
     def episode_stats(self) -> dict[str, float]:
         times = np.array(self.solve_times) if self.solve_times else np.array([math.nan])
