@@ -151,6 +151,15 @@ class FrontEnd(Protocol):
 def _columns(psi: Any, delta: Any, delta_c: Any) -> np.ndarray:
     """The samples as (n, 3) columns; arrays of different lengths are an error naming them
     (non-finite samples are dropped samples here: each front end says what it did)."""
+    if (
+        type(psi) is type(delta) is type(delta_c) is np.ndarray
+        and psi.dtype == delta.dtype == delta_c.dtype == np.float64
+        and psi.ndim == delta.ndim == delta_c.ndim == 1
+        and psi.shape == delta.shape == delta_c.shape
+    ):  # the usual case (the env's samples): no conversion or check needed
+        out = np.empty((psi.shape[0], 3))
+        out[:, 0], out[:, 1], out[:, 2] = psi, delta, delta_c
+        return out
     arrays = [np.asarray(a, float).ravel() for a in (psi, delta, delta_c)]
     return np.column_stack(check_log_arrays(arrays, finite=False))
 
