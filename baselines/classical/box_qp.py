@@ -88,6 +88,20 @@ class BoxQP:
         self._eval()
         return self._out[0].copy()
 
+    def solve_gauss_newton(
+        self, jac: np.ndarray, rho: np.ndarray, u: np.ndarray, lb: np.ndarray, ub: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`solve` of the Gauss–Newton step of ‖ρ(u)‖² at u within lb ≤ u + Δ ≤ ub:
+        H = JᵀJ, g = Jᵀρ, bounds lb − u, ub − u, computed straight into the QP's buffers
+        (the same products as ``jac.T @ jac``, ``jac.T @ rho``, without temporaries)."""
+        q, n = self._in, self.n
+        np.matmul(jac.T, jac, out=q["h"].reshape(n, n))
+        np.matmul(jac.T, rho, out=q["g"])
+        np.subtract(lb, u, out=q["lbx"])
+        np.subtract(ub, u, out=q["ubx"])
+        self._eval()
+        return self._out[0].copy()
+
 
 def sqp(
     guess: np.ndarray,

@@ -161,7 +161,7 @@ class NMPCSolver:
 
     def _gauss_newton_step(self, u: np.ndarray, rho: np.ndarray, jac: np.ndarray) -> np.ndarray:
         """Box-constrained Gauss–Newton step Δ (the SQP's QP), solved by qrqp."""
-        return self._qp.solve(jac.T @ jac, jac.T @ rho, self.lb - u, self.ub - u)
+        return self._qp.solve_gauss_newton(jac, rho, u, self.lb, self.ub)
 
     def _bind(self, function: ca.Function, outputs: list[np.ndarray]):
         return bind(function, [self._u, self._p], outputs)
@@ -194,7 +194,7 @@ class NMPCSolver:
         """The Gauss–Newton step at u (None: ρ or J not finite); parameters in the buffer."""
         self._u[:] = u
         self._jac_eval[1]()
-        rho, jac = self._rho.copy(), self._jac.T
+        rho, jac = self._rho, self._jac.T  # used before the next evaluation overwrites them
         if not (np.isfinite(rho).all() and np.isfinite(jac).all()):
             return None
         return self._gauss_newton_step(u, rho, jac)
