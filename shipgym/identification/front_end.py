@@ -179,6 +179,8 @@ class DifferencesFrontEnd:
         self, psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray
     ) -> tuple[RegressionSignals, str | None]:
         new = _columns(psi, delta, delta_c)
+        if new.shape[0] and np.isfinite(new).all():  # the usual case: one unbroken run
+            return self._run(new), None
         finite = np.all(np.isfinite(new), axis=1)
         note = (
             None
