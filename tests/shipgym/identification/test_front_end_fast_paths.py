@@ -36,3 +36,19 @@ def test_hampel_full_windows_equal_numpys_median_bit_for_bit() -> None:
         a, b = _stream(fast, x, 1), _stream(slow, x, 1)
         assert a.tobytes() == b.tobytes()
         assert fast.replaced == slow.replaced > 0
+
+
+def test_row_window_keeps_the_rows_of_a_concatenated_and_trimmed_window() -> None:
+    """Appends of 1-120 rows and drops, across compactions and a growth, against vstack."""
+    from shipgym.identification.online import _RowWindow
+
+    rng = np.random.default_rng(2)
+    window, reference = _RowWindow(3, 64), np.zeros((0, 3))
+    for _ in range(400):
+        rows = rng.standard_normal((int(rng.integers(1, 121)), 3))
+        window.append(rows)
+        reference = np.vstack([reference, rows])
+        k = int(rng.integers(0, len(window) + 1))
+        window.drop(k)
+        reference = reference[k:]
+        assert window.view().tobytes() == reference.tobytes() and len(window) == len(reference)
