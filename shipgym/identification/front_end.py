@@ -247,18 +247,28 @@ class HampelFilter:
             self._buffer = buf
             return np.zeros(0)
         centre = buf[start:stop]
-        med, mad = np.empty_like(centre), np.empty_like(centre)
         cut = min(max(half - start, 0), stop - start)  # stream start: windows cut at buf[0]
+        if cut == 0:  # every window full (after the stream's first samples)
+            med, mad = self._full_median_mad(buf, start - half, centre.shape[0])
+            return self._replace(buf, centre, med, mad, stop)
+        med, mad = np.empty_like(centre), np.empty_like(centre)
         for i in range(cut):
             m_i, d_i = _median_mad(buf[: start + i + half + 1][None, :])
             med[i], mad[i] = m_i[0], d_i[0]
         if cut < centre.shape[0]:
             first = start + cut - half  # buf index of the first full window
             med[cut:], mad[cut:] = self._full_median_mad(buf, first, centre.shape[0] - cut)
+        return self._replace(buf, centre, med, mad, stop)
+
+    def _replace(
+        self, buf: np.ndarray, centre: np.ndarray, med: np.ndarray, mad: np.ndarray, stop: int
+    ) -> np.ndarray:
+        """The centres with the outliers replaced by their window's median; keeps the
+        samples the next windows need."""
         bad = ~np.isfinite(centre) | (np.abs(centre - med) > self.threshold * MAD_TO_SIGMA * mad)
         out = np.where(bad, med, centre)
         self.replaced += int(np.count_nonzero(bad & np.isfinite(med)))
-        keep = max(stop - half, 0)
+        keep = max(stop - self.delay, 0)
         self._buffer, self._past = buf[keep:], stop - keep
         return out
 
