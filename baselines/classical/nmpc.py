@@ -322,9 +322,6 @@ class NMPC:
         self._index = tuple(model.state_index(k) for k in ("x", "y", "psi", "r", "r_dot", "delta"))
         self._identified: Any = None  # the identifier's last params object …
         self._estimate: Any = None  # … and its prediction-model parameters
-        # a new parameters object each step an estimate is taken (as the uncached code made
-        # one): the model fallback below re-solves exactly when it did
-        self._version = self._good_version = 0
         self._vectors: dict[int, tuple[Any, np.ndarray]] = {}
         self._dicts: dict[int, tuple[Any, dict[str, float]]] = {}
 
@@ -366,6 +363,9 @@ class NMPC:
         return self.plan.copy()
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        # prediction_params makes a new parameters object on a reduced ship each time it is
+        # called: the model fallback below treats a step's cached estimate as new, as then
+        fresh = False
         if self.identifier is not None and "samples" in info:
             self.identifier.update(info["samples"])
             identified = self.identifier.params
@@ -374,8 +374,7 @@ class NMPC:
                 self._estimate = self.ship_plan.prediction_params(identified)
             estimate = self._estimate
             if estimate is not None:
-                if self.ship_plan.reduce or estimate is not self.params:
-                    self._version += 1  # prediction_params made a new object each step
+                fresh = self.ship_plan.reduce
                 self.params = estimate
         x, y = info["position"]
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
@@ -398,8 +397,7 @@ class NMPC:
         used = self.params
         if ok:
             self._good_params = self.params
-            self._good_version = self._version
-        elif self._good_version != self._version:
+        elif fresh or self._good_params is not self.params:
             used = self._good_params
             # the identified model makes the prediction diverge: use the last one that worked
             self.model_fallbacks += 1
