@@ -266,21 +266,29 @@ class TrialRowsVectorEnv(VectorEnv):
         r_m = np.where(advance, last[:, k.ir], self._r_m)
         xs, ys = self._state[:, k.ix].tolist(), self._state[:, k.iy].tolist()
         samples: dict[int, dict[str, np.ndarray]] = {}
+        if self.record_samples:  # every row's at once: views into fresh (N, n_sub) arrays
+            start = np.concatenate((x_start[:, None], traj[:, :-1]), axis=1)
+            measured_psi, measured_r = traj[:, :, k.ipsi].copy(), traj[:, :, k.ir].copy()
+            psi_s = np.concatenate((psi_m0[:, None], measured_psi[:, :-1]), axis=1)
+            r_s = np.concatenate((r_m0[:, None], measured_r[:, :-1]), axis=1)
+            t_s = t0[:, None] + self._sample_offsets
+            delta_s = start[:, :, k.idelta]
+            delta_c_s = np.repeat(delta_c[:, None], k.substeps, axis=1)
         for i in np.flatnonzero(advance).tolist():
             tr = trials[i]
-            measured = None
-            if self.record_samples or not tr.sensor.ideal:
-                measured = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
-                psi_m[i], r_m[i] = measured[0][-1], measured[1][-1]
+            if not tr.sensor.ideal:
+                p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
+                psi_m[i], r_m[i] = p_i[-1], r_i[-1]
+                if self.record_samples:
+                    psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
             if self.record_samples:  # at the substep starts, before the tracker moves on
-                start = np.concatenate((x_start[i : i + 1], traj[i, :-1]))
                 samples[i] = {
-                    "t": t0[i] + self._sample_offsets,
-                    "psi": np.concatenate(([psi_m0[i]], measured[0][:-1])),
-                    "r": np.concatenate(([r_m0[i]], measured[1][:-1])),
-                    "delta": start[:, k.idelta],
-                    "delta_c": np.full(k.substeps, delta_c[i]),
-                    "e": tr.tracker.cross_track_of(start[:, k.ix], start[:, k.iy]),
+                    "t": t_s[i],
+                    "psi": psi_s[i],
+                    "r": r_s[i],
+                    "delta": delta_s[i],
+                    "delta_c": delta_c_s[i],
+                    "e": tr.tracker.cross_track_of(start[i, :, k.ix], start[i, :, k.iy]),
                 }
             self._frames[i] = tr.tracker.update(xs[i], ys[i])
         self._psi_m, self._r_m = psi_m, r_m
