@@ -328,9 +328,11 @@ def plan_jobs(
     skip: set[tuple[str, str]],
     references: str = "table",
 ) -> list[Job]:
-    """Every job of a run: per scenario and controller that applies, one job per seed for
-    a classical controller, one job of all seeds per training seed for a learned agent.
-    ``scenarios``: names, or name → recorded settings (the jobs run those)."""
+    """Every job of a run: per scenario and controller that applies, one job of all seeds
+    per training seed (a learned agent's) or of all seeds (a classical controller's: they
+    run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
+    reference table is looked up trial by trial).  ``scenarios``: names, or name →
+    recorded settings (the jobs run those)."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
@@ -341,6 +343,10 @@ def plan_jobs(
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
                     jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
+                elif not grants_truth(c):
+                    jobs.append(
+                        Job(c, scenario, tuple(seed_list), k, randomize, settings, references)
+                    )
                 else:
                     jobs += [
                         Job(c, scenario, (seed,), k, randomize, settings, references)
