@@ -70,7 +70,13 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         n = self.num_envs
         #: rows whose episode has ended (they stay done)
         self.finished = np.ones(n, dtype=bool)
-        self._logs: list[dict[str, list[float]]] = []
+        #: the episode logs: (LOG_FIELDS, row, step) [SI], row i's first steps[i] columns
+        self._log = np.zeros((len(core.LOG_FIELDS), n, int(self._max_steps_of().max())))
+        self._started = False
+
+    def _max_steps_of(self) -> np.ndarray:
+        """Each row's time limit in control periods."""
+        return np.array([core.StepConstants.of(sc).max_steps for sc in self.scenarios])
 
     def controller_context(self, i: int) -> ControllerContext:
         """What row i's controller may know (as the single env's ``controller_context``)."""
@@ -85,7 +91,7 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         for i, (sc, s) in enumerate(zip(self.scenarios, self.seeds, strict=True)):
             self._install(i, Trial.of(sc, s, self.action_mode, False))
         self.finished[:] = False
-        self._logs = [{name: [] for name in core.LOG_FIELDS} for _ in range(self.num_envs)]
+        self._started = True
         self._reached_goal = np.zeros(self.num_envs, dtype=bool)
         frames = self._frames
         infos = [self._row_info(i, frames[i]) for i in range(self.num_envs)]
@@ -94,7 +100,7 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
     def step(
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        if not self._logs:
+        if not self._started:
             raise RuntimeError("call reset() before step()")
         live = ~self.finished
         a = np.zeros(self.action_space.shape)
@@ -105,22 +111,17 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         k = self._k0
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
         x_col, y_col = self._state[:, k.ix], self._state[:, k.iy]
-        for i in np.flatnonzero(live).tolist():
+        rows = np.flatnonzero(live)
+        self._log[:, rows, self._steps[rows] - 1] = (
+            self._t[rows],
+            period.frame.cross_track[rows],
+            period.heading_error[rows],
+            self._state[rows, k.idelta],
+            self._delta_c[rows],
+            period.reward[rows],
+        )
+        for i in rows.tolist():
             frame = self._frames[i]
-            log = self._logs[i]
-            for column, value in zip(
-                log.values(),
-                (
-                    float(self._t[i]),
-                    float(frame.cross_track),
-                    float(period.heading_error[i]),
-                    float(self._state[i, k.idelta]),
-                    float(self._delta_c[i]),
-                    float(period.reward[i]),
-                ),
-                strict=True,
-            ):
-                column.append(value)
             info = self._row_info(i, frame, float(x_col[i]), float(y_col[i]))
             if i in period.samples:
                 info["samples"] = period.samples[i]
@@ -157,6 +158,7 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
     def episode_metrics(self, i: int) -> dict[str, Any]:
         """Row i's episode metrics so far (the single env's ``episode_metrics()``)."""
         sc = self.scenarios[i]
-        columns = {name: np.array(values) for name, values in self._logs[i].items()}
+        steps = int(self._steps[i])
+        columns = {name: self._log[j, i, :steps].copy() for j, name in enumerate(core.LOG_FIELDS)}
         log = core.episode_log(columns, sc, bool(self._reached_goal[i]))
         return compute_metrics(log, core.metric_settings(sc))
