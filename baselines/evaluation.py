@@ -1,7 +1,8 @@
 """The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9).
 
-:func:`run_episode` runs one episode; :func:`evaluate_batch` runs several (a learned
-policy's in lockstep, one network forward per step for all, with the same bits).
+:func:`run_episode` runs one episode; :func:`evaluate_batch` runs several in lockstep, as
+the rows of one :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (a learned
+policy with one network forward per step for all), with the same bits.
 """
 
 from __future__ import annotations

@@ -7,10 +7,11 @@ seed, and the sensor noise varies with it too.  A learned agent runs once per tr
 evaluation seeds.
 
 The work is cut into jobs (:class:`Job`, names and seeds only: the worker builds each
-seed's trial): a classical controller's job is one (scenario, seed) episode; a learned
-agent's is one training seed on one scenario for all the evaluation seeds, evaluated
-batched (:func:`shipgym_baselines.evaluation.evaluate_batch`: one network forward per step for all
-seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
+seed's trial): a classical controller's job is one scenario for all the evaluation seeds,
+a learned agent's one training seed on one scenario for all of them, the oracle's one
+(scenario, seed) trial; a job's seeds run in lockstep
+(:func:`shipgym_baselines.evaluation.evaluate_batch`: the rows of one evaluation trials env, one
+network forward per step for a learned agent's, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
 ``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
