@@ -4,8 +4,6 @@ give, bit for bit, what ``run_episode`` gives one seed at a time (compute times 
 
 from __future__ import annotations
 
-import time
-
 import pytest
 
 from shipgym.envs.eval_trials import lockstep_problem
@@ -14,7 +12,6 @@ from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate_batch, run_episode
 from shipgym_baselines.leaderboard import Job, trials
-from shipgym_baselines.registry import make_controller
 from shipgym_baselines.suite import load_suite
 
 from .test_evaluation import _assert_same_episodes, _one_by_one
@@ -26,12 +23,15 @@ SEEDS = [EVAL_SEED_OFFSET + i for i in range(3)]
 SCENARIOS = ("heldout:8", "heldout:6")
 
 
+def _randomize() -> dict:
+    randomize = load_suite("default").randomize
+    return randomize.model_dump() if hasattr(randomize, "model_dump") else randomize
+
+
 def _suite_trials(controller: str, scenario: str) -> list:
     """The default suite's trial of each seed (start offset, heading, jump-time jitter,
     current factor), as the leaderboard resolves them."""
-    randomize = load_suite("default").randomize
-    randomize = randomize.model_dump() if hasattr(randomize, "model_dump") else randomize
-    return trials(Job(controller, scenario, tuple(SEEDS), None, randomize))
+    return trials(Job(controller, scenario, tuple(SEEDS), None, _randomize()))
 
 
 @pytest.mark.parametrize(
@@ -82,20 +82,22 @@ def test_what_falls_back_to_one_env_per_episode() -> None:
     _assert_same_episodes(evaluate_batch(PIDLOS(), mixed, seeds), expected)
 
 
-def test_lockstep_spends_less_cpu_per_step_than_one_by_one() -> None:
-    """Ten seeds of a cheap controller on a 3-DOF ship: the lockstep run's CPU time is
-    below the one-by-one run's (the per-episode env setup and the per-step plant call are
-    shared; measured figures in docs/leaderboard-cost.md)."""
+def test_one_plant_call_per_step_for_all_seeds(monkeypatch) -> None:
+    """Ten seeds of a classical controller: the plant is integrated once per control step
+    for all rows (as many calls as the longest episode's steps, not the sum of them)."""
+    from shipgym.models.integrator import PeriodIntegrator
+
+    calls = []
+    real = PeriodIntegrator.substep_states
+
+    def counted(self, x0, u, w, p):
+        calls.append(len(x0))
+        return real(self, x0, u, w, p)
+
+    monkeypatch.setattr(PeriodIntegrator, "substep_states", counted)
     seeds = [EVAL_SEED_OFFSET + i for i in range(10)]
-    base = load_scenario("mariner_rudder_aging").with_overrides({"time_limit": 300.0})
-    per_seed = [base] * len(seeds)
-    evaluate_batch("zero_rudder", per_seed[:2], seeds[:2])  # warm: the mapped plant
-    start = time.process_time()
-    evaluate_batch("zero_rudder", per_seed, seeds)
-    lockstep = time.process_time() - start
-    start = time.process_time()
-    for seed in seeds:
-        policy, mode = make_controller("zero_rudder")
-        run_episode(policy, base, seed, mode)
-    one_by_one = time.process_time() - start
-    assert lockstep < one_by_one
+    per_seed = trials(Job("zero_rudder", "rudder_aging", tuple(seeds), None, _randomize()))
+    results = evaluate_batch("zero_rudder", per_seed, seeds)
+    steps = [r.metrics["steps"] for r in results]
+    assert len(set(steps)) > 1  # the trials end apart
+    assert calls == [len(seeds)] * max(steps)
