@@ -11,8 +11,9 @@ seed's trial): a classical controller's job is one scenario for all the evaluati
 a learned agent's one training seed on one scenario for all of them, the oracle's one
 (scenario, seed) trial; a job's seeds run in lockstep
 (:func:`shipgym_baselines.evaluation.evaluate_batch`: the rows of one evaluation trials env, one
-network forward per step for a learned agent's, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
-``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+network forward per step for a learned agent's, equal to the episodes one by one).
+``local`` runs the jobs in a process pool; ``ray`` submits the same job function to a Ray
+cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
 ``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`shipgym_baselines.ranking`: cost over
