@@ -7,11 +7,13 @@ seed, and the sensor noise varies with it too.  A learned agent runs once per tr
 evaluation seeds.
 
 The work is cut into jobs (:class:`Job`, names and seeds only: the worker builds each
-seed's trial): a classical controller's job is one (scenario, seed) episode; a learned
-agent's is one training seed on one scenario for all the evaluation seeds, evaluated
-batched (:func:`shipgym_baselines.evaluation.evaluate_batch`: one network forward per step for all
-seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
-``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+seed's trial): a classical controller's job is one scenario for all the evaluation seeds,
+a learned agent's one training seed on one scenario for all of them, the oracle's one
+(scenario, seed) trial; a job's seeds run in lockstep
+(:func:`shipgym_baselines.evaluation.evaluate_batch`: the rows of one evaluation trials env, one
+network forward per step for a learned agent's, equal to the episodes one by one).
+``local`` runs the jobs in a process pool; ``ray`` submits the same job function to a Ray
+cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
 ``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`shipgym_baselines.ranking`: cost over
@@ -328,9 +330,11 @@ def plan_jobs(
     skip: set[tuple[str, str]],
     references: str = "table",
 ) -> list[Job]:
-    """Every job of a run: per scenario and controller that applies, one job per seed for
-    a classical controller, one job of all seeds per training seed for a learned agent.
-    ``scenarios``: names, or name → recorded settings (the jobs run those)."""
+    """Every job of a run: per scenario and controller that applies, one job of all seeds
+    per training seed (a learned agent's) or of all seeds (a classical controller's: they
+    run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
+    reference table is looked up trial by trial).  ``scenarios``: names, or name →
+    recorded settings (the jobs run those)."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
@@ -341,6 +345,10 @@ def plan_jobs(
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
                     jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
+                elif not grants_truth(c):
+                    jobs.append(
+                        Job(c, scenario, tuple(seed_list), k, randomize, settings, references)
+                    )
                 else:
                     jobs += [
                         Job(c, scenario, (seed,), k, randomize, settings, references)

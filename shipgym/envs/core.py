@@ -155,7 +155,8 @@ def action_space(action_mode: str) -> spaces.Box:
 
 @dataclasses.dataclass
 class EnvParts:
-    """Everything an env builds from its scenario, for one ship (``batch=None``) or N."""
+    """Everything an env builds from its scenario, for one ship (``batch=None``) or N
+    (the plant mapped over them on ``threads`` threads, :class:`PeriodIntegrator`)."""
 
     scenario: Scenario
     action_mode: str
@@ -178,6 +179,7 @@ class EnvParts:
         compile: bool,
         batch: int | None = None,
         context_features: bool = False,
+        threads: int = 2,
     ) -> EnvParts:
         if action_mode not in ACTION_MODES:
             raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
@@ -185,7 +187,12 @@ class EnvParts:
         k = StepConstants.of(sc)
         model = sc.model
         integrator = PeriodIntegrator(
-            model, k.fine_step, k.substeps, compile=compile, batch=1 if batch is None else batch
+            model,
+            k.fine_step,
+            k.substeps,
+            compile=compile,
+            batch=1 if batch is None else batch,
+            threads=threads,
         )
         disturbances = Disturbances(
             sc.config.disturbances,
@@ -210,7 +217,7 @@ class EnvParts:
             observation_space=observation_space(context_features),
             action_space=action_space(action_mode),
             context_row=scenario_context_row(sc) if context_features else _NO_CONTEXT,
-            metric_settings=MetricSettings(convergence_threshold=sc.config.convergence_threshold),
+            metric_settings=metric_settings(sc),
             autopilot_gains=gains,
         )
 
@@ -427,6 +434,11 @@ def episode_log(
         goal_bonus=scenario.config.reward.goal_bonus,
         dt=scenario.control_period,
     )
+
+
+def metric_settings(scenario: Scenario) -> MetricSettings:
+    """The episode metrics' settings of ``scenario`` (its convergence threshold)."""
+    return MetricSettings(convergence_threshold=scenario.config.convergence_threshold)
 
 
 def batch_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:

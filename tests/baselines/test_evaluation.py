@@ -118,8 +118,12 @@ def _trials(scenario: str, n: int) -> list[Scenario]:
     ]
 
 
+#: metrics that are times measured on the machine (the controller's act, its solver)
+TIMINGS = ("compute_ms", "solve_ms")
+
+
 def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[EpisodeResult]) -> None:
-    """Equal metrics (compute times aside) and trajectories, bit for bit."""
+    """Equal metrics (measured times aside) and trajectories, bit for bit."""
     assert len(batched) == len(one_by_one)
     for a, b in zip(batched, one_by_one, strict=True):
         assert (a.controller, a.kind, a.scenario, a.seed, a.training_seed) == (
@@ -129,8 +133,8 @@ def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[Episode
             b.seed,
             b.training_seed,
         )
-        keys = {k for k in a.metrics if not k.startswith("compute_ms")}
-        assert keys == {k for k in b.metrics if not k.startswith("compute_ms")}
+        keys = {k for k in a.metrics if not k.startswith(TIMINGS)}
+        assert keys == {k for k in b.metrics if not k.startswith(TIMINGS)}
         differ = [k for k in keys if not _same(a.metrics[k], b.metrics[k])]
         assert not differ, (a.controller, a.seed, differ)
         assert a.trajectory.keys() == b.trajectory.keys()

@@ -239,9 +239,10 @@ def test_a_learned_job_is_one_training_seed_on_all_seeds(agent: Path) -> None:
     assert [(j.seeds, j.training_seed) for j in jobs] == [
         ((7, 8), 0),
         ((7, 8), 1),
-        ((7,), None),
-        ((8,), None),
+        ((7, 8), None),  # a classical controller's seeds in lockstep too
     ]
+    oracle = plan_jobs(["oracle"], ["nominal"], [7, 8], {"oracle": [None]}, None, set())
+    assert [j.seeds for j in oracle] == [(7,), (8,)]  # the reference table, trial by trial
     # batched through evaluate_batch: the episodes run_job gives one by one, trial by trial
     batch = run_batch(Job(str(agent), "rudder_aging", (10_000, 10_001), 1, RANDOMIZE))
     for result in batch:
