@@ -183,9 +183,11 @@ class Scorer:
         return geometric_mean(ratios)
 
 
-def open_study(plan: StudyPlan, resume: bool, create: bool = True) -> Any:
+def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool = True) -> Any:
     """The plan's Optuna study: created (refused if it exists and not ``resume``) or
-    loaded (``resume``: refused if there is none)."""
+    loaded (``resume``: refused if there is none).  ``driver``: the process that runs the
+    study marks the trials a killed process left running as failed; a Ray task (False) must
+    not, or it would fail another task's trial that is running now."""
     import optuna
 
     exists = study_exists(plan)
@@ -201,7 +203,8 @@ def open_study(plan: StudyPlan, resume: bool, create: bool = True) -> Any:
     finished = 0
     if exists:
         study = optuna.load_study(study_name=plan.study_name, storage=plan.storage)
-        _fail_stale(study)
+        if driver:
+            _fail_stale(study)
         finished = sum(t.state.name in FINISHED for t in study.trials)
     sampler = optuna.samplers.TPESampler(
         seed=plan.config.sampler_seed + finished,
@@ -393,7 +396,7 @@ def _ray_worker(tuning: str, ship: str | None, folder: str, storage: str, total:
     config = load_tuning(tuning)
     name = f"{config.name}:{ship}" if ship else config.name
     plan = StudyPlan(tuning, config, ship, Path(folder), storage, name)
-    study = open_study(plan, resume=True, create=False)
+    study = open_study(plan, resume=True, create=False, driver=False)
     scorer = Scorer(plan)
     states = (TrialState.COMPLETE, TrialState.PRUNED, TrialState.FAIL)
     if sum(t.state in states for t in study.trials) >= total:

@@ -261,6 +261,23 @@ def test_every_packaged_tuning_config_loads() -> None:
     assert optuna.__version__
 
 
+def test_only_the_driver_fails_a_running_trial(tmp_path: Path) -> None:
+    """A trial left RUNNING is failed when the driver resumes the study (a killed process's
+    trial), but not when a Ray task opens it (another task's trial that is running now: the
+    race that made a task's ``tell`` fail with "Cannot tell a FAIL trial")."""
+    from shipgym_baselines.tuning.study import StudyPlan
+
+    config = TuningConfig.model_validate(TINY)
+    plan = StudyPlan("toy", config, None, tmp_path, f"sqlite:///{tmp_path}/toy.db", "toy")
+    running = open_study(plan, resume=False).ask()
+    open_study(plan, resume=True, create=False, driver=False)
+    assert open_study(plan, resume=True).trials[running.number].state.name == "FAIL"
+    plan2 = StudyPlan("toy2", config, None, tmp_path, f"sqlite:///{tmp_path}/toy2.db", "toy2")
+    running = open_study(plan2, resume=False).ask()
+    task_view = open_study(plan2, resume=True, create=False, driver=False)
+    assert task_view.trials[running.number].state.name == "RUNNING"
+
+
 @pytest.mark.slow
 def test_ray_tasks_share_the_study_storage(tiny: Path, tmp_path: Path) -> None:
     """--backend ray: two Ray tasks run the trials of one study through its SQLite storage
