@@ -350,7 +350,11 @@ def train(
     wall_offset = 0.0
     if previous is not None:
         ckpt, steps = previous
-        if config.env.normalize_reward:
+        if config.env.normalize_per_ship:  # its statistics are not checkpointed: re-estimated
+            from shipgym_baselines.learned.per_ship import VecNormalizePerShip
+
+            venv = VecNormalizePerShip(venv, groups, gamma)
+        elif config.env.normalize_reward:
             venv = VecNormalize.load(
                 str(out / "checkpoints" / f"ckpt_vecnormalize_{steps}_steps.pkl"), venv
             )

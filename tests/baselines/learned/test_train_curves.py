@@ -95,3 +95,16 @@ def test_a_context_feature_agent_is_evaluated_with_its_features(tmp_path: Path) 
     on_board = evaluate(policy, "nominal", [seed])[0].metrics
     _, direct_cost = run_agent_episode(policy.model, "nominal", seed, "rudder", True)
     assert on_board["cost"] == pytest.approx(direct_cost, rel=1e-6)
+
+
+def test_a_per_ship_normalised_run_resumes_from_its_checkpoint(tmp_path: Path) -> None:
+    """A run with per-ship reward normalisation resumes (its statistics are re-estimated,
+    not loaded: they are not checkpointed), as a study's second part does."""
+    env = {"vec_env": "batched", "n_envs": 4, "normalize_per_ship": True}
+    out = tmp_path / "run"
+    train(_tiny(n_timesteps=256, env=env), out_dir=out, progress=False, tensorboard=False)
+    meta = train(
+        _tiny(n_timesteps=512, env=env), out_dir=out, resume=True, progress=False, tensorboard=False
+    )
+    assert meta["env_steps"] == 512
+    assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
