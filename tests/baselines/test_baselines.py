@@ -82,7 +82,7 @@ def test_leaderboard_writes_tables_with_contract_keys(smoke: tuple[Path, list[di
     # the NMPC family runs on every ship (issue 17): a row with numbers on the Mariner too
     nmpc = {r["scenario"]: r for r in on_disk if r["controller"] == "nmpc_lambda_lssvm"}
     assert all(row["applies"] is True for row in nmpc.values())
-    assert nmpc["mariner_track"]["ace"] < pid["mariner_track"]["ace"]
+    assert nmpc["mariner_track"]["ace"] < zero["mariner_track"]["ace"]
     ppo = next(r for r in on_disk if r["controller"] == "ppo")
     assert ppo["kind"] == "learned" and ppo["train_env_steps"] > 0
     assert {r["split"] for r in on_disk} == {"catalogue", "heldout"}
