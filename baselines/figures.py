@@ -54,6 +54,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
 from shipgym_baselines.ranking import ORACLE
 from shipgym_baselines.runs import write_bytes
@@ -61,8 +62,6 @@ from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
-#: most points of a drawn line (longer trajectories are thinned by a stride, last point kept)
-MAX_POINTS = 2000
 #: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
 #: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)
 PROFILE_REPS = 200
@@ -263,13 +262,6 @@ def family_panels(
 
 
 # ------------------------------------------------------------------------ one scenario
-def _thin(values: Any, step: int) -> np.ndarray:
-    a = np.asarray(values, dtype=np.float64)
-    if step <= 1:
-        return a
-    return np.concatenate([a[::step], a[-1:]]) if (a.size - 1) % step else a[::step]
-
-
 def _episode_label(name: str, ep: DrawnEpisode) -> str:
     if ep.training_seed is None:
         return f"{name} (seed {ep.seed})"
@@ -343,7 +335,6 @@ def _change_line(ax: Any, change_time: float | None) -> None:
 _PANEL_W, _ROWS_H = 2.4, (2.1, 1.6, 1.6)
 _LEFT, _RIGHT, _TOP, _GAP, _ROW_GAP, _OWN_GAP = 0.8, 0.15, 0.65, 0.2, 0.5, 0.55
 _LEGEND_LINE = 0.14  # [in] a legend entry
-_TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
 
 
 def _scales(
@@ -435,10 +426,12 @@ def plot_scenario(
     episodes = {name: ep for name, ep in everything.items() if name != ORACLE}
     oracle = [ORACLE] if ORACLE in everything else []
     panels = family_panels(episodes, kinds) or [("no episode kept", [])]
-    longest = max((len(ep.trajectory["t"]) for ep in everything.values()), default=1)
-    step = max(1, math.ceil(longest / MAX_POINTS))
-    lines = {
-        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in everything.items()
+    lines = {  # M4: every pixel column keeps its extent (a limit cycle stays one)
+        n: {
+            k: np.asarray(v, dtype=np.float64)
+            for k, v in thin_trajectory(ep.trajectory, DRAWN_KEYS).items()
+        }
+        for n, ep in everything.items()
     }
     path = np.asarray(path_xy, dtype=np.float64) if path_xy is not None else np.empty((0, 2))
     pad = ship_length or 1.0

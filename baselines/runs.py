@@ -57,6 +57,7 @@ from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
@@ -529,12 +530,15 @@ def _repair(file: Path) -> None:
 
 
 def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
-    """A trajectory as its file keeps it (issue 20: the run folder's weight): float arrays
-    as float32 (7 significant digits: a millimetre on a 10 km route, far below a figure's
-    pixel; the episode's metrics are computed before, at full precision), the rest as
-    they are; the file is deflated (``np.savez_compressed``: ≈ 2.6x smaller in all)."""
+    """A trajectory as its file keeps it (issue 20: the run folder's weight): only the
+    arrays a figure draws (:data:`~shipgym_baselines.decimation.DRAWN_KEYS`), thinned to
+    what a figure can show without aliasing (M4,
+    :func:`~shipgym_baselines.decimation.thin_trajectory`), float arrays as float32 (7
+    significant digits: a millimetre on a 10 km route, far below a figure's pixel; the
+    episode's metrics are computed before, at full precision); the file is deflated
+    (``np.savez_compressed``)."""
     out = {}
-    for key, value in trajectory.items():
+    for key, value in thin_trajectory(trajectory, DRAWN_KEYS).items():
         array = np.asarray(value)
         out[key] = array.astype(np.float32) if array.dtype.kind == "f" else array
     return out
