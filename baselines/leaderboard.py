@@ -385,6 +385,7 @@ def run_leaderboard(
     command: list[str] | None = None,
     on_episode: Callable[[EpisodeResult], None] | None = None,
     recompute_references: bool = False,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -394,7 +395,8 @@ def run_leaderboard(
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
-    its shipped reference table (:mod:`shipgym_baselines.references`).  ``workers``: local processes
+    its shipped reference table (:mod:`shipgym_baselines.references`); ``vector_figures``:
+    the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
@@ -453,7 +455,7 @@ def run_leaderboard(
             keep_drawn(log, rows, row)
         with log.manifest.claiming():  # the tables and figures: listed for --force
             results = load_results(log.folder)
-            return write_results(log.folder, log.record["suite"], results, workers=workers)
+            return write_results(log.folder, log.record["suite"], results, workers, vector_figures)
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -501,6 +503,7 @@ def write_results(
     suite: Mapping[str, Any],
     results: list[EpisodeResult],
     workers: int | None = None,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Tables, ranking and figures into ``out`` from episode results and a suite as
     ``run.json`` keeps it (:func:`suite_record`); returns the rows.
@@ -514,7 +517,8 @@ def write_results(
     profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.pages`: all of it on one page).  The
     ranking of each split and each figure are independent tasks, run in a
     pool of ``workers`` processes (default: the cores) when there are
-    :data:`POOLED_FIGURES` scenario figures or more.
+    :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
+    vector copy too (the page shows the PNGs; issue 20).
     """
     from shipgym_baselines import figures, pages
 
@@ -541,6 +545,7 @@ def write_results(
                 {key: ep for key, ep in drawn.items() if key[0] == scenario},
                 suite["scenarios"],
                 kinds,
+                vector=vector_figures,
             )
             for scenario in shown
         }
@@ -556,6 +561,7 @@ def write_results(
                 ranked,
                 splits,
                 kinds,
+                vector_figures,
             )
             for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
         ]
@@ -574,7 +580,7 @@ def write_results(
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
-        files += figures.plot_learning_curves(out, learned_curves(kinds))
+        files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
     pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
     return rows
 
