@@ -47,7 +47,7 @@ from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from shipgym_baselines.figures import median_ace_episode
-from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
@@ -574,7 +574,7 @@ def write_results(
         )
         scores = score_table(ranked, splits, kinds)
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
-        (out / SCENARIO_SCORES_FILE).write_text(dumps(scores, indent=2) + "\n")
+        (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked)
         write_tables(rows, out, head=head)
@@ -866,7 +866,7 @@ def _fmt(value: Any, std: Any = None) -> str:
 def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
     before the rows (the ranking)."""
-    (out / "leaderboard.json").write_text(dumps(rows, indent=2))
+    (out / "leaderboard.json").write_text(dumps_rows(rows))  # one row a line
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")

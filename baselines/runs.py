@@ -59,6 +59,7 @@ import numpy as np
 
 from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
 from shipgym_baselines.signals import signal_number
@@ -724,7 +725,8 @@ class RunLog:
                     exc.filename = str(self.folder / tmp)  # the message names it
                 raise
         assert self._file is not None, "append after finish"
-        self._write_line((json.dumps(record, allow_nan=False) + "\n").encode())
+        line = json.dumps(record, allow_nan=False, separators=COMPACT)  # no spaces
+        self._write_line((line + "\n").encode())
         if time.monotonic() - self._synced >= FSYNC_INTERVAL_S:
             os.fsync(self._file.fileno())
             self._synced = time.monotonic()
