@@ -173,6 +173,7 @@ def _write(
         "suite": suite,
     }
     write_json(target / REPORT_FILE, document)
+    manifest.compact(keep=(REPORT_FILE, temporary_file(target / REPORT_FILE).name))
     return rows
 
 

@@ -777,6 +777,8 @@ class RunLog:
             cpu_s=self._earlier[1] + cpu,
         )
         self._write_record(in_place=status != "complete")
+        run_tmp = temporary_file(self.folder / RUN_FILE).name
+        self.manifest.compact(keep=(RUN_FILE, run_tmp, EPISODES_FILE))
 
     def elapsed(self) -> tuple[float, float]:
         """Wall-clock and CPU seconds of this invocation so far (:func:`cpu_seconds`)."""
