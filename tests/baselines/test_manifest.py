@@ -95,3 +95,4 @@ def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -
         clear_listed(out)
     (out / "mine.txt").unlink()
     clear_listed(out)
+    assert snapshot(out) == set()  # the lock is released when the run ends
