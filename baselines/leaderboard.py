@@ -614,9 +614,9 @@ POOLED_FIGURES = 4
 class _Inline:
     """An executor that runs each task as it is submitted (a small run needs no pool)."""
 
-    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+    def submit(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Future:
         future: Future = Future()
-        future.set_result(fn(*args))
+        future.set_result(fn(*args, **kwargs))
         return future
 
 
