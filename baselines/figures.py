@@ -54,6 +54,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
 from shipgym_baselines.ranking import ORACLE
 from shipgym_baselines.runs import write_bytes
@@ -61,8 +62,6 @@ from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
-#: most points of a drawn line (longer trajectories are thinned by a stride, last point kept)
-MAX_POINTS = 2000
 #: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
 #: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)
 PROFILE_REPS = 200
@@ -119,22 +118,26 @@ def figure_stem(name: str) -> str:
 
 
 def save_figure(
-    fig: Any, out_dir: str | Path, stem: str, tight: bool = False, vector: str = ".svg"
+    fig: Any, out_dir: str | Path, stem: str, tight: bool = False, vector: str | None = None
 ) -> list[Path]:
-    """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and its
-    vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for a figure
-    of long trajectories) into ``out_dir`` (made if missing), close it and return both
-    paths.  ``tight``: crop to what is drawn (for a figure drawn outside its canvas, as
-    rliable's interval plot is); a layout engine's layout is computed once (the PNG) and
-    kept for the SVG."""
+    """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and, if
+    asked, its vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for
+    a figure of long trajectories; None: none, the default of a run, issue 20: the page
+    shows the PNG and the copy would double the figures' weight) into ``out_dir`` (made if
+    missing), close it and return the paths.  ``tight``: crop to what is drawn (for a
+    figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
+    layout is computed once (the PNG) and kept for the SVG."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [out / f"{stem}.png", out / f"{stem}{vector}"]
+    paths = [out / f"{stem}.png"] + ([out / f"{stem}{vector}"] if vector else [])
     bbox = "tight" if tight else None
     with pyplot().rc_context(LIGHT_FIGURES):
         png = io.BytesIO()
         fig.savefig(png, format="png", dpi=FIGURE_DPI, bbox_inches=bbox)
         write_page_png(png.getvalue(), paths[0])
+        if not vector:
+            pyplot().close(fig)
+            return paths
         fig.set_layout_engine("none")
         svg = io.BytesIO()
         fig.savefig(svg, format="svg", bbox_inches=bbox, metadata={"Date": None})
@@ -263,13 +266,6 @@ def family_panels(
 
 
 # ------------------------------------------------------------------------ one scenario
-def _thin(values: Any, step: int) -> np.ndarray:
-    a = np.asarray(values, dtype=np.float64)
-    if step <= 1:
-        return a
-    return np.concatenate([a[::step], a[-1:]]) if (a.size - 1) % step else a[::step]
-
-
 def _episode_label(name: str, ep: DrawnEpisode) -> str:
     if ep.training_seed is None:
         return f"{name} (seed {ep.seed})"
@@ -343,7 +339,6 @@ def _change_line(ax: Any, change_time: float | None) -> None:
 _PANEL_W, _ROWS_H = 2.4, (2.1, 1.6, 1.6)
 _LEFT, _RIGHT, _TOP, _GAP, _ROW_GAP, _OWN_GAP = 0.8, 0.15, 0.65, 0.2, 0.5, 0.55
 _LEGEND_LINE = 0.14  # [in] a legend entry
-_TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
 
 
 def _scales(
@@ -422,6 +417,7 @@ def plot_scenario(
     ship_length: float | None = None,
     kinds: Mapping[str, str] | None = None,
     chosen_by: str = "median-ACE",
+    vector: bool = False,
 ) -> list[Path]:
     """Small multiples of one scenario (module doc) from ``drawn``: controller → episode;
     ``change_time`` [s] (None: no parameter change), ``path_xy`` (N, 2) points of the path
@@ -429,16 +425,19 @@ def plot_scenario(
     outside the shipped names), ``chosen_by``: how the episodes were picked, for the title
     (:func:`median_ace_episode`'s "median-ACE", or e.g. "first").  Every column has the same
     axes, except the references' (zero_rudder, random: their own scale, so a drifting
-    reference does not flatten the rest).  Returns the PNG and SVG paths."""
+    reference does not flatten the rest).  ``vector``: write the SVGZ copy too.  Returns
+    the PNG (and SVGZ) paths."""
     plt = pyplot()
     everything = {name: _as_drawn(ep) for name, ep in drawn.items()}
     episodes = {name: ep for name, ep in everything.items() if name != ORACLE}
     oracle = [ORACLE] if ORACLE in everything else []
     panels = family_panels(episodes, kinds) or [("no episode kept", [])]
-    longest = max((len(ep.trajectory["t"]) for ep in everything.values()), default=1)
-    step = max(1, math.ceil(longest / MAX_POINTS))
-    lines = {
-        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in everything.items()
+    lines = {  # M4: every pixel column keeps its extent (a limit cycle stays one)
+        n: {
+            k: np.asarray(v, dtype=np.float64)
+            for k, v in thin_trajectory(ep.trajectory, DRAWN_KEYS).items()
+        }
+        for n, ep in everything.items()
     }
     path = np.asarray(path_xy, dtype=np.float64) if path_xy is not None else np.empty((0, 2))
     pad = ship_length or 1.0
@@ -515,7 +514,8 @@ def plot_scenario(
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
     )
-    return save_figure(fig, out_dir, "scenario_" + figure_stem(scenario), vector=".svgz")
+    stem = "scenario_" + figure_stem(scenario)
+    return save_figure(fig, out_dir, stem, vector=".svgz" if vector else None)
 
 
 def _scenario_title(
@@ -552,6 +552,7 @@ def plot_scenarios(
     scenarios: Mapping[str, Any] | None = None,
     kinds: Mapping[str, str] | None = None,
     chosen_by: str = "median-ACE",
+    vector: bool = False,
 ) -> list[Path]:
     """:func:`plot_scenario` for every scenario of ``drawn`` ((scenario, controller) →
     episode), in sorted order; ``scenarios``: name → what
@@ -571,6 +572,7 @@ def plot_scenarios(
             by_scenario[name],
             kinds=kinds,
             chosen_by=chosen_by,
+            vector=vector,
             **scenario_geometry(spec),
         )
     return files
@@ -604,19 +606,20 @@ def plot_ranking(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
     kinds: Mapping[str, str] | None = None,
+    vector: bool = False,
 ) -> list[Path]:
     """Per split of ``aggregate``: ``ranking_<split>`` (rliable's interval estimates, the
     cost ratios on a log axis; a row of the split's partial table is drawn too, its label
     saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
-    ratio from ``episodes``, one panel per family); see the module doc.  Returns every
-    written file."""
+    ratio from ``episodes``, one panel per family); see the module doc; ``vector``: their
+    SVG copies too.  Returns every written file."""
     from shipgym_baselines.ranking import PARTIAL
 
     files: list[Path] = []
     for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in aggregate):
         rows = [r for r in aggregate if r["split"].removesuffix(PARTIAL) == split]
-        files += _plot_intervals(out_dir, split, rows)
-        files += _plot_profiles(out_dir, split, episodes, splits, kinds)
+        files += _plot_intervals(out_dir, split, rows, vector)
+        files += _plot_profiles(out_dir, split, episodes, splits, kinds, vector)
     return files
 
 
@@ -626,7 +629,9 @@ def _ranking_label(row: Mapping[str, Any], common: int) -> str:
     return row["controller"] if n == common else f"{row['controller']} ({n} of {common} scen.)"
 
 
-def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]]) -> list:
+def _plot_intervals(
+    out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]], vector: bool = False
+) -> list:
     from rliable import plot_utils
 
     plt = pyplot()
@@ -666,7 +671,8 @@ def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str,
         fontsize=10,
         y=1.0 + 0.5 / fig.get_figheight(),  # above the panels' titles, however few rows
     )
-    return save_figure(fig, out_dir, "ranking_" + figure_stem(split), tight=True)
+    stem = "ranking_" + figure_stem(split)
+    return save_figure(fig, out_dir, stem, tight=True, vector=".svg" if vector else None)
 
 
 def _log_ratio_axis(ax: Any, values: Iterable[float]) -> None:
@@ -699,6 +705,7 @@ def _plot_profiles(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
     kinds: Mapping[str, str] | None,
+    vector: bool = False,
 ) -> list[Path]:
     from rliable import plot_utils
 
@@ -753,7 +760,9 @@ def _plot_profiles(
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
     )
-    return save_figure(fig, out_dir, "profile_" + figure_stem(split))
+    return save_figure(
+        fig, out_dir, "profile_" + figure_stem(split), vector=".svg" if vector else None
+    )
 
 
 # ------------------------------------------------------------------ learning curves
@@ -762,7 +771,7 @@ LEARNING_CURVES_STEM = "learning_curves"
 
 
 def plot_learning_curves(
-    out_dir: str | Path, curves: Mapping[str, Sequence[Mapping[str, Any]]]
+    out_dir: str | Path, curves: Mapping[str, Sequence[Mapping[str, Any]]], vector: bool = False
 ) -> list[Path]:
     """``learning_curves``: one panel per learned agent, its validation mean return over
     env steps for each training seed (a band of ± one std over the validation episodes).
@@ -790,4 +799,4 @@ def plot_learning_curves(
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     fig.tight_layout()
-    return save_figure(fig, out_dir, LEARNING_CURVES_STEM)
+    return save_figure(fig, out_dir, LEARNING_CURVES_STEM, vector=".svg" if vector else None)

@@ -49,7 +49,7 @@ from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from shipgym_baselines.figures import median_ace_episode
-from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
@@ -393,6 +393,7 @@ def run_leaderboard(
     command: list[str] | None = None,
     on_episode: Callable[[EpisodeResult], None] | None = None,
     recompute_references: bool = False,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -402,7 +403,8 @@ def run_leaderboard(
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
-    its shipped reference table (:mod:`shipgym_baselines.references`).  ``workers``: local processes
+    its shipped reference table (:mod:`shipgym_baselines.references`); ``vector_figures``:
+    the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
@@ -461,7 +463,7 @@ def run_leaderboard(
             keep_drawn(log, rows, row)
         with log.manifest.claiming():  # the tables and figures: listed for --force
             results = load_results(log.folder)
-            return write_results(log.folder, log.record["suite"], results, workers=workers)
+            return write_results(log.folder, log.record["suite"], results, workers, vector_figures)
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -509,6 +511,7 @@ def write_results(
     suite: Mapping[str, Any],
     results: list[EpisodeResult],
     workers: int | None = None,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Tables, ranking and figures into ``out`` from episode results and a suite as
     ``run.json`` keeps it (:func:`suite_record`); returns the rows.
@@ -522,7 +525,8 @@ def write_results(
     profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.pages`: all of it on one page).  The
     ranking of each split and each figure are independent tasks, run in a
     pool of ``workers`` processes (default: the cores) when there are
-    :data:`POOLED_FIGURES` scenario figures or more.
+    :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
+    vector copy too (the page shows the PNGs; issue 20).
     """
     from shipgym_baselines import figures, pages
 
@@ -549,6 +553,7 @@ def write_results(
                 {key: ep for key, ep in drawn.items() if key[0] == scenario},
                 suite["scenarios"],
                 kinds,
+                vector=vector_figures,
             )
             for scenario in shown
         }
@@ -564,6 +569,7 @@ def write_results(
                 ranked,
                 splits,
                 kinds,
+                vector_figures,
             )
             for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
         ]
@@ -576,13 +582,13 @@ def write_results(
         )
         scores = score_table(ranked, splits, kinds)
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
-        (out / SCENARIO_SCORES_FILE).write_text(dumps(scores, indent=2) + "\n")
+        (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked)
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
-        files += figures.plot_learning_curves(out, learned_curves(kinds))
+        files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
     pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
     return rows
 
@@ -616,9 +622,9 @@ POOLED_FIGURES = 4
 class _Inline:
     """An executor that runs each task as it is submitted (a small run needs no pool)."""
 
-    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+    def submit(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Future:
         future: Future = Future()
-        future.set_result(fn(*args))
+        future.set_result(fn(*args, **kwargs))
         return future
 
 
@@ -868,7 +874,7 @@ def _fmt(value: Any, std: Any = None) -> str:
 def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
     before the rows (the ranking)."""
-    (out / "leaderboard.json").write_text(dumps(rows, indent=2))
+    (out / "leaderboard.json").write_text(dumps_rows(rows))  # one row a line
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")

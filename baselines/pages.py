@@ -30,10 +30,13 @@ from __future__ import annotations
 
 import base64
 import html
+import io
+import itertools
 import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from shipgym_baselines.figures import LEARNING_CURVES_STEM, figure_stem
 from shipgym_baselines.ranking import (
@@ -48,6 +51,8 @@ from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import controller_style
 
 PAGE_FILE = "leaderboard.html"
+#: most significant digits of a cell's sort key (``data-sort``)
+SORT_DIGITS = 7
 SPLIT_TITLES = {"catalogue": "Catalogue scenarios", "heldout": "Held-out scenarios"}
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
@@ -73,15 +78,16 @@ table{border-collapse:collapse;font-variant-numeric:tabular-nums}
 th,td{padding:3px 8px;border-bottom:1px solid #eaeef2;text-align:right;white-space:nowrap}
 th{background:#f6f8fa;position:sticky;top:0;cursor:pointer;user-select:none;z-index:1}
 th[aria-sort=ascending]::after{content:" \\25B2"}th[aria-sort=descending]::after{content:" \\25BC"}
-td.name,th.name{text-align:left;position:sticky;left:0;background:#fff;z-index:2}
-th.name{background:#f6f8fa;z-index:3}
-td.text,th.text{text-align:left}
-small.ci{color:#57606a;display:block;font-size:11px}
-table.compact small.ci{display:inline;margin-left:6px}
+td:first-child,th:first-child{text-align:left;position:sticky;left:0;background:#fff;z-index:2}
+th:first-child{background:#f6f8fa;z-index:3}
+th.text,table.ranking td:nth-child(3),#scores td:nth-child(2),#rows td:nth-child(-n+4){
+text-align:left}
+td i{color:#57606a;display:block;font-size:11px;font-style:normal}
+table.compact td i{display:inline;margin-left:6px}
 .splits{display:flex;flex-wrap:wrap;gap:8px 24px;align-items:flex-start}
 td.na{color:#8c959f;font-style:italic}
-span.swatch{display:inline-block;width:22px;height:0;border-top-width:3px;margin-right:6px;
-vertical-align:middle}
+td:first-child span{display:inline-block;width:22px;height:0;border-top-width:3px;
+margin-right:6px;vertical-align:middle}
 figure{margin:10px 0 22px}figure img{max-width:100%;height:auto;border:1px solid #eaeef2}
 figcaption{color:#57606a;font-size:12px}
 details>summary{cursor:pointer;font-weight:600;margin:8px 0}
@@ -89,9 +95,12 @@ details>summary{cursor:pointer;font-weight:600;margin:8px 0}
 
 _JS = """
 (function () {
-  function key(row, col, numeric) {
-    var v = row.cells[col].getAttribute("data-sort");
-    if (v === null || v === "") return null;
+  function key(row, col, numeric) {  // data-sort, else the cell's text
+    var cell = row.cells[col];
+    if (!cell) return null;
+    var v = cell.getAttribute("data-sort");
+    if (v === null) v = cell.textContent;
+    if (v === "") return null;
     if (!numeric) return v.toLowerCase();
     var x = parseFloat(v);
     return isNaN(x) ? null : x;
@@ -170,16 +179,34 @@ def _interval(ci: Any) -> str:
     return ""
 
 
-def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> str:
+class _Td(NamedTuple):
+    """A body cell: its inner HTML, its sort value (a finite number; None sorts last; for a
+    text cell unused: the script sorts by the text), the number its text starts with (what
+    the script reads without ``data-sort``) and further attributes."""
+
+    html: str
+    value: float | None = None
+    shown: float | None = None
+    attrs: str = ""
+
+
+def _leading_number(text: str) -> float | None:
+    """The number ``parseFloat`` reads at the start of a cell's text (None: NaN)."""
+    match = _LEADING_NUMBER.match(text)
+    return float(match.group(0)) if match else None
+
+
+_LEADING_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> _Td:
     """A numeric cell: the value, its interval (or ± std) below, the value as sort key."""
     sort = _finite(value)
     extra = _interval(ci) or (f"± {std:.3f}" if _finite(std) is not None else "")
     style = f' style="background:{_shade(sort)}"' if shade and sort is not None else ""
-    small = f'<small class="ci">{_e(extra)}</small>' if extra else ""
-    return (
-        f'<td data-sort="{"" if sort is None else repr(sort)}"{style}>'
-        f"{_e(_number(value))}{small}</td>"
-    )
+    small = f"<i>{_e(extra)}</i>" if extra else ""
+    text = _number(value)
+    return _Td(f"{_e(text)}{small}", sort, _leading_number(text), style)
 
 
 def _shade(ratio: float) -> str:
@@ -189,20 +216,27 @@ def _shade(ratio: float) -> str:
     return f"hsl({120 * (1.0 - t):.0f},65%,88%)"
 
 
-def _text_cell(text: Any) -> str:
-    return f'<td class="text" data-sort="{_e(text)}">{_e(text)}</td>'
+def _text_cell(text: Any) -> _Td:
+    return _Td(_e(text))
 
 
-def _name_cell(name: str) -> str:
+def _swatch_class(name: str) -> tuple[str, str]:
+    """(class, CSS rule) of a controller's swatch: its line's colour and style."""
     style = controller_style(name)
     border = {"-": "solid", "--": "dashed", "-.": "dashed", ":": "dotted"}.get(
         style.linestyle, "solid"
     )
-    swatch = (
-        f'<span class="swatch" style="border-top-style:{border};'
-        f'border-top-color:{_e(style.color)}"></span>'
-    )
-    return f'<td class="name" data-sort="{_e(name)}">{swatch}{_e(name)}</td>'
+    cls = "k" + "".join(c for c in style.color if c.isalnum()).lower() + border[:2]
+    return cls, f".{cls}{{border-top-style:{border};border-top-color:{_e(style.color)}}}"
+
+
+def swatch_css(names: Iterable[str]) -> str:
+    """The swatch classes of these controllers, each rule once."""
+    return "".join(sorted({_swatch_class(n)[1] for n in names}))
+
+
+def _name_cell(name: str) -> _Td:
+    return _Td(f'<span class="{_swatch_class(name)[0]}"></span>{_e(name)}')
 
 
 def _head(columns: Iterable[tuple[str, str, str]]) -> str:
@@ -211,24 +245,75 @@ def _head(columns: Iterable[tuple[str, str, str]]) -> str:
     name."""
     cells = []
     for i, (key, text, kind) in enumerate(columns):
-        cls = "name" if i == 0 else ("text" if kind == "text" else "")
         first = ' data-first="ascending"' if kind == "lower" else ""
         cells.append(
             f'<th data-key="{_e(key)}" data-type="{"number" if kind == "lower" else kind}"'
             + first
-            + (f' class="{cls}"' if cls else "")
+            + (' class="text"' if kind == "text" and i else "")
             + f">{text}</th>"
         )
     return "<thead><tr>" + "".join(cells) + "</tr></thead>"
 
 
-def _table(table_id: str, head: str, body: Iterable[str], compact: bool = False) -> str:
-    """A sortable table; ``compact``: intervals beside the values, not below."""
-    rows = "".join(f"<tr>{r}</tr>" for r in body)
-    cls = "sortable compact" if compact else "sortable"
+def _same_order(values: Sequence[float | None], keys: Sequence[float | None]) -> bool:
+    """Whether ``keys`` sort the cells as ``values`` do: equal values equal keys, distinct
+    ones in the same order, None (last) where None."""
+    pairs = sorted({(v, k) for v, k in zip(values, keys, strict=True) if v is not None})
+    if any((v is None) != (k is None) for v, k in zip(values, keys, strict=True)):
+        return False
+    for (v0, k0), (v1, k1) in itertools.pairwise(pairs):
+        if v0 == v1 or k0 is None or k1 is None or not k0 < k1:
+            return False
+    return True
+
+
+def sort_keys(values: Sequence[float | None], shown: Sequence[float | None]) -> list[str] | None:
+    """A numeric column's ``data-sort`` keys: None where the numbers its cells' texts start
+    with sort them as their values do (the script reads the text), else each value at the
+    fewest significant digits that keep the values' order and ties, at most 7 (values that
+    differ only beyond the 7th digit tie, and keep their order in the page; "" for none)."""
+    if _same_order(values, shown):
+        return None
+    for digits in range(1, SORT_DIGITS + 1):
+        keys = ["" if v is None else f"{v:.{digits}g}" for v in values]
+        if _same_order(values, [float(k) if k else None for k in keys]):
+            break
+    return keys
+
+
+def _table(
+    table_id: str,
+    columns: Sequence[tuple[str, str, str]],
+    body: Sequence[Sequence[_Td]],
+    compact: bool = False,
+    cls: str = "",
+) -> str:
+    """A sortable table; ``compact``: intervals beside the values, not below.  A numeric
+    column carries ``data-sort`` keys only where its texts would sort otherwise
+    (:func:`sort_keys`); the script sorts a text column by its texts."""
+    keys: dict[int, list[str]] = {}
+    for col, (_, _, kind) in enumerate(columns):
+        if kind == "text":
+            continue
+        cells = [(row, row[col]) for row in body if col < len(row)]
+        found = sort_keys([c.value for _, c in cells], [c.shown for _, c in cells])
+        if found is not None:
+            keys[col] = found
+    where = {col: 0 for col in keys}
+    rows = []
+    for row in body:
+        tds = []
+        for col, td in enumerate(row):
+            sort = ""
+            if col in keys:
+                sort = f' data-sort="{keys[col][where[col]]}"'
+                where[col] += 1
+            tds.append(f"<td{sort}{td.attrs}>{td.html}</td>")
+        rows.append("<tr>" + "".join(tds) + "</tr>")
+    classes = " ".join(c for c in ("sortable", "compact" if compact else "", cls) if c)
     return (
-        f'<div class="scroll"><table class="{cls}" id="{_e(table_id)}">{head}'
-        f"<tbody>{rows}</tbody></table></div>"
+        f'<div class="scroll"><table class="{classes}" id="{_e(table_id)}">{_head(columns)}'
+        f"<tbody>{''.join(rows)}</tbody></table></div>"
     )
 
 
@@ -236,8 +321,7 @@ def _table(table_id: str, head: str, body: Iterable[str], compact: bool = False)
 def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
     cost ratio's IQM, lowest first); a split's partial table is titled as such."""
-    head = _head(
-        [
+    columns = [
             ("controller", "controller", "text"),
             ("rank", "rank", "number"),
             ("kind", "kind", "text"),
@@ -248,8 +332,7 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("cost_ratio_gmean", "geometric mean", "lower"),
             ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
             ("failure_rate", "failure rate", "lower"),
-        ]
-    )
+    ]  # fmt: skip
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):
         rows = [r for r in aggregate if r["split"] == split]
@@ -258,25 +341,27 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             scenarios = r.get("scenarios")
             n = len(scenarios) if isinstance(scenarios, Sequence) else scenarios
             body.append(
-                _name_cell(r["controller"])
-                + f'<td data-sort="{-rank}">{rank}</td>'  # best-first on the first click
-                + _text_cell(r.get("kind", ""))
-                + _cell(n)
-                + _cell(r.get("runs"))
-                + _cell(r.get("training_seeds"))
-                + _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95"))
-                + _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95"))
-                + _cell(
-                    r.get("prob_improvement_over_pid_los"),
-                    r.get("prob_improvement_over_pid_los_ci95"),
-                )
-                + _cell(r.get("failure_rate"), r.get("failure_rate_ci95"))
+                [
+                    _name_cell(r["controller"]),
+                    _Td(str(rank), -rank, rank),  # best-first on the first click
+                    _text_cell(r.get("kind", "")),
+                    _cell(n),
+                    _cell(r.get("runs")),
+                    _cell(r.get("training_seeds")),
+                    _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95")),
+                    _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95")),
+                    _cell(
+                        r.get("prob_improvement_over_pid_los"),
+                        r.get("prob_improvement_over_pid_los_ci95"),
+                    ),
+                    _cell(r.get("failure_rate"), r.get("failure_rate_ci95")),
+                ]
             )
         base = split.removesuffix(PARTIAL)
         title = SPLIT_TITLES.get(base, base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        table = _table(f"ranking-{split}", head, body, compact=True)
+        table = _table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
     notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
@@ -331,14 +416,14 @@ def score_table(
             tds.append(_cell(agg.get("cost_ratio_iqm"), agg.get("cost_ratio_iqm_ci95")))
         for s in scenarios:
             if (name, s) in not_applicable:
-                tds.append('<td class="na" data-sort="" title="does not apply">n/a</td>')
+                tds.append(_Td("n/a", attrs=' class="na" title="does not apply"'))
             else:
                 sc = cell.get((name, s), {})
                 tds.append(
                     _cell(sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True)
                 )
-        body.append("".join(tds))
-    return _table("scores", _head(columns), body)
+        body.append(tds)
+    return _table("scores", columns, body)
 
 
 def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
@@ -367,14 +452,12 @@ def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
         ]
         tds += [_cell(r.get("seeds")), _cell(r.get("training_seeds"))]
         if r.get("applies", True) is False:
-            tds.append(
-                f'<td class="na" colspan="{len(metrics)}" data-sort="" '
-                'style="text-align:left">does not apply</td>'
-            )
+            attrs = f' class="na" colspan="{len(metrics)}" style="text-align:left"'
+            tds.append(_Td("does not apply", attrs=attrs))
         else:
             tds += [_cell(r.get(k), r.get(f"{k}_ci95"), r.get(f"{k}_std")) for k in metrics]
-        body.append("".join(tds))
-    return _table("rows", _head(columns), body)
+        body.append(tds)
+    return _table("rows", columns, body)
 
 
 # ------------------------------------------------------------------------------ figures
@@ -384,10 +467,28 @@ def _anchor(name: str) -> str:
     return "scenario_" + figure_stem(name)
 
 
+def page_image(png: Path) -> tuple[str, bytes]:
+    """(MIME type, bytes) of a PNG as the page embeds it: the same pixels as lossless WebP
+    where that is smaller (a palette figure: ≈ 20 % smaller; every current browser shows
+    WebP; effort 4 of 6: 0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the
+    PNG as it is."""
+    data = png.read_bytes()
+    from PIL import Image, features
+
+    if not features.check("webp"):
+        return "image/png", data
+    with Image.open(png) as image:
+        out = io.BytesIO()
+        image.save(out, format="WEBP", lossless=True, quality=100, method=4)
+    webp = out.getvalue()
+    return ("image/webp", webp) if len(webp) < len(data) else ("image/png", data)
+
+
 def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
     """stem → (data URI, file name) of each figure, the PNG where a stem has one (a
-    page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`: the page stays
-    light, issue 20), else the SVG; in the order of ``figures``."""
+    page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`, embedded as
+    :func:`page_image` gives it: the page stays light, issue 20), else the SVG; in the
+    order of ``figures``."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
         if f.suffix.lower() not in (".svg", ".png"):
@@ -396,9 +497,11 @@ def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]
             by_stem[f.stem] = f
     out = {}
     for stem, f in by_stem.items():
-        png = f.suffix.lower() == ".png"
-        mime = "image/png" if png else "image/svg+xml"
-        data = base64.b64encode(f.read_bytes()).decode("ascii")
+        if f.suffix.lower() == ".png":
+            mime, raw = page_image(f)
+        else:
+            mime, raw = "image/svg+xml", f.read_bytes()
+        data = base64.b64encode(raw).decode("ascii")
         out[stem] = (f"data:{mime};base64,{data}", f.name)
     return out
 
@@ -445,12 +548,14 @@ def page(
 ) -> str:
     """The page's HTML (module doc)."""
     ranking_figs, scenario_figs = figure_sections(figures, (r["scenario"] for r in rows))
+    names = [r["controller"] for r in [*rows, *aggregate]]
+    names += [c["controller"] for s in scores for c in s["controllers"]]
     sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
+        f"<title>{_e(title)}</title><style>{_CSS}{swatch_css(names)}</style></head><body>"
         f"<h1>{_e(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"

@@ -57,7 +57,9 @@ from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
 from shipgym_baselines.signals import signal_number
@@ -529,12 +531,15 @@ def _repair(file: Path) -> None:
 
 
 def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
-    """A trajectory as its file keeps it (issue 20: the run folder's weight): float arrays
-    as float32 (7 significant digits: a millimetre on a 10 km route, far below a figure's
-    pixel; the episode's metrics are computed before, at full precision), the rest as
-    they are; the file is deflated (``np.savez_compressed``: ≈ 2.6x smaller in all)."""
+    """A trajectory as its file keeps it (issue 20: the run folder's weight): only the
+    arrays a figure draws (:data:`~shipgym_baselines.decimation.DRAWN_KEYS`), thinned to
+    what a figure can show without aliasing (M4,
+    :func:`~shipgym_baselines.decimation.thin_trajectory`), float arrays as float32 (7
+    significant digits: a millimetre on a 10 km route, far below a figure's pixel; the
+    episode's metrics are computed before, at full precision); the file is deflated
+    (``np.savez_compressed``)."""
     out = {}
-    for key, value in trajectory.items():
+    for key, value in thin_trajectory(trajectory, DRAWN_KEYS).items():
         array = np.asarray(value)
         out[key] = array.astype(np.float32) if array.dtype.kind == "f" else array
     return out
@@ -720,7 +725,8 @@ class RunLog:
                     exc.filename = str(self.folder / tmp)  # the message names it
                 raise
         assert self._file is not None, "append after finish"
-        self._write_line((json.dumps(record, allow_nan=False) + "\n").encode())
+        line = json.dumps(record, allow_nan=False, separators=COMPACT)  # no spaces
+        self._write_line((line + "\n").encode())
         if time.monotonic() - self._synced >= FSYNC_INTERVAL_S:
             os.fsync(self._file.fileno())
             self._synced = time.monotonic()
@@ -771,6 +777,8 @@ class RunLog:
             cpu_s=self._earlier[1] + cpu,
         )
         self._write_record(in_place=status != "complete")
+        run_tmp = temporary_file(self.folder / RUN_FILE).name
+        self.manifest.compact(keep=(RUN_FILE, run_tmp, EPISODES_FILE))
 
     def elapsed(self) -> tuple[float, float]:
         """Wall-clock and CPU seconds of this invocation so far (:func:`cpu_seconds`)."""

@@ -157,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
         force=args.force,
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
+        vector_figures=args.vector_figures,
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

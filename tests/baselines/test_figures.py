@@ -75,7 +75,9 @@ def scenario_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
     }
     path = np.array([[0.0, 0.0], [240.0, 0.0]])
     out = tmp_path_factory.mktemp("figures")
-    return plot_scenario(out, "heldout:0", drawn, change_time=60.0, path_xy=path, ship_length=3.25)
+    return plot_scenario(
+        out, "heldout:0", drawn, change_time=60.0, path_xy=path, ship_length=3.25, vector=True
+    )
 
 
 def test_a_scenario_figure_is_a_page_sized_png_and_an_svgz(scenario_files: list[Path]) -> None:
@@ -115,7 +117,7 @@ def test_a_controller_has_its_colour_in_every_figure(
     ]
     splits = {"a": "catalogue", "b": "catalogue"}
     aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
-    files = plot_ranking(tmp_path, aggregate, episodes, splits)
+    files = plot_ranking(tmp_path, aggregate, episodes, splits, vector=True)
     assert [f.name for f in files] == [
         "ranking_catalogue.png",
         "ranking_catalogue.svg",

@@ -95,7 +95,7 @@ def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
     assert [c["seed"] for c in curves] == [0, 1]
     assert agent_curves("sac", root) == []
     figures = tmp_path / "figures"
-    files = plot_learning_curves(figures, {"ppo": curves, "sac": []})
+    files = plot_learning_curves(figures, {"ppo": curves, "sac": []}, vector=True)
     assert {f.name for f in files} == {f"{LEARNING_CURVES_STEM}.png", f"{LEARNING_CURVES_STEM}.svg"}
     assert plot_learning_curves(figures, {"sac": []}) == []
     ranking_html, scenario_html = figure_sections(files)
