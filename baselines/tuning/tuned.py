@@ -29,7 +29,9 @@ def agent_tuning(agent_name: str) -> TuningConfig:
     try:
         tuning = load_tuning(agent_name)
     except TuningError as exc:
-        raise RunError(f"--settings tuned: no tuning config for agent {agent_name!r} ({exc})")
+        raise RunError(
+            f"--settings tuned: the tuning config of agent {agent_name!r}: {exc}"
+        ) from exc
     if tuning.kind != "learned" or tuning.training is None:
         raise RunError(f"--settings tuned: tuning config {agent_name!r} is not a learned study")
     if tuning.final is None:

@@ -86,5 +86,5 @@ def test_no_chosen_settings_is_refused_naming_the_file(
 
 
 def test_an_agent_without_a_tuning_config_is_refused() -> None:
-    with pytest.raises(RunError, match="no tuning config for agent 'td3_custom'"):
+    with pytest.raises(RunError, match="tuning config of agent 'td3_custom'"):
         tuned_agent(load_agent_config("td3").model_copy(update={"name": "td3_custom"}))
