@@ -104,6 +104,8 @@ def test_a_killed_sweep_resumes_where_each_seed_stood(
     assert main(one) == 0
     for name in ("model.zip", "meta.json", "best_model.zip"):  # killed before the end
         (out / "seed_1" / name).unlink()
+    checkpoint = out / "seed_1" / "checkpoints" / "ckpt_128_steps.zip"
+    stamp = checkpoint.stat().st_mtime_ns
     (out / "seed_2" / "eval").mkdir(parents=True)  # started, killed before a checkpoint
     capsys.readouterr()
 
@@ -114,6 +116,9 @@ def test_a_killed_sweep_resumes_where_each_seed_stood(
     assert [m["seed"] for m in metas] == [0, 1, 2]
     assert (out / "seed_0" / "meta.json").read_text() == finished  # only exported
     assert all(m["env_steps"] == 256 for m in metas)
+    assert checkpoint.stat().st_mtime_ns == stamp  # resumed from it, not trained afresh
+    assert (out / "seed_1" / "checkpoints" / "ckpt_256_steps.zip").is_file()
+    assert (out / "seed_2" / "checkpoints" / "ckpt_256_steps.zip").is_file()
     curve = json.loads((out / "seed_1" / "learning_curve.json").read_text())
     assert curve["env_steps"] == [128, 256]  # the first evaluation before the kill, kept
     for seed in (0, 1, 2):
