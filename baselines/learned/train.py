@@ -441,13 +441,21 @@ def _check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bo
     record = json.loads(json.dumps(tuned_from))  # as JSON reads it back
     if resuming and file.is_file():
         started = json.loads(file.read_text())
-        if started != record:
+        if _substance(started) != _substance(record):
             raise RunError(
                 f"--resume: {out} was started with other settings ({file}); train it "
                 "afresh with --force, or resume with the settings it started with"
             )
         return
     file.write_text(json.dumps(record, indent=2))
+
+
+def _substance(tuned_from: dict[str, Any] | None) -> Any:
+    """What a resumed run must share with its start: the applied settings and final block
+    (not where the files lie: a moved checkout resumes)."""
+    if tuned_from is None:
+        return None
+    return {key: tuned_from.get(key) for key in ("settings", "final")}
 
 
 def save_obs_statistics(venv: Any, out: Path) -> Path | None:
