@@ -59,7 +59,10 @@ TRAINING_OUTPUTS = (
     "eval",
     "tb",
     "learning_curve.json",
+    "tuned_from.json",
 )
+#: the chosen settings a run was started with (``--settings tuned``; null: the config's)
+TUNED_FROM_FILE = "tuned_from.json"
 
 
 def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
@@ -286,11 +289,14 @@ def train(
     progress: bool = True,
     tensorboard: bool = True,
     force: bool = False,
+    tuned_from: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Train (or resume) an agent; returns the meta written to ``out_dir/meta.json``.
 
     Without ``resume``, an ``out_dir`` that is not empty is refused (:class:`RunError`)
-    unless ``force`` (its earlier outputs are removed first)."""
+    unless ``force`` (its earlier outputs are removed first).  ``tuned_from``: the study
+    settings applied to ``config`` (:func:`shipgym_baselines.tuning.tuned.tuned_agent`),
+    recorded in the meta; a resumed run must be resumed with the settings it started with."""
     import stable_baselines3
     import torch
     from stable_baselines3.common.vec_env import VecNormalize
@@ -319,6 +325,7 @@ def train(
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
         raise RunError(f"--resume: no checkpoint in {out / 'checkpoints'}")
+    _check_tuned_from(out, tuned_from, resuming=previous is not None)
     if previous is not None and previous[1] >= config.n_timesteps:
         raise RunError(
             f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
@@ -418,6 +425,7 @@ def train(
         "selection": config.eval.select_on,
         "plateau": None if config.plateau is None else config.plateau.model_dump(),
         "stopped_on_plateau_at": curves.stopped_at,
+        "tuned_from": tuned_from,
         "versions": {
             "shipgym": shipgym.__version__,
             "stable_baselines3": stable_baselines3.__version__,
@@ -428,6 +436,30 @@ def train(
     save_obs_statistics(venv, out)
     venv.close()
     return meta
+
+
+def _check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bool) -> None:
+    """A fresh run records the settings it starts with (``tuned_from.json``); a resumed one
+    is refused if they changed since (e.g. a study rewrote the chosen settings)."""
+    file = out / TUNED_FROM_FILE
+    record = json.loads(json.dumps(tuned_from))  # as JSON reads it back
+    if resuming and file.is_file():
+        started = json.loads(file.read_text())
+        if _substance(started) != _substance(record):
+            raise RunError(
+                f"--resume: {out} was started with other settings ({file}); train it "
+                "afresh with --force, or resume with the settings it started with"
+            )
+        return
+    file.write_text(json.dumps(record, indent=2))
+
+
+def _substance(tuned_from: dict[str, Any] | None) -> Any:
+    """What a resumed run must share with its start: the applied settings and final block
+    (not where the files lie: a moved checkout resumes)."""
+    if tuned_from is None:
+        return None
+    return {key: tuned_from.get(key) for key in ("settings", "final")}
 
 
 def save_obs_statistics(venv: Any, out: Path) -> Path | None:
@@ -519,20 +551,30 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
 
     ``job``: ``config`` (name, path or AgentConfig), ``out_dir``, optional ``seed``,
     ``n_timesteps``, ``resume``, ``force``, ``progress``, ``ship`` (export to the shipped
-    policies, :func:`ship_policy`).
+    policies, :func:`ship_policy`), ``tuned_from`` (recorded in the meta),
+    ``fresh_if_unstarted`` (with ``resume``: a run without a checkpoint, killed before its
+    first one or never started, is trained afresh instead of refused).
     """
     config = job["config"]
     if not isinstance(config, AgentConfig):
         config = load_agent_config(config)
+    resume, force = job.get("resume", False), job.get("force", False)
+    if resume and job.get("fresh_if_unstarted"):
+        # a sweep re-run after a kill: a run that reached no checkpoint (and saved no
+        # model) starts afresh; its partial logs are all it had
+        out = Path(job["out_dir"])
+        if latest_checkpoint(out) is None and not (out / "model.zip").is_file():
+            resume, force = False, True
     meta = train(
         config,
         out_dir=job["out_dir"],
         seed=job.get("seed"),
         n_timesteps=job.get("n_timesteps"),
-        resume=job.get("resume", False),
+        resume=resume,
         progress=job.get("progress", False),
         tensorboard=job.get("tensorboard", True),
-        force=job.get("force", False),
+        force=force,
+        tuned_from=job.get("tuned_from"),
     )
     if job.get("ship"):
         meta["shipped_to"] = str(ship_policy(job["out_dir"]))

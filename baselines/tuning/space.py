@@ -30,6 +30,7 @@ from typing import Any, Literal
 from pydantic import Field, model_validator
 
 from shipgym.config import ConfigError, StrictModel, list_names, load_yaml_model, resolve
+from shipgym_baselines.learned.curves import PlateauRule
 
 #: the objectives a study can minimise
 OBJECTIVES = ("cost_ratio_gmean",)
@@ -89,6 +90,30 @@ class TrainingSpec(StrictModel):
     evaluations: int = Field(2, ge=1)
 
 
+#: the final training's default plateau rule: under 2 % gain of the selection metric (the
+#: relative cost) over the last 25 % of training (issue 21's example)
+FINAL_PLATEAU = PlateauRule(min_gain=0.02, window=0.25, min_evaluations=4, metric="selection")
+
+
+class FinalSpec(StrictModel):
+    """Learned studies: the protocol's final training with the chosen settings
+    (``shipgym train AGENT --settings tuned``): its env-step budget, plateau rule, model
+    selection and seeds (docs/training.md, "From a study to shipped agents")."""
+
+    n_timesteps: int = Field(ge=1)
+    plateau: PlateauRule = FINAL_PLATEAU
+    select_on: Literal["return", "relative_cost"] = "relative_cost"
+    seeds: list[int] = Field(default_factory=lambda: [0, 1, 2], min_length=1)
+
+    @model_validator(mode="after")
+    def _valid(self) -> FinalSpec:
+        if any(seed < 0 for seed in self.seeds) or len(set(self.seeds)) != len(self.seeds):
+            raise ValueError(f"seeds: distinct non-negative integers, got {self.seeds}")
+        if self.plateau.metric == "selection" and self.select_on != "relative_cost":
+            raise ValueError("plateau.metric 'selection' needs select_on: relative_cost")
+        return self
+
+
 class TuningConfig(StrictModel):
     name: str
     description: str = ""
@@ -107,6 +132,8 @@ class TuningConfig(StrictModel):
     default: dict[str, Any] = Field(default_factory=dict)
     params: dict[str, ParamSpec]
     training: TrainingSpec | None = None
+    #: learned studies: the final training with the chosen settings (None: not defined)
+    final: FinalSpec | None = None
 
     @model_validator(mode="after")
     def _valid(self) -> TuningConfig:
@@ -114,6 +141,8 @@ class TuningConfig(StrictModel):
             raise ValueError("params: list at least one tuned parameter")
         if (self.kind == "learned") != (self.training is not None):
             raise ValueError("training: a learned study gives it, a classical one does not")
+        if self.final is not None and self.kind != "learned":
+            raise ValueError("final: the final training of a learned study (kind: learned)")
         if self.kind == "learned" and self.per_ship:
             raise ValueError("per_ship: a learned agent is one policy for every ship (false)")
         both = sorted(set(self.fixed) & set(self.params))
