@@ -36,6 +36,7 @@ from shipgym.disturbances import Disturbances
 from shipgym.guidance import desired_heading
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
+from shipgym.numerics import ARRAY
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.events import ParameterSchedule
 from shipgym.scenarios.loader import nominal_nomoto
@@ -343,6 +344,32 @@ def observation_columns(
         speed / k.nominal_speed,
         frame.angle_change_next / math.pi,
         d / (d + 10.0 * k.ship_length),
+    )
+
+
+def batch_observation(
+    frame: TrackFrame,
+    heading: np.ndarray,
+    yaw_rate: np.ndarray,
+    rudder_angle: np.ndarray,
+    rudder_command: np.ndarray,
+    speed: np.ndarray,
+    k: StepConstants,
+    context: np.ndarray | None = None,
+) -> np.ndarray:
+    """The (N, 9) float32 observations of N envs (:func:`observation_columns` on arrays,
+    clipped to the observation bounds), with ``context`` ((N, C) or (C,): the
+    controller-context features, float32) appended when given: the batched envs' one
+    observation."""
+    columns = observation_columns(
+        frame, heading, yaw_rate, rudder_angle, rudder_command, speed, k, ARRAY
+    )
+    obs = np.stack(columns, axis=1).astype(np.float32)
+    np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+    if context is None:
+        return obs
+    return np.concatenate(
+        [obs, np.broadcast_to(context, (obs.shape[0], context.shape[-1]))], axis=1
     )
 
 

@@ -31,7 +31,6 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs import core
-from shipgym.envs.core import OBS_HIGH, OBS_LOW
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY, SCALAR
 from shipgym.scenarios import Scenario
@@ -320,7 +319,7 @@ class TrialRowsVectorEnv(VectorEnv):
 
     def _observation(self, frame: TrackFrame | None = None) -> np.ndarray:
         k = self._k0
-        columns = core.observation_columns(
+        return core.batch_observation(
             self._stacked_frames() if frame is None else frame,
             self._psi_m,
             self._r_m,
@@ -328,13 +327,8 @@ class TrialRowsVectorEnv(VectorEnv):
             self._delta_c,
             self._speed,
             k,
-            ARRAY,
+            self._context if self.context_features else None,
         )
-        obs = np.stack(columns, axis=1).astype(np.float32)
-        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
-        if self.context_features:
-            return np.concatenate([obs, self._context], axis=1)
-        return obs
 
     def close(self, **kwargs: Any) -> None:
         return None

@@ -35,7 +35,7 @@ from gymnasium.vector.utils import batch_space
 from shipgym.angles import wrap_angle
 from shipgym.disturbances import SensorModel
 from shipgym.envs import core
-from shipgym.envs.core import LOG_FIELDS, OBS_HIGH, OBS_LOW
+from shipgym.envs.core import LOG_FIELDS
 from shipgym.metrics import compute_metrics
 from shipgym.numerics import ARRAY
 from shipgym.scenarios import load_scenario
@@ -285,7 +285,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
 
     def _observation(self) -> np.ndarray:
         k = self._k
-        columns = core.observation_columns(
+        return core.batch_observation(
             self._tracker.frame,
             self._psi_m,
             self._r_m,
@@ -293,14 +293,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
             self._delta_c,
             self._speed,
             k,
-            ARRAY,
+            self._parts.context_row if self.context_features else None,
         )
-        obs = np.stack(columns, axis=1).astype(np.float32)
-        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
-        if self.context_features:
-            row = self._parts.context_row
-            return np.concatenate([obs, np.broadcast_to(row, (self.num_envs, row.size))], axis=1)
-        return obs
 
     def _info(self) -> dict[str, Any]:
         k = self._k
