@@ -176,7 +176,9 @@ def run_episode(
 @runtime_checkable
 class BatchPolicy(Policy, Protocol):
     """A policy that acts for several episodes in lockstep (a learned policy: one network
-    forward for all), each action the one ``act`` would give in that episode alone."""
+    forward for all), each action the one ``act`` would give in that episode alone.  It
+    reads the observations only (``act_batch`` gets no info), so its episodes' rows are
+    stepped without ``samples``."""
 
     def reset_batch(self, contexts: Sequence[Any]) -> None: ...
 
@@ -229,7 +231,8 @@ def evaluate_batch(
         policy, mode = controller, None
     mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
     if isinstance(policy, BatchPolicy):
-        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id))
+        # a batch policy acts on the observations alone: its rows skip the samples
+        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, samples=False))
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
@@ -265,8 +268,10 @@ class _Episodes(Protocol):
 class _VectorEpisodes:
     """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`."""
 
-    def __init__(self, scenarios: list[Scenario], seeds: list[int], action_mode: str) -> None:
-        self.env = EvaluationTrialsVectorEnv(scenarios, seeds, action_mode)
+    def __init__(
+        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, samples: bool = True
+    ) -> None:
+        self.env = EvaluationTrialsVectorEnv(scenarios, seeds, action_mode, samples=samples)
         self.seeds = seeds
         obs, info = self.env.reset()
         self.obs = list(obs)
@@ -340,14 +345,17 @@ class _SingleEpisodes:
 _SINGLE_ENTRY_POINT = "shipgym.envs.path_follow:ShipPathFollowEnv"
 
 
-def _episodes(scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str) -> _Episodes:
+def _episodes(
+    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, samples: bool = True
+) -> _Episodes:
     """The episodes as the rows of one vectorized env when they can be (the env is the
     single ShipPathFollow env and the trials share the ship and its step constants: see
-    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each."""
+    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``samples``:
+    whether the rows' infos carry ``samples`` (a batch policy reads observations only)."""
     if gym.spec(env_id).entry_point == _SINGLE_ENTRY_POINT:
         loaded = [load_scenario(s) for s in scenarios]
         if loaded and lockstep_problem(loaded) is None:
-            return _VectorEpisodes(loaded, seeds, action_mode)
+            return _VectorEpisodes(loaded, seeds, action_mode, samples)
         scenarios = loaded
     return _SingleEpisodes(scenarios, seeds, action_mode, env_id)
 

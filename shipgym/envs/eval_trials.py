@@ -55,7 +55,11 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         seeds: Sequence[int],
         action_mode: str = "rudder",
         compile: bool = True,
+        samples: bool = True,
     ) -> None:
+        #: whether the rows' infos carry ``samples`` (False: for a policy that reads only
+        #: observations, e.g. a learned agent; the rest of each info is the same)
+        self.record_samples = samples
         self.scenarios = [load_scenario(s) for s in scenarios]
         self.seeds = [int(s) for s in seeds]
         if not self.scenarios or len(self.scenarios) != len(self.seeds):

@@ -91,3 +91,27 @@ def test_rows_of_different_ships_or_step_constants_are_refused() -> None:
         EvaluationTrialsVectorEnv([nomoto, mariner], [0, 1])
     with pytest.raises(ValueError, match="2 scenarios for 1 seeds"):
         EvaluationTrialsVectorEnv([nomoto, nomoto], [0])
+
+
+def test_rows_without_samples_step_the_same() -> None:
+    """``samples=False`` (a policy that reads observations only): the same observations,
+    rewards, ends and infos bit for bit, without the ``samples`` key."""
+    trials = _variants("rudder_aging")
+    with_s = EvaluationTrialsVectorEnv(trials, SEEDS)
+    without = EvaluationTrialsVectorEnv(trials, SEEDS, samples=False)
+    obs_a, info_a = with_s.reset()
+    obs_b, info_b = without.reset()
+    np.testing.assert_array_equal(obs_a, obs_b)
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        action = rng.uniform(-1.0, 1.0, size=with_s.action_space.shape)
+        *out_a, info_a = with_s.step(action)
+        *out_b, info_b = without.step(action)
+        for a, b in zip(out_a, out_b, strict=True):
+            np.testing.assert_array_equal(a, b)
+        for row_a, row_b in zip(info_a["rows"], info_b["rows"], strict=True):
+            if row_a is None:
+                assert row_b is None
+                continue
+            assert "samples" in row_a and "samples" not in row_b
+            _assert_same({k: v for k, v in row_a.items() if k != "samples"}, row_b, "info")
