@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.utils import seeding
 
 from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains, pid_step
@@ -345,6 +346,34 @@ def observation_columns(
         frame.angle_change_next / math.pi,
         d / (d + 10.0 * k.ship_length),
     )
+
+
+def reseed_rows(
+    rngs: list[np.random.Generator | None],
+    seed: int | list[int | None] | None,
+    options: dict | None,
+) -> np.ndarray:
+    """A batched env's ``reset(seed=…, options=…)`` arguments applied to its per-env
+    generators ``rngs`` (in place), as SyncVectorEnv does: an int seeds env i with
+    ``seed + i``, a list one seed per env, None keeps a seeded generator (and seeds a
+    missing one from entropy); ``options["reset_mask"]`` resets only the masked envs.
+    Returns the mask of the envs to reset."""
+    n = len(rngs)
+    if seed is None or isinstance(seed, int):
+        seeds = [None if seed is None else seed + i for i in range(n)]
+    else:
+        if len(seed) != n:
+            raise ValueError(f"need {n} seeds, got {len(seed)}")
+        seeds = list(seed)
+    mask = np.ones(n, dtype=bool)
+    if options and "reset_mask" in options:  # as SyncVectorEnv: reset only these envs
+        mask = np.asarray(options["reset_mask"], dtype=bool)
+        if mask.shape != (n,):
+            raise ValueError(f"reset_mask must have shape ({n},)")
+    for i, s in enumerate(seeds):
+        if mask[i] and (s is not None or rngs[i] is None):
+            rngs[i], _ = seeding.np_random(s)
+    return mask
 
 
 def batch_observation(

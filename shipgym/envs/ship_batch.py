@@ -31,7 +31,6 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import numpy as np
-from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 
 from shipgym.envs import core
@@ -113,20 +112,7 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is None or isinstance(seed, int):
-            seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
-        else:
-            if len(seed) != self.num_envs:
-                raise ValueError(f"need {self.num_envs} seeds, got {len(seed)}")
-            seeds = list(seed)
-        mask = np.ones(self.num_envs, dtype=bool)
-        if options and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"], dtype=bool)
-            if mask.shape != (self.num_envs,):
-                raise ValueError(f"reset_mask must have shape ({self.num_envs},)")
-        for i, s in enumerate(seeds):
-            if mask[i] and (s is not None or self._rngs[i] is None):
-                self._rngs[i], _ = seeding.np_random(s)
+        mask = core.reseed_rows(self._rngs, seed, options)
         self._reset_envs(mask)
         self._autoreset[mask] = False
         self._started = True
