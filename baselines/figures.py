@@ -76,7 +76,8 @@ LIGHT_FIGURES = {
 }
 #: widest PNG [px]: a figure drawn at FIGURE_DPI is written at 1/2, 1/3, … of its pixels,
 #: the first that fits (a 200-dpi figure at 100 dpi or less: the page shows no more; the
-#: vector copy keeps every detail)
+#: vector copy keeps every detail; fewer pixels barely lighten a line figure: its
+#: compressed bytes follow the lines' length in pixels, not the area)
 PAGE_WIDTH = 1400
 #: colours of a PNG's palette (lines, their antialiasing and the text)
 PAGE_COLOURS = 64
@@ -127,14 +128,23 @@ def save_figure(
     missing), close it and return the paths.  ``tight``: crop to what is drawn (for a
     figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
     layout is computed once (the PNG) and kept for the SVG."""
+    from PIL import Image
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / f"{stem}.png"] + ([out / f"{stem}{vector}"] if vector else [])
     bbox = "tight" if tight else None
     with pyplot().rc_context(LIGHT_FIGURES):
-        png = io.BytesIO()
-        fig.savefig(png, format="png", dpi=FIGURE_DPI, bbox_inches=bbox)
-        write_page_png(png.getvalue(), paths[0])
+        if tight:  # the crop is savefig's: through a PNG
+            png = io.BytesIO()
+            fig.savefig(png, format="png", dpi=FIGURE_DPI, bbox_inches=bbox)
+            with Image.open(png) as image:
+                rgb = image.convert("RGB")
+        else:  # the canvas's pixels as drawn (no PNG written and read back)
+            fig.set_dpi(FIGURE_DPI)
+            fig.canvas.draw()
+            rgb = Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3])
+        write_page_png(rgb, paths[0])
         if not vector:
             pyplot().close(fig)
             return paths
@@ -149,23 +159,20 @@ def save_figure(
     return paths
 
 
-def write_page_png(png: bytes, path: Path) -> None:
-    """``png`` (matplotlib's RGBA at :data:`FIGURE_DPI`, opaque) written as the page shows
-    it (issue 20: the page's weight): reduced by the smallest whole factor that makes it at
-    most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the dpi recorded
-    accordingly), a :data:`PAGE_COLOURS`-colour palette without dithering (a line figure
-    has few colours beyond its antialiasing), deflated at the highest level."""
+def write_page_png(rgb: Any, path: Path) -> None:
+    """``rgb`` (a PIL RGB image of the figure drawn at :data:`FIGURE_DPI`) written as the
+    page shows it (issue 20: the page's weight): reduced by the smallest whole factor that
+    makes it at most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the
+    dpi recorded accordingly), a :data:`PAGE_COLOURS`-colour palette without dithering (a
+    line figure has few colours beyond its antialiasing), deflated at the highest level."""
     from PIL import Image
 
-    with Image.open(io.BytesIO(png)) as image:
-        rgb = image.convert("RGB")
-        dpi = image.info.get("dpi", (FIGURE_DPI, FIGURE_DPI))
     factor = math.ceil(rgb.width / PAGE_WIDTH)
     if factor > 1:
         rgb = rgb.reduce(factor)
     palette = rgb.quantize(PAGE_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
     page = io.BytesIO()
-    palette.save(page, format="PNG", optimize=True, dpi=(dpi[0] / factor, dpi[1] / factor))
+    palette.save(page, format="PNG", optimize=True, dpi=(FIGURE_DPI / factor,) * 2)
     write_bytes(path, page.getvalue())
 
 
