@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import gzip
 import io
+import json
 import math
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
@@ -79,8 +80,20 @@ LIGHT_FIGURES = {
 #: vector copy keeps every detail; fewer pixels barely lighten a line figure: its
 #: compressed bytes follow the lines' length in pixels, not the area)
 PAGE_WIDTH = 1400
-#: colours of a PNG's palette (lines, their antialiasing and the text)
-PAGE_COLOURS = 64
+#: a scenario figure's PNG text chunks for the page (issue 20): its legends as JSON (a list
+#: of [column title, [[controller, label], …]]; the oracle's label ends ", the reference")
+#: and where they start (the fraction of the height from the top); the page shows the
+#: image above that line and the legends as text (crisp at any zoom, and ≈ 15 % of the
+#: image's bytes)
+LEGEND_KEY = "shipgym:legend"
+LEGEND_TOP_KEY = "shipgym:legend-top"
+#: most colours of a page PNG's palette: the figure's own colours (every line, marker, text
+#: and patch, an alpha one as it shows on white), each also half-way to white (the
+#: antialiasing of a thin line on the white axes), and a ramp of PAGE_GREYS greys (text,
+#: grid); every pixel takes its nearest (issue 20: a controller keeps its colour on the
+#: page; an adaptive 64-colour palette spent itself on near-whites and greyed the lines)
+PAGE_COLOURS = 256
+PAGE_GREYS = 9
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
 REFERENCES = ("zero_rudder", "random", ORACLE)
@@ -119,7 +132,12 @@ def figure_stem(name: str) -> str:
 
 
 def save_figure(
-    fig: Any, out_dir: str | Path, stem: str, tight: bool = False, vector: str | None = None
+    fig: Any,
+    out_dir: str | Path,
+    stem: str,
+    tight: bool = False,
+    vector: str | None = None,
+    page_text: Mapping[str, str] | None = None,
 ) -> list[Path]:
     """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and, if
     asked, its vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for
@@ -127,7 +145,8 @@ def save_figure(
     shows the PNG and the copy would double the figures' weight) into ``out_dir`` (made if
     missing), close it and return the paths.  ``tight``: crop to what is drawn (for a
     figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
-    layout is computed once (the PNG) and kept for the SVG."""
+    layout is computed once (the PNG) and kept for the SVG.  ``page_text``: text chunks
+    of the PNG for the page (:data:`LEGEND_KEY`, :data:`LEGEND_TOP_KEY`)."""
     from PIL import Image
 
     out = Path(out_dir)
@@ -144,7 +163,7 @@ def save_figure(
             fig.set_dpi(FIGURE_DPI)
             fig.canvas.draw()
             rgb = Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3])
-        write_page_png(rgb, paths[0])
+        write_page_png(rgb, paths[0], page_text, figure_colours(fig))
         if not vector:
             pyplot().close(fig)
             return paths
@@ -159,20 +178,74 @@ def save_figure(
     return paths
 
 
-def write_page_png(rgb: Any, path: Path) -> None:
+def figure_colours(fig: Any) -> set[tuple[float, float, float]]:
+    """The RGB colours [0, 1] that ``fig``'s artists draw with (lines, markers, text,
+    patches, collections), an alpha colour as it shows on white."""
+    from matplotlib.collections import Collection
+    from matplotlib.colors import to_rgba, to_rgba_array
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.text import Text
+
+    rgba: list[Any] = []
+    for artist in fig.findobj():
+        if isinstance(artist, Line2D):
+            rgba.append(to_rgba(artist.get_color(), artist.get_alpha()))
+            for marker in (artist.get_markerfacecolor(), artist.get_markeredgecolor()):
+                if not (isinstance(marker, str) and marker == "none"):
+                    rgba.append(to_rgba(marker, artist.get_alpha()))
+        elif isinstance(artist, Text) and artist.get_text():
+            rgba.append(to_rgba(artist.get_color(), artist.get_alpha()))
+        elif isinstance(artist, Patch | Collection):
+            faces = [artist.get_facecolor(), artist.get_edgecolor()]
+            for colours in faces:
+                rgba += list(to_rgba_array(colours))
+    colours = set()
+    for r, g, b, a in rgba:
+        if a > 0.0:
+            colours.add(tuple(float(v) * a + (1.0 - a) for v in (r, g, b)))
+    return colours
+
+
+def page_palette(colours: Iterable[tuple[float, float, float]]) -> list[tuple[int, int, int]]:
+    """The page PNG's palette (:data:`PAGE_COLOURS`, 8-bit RGB): the grey ramp, then
+    ``colours``, each also half-way to white; the first :data:`PAGE_COLOURS` distinct
+    ones."""
+    greys = [(g, g, g) for g in np.linspace(0.0, 1.0, PAGE_GREYS).tolist()]
+    palette = []
+    for c in [*greys, *sorted(colours)]:
+        for t in (0.0, 0.5):
+            palette.append(tuple(round(255.0 * (v * (1.0 - t) + t)) for v in c))
+    return list(dict.fromkeys(palette))[:PAGE_COLOURS]
+
+
+def write_page_png(
+    rgb: Any,
+    path: Path,
+    text: Mapping[str, str] | None = None,
+    colours: Iterable[tuple[float, float, float]] = (),
+) -> None:
     """``rgb`` (a PIL RGB image of the figure drawn at :data:`FIGURE_DPI`) written as the
     page shows it (issue 20: the page's weight): reduced by the smallest whole factor that
     makes it at most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the
-    dpi recorded accordingly), a :data:`PAGE_COLOURS`-colour palette without dithering (a
-    line figure has few colours beyond its antialiasing), deflated at the highest level."""
-    from PIL import Image
+    dpi recorded accordingly), each pixel the nearest colour of :func:`page_palette` of
+    the figure's ``colours`` (:func:`figure_colours`; no dithering), deflated at the
+    highest level; ``text``: its text chunks (key → value)."""
+    from PIL import Image, PngImagePlugin
 
+    info = PngImagePlugin.PngInfo()
+    for key, value in (text or {}).items():
+        info.add_itxt(key, value)
     factor = math.ceil(rgb.width / PAGE_WIDTH)
     if factor > 1:
         rgb = rgb.reduce(factor)
-    palette = rgb.quantize(PAGE_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    entries = page_palette(colours)
+    flat = [v for c in entries for v in c]
+    palette_image = Image.new("P", (1, 1))
+    palette_image.putpalette(flat + flat[:3] * (256 - len(entries)))
+    indexed = rgb.quantize(palette=palette_image, dither=Image.Dither.NONE)
     page = io.BytesIO()
-    palette.save(page, format="PNG", optimize=True, dpi=(FIGURE_DPI / factor,) * 2)
+    indexed.save(page, format="PNG", optimize=True, dpi=(FIGURE_DPI / factor,) * 2, pnginfo=info)
     write_bytes(path, page.getvalue())
 
 
@@ -454,9 +527,11 @@ def plot_scenario(
     fig = plt.figure()
     most = max(len(members) for _, members in panels) + len(oracle)
     columns = _column_axes(fig, _ROWS_H, own_scale, legend_lines=max(most, 1))
+    legends: list[tuple[str, list[tuple[str, str]]]] = []
     for col, ((title, members), (ax_track, ax_e, ax_d)) in enumerate(
         zip(panels, columns, strict=True)
     ):
+        legend: list[tuple[str, str]] = []
         lim = _scales(lines, members + oracle, path, pad) if own_scale[col] else shared
         handles: list[Any] = []
         if path.size:
@@ -464,6 +539,7 @@ def plot_scenario(
         for name in oracle:  # the reference in every column
             tr = lines[name]
             label = _episode_label(name, everything[name]) + ", the reference"
+            legend.append((name, label))
             handles += ax_track.plot(
                 tr["x"], tr["y"], lw=1.2, label=label, gid=f"{name}/track", **_ORACLE_STYLE
             )
@@ -478,6 +554,7 @@ def plot_scenario(
         for name in members:
             tr, style = lines[name], controller_style(name)
             label = _episode_label(name, episodes[name])
+            legend.append((name, label))
             handles += ax_track.plot(
                 tr["x"], tr["y"], lw=1.0, label=label, gid=f"{name}/track", **style.kwargs()
             )
@@ -515,6 +592,7 @@ def plot_scenario(
                 ax.tick_params(labelleft=False)  # the same scale as the column to its left
         if handles:
             _legend_below(ax_d, handles)
+        legends.append((title + (" (own scale)" if own_scale[col] else ""), legend))
     fig.suptitle(
         _scenario_title(scenario, everything, change_time, ship_length, chosen_by),
         fontsize=10,
@@ -522,7 +600,12 @@ def plot_scenario(
         va="top",
     )
     stem = "scenario_" + figure_stem(scenario)
-    return save_figure(fig, out_dir, stem, vector=".svgz" if vector else None)
+    below = _TOP + sum(_ROWS_H) + len(_ROWS_H) * _ROW_GAP  # [in] from the top: the legends
+    page_text = {
+        LEGEND_KEY: json.dumps(legends, ensure_ascii=False),
+        LEGEND_TOP_KEY: f"{below / fig.get_figheight():.6f}",
+    }
+    return save_figure(fig, out_dir, stem, vector=".svgz" if vector else None, page_text=page_text)
 
 
 def _scenario_title(

@@ -29,16 +29,23 @@ writes the page and returns its path.
 from __future__ import annotations
 
 import base64
+import gzip
 import html
 import io
 import itertools
+import json
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from shipgym_baselines.figures import LEARNING_CURVES_STEM, figure_stem
+from shipgym_baselines.figures import (
+    LEARNING_CURVES_STEM,
+    LEGEND_KEY,
+    LEGEND_TOP_KEY,
+    figure_stem,
+)
 from shipgym_baselines.ranking import (
     NO_RANKING,
     ORACLE,
@@ -90,11 +97,25 @@ td:first-child span{display:inline-block;width:22px;height:0;border-top-width:3p
 margin-right:6px;vertical-align:middle}
 figure{margin:10px 0 22px}figure img{max-width:100%;height:auto;border:1px solid #eaeef2}
 figcaption{color:#57606a;font-size:12px}
+.legend{display:flex;flex-wrap:wrap;gap:2px 18px;font-size:12px;margin:4px 0}
+.legend ul{list-style:none;margin:0;padding:0}.legend b{font-weight:600}
+.legend span{display:inline-block;width:22px;height:0;border-top-width:2px;margin-right:6px;
+vertical-align:middle}
 details>summary{cursor:pointer;font-weight:600;margin:8px 0}
 """
 
 _JS = """
 (function () {
+  // a packed table body (issue 20: the long table deflated): its rows, unpacked in place
+  document.querySelectorAll("tbody[data-gzip]").forEach(function (body) {
+    var bin = atob(body.getAttribute("data-gzip")), bytes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+    var rows = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
+    new Response(rows).text().then(function (text) {
+      body.innerHTML = text;
+      body.removeAttribute("data-gzip");
+    });
+  });
   function key(row, col, numeric) {  // data-sort, else the cell's text
     var cell = row.cells[col];
     if (!cell) return null;
@@ -317,6 +338,28 @@ def _table(
     )
 
 
+def packed_body(table: str) -> str:
+    """``table`` (:func:`_table`'s HTML) with its body's rows deflated into the body's
+    ``data-gzip`` attribute (gzip, base64; the page's script unpacks them with the
+    browser's ``DecompressionStream``): the long table's markup is ≈ 6 times lighter."""
+    head, sep, rest = table.partition("<tbody>")
+    inner, end, tail = rest.partition("</tbody>")
+    if not sep or not end:
+        raise ValueError("packed_body: the table has no <tbody>")
+    packed = gzip.compress(inner.encode("utf-8"), compresslevel=9, mtime=0)
+    data = base64.b64encode(packed).decode("ascii")
+    return f'{head}<tbody data-gzip="{data}"></tbody>{tail}'
+
+
+def unpacked_body(table: str) -> str:
+    """The inverse of :func:`packed_body` (tests, and readers of the page's source)."""
+    match = re.search(r'<tbody data-gzip="([A-Za-z0-9+/=]*)"></tbody>', table)
+    if match is None:
+        return table
+    inner = gzip.decompress(base64.b64decode(match.group(1))).decode("utf-8")
+    return table[: match.start()] + f"<tbody>{inner}</tbody>" + table[match.end() :]
+
+
 # ----------------------------------------------------------------------------- sections
 def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
@@ -467,25 +510,58 @@ def _anchor(name: str) -> str:
     return "scenario_" + figure_stem(name)
 
 
-def page_image(png: Path) -> tuple[str, bytes]:
-    """(MIME type, bytes) of a PNG as the page embeds it: the same pixels as lossless WebP
-    where that is smaller (a palette figure: ≈ 20 % smaller; every current browser shows
-    WebP; effort 4 of 6: 0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the
-    PNG as it is."""
+class PageImage(NamedTuple):
+    """A figure as the page embeds it: MIME type, bytes, and the legends it carries as text
+    (a scenario figure's :data:`~shipgym_baselines.figures.LEGEND_KEY`; None: in the
+    image)."""
+
+    mime: str
+    data: bytes
+    legends: list[tuple[str, list[tuple[str, str]]]] | None = None
+
+
+def page_image(png: Path) -> PageImage:
+    """A PNG as the page embeds it: the same pixels as lossless WebP where that is smaller
+    (a palette figure: ≈ 20 % smaller; every current browser shows WebP; effort 4 of 6:
+    0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the PNG as it is.  A
+    scenario figure whose PNG says where its legends start
+    (:data:`~shipgym_baselines.figures.LEGEND_TOP_KEY`) is cut above them and its legends
+    returned as text (the page writes them under the image, issue 20)."""
     data = png.read_bytes()
     from PIL import Image, features
 
-    if not features.check("webp"):
-        return "image/png", data
     with Image.open(png) as image:
+        image.load()
+        text = dict(getattr(image, "text", {}))
+        legends = None
+        if LEGEND_KEY in text and LEGEND_TOP_KEY in text:
+            legends = [
+                (t, [tuple(e) for e in entries]) for t, entries in json.loads(text[LEGEND_KEY])
+            ]
+            top = round(float(text[LEGEND_TOP_KEY]) * image.height)
+            image = image.crop((0, 0, image.width, top))
+        if not features.check("webp"):
+            if legends is None:
+                return PageImage("image/png", data)
+            out = io.BytesIO()
+            image.save(out, format="PNG", optimize=True)
+            return PageImage("image/png", out.getvalue(), legends)
         out = io.BytesIO()
         image.save(out, format="WEBP", lossless=True, quality=100, method=4)
     webp = out.getvalue()
-    return ("image/webp", webp) if len(webp) < len(data) else ("image/png", data)
+    if legends is None and len(webp) >= len(data):
+        return PageImage("image/png", data)
+    return PageImage("image/webp", webp, legends)
 
 
-def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
-    """stem → (data URI, file name) of each figure, the PNG where a stem has one (a
+class _Embedded(NamedTuple):
+    uri: str
+    file: str
+    legends: list[tuple[str, list[tuple[str, str]]]] | None
+
+
+def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
+    """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
     page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`, embedded as
     :func:`page_image` gives it: the page stays light, issue 20), else the SVG; in the
     order of ``figures``."""
@@ -498,43 +574,70 @@ def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]
     out = {}
     for stem, f in by_stem.items():
         if f.suffix.lower() == ".png":
-            mime, raw = page_image(f)
+            image = page_image(f)
         else:
-            mime, raw = "image/svg+xml", f.read_bytes()
-        data = base64.b64encode(raw).decode("ascii")
-        out[stem] = (f"data:{mime};base64,{data}", f.name)
+            image = PageImage("image/svg+xml", f.read_bytes())
+        data = base64.b64encode(image.data).decode("ascii")
+        out[stem] = _Embedded(f"data:{image.mime};base64,{data}", f.name, image.legends)
     return out
 
 
-def _figure(stem: str, uri: str, name: str, caption: str) -> str:
+#: the oracle's line in the scenario figures (black, dashed), as a legend swatch
+_REFERENCE_SWATCH = "kref"
+_REFERENCE_CSS = f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
+
+
+def _legend_swatch(name: str, label: str) -> str:
+    """The swatch class of a legend entry: the reference's line, else the controller's."""
+    return _REFERENCE_SWATCH if label.endswith(", the reference") else _swatch_class(name)[0]
+
+
+def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
+    """A scenario figure's legends as text: one block per panel column, each episode's line
+    swatch and label."""
+    blocks = []
+    for title, entries in legends:
+        items = "".join(
+            f'<li><span class="{_legend_swatch(name, label)}"></span>{_e(label)}</li>'
+            for name, label in entries
+        )
+        blocks.append(f"<div><b>{_e(title)}</b><ul>{items}</ul></div>")
+    return f'<div class="legend">{"".join(blocks)}</div>'
+
+
+def _figure(stem: str, fig: _Embedded, caption: str) -> str:
+    legend = _legend_html(fig.legends) if fig.legends else ""
     return (
-        f'<figure id="fig-{_e(stem)}"><img src="{uri}" alt="{_e(caption)}" loading="lazy">'
-        f"<figcaption>{_e(caption)} — <code>{_e(name)}</code></figcaption></figure>"
+        f'<figure id="fig-{_e(stem)}"><img src="{fig.uri}" alt="{_e(caption)}" loading="lazy">'
+        f"{legend}<figcaption>{_e(caption)} — <code>{_e(fig.file)}</code></figcaption></figure>"
     )
 
 
 def figure_sections(
     figures: Iterable[str | Path], scenarios: Iterable[str] = ()
-) -> tuple[str, str]:
-    """(ranking figures, scenario figures) as HTML: per split its interval estimates, then
-    its performance profiles; the scenario figures in the order of ``figures``, captioned
-    with the scenario's name where ``scenarios`` has it."""
+) -> tuple[str, str, list[str]]:
+    """(ranking figures, scenario figures, the controllers their legends name) as HTML: per
+    split its interval estimates, then its performance profiles; the scenario figures in
+    the order of ``figures``, captioned with the scenario's name where ``scenarios`` has
+    it."""
     names = {_anchor(s): s for s in scenarios}
     ranking: list[tuple[str, int, str]] = []
     drawn = []
-    for stem, (uri, file) in embedded_figures(figures).items():
+    legend_names: list[str] = []
+    for stem, fig in embedded_figures(figures).items():
         kind, _, split = stem.partition("_")
+        legend_names += [n for _, entries in fig.legends or () for n, _ in entries]
         if stem == LEARNING_CURVES_STEM:  # after the ranking figures of every split
             caption = "learning curves of the learned agents (validation return per seed)"
-            ranking.append(("~", True, _figure(stem, uri, file, caption)))
+            ranking.append(("~", True, _figure(stem, fig, caption)))
         elif kind in ("ranking", "profile"):
             what = "interval estimates" if kind == "ranking" else "performance profiles"
-            html_ = _figure(stem, uri, file, f"{what}, {split}")
-            ranking.append((split, kind == "profile", html_))
+            ranking.append((split, kind == "profile", _figure(stem, fig, f"{what}, {split}")))
         else:
             label = names.get(stem, stem.removeprefix("scenario_"))
-            drawn.append(_figure(stem, uri, file, f"scenario {label}"))
-    return "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2])), "".join(drawn)
+            drawn.append(_figure(stem, fig, f"scenario {label}"))
+    ranking_html = "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2]))
+    return ranking_html, "".join(drawn), legend_names
 
 
 # --------------------------------------------------------------------------------- page
@@ -547,15 +650,18 @@ def page(
     subtitle: str | None = None,
 ) -> str:
     """The page's HTML (module doc)."""
-    ranking_figs, scenario_figs = figure_sections(figures, (r["scenario"] for r in rows))
-    names = [r["controller"] for r in [*rows, *aggregate]]
+    ranking_figs, scenario_figs, legend_names = figure_sections(
+        figures, (r["scenario"] for r in rows)
+    )
+    names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
     names += [c["controller"] for s in scores for c in s["controllers"]]
     sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{_e(title)}</title><style>{_CSS}{swatch_css(names)}</style></head><body>"
+        f"<title>{_e(title)}</title><style>{_CSS}{swatch_css(names)}{_REFERENCE_CSS}</style>"
+        "</head><body>"
         f"<h1>{_e(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
@@ -570,7 +676,9 @@ def page(
         f'<h2 id="ranking-figures">Ranking figures</h2>{ranking_figs or "<p>No figures.</p>"}'
         f'<h2 id="figures">Scenarios</h2>{scenario_figs or "<p>No figures.</p>"}'
         '<h2 id="all-rows">All rows</h2><details><summary>One row per scenario and controller '
-        f"({len(rows)} rows): means with 95 % intervals</summary>{row_table(rows)}</details>"
+        f"({len(rows)} rows): means with 95 % intervals</summary>{packed_body(row_table(rows))}"
+        "<noscript><p>The rows need the page's script; they are also in leaderboard.md and "
+        "leaderboard.csv.</p></noscript></details>"
         f"<script>{_JS}</script></body></html>\n"
     )
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gzip
+import json
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -13,6 +14,8 @@ from PIL import Image
 
 from shipgym_baselines import figures
 from shipgym_baselines.figures import (
+    LEGEND_KEY,
+    LEGEND_TOP_KEY,
     PAGE_COLOURS,
     PAGE_WIDTH,
     DrawnEpisode,
@@ -90,6 +93,24 @@ def test_a_scenario_figure_is_a_page_sized_png_and_an_svgz(scenario_files: list[
         assert PAGE_WIDTH / 2 < image.width <= PAGE_WIDTH  # not a thumbnail
         assert image.mode == "P" and len(image.getcolors()) <= PAGE_COLOURS
     assert parse(svg).getroot().tag == f"{SVG}svg"
+
+
+def test_the_page_png_keeps_each_controllers_colour(scenario_files: list[Path]) -> None:
+    """issue 20: the page PNG's palette holds each drawn controller's exact colour (an
+    adaptive palette had turned them grey), and those pixels are there; the legends' text
+    and where they start ride in the PNG for the page."""
+    with Image.open(scenario_files[0]) as image:
+        palette = image.getpalette()
+        used = {tuple(palette[3 * i : 3 * i + 3]) for _, i in image.getcolors()}
+        text = dict(image.text)
+    for name in ("pid_los", "lqr", "ppo"):
+        colour = controller_style(name).color.lstrip("#")
+        assert tuple(int(colour[k : k + 2], 16) for k in (0, 2, 4)) in used, name
+    legends = json.loads(text[LEGEND_KEY])
+    labels = [label for _, entries in legends for _, label in entries]
+    assert "ppo (seed 10003, training seed 1)" in labels
+    assert "oracle (seed 10003), the reference" in labels
+    assert 0.5 < float(text[LEGEND_TOP_KEY]) < 1.0
 
 
 def test_the_figure_says_what_is_drawn_with_units(scenario_files: list[Path]) -> None:
