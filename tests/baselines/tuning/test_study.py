@@ -201,6 +201,16 @@ def test_bad_tuning_configs_name_the_key(tmp_path: Path) -> None:
             },
             "tuned",
         ),
+        (  # a learned default that would train in another env than the trials
+            {
+                "kind": "learned",
+                "per_ship": False,
+                "training": {"agent": "ppo", "n_timesteps": 256},
+                "fixed": {"env.n_envs": 64, "hyperparams.n_steps": 32},
+                "default": {"env.n_envs": 64},
+            },
+            r"default: .*\['hyperparams.n_steps'\]",
+        ),
     ]:
         file = tmp_path / "bad.yaml"
         file.write_text(yaml.safe_dump({**TINY, **edit}))
@@ -249,6 +259,14 @@ def test_a_learned_study_trains_scores_and_prunes_through_the_same_command(
     assert report["validation"]["trials"] == ["validation:0"]
     assert report["best_value"] == pytest.approx(trial["value"])
     assert report["chosen"]["section"] == "all"
+    # the winner's settings as it was scored: the best trial under the fixed settings, or
+    # the default (which trains as every trial does)
+    winner = (
+        config["default"]
+        if report["chosen"]["kept_default"]
+        else {**config["fixed"], **report["best_params"]}
+    )
+    assert report["chosen"]["settings"] == winner
 
 
 def test_every_packaged_tuning_config_loads() -> None:
