@@ -184,6 +184,30 @@ def test_chosen_settings_reach_the_default_construction(
         assert (l1.settings.K1, l1.settings.K2) == (0.05, 30.0)
         assert (l1_paper.settings.K1, l1_paper.settings.K2) == (0.02, 15.0)
         assert (l1_given.settings.K1, l1_given.settings.K2) == (0.01, 30.0)
+        from shipgym_baselines.classical.lqr import (
+            LQR,
+            PAPER_LAMBDA_DELTA,
+            PAPER_LAMBDA_PSI,
+            AdaptiveLQR,
+            length_scaled_lambda_y,
+        )
+
+        weights = {"lambda_y": 0.3, "lambda_psi": 4.0, "lambda_delta": 2.0}
+        chosen.write_chosen("lqr", "nomoto2", weights, {}, tmp_path)
+        chosen._packaged.cache_clear()
+        lqr, lqr_paper, lqr_given, adaptive = (
+            LQR(),
+            LQR(preset="paper"),
+            LQR(lambda_psi=9.0),
+            AdaptiveLQR(),  # its own study's section (none): the paper's weights
+        )
+        for policy in (lqr, lqr_paper, lqr_given, adaptive):
+            policy.reset(ctx)
+        paper = (length_scaled_lambda_y(ctx.ship_length), PAPER_LAMBDA_PSI, PAPER_LAMBDA_DELTA)
+        as_tuple = lambda w: (w.lambda_y, w.lambda_psi, w.lambda_delta)  # noqa: E731
+        assert as_tuple(lqr.weights) == (0.3, 4.0, 2.0)
+        assert as_tuple(lqr_paper.weights) == paper == as_tuple(adaptive.weights)
+        assert as_tuple(lqr_given.weights) == (0.3, 9.0, 2.0)
     finally:
         chosen._packaged.cache_clear()
 
