@@ -68,6 +68,7 @@ from scipy.linalg import solve_continuous_are
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
 from shipgym_baselines.tuning.chosen import tuned_settings
@@ -184,7 +185,9 @@ class LQR:
     ``preset="tuned"``, else the paper's); ``speed``: "measured" | "nominal";
     ``resolve_tolerance``: relative change of (a, c, U) that triggers a new Riccati solve;
     ``preset``: "tuned" reads the ship's section of ``configs/tuning/chosen/<name>.yaml``
-    (``shipgym tune lqr``, docs/tuning.md) under the weights given here, "paper" does not.
+    (``shipgym tune lqr``, docs/tuning.md) under the weights given here, "paper" does not;
+    ``drift_compensation``: the state's heading error as the course error ψ + β − ψp with
+    the measured drift angle β (None: the chosen setting, else off, the paper's).
     """
 
     kind = "classical"
@@ -200,6 +203,7 @@ class LQR:
         speed: str = "measured",
         resolve_tolerance: float = 0.01,
         preset: str = "tuned",
+        drift_compensation: bool | None = None,
     ) -> None:
         if (a0 is None) != (c0 is None):
             raise ValueError("give both a0 and c0, or neither (default initial guess)")
@@ -225,6 +229,8 @@ class LQR:
             )
             if v is not None
         }
+        if drift_compensation is not None:
+            self.explicit["drift_compensation"] = bool(drift_compensation)
         self.speed_source = speed
         self.resolve_tolerance = resolve_tolerance
 
@@ -241,6 +247,10 @@ class LQR:
             given.get("lambda_psi", PAPER_LAMBDA_PSI),
             given.get("lambda_delta", PAPER_LAMBDA_DELTA),
         )
+        #: the heading error of eq. (25) as the course error ψ + β − ψp (β measured,
+        #: classical.drift, as the PID family and L1 compensate it); off: the paper's ψ − ψp
+        self.drift_compensation = bool(given.get("drift_compensation", False))
+        self._last: dict[str, Any] | None = None
         self.rate_limit = float(getattr(context.nominal_model, "rudder_rate_limit", math.inf))
         self.tracker = context.new_tracker()
         self._started = False
@@ -283,13 +293,14 @@ class LQR:
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
         self._started = True
         # Borkowski (2018) eq. (25): state in the frame of the active leg
-        state = np.array(
-            [
-                frame.cross_track,
-                wrap_angle(info["heading"] - frame.path_angle),
-                info["yaw_rate"],
-            ]
-        )
+        heading_error = wrap_angle(info["heading"] - frame.path_angle)
+        if self.drift_compensation:  # the course error: ė = U sin(ψ + β − ψp)
+            _, drift = course_and_drift(
+                info, self._last, self.ctx.control_period, self.ctx.nominal_speed
+            )
+            heading_error = wrap_angle(heading_error + drift)
+            self._last = {"position": (float(x), float(y)), "psi": float(info["heading"])}
+        state = np.array([frame.cross_track, heading_error, info["yaw_rate"]])
         a, c = self._model(info)
         speed = self._speed(info)
         K = self._gain(a, c, speed)
