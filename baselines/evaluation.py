@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
+from shipgym.envs.core import TRAJECTORY_KEYS
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError
@@ -70,13 +71,14 @@ class EpisodeResult:
 
 class _Record:
     """One episode's record as the loop keeps it: the trajectory rows of its infos, the
-    time each ``act`` took and the last info."""
+    time each ``act`` took and the last info.  ``info=None``: a lean record (no per-step
+    info; the trajectory is given to :meth:`result` and the last info to :meth:`end`)."""
 
-    def __init__(self, scenario_name: str, seed: int, info: dict[str, Any]) -> None:
+    def __init__(self, scenario_name: str, seed: int, info: dict[str, Any] | None) -> None:
         self.scenario_name = scenario_name
         self.seed = seed
         self.info = info
-        self.rows: list[tuple[float, ...]] = [_traj_row(info)]
+        self.rows: list[tuple[float, ...]] | None = None if info is None else [_traj_row(info)]
         self.act_times: list[float] = []
 
     def add(self, info: dict[str, Any], act_time: float) -> None:
@@ -85,21 +87,26 @@ class _Record:
         self.info = info
         self.rows.append(_traj_row(info))
 
-    def result(self, policy: Policy) -> EpisodeResult:
+    def result(
+        self, policy: Policy, trajectory: dict[str, np.ndarray] | None = None
+    ) -> EpisodeResult:
+        """The episode's result; ``trajectory``: a lean record's (the env's columns)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
         metrics.update(compute_time_metrics(self.act_times))
         stats = getattr(policy, "episode_stats", None)
         if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
             metrics.update(stats())
-        traj = np.array(self.rows)
+        if trajectory is None:
+            traj = np.array(self.rows)
+            trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
         return EpisodeResult(
             controller=policy.name,
             kind=policy.kind,
             scenario=self.scenario_name,
             seed=self.seed,
             metrics=metrics,
-            trajectory={k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)},
+            trajectory=trajectory,
             training_seed=training_seed(policy),
         )
 
@@ -231,8 +238,8 @@ def evaluate_batch(
         policy, mode = controller, None
     mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
     if isinstance(policy, BatchPolicy):
-        # a batch policy acts on the observations alone: its rows skip the samples
-        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, samples=False))
+        # a batch policy acts on the observations alone: its rows skip the per-step infos
+        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, lean=True))
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
@@ -266,12 +273,21 @@ class _Episodes(Protocol):
 
 
 class _VectorEpisodes:
-    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`."""
+    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`; ``lean`` (a
+    batch policy, which reads observations only): the rows give no per-step info
+    (``row_infos="end"``, no samples) and the trajectories are the env's columns."""
 
     def __init__(
-        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, samples: bool = True
+        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, lean: bool = False
     ) -> None:
-        self.env = EvaluationTrialsVectorEnv(scenarios, seeds, action_mode, samples=samples)
+        self.lean = lean
+        self.env = EvaluationTrialsVectorEnv(
+            scenarios,
+            seeds,
+            action_mode,
+            samples=not lean,
+            row_infos="end" if lean else "all",
+        )
         self.seeds = seeds
         obs, info = self.env.reset()
         self.obs = list(obs)
@@ -296,11 +312,18 @@ class _VectorEpisodes:
         rows = info["rows"]
         for i, act_time in zip(live, times, strict=True):
             self.obs[i] = obs[i]
-            self.records[i].add(rows[i], act_time)
+            record = self.records[i]
+            if self.lean:  # an info only at the row's last step
+                record.act_times.append(act_time)
+                if rows[i] is not None:
+                    record.info = rows[i]
+            else:
+                record.add(rows[i], act_time)
         self.done = self.env.finished.tolist()
 
     def result(self, i: int, policy: Policy) -> EpisodeResult:
-        return self.records[i].result(policy)
+        trajectory = self.env.trajectory(i) if self.lean else None
+        return self.records[i].result(policy, trajectory)
 
     def close(self) -> None:
         self.env.close()
@@ -346,16 +369,16 @@ _SINGLE_ENTRY_POINT = "shipgym.envs.path_follow:ShipPathFollowEnv"
 
 
 def _episodes(
-    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, samples: bool = True
+    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, lean: bool = False
 ) -> _Episodes:
     """The episodes as the rows of one vectorized env when they can be (the env is the
     single ShipPathFollow env and the trials share the ship and its step constants: see
-    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``samples``:
-    whether the rows' infos carry ``samples`` (a batch policy reads observations only)."""
+    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``lean``: the
+    rows give no per-step info and no samples (a batch policy reads observations only)."""
     if gym.spec(env_id).entry_point == _SINGLE_ENTRY_POINT:
         loaded = [load_scenario(s) for s in scenarios]
         if loaded and lockstep_problem(loaded) is None:
-            return _VectorEpisodes(loaded, seeds, action_mode, samples)
+            return _VectorEpisodes(loaded, seeds, action_mode, lean)
         scenarios = loaded
     return _SingleEpisodes(scenarios, seeds, action_mode, env_id)
 
@@ -409,7 +432,7 @@ def compute_time_metrics(act_times: list[float]) -> dict[str, float]:
     }
 
 
-_TRAJ_KEYS = ("t", "x", "y", "cross_track_error", "heading", "rudder_angle", "rudder_command")
+_TRAJ_KEYS = TRAJECTORY_KEYS
 
 
 def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:

@@ -307,6 +307,8 @@ class PchipPath:
 
         # Parameter grid, containing every knot exactly.
         n = int(samples_per_segment)
+        #: grid subintervals per waypoint interval
+        self.samples_per_segment: int = n
         frac = np.linspace(0.0, 1.0, n + 1)[:-1]
         tg = (knots[:-1, None] + chords[:, None] * frac[None, :]).ravel()
         tg = np.concatenate((tg, knots[-1:]))

@@ -180,15 +180,29 @@ class PathTracker:
         self.frame = frame
         return frame
 
+    def origin(self) -> tuple[Any, Any]:
+        """The point [m] of the path the current frame is measured from: the active leg's
+        start (polyline) or the closest point (curve); floats, or arrays over the ships."""
+        if self.is_curve:
+            return self.point.x, self.point.y
+        tab = self._legs.arrays if self.batch is not None else self._legs.lists
+        return tab["x0"][self.leg], tab["y0"][self.leg]
+
     def cross_track_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-        """Cross-track errors [m] of sample positions of one ship relative to its frame.
+        """Cross-track errors [m] of sample positions relative to the current frame: of one
+        ship (xs, ys of shape (n,)), or of N ships (shape (N, n): row i relative to ship i's
+        frame).
 
         Exact for a polyline (the active leg); for a curve, relative to the tangent line at
-        the current closest point (accurate over one control period of travel).
+        the current closest point (accurate over one control period of travel).  The unit
+        direction is libm's cos / sin of the path angle for one ship and for N alike (the
+        same bits per ship).
         """
-        f = self.frame
-        if self.is_curve:
-            x0, y0 = self.point.x, self.point.y
-        else:
-            x0, y0 = self._legs.lists["x0"][self.leg], self._legs.lists["y0"][self.leg]
-        return cross_track(xs - x0, ys - y0, math.cos(f.path_angle), math.sin(f.path_angle))
+        angle = self.frame.path_angle
+        x0, y0 = self.origin()
+        if self.batch is None:
+            return cross_track(xs - x0, ys - y0, math.cos(angle), math.sin(angle))
+        angles = angle.tolist()
+        c = np.fromiter(map(math.cos, angles), np.float64, len(angles))[:, None]
+        s = np.fromiter(map(math.sin, angles), np.float64, len(angles))[:, None]
+        return cross_track(xs - x0[:, None], ys - y0[:, None], c, s)

@@ -85,6 +85,17 @@ GUIDANCE_OFFSET_MAX = math.radians(30.0)
 
 #: the per-control-step columns both envs log for the episode metrics (true values)
 LOG_FIELDS = ("t", "cross_track_error", "heading_error", "rudder_angle", "rudder_command", "reward")
+#: an episode's trajectory as the evaluation keeps it: per control step (the reset's
+#: included) these ``info`` values, ``position`` split into x and y [m]
+TRAJECTORY_KEYS = (
+    "t",
+    "x",
+    "y",
+    "cross_track_error",
+    "heading",
+    "rudder_angle",
+    "rudder_command",
+)
 
 
 @dataclasses.dataclass(frozen=True)

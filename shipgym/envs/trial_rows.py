@@ -19,7 +19,6 @@ variant) and every step constant but the time limit (:func:`shared_constants_pro
 from __future__ import annotations
 
 import dataclasses
-import operator
 from typing import Any
 
 import numpy as np
@@ -31,14 +30,12 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs import core
+from shipgym.envs.row_tracking import RouteGroups, RowTrackers
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY, SCALAR
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.loader import nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
-
-#: a TrackFrame's fields as a tuple, in declaration order
-_FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
 
 
 @dataclasses.dataclass
@@ -177,12 +174,15 @@ class TrialRowsVectorEnv(VectorEnv):
         self._speed = np.full(num_envs, k.nominal_speed)
         self._integral = np.zeros(num_envs)
         self._context = np.zeros((num_envs, self._parts.context_row.size), dtype=np.float32)
-        self._frames: list[TrackFrame | None] = [None] * num_envs
+        self._noisy = np.zeros(num_envs, dtype=bool)  # rows whose sensors add noise
+        #: the rows' path tracking (the subclass sets it: per row, or per route at reset)
+        self._tracks: RowTrackers | RouteGroups = RowTrackers(num_envs)
         self._sample_offsets = k.fine_step * np.arange(k.substeps)
 
     # ------------------------------------------------------------------ rows
     def _install(self, i: int, tr: Trial) -> None:
-        """Start row i's episode on trial ``tr`` (a single env's reset)."""
+        """Start row i's episode on trial ``tr`` (a single env's reset; the path tracking
+        is the caller's: :class:`RowTrackers` or :class:`RouteGroups`)."""
         k = self._k0
         self._trials[i] = tr
         sc = tr.scenario
@@ -204,7 +204,7 @@ class TrialRowsVectorEnv(VectorEnv):
         tr.sensor.reset()
         psi_m, r_m = tr.sensor.measure(x[k.ipsi : k.ipsi + 1], x[k.ir : k.ir + 1], tr.rng)
         self._psi_m[i], self._r_m[i] = float(psi_m[0]), float(r_m[0])
-        self._frames[i] = tr.tracker.reset(float(x[k.ix]), float(x[k.iy]))
+        self._noisy[i] = not tr.sensor.ideal
         if self.context_features:
             self._context[i] = tr.context_row
 
@@ -212,17 +212,17 @@ class TrialRowsVectorEnv(VectorEnv):
         """One control period of the ``live`` rows with actions ``a`` (n_envs, n_act),
         checked and clipped (:func:`core.batch_actions`); the other rows keep their state."""
         k = self._k0
-        rows = np.flatnonzero(live)
         trials: list[Trial] = self._trials  # type: ignore[assignment]
+        tracks = self._tracks
         if self.action_mode == "rudder":
             delta_c = a[:, 0] * k.rudder_limit
         else:
             delta_c = self._delta_c.copy()
-            for i in rows:
+            for i in np.flatnonzero(live):
                 delta_c[i], self._integral[i] = core.guidance_command(
                     a[i, 0],
                     a[i, 1],
-                    self._frames[i],
+                    tracks.row_frame(i),
                     self._psi_m[i],
                     self._r_m[i],
                     self._integral[i],
@@ -263,35 +263,36 @@ class TrialRowsVectorEnv(VectorEnv):
         psi_m0, r_m0 = self._psi_m, self._r_m
         psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
         r_m = np.where(advance, last[:, k.ir], self._r_m)
-        xs, ys = self._state[:, k.ix].tolist(), self._state[:, k.iy].tolist()
         samples: dict[int, dict[str, np.ndarray]] = {}
         if self.record_samples:  # every row's at once: views into fresh (N, n_sub) arrays
             start = np.concatenate((x_start[:, None], traj[:, :-1]), axis=1)
+            # at the substep starts, before the tracker moves on
+            e_s = tracks.cross_track_of(start[:, :, k.ix], start[:, :, k.iy])
             measured_psi, measured_r = traj[:, :, k.ipsi].copy(), traj[:, :, k.ir].copy()
             psi_s = np.concatenate((psi_m0[:, None], measured_psi[:, :-1]), axis=1)
             r_s = np.concatenate((r_m0[:, None], measured_r[:, :-1]), axis=1)
             t_s = t0[:, None] + self._sample_offsets
             delta_s = start[:, :, k.idelta]
             delta_c_s = np.repeat(delta_c[:, None], k.substeps, axis=1)
-        for i in np.flatnonzero(advance).tolist():
+        for i in np.flatnonzero(advance & self._noisy).tolist():
             tr = trials[i]
-            if not tr.sensor.ideal:
-                p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
-                psi_m[i], r_m[i] = p_i[-1], r_i[-1]
-                if self.record_samples:
-                    psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
-            if self.record_samples:  # at the substep starts, before the tracker moves on
+            p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
+            psi_m[i], r_m[i] = p_i[-1], r_i[-1]
+            if self.record_samples:
+                psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
+        if self.record_samples:
+            for i in np.flatnonzero(advance).tolist():
                 samples[i] = {
                     "t": t_s[i],
                     "psi": psi_s[i],
                     "r": r_s[i],
                     "delta": delta_s[i],
                     "delta_c": delta_c_s[i],
-                    "e": tr.tracker.cross_track_of(start[i, :, k.ix], start[i, :, k.iy]),
+                    "e": e_s[i],
                 }
-            self._frames[i] = tr.tracker.update(xs[i], ys[i])
+        tracks.update(self._state[:, k.ix], self._state[:, k.iy], advance)
         self._psi_m, self._r_m = psi_m, r_m
-        frame = self._stacked_frames()
+        frame = tracks.frame
         heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
         reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
         kk = self._kk  # the constants with each row's own max_steps
@@ -309,18 +310,10 @@ class TrialRowsVectorEnv(VectorEnv):
             samples=samples,
         )
 
-    def _stacked_frames(self) -> TrackFrame:
-        """The rows' frames as one TrackFrame of arrays."""
-        table = np.array([_FRAME_ROW(f) for f in self._frames], dtype=float)
-        cols = table.T
-        return TrackFrame(
-            cols[0], cols[1], cols[2], cols[3].astype(np.int64), cols[4], cols[5], cols[6] > 0.5
-        )
-
     def _observation(self, frame: TrackFrame | None = None) -> np.ndarray:
         k = self._k0
         return core.batch_observation(
-            self._stacked_frames() if frame is None else frame,
+            self._tracks.frame if frame is None else frame,
             self._psi_m,
             self._r_m,
             self._state[:, k.idelta],

@@ -1,0 +1,152 @@
+"""Path tracking of the rows of the batched trial envs (:mod:`shipgym.envs.trial_rows`).
+
+Two bookkeepings with one interface; both give row i the frame of its single env's tracker,
+bit for bit (tested), as arrays over the rows (:attr:`frame`) and, where one row's frame is
+read (its ``info``, the guidance-mode command), as the single env's Python types
+(:meth:`row_frame`: float, int leg, bool ``at_goal``):
+
+* :class:`RouteGroups` (the evaluation env, whose rows are all installed at reset): rows
+  whose trials follow the same route (:func:`route_key`: trials of one scenario move the
+  start, not the waypoints) are tracked by ONE batched
+  :class:`~shipgym.tracking.PathTracker` (``batch=n``, masked to the advancing rows);
+* :class:`RowTrackers` (the training env, whose rows draw a new trial, a new route, at each
+  autoreset): one scalar tracker per row.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import operator
+from typing import Any
+
+import numpy as np
+
+from shipgym.tracking import PathTracker, TrackFrame
+
+#: a TrackFrame's fields as a tuple, in declaration order
+_FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
+#: the dtype of each TrackFrame field over rows (leg: index, at_goal: flag)
+_FIELD_DTYPES = tuple(
+    np.int64 if f.name == "leg" else bool if f.name == "at_goal" else np.float64
+    for f in dataclasses.fields(TrackFrame)
+)
+
+
+def route_key(tracker: PathTracker) -> tuple[Any, ...]:
+    """What two trackers must share to be tracked as rows of one batched tracker: the path
+    class, its waypoints (bit for bit) and PCHIP grid, the acceptance radius [m] and the
+    switching rule."""
+    path = tracker.path
+    return (
+        type(path),
+        path.waypoints.shape,
+        path.waypoints.tobytes(),
+        getattr(path, "samples_per_segment", None),
+        tracker.radius,
+        tracker.switching,
+    )
+
+
+class RouteGroups:
+    """The rows' tracking by route: one batched tracker per group of rows with the same
+    route (module doc), started at the positions (x, y) [m] of all rows."""
+
+    def __init__(self, trackers: list[PathTracker], x: np.ndarray, y: np.ndarray) -> None:
+        rows_of: dict[tuple[Any, ...], list[int]] = {}
+        for i, tracker in enumerate(trackers):
+            rows_of.setdefault(route_key(tracker), []).append(i)
+        self.n = len(trackers)
+        #: per group: its rows (indices, ascending) and its batched tracker
+        self.groups: list[tuple[np.ndarray, PathTracker]] = []
+        for rows in rows_of.values():
+            first = trackers[rows[0]]
+            batched = PathTracker(first.path, first.radius, first.switching, batch=len(rows))
+            self.groups.append((np.array(rows), batched))
+        #: one group holding every row in order: its frame is the rows' frame as it is
+        self._whole = len(self.groups) == 1
+        for rows, tracker in self.groups:
+            tracker.reset(self._take(x, rows), self._take(y, rows))
+        self._gather()
+
+    def _take(self, a: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return a if self._whole else a[rows]
+
+    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
+        """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
+        for rows, tracker in self.groups:
+            mask = self._take(advance, rows)
+            if mask.any():
+                tracker.update(self._take(x, rows), self._take(y, rows), mask)
+        self._gather()
+
+    def _gather(self) -> None:
+        """The groups' frames as one TrackFrame over all rows."""
+        if self._whole:
+            self.frame: TrackFrame = self.groups[0][1].frame
+        else:
+            columns = [np.empty(self.n, dtype=dtype) for dtype in _FIELD_DTYPES]
+            for rows, tracker in self.groups:
+                for column, values in zip(columns, _FRAME_ROW(tracker.frame), strict=True):
+                    column[rows] = values
+            self.frame = TrackFrame(*columns)
+        self._lists: tuple[list[Any], ...] | None = None
+
+    def row_frame(self, i: int) -> TrackFrame:
+        """Row i's frame in the single env's types (float, int leg, bool at_goal)."""
+        if self._lists is None:
+            self._lists = tuple(np.asarray(c).tolist() for c in _FRAME_ROW(self.frame))
+        return TrackFrame(*(column[i] for column in self._lists))
+
+    def cross_track_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Cross-track errors [m] of sample positions (N, n) of every row relative to its
+        frame (:meth:`PathTracker.cross_track_of`)."""
+        if self._whole:
+            return self.groups[0][1].cross_track_of(xs, ys)
+        e = np.empty(np.shape(xs))
+        for rows, tracker in self.groups:
+            e[rows] = tracker.cross_track_of(xs[rows], ys[rows])
+        return e
+
+
+class RowTrackers:
+    """The rows' tracking with one scalar tracker per row (each row's route its own)."""
+
+    def __init__(self, n: int) -> None:
+        self._trackers: list[PathTracker | None] = [None] * n
+        self._frames: list[TrackFrame | None] = [None] * n
+        self._frame: TrackFrame | None = None
+
+    def install(self, i: int, tracker: PathTracker, x: float, y: float) -> None:
+        """Row i follows ``tracker``'s route, started at (x, y) [m]."""
+        self._trackers[i] = tracker
+        self._frames[i] = tracker.reset(x, y)
+        self._frame = None
+
+    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
+        """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
+        xs, ys = x.tolist(), y.tolist()
+        for i in np.flatnonzero(advance).tolist():
+            self._frames[i] = self._trackers[i].update(xs[i], ys[i])
+        self._frame = None
+
+    @property
+    def frame(self) -> TrackFrame:
+        """The rows' frames as one TrackFrame of arrays."""
+        if self._frame is None:
+            table = np.array([_FRAME_ROW(f) for f in self._frames], dtype=float)
+            cols = table.T
+            self._frame = TrackFrame(
+                cols[0], cols[1], cols[2], cols[3].astype(np.int64), cols[4], cols[5], cols[6] > 0.5
+            )
+        return self._frame
+
+    def row_frame(self, i: int) -> TrackFrame:
+        """Row i's frame (its tracker's)."""
+        return self._frames[i]
+
+    def cross_track_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Cross-track errors [m] of sample positions (N, n) of every row relative to its
+        frame."""
+        return np.stack(
+            [t.cross_track_of(xs[i], ys[i]) for i, t in enumerate(self._trackers)]  # type: ignore[union-attr]
+        )
