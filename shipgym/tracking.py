@@ -49,21 +49,24 @@ def polyline_frame(x: Any, y: Any, leg: Any, table: LegTable, radius: float, xp:
     The goal counts as reached on the last leg inside the acceptance circle of the final
     waypoint or once abeam of it.
     """
-    tab = table.arrays if xp.batched else table.lists
-    rx, ry = x - tab["x0"][leg], y - tab["y0"][leg]
-    c, s = tab["c"][leg], tab["s"][leg]
+    if xp.batched:  # the active legs' constants in one gather
+        x0, y0, x1, y1, c, s, length, angle, change = table.matrix.take(leg, axis=1)
+    else:
+        tab = table.lists
+        x0, y0, x1, y1 = tab["x0"][leg], tab["y0"][leg], tab["x1"][leg], tab["y1"][leg]
+        c, s, length = tab["c"][leg], tab["s"][leg], tab["length"][leg]
+        angle, change = tab["angle"][leg], tab["change"][leg]
+    rx, ry = x - x0, y - y0
     along = along_track(rx, ry, c, s)
     gx, gy = x - table.goal[0], y - table.goal[1]
-    nx, ny = x - tab["x1"][leg], y - tab["y1"][leg]
-    at_goal = (leg == table.last_leg) & (
-        (xp.sqrt(gx * gx + gy * gy) <= radius) | (along >= tab["length"][leg])
-    )
+    nx, ny = x - x1, y - y1
+    at_goal = (leg == table.last_leg) & ((xp.sqrt(gx * gx + gy * gy) <= radius) | (along >= length))
     return TrackFrame(
         cross_track(rx, ry, c, s),
-        tab["angle"][leg],
+        angle,
         along,
         leg,
-        tab["change"][leg],
+        change,
         xp.sqrt(nx * nx + ny * ny),
         at_goal,
     )
@@ -95,6 +98,8 @@ def curve_frame(x: Any, y: Any, point: CurvePoint, path: PchipPath, radius: floa
 
 def _select(mask: np.ndarray, new: Any, old: Any) -> Any:
     """Field by field: ``new`` where ``mask``, else ``old`` (dataclasses of arrays)."""
+    if mask.all():
+        return new
     return type(new)(
         *(
             np.where(mask, getattr(new, f.name), getattr(old, f.name))
@@ -172,7 +177,7 @@ class PathTracker:
         return self._store(frame, mask)
 
     def _masked(self, mask: Any, new: Any, old: Any) -> Any:
-        return new if mask is None else np.where(mask, new, old)
+        return new if mask is None or mask.all() else np.where(mask, new, old)
 
     def _store(self, frame: TrackFrame, mask: Any) -> TrackFrame:
         if mask is not None and self.frame is not None:

@@ -8,9 +8,15 @@ read (its ``info``, the guidance-mode command), as the single env's Python types
 * :class:`RouteGroups` (the evaluation env, whose rows are all installed at reset): rows
   whose trials follow the same route (:func:`route_key`: trials of one scenario move the
   start, not the waypoints) are tracked by ONE batched
-  :class:`~shipgym.tracking.PathTracker` (``batch=n``, masked to the advancing rows);
+  :class:`~shipgym.tracking.PathTracker` (``batch=n``, masked to the advancing rows) when
+  the group has at least :data:`MIN_BATCHED_ROWS` rows, else by one scalar tracker each;
 * :class:`RowTrackers` (the training env, whose rows draw a new trial, a new route, at each
   autoreset): one scalar tracker per row.
+
+A batched tracker costs a fixed ≈ 20 µs (polyline) / ≈ 240 µs (PCHIP curve) of CPU per
+update whatever the number of rows; a scalar one ≈ 2 µs / ≈ 20 µs per row (numpy's per-call
+overhead against Python floats; issue 18, measured with ``time.process_time``): the batched
+curve tracker pays off from about 14 rows, the polyline one from about 8.
 """
 
 from __future__ import annotations
@@ -25,6 +31,10 @@ from shipgym.tracking import PathTracker, TrackFrame
 
 #: a TrackFrame's fields as a tuple, in declaration order
 _FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
+#: the fewest rows of one route a batched tracker follows (fewer: one scalar tracker each),
+#: by path kind (the measured break-even, module doc)
+MIN_BATCHED_ROWS = {"polyline": 8, "curve": 16}
+
 #: the dtype of each TrackFrame field over rows (leg: index, at_goal: flag)
 _FIELD_DTYPES = tuple(
     np.int64 if f.name == "leg" else bool if f.name == "at_goal" else np.float64
@@ -49,23 +59,32 @@ def route_key(tracker: PathTracker) -> tuple[Any, ...]:
 
 class RouteGroups:
     """The rows' tracking by route: one batched tracker per group of rows with the same
-    route (module doc), started at the positions (x, y) [m] of all rows."""
+    route, or one scalar tracker per row of a small group (module doc), started at the
+    positions (x, y) [m] of all rows."""
 
     def __init__(self, trackers: list[PathTracker], x: np.ndarray, y: np.ndarray) -> None:
         rows_of: dict[tuple[Any, ...], list[int]] = {}
         for i, tracker in enumerate(trackers):
             rows_of.setdefault(route_key(tracker), []).append(i)
         self.n = len(trackers)
-        #: per group: its rows (indices, ascending) and its batched tracker
-        self.groups: list[tuple[np.ndarray, PathTracker]] = []
-        for rows in rows_of.values():
-            first = trackers[rows[0]]
-            batched = PathTracker(first.path, first.radius, first.switching, batch=len(rows))
-            self.groups.append((np.array(rows), batched))
         #: one group holding every row in order: its frame is the rows' frame as it is
-        self._whole = len(self.groups) == 1
-        for rows, tracker in self.groups:
-            tracker.reset(self._take(x, rows), self._take(y, rows))
+        self._whole = len(rows_of) == 1
+        #: per group: its rows (indices, ascending) and its tracking (batched or per row)
+        self.groups: list[tuple[np.ndarray, PathTracker | RowTrackers]] = []
+        for members in rows_of.values():
+            rows = np.array(members)
+            xs, ys = self._take(x, rows), self._take(y, rows)
+            first = trackers[members[0]]
+            kind = "curve" if first.is_curve else "polyline"
+            if len(members) >= MIN_BATCHED_ROWS[kind]:
+                tracking = PathTracker(first.path, first.radius, first.switching, len(members))
+                tracking.reset(xs, ys)
+            else:
+                tracking = RowTrackers(len(members))
+                positions = zip(members, xs.tolist(), ys.tolist(), strict=True)
+                for j, (i, x_j, y_j) in enumerate(positions):
+                    tracking.install(j, trackers[i], x_j, y_j)
+            self.groups.append((rows, tracking))
         self._gather()
 
     def _take(self, a: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -73,7 +92,7 @@ class RouteGroups:
 
     def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
         """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
-        for rows, tracker in self.groups:
+        for rows, tracker in self.groups:  # a PathTracker(batch) or RowTrackers
             mask = self._take(advance, rows)
             if mask.any():
                 tracker.update(self._take(x, rows), self._take(y, rows), mask)
@@ -90,6 +109,11 @@ class RouteGroups:
                     column[rows] = values
             self.frame = TrackFrame(*columns)
         self._lists: tuple[list[Any], ...] | None = None
+
+    @property
+    def batched_rows(self) -> int:
+        """How many rows batched trackers follow (the rest: one scalar tracker each)."""
+        return sum(len(rows) for rows, t in self.groups if isinstance(t, PathTracker))
 
     def row_frame(self, i: int) -> TrackFrame:
         """Row i's frame in the single env's types (float, int leg, bool at_goal)."""
