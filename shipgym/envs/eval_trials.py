@@ -145,18 +145,24 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         if not self._started:
             raise RuntimeError("call reset() before step()")
         live = ~self.finished
-        a = np.zeros(self.action_space.shape)
-        a[live] = core.batch_actions(np.asarray(actions)[live], (int(live.sum()), a.shape[1]))
+        if live.all():
+            a = core.batch_actions(actions, self.action_space.shape)
+        else:
+            a = np.zeros(self.action_space.shape)
+            a[live] = core.batch_actions(np.asarray(actions)[live], (int(live.sum()), a.shape[1]))
         period = self._advance(a, live)
-        terminated, truncated = period.terminated & live, period.truncated & live
+        # the period's ends are the stepped rows' (goal, corridor, time limit: of the rows
+        # that advanced; a non-finite state: of a live row)
+        terminated, truncated = period.terminated, period.truncated
         ended = terminated | truncated
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
-        rows = np.flatnonzero(live)
-        self._write_columns(
-            rows, self._steps[rows], period.frame.cross_track, period.heading_error, period.reward
-        )
+        rows = live.nonzero()[0]
+        if rows.size:  # the live rows step together: one step count
+            step = int(self._steps[rows[0]])
+            frame = period.frame
+            self._write_columns(rows, step, frame.cross_track, period.heading_error, period.reward)
         reasons = period.reasons() if ended.any() else None
-        for i in (rows if self.row_infos == "all" else np.flatnonzero(ended)).tolist():
+        for i in (rows if self.row_infos == "all" else ended.nonzero()[0]).tolist():
             info = self._row_info(i)
             if i in period.samples:
                 info["samples"] = period.samples[i]
@@ -177,25 +183,31 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
     def _write_columns(
         self,
         rows: np.ndarray,
-        step: Any,
+        step: int,
         cross_track: np.ndarray,
         heading_error: np.ndarray | None,
         reward: np.ndarray | None,
     ) -> None:
         """Column ``step`` (0: the reset) of the ``rows``' episode columns (_COLUMNS)."""
         k = self._k0
+        whole = rows.size == self.num_envs  # every row: no gathers
+
+        def take(values: np.ndarray) -> np.ndarray:
+            return values if whole else values[rows]
+
+        state = take(self._state)
         values = [
-            self._t[rows],
-            self._state[rows, k.ix],
-            self._state[rows, k.iy],
-            cross_track[rows],
-            self._psi_m[rows],
-            self._state[rows, k.idelta],
-            self._delta_c[rows],
+            take(self._t),
+            state[:, k.ix],
+            state[:, k.iy],
+            take(cross_track),
+            take(self._psi_m),
+            state[:, k.idelta],
+            take(self._delta_c),
         ]
         if heading_error is not None:
-            values += [heading_error[rows], reward[rows]]
-        self._columns[: len(values), rows, step] = values
+            values += [take(heading_error), take(reward)]
+        self._columns[: len(values), slice(None) if whole else rows, step] = values
 
     def trajectory(self, i: int) -> dict[str, np.ndarray]:
         """Row i's trajectory so far: per key of ``core.TRAJECTORY_KEYS`` its values at the

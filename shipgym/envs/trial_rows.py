@@ -210,15 +210,20 @@ class TrialRowsVectorEnv(VectorEnv):
 
     def _advance(self, a: np.ndarray, live: np.ndarray) -> Period:
         """One control period of the ``live`` rows with actions ``a`` (n_envs, n_act),
-        checked and clipped (:func:`core.batch_actions`); the other rows keep their state."""
+        checked and clipped (:func:`core.batch_actions`); the other rows keep their state.
+
+        While every row steps (and every plant state stays finite), the masked selections
+        (``np.where(live, new, old)``) are skipped: they would return ``new`` (issue 18:
+        the step's fixed cost is its ≈ 100 numpy calls)."""
         k = self._k0
         trials: list[Trial] = self._trials  # type: ignore[assignment]
         tracks = self._tracks
+        every = bool(live.all())
         if self.action_mode == "rudder":
             delta_c = a[:, 0] * k.rudder_limit
         else:
             delta_c = self._delta_c.copy()
-            for i in np.flatnonzero(live):
+            for i in live.nonzero()[0].tolist():
                 delta_c[i], self._integral[i] = core.guidance_command(
                     a[i, 0],
                     a[i, 1],
@@ -229,13 +234,15 @@ class TrialRowsVectorEnv(VectorEnv):
                     trials[i],
                     SCALAR,
                 )
-        delta_c = np.where(live, delta_c, self._delta_c)
-        prev_delta_c = self._delta_c.copy()
-        t0 = self._t.copy()
+        if not every:
+            delta_c = np.where(live, delta_c, self._delta_c)
+        # the arrays below are replaced, never written in place, during a period
+        prev_delta_c = self._delta_c
+        t0 = self._t
         # true parameters of the period: only for rows whose event acts on it (or just did)
         t1 = t0 + k.control_period
-        changing = live & (self._event_end >= t0 - 1e-9) & (self._event_start <= t1 + 1e-9)
-        for i in np.flatnonzero(changing | (live & self._p_dirty)).tolist():
+        changing = (self._event_end >= t0 - 1e-9) & (self._event_start <= t1 + 1e-9)
+        for i in ((changing | self._p_dirty) & live).nonzero()[0].tolist():
             tr = trials[i]
             self._p_dirty[i] = core.refresh_parameters(
                 tr.scenario.schedule,
@@ -244,25 +251,34 @@ class TrialRowsVectorEnv(VectorEnv):
                 self._p_block[i],
                 bool(self._p_dirty[i]),
             )
-        for i in np.flatnonzero(live & self._time_varying).tolist():  # disturbances
+        for i in (live & self._time_varying).nonzero()[0].tolist():  # disturbances
             trials[i].disturbances.fill_one(self._w_block[i], float(t0[i]), trials[i].rng)
         x_start = self._state
         traj = self._integrator.substep_states(x_start, delta_c, self._w_block, self._p_block)
-        steps = np.where(live, self._steps + 1, self._steps)
         last = traj[:, -1]
-        finite = np.all(np.isfinite(last), axis=1)
-        advance = live & finite
+        finite = np.isfinite(last).all(axis=1)
+        moved = every and bool(finite.all())  # every row advances
+        steps = self._steps + 1
+        if every:
+            self._t = steps * k.control_period
+        else:
+            steps = np.where(live, steps, self._steps)
+            self._t = np.where(live, steps * k.control_period, self._t)
+        advance = live if moved else live & finite
         self._steps = steps
-        self._t = np.where(live, steps * k.control_period, self._t)
         self._delta_c = delta_c
-        self._state = np.where(advance[:, None], last, self._state)
+        self._state = last.copy() if moved else np.where(advance[:, None], last, self._state)
         if k.substeps > 1:
             dx = last[:, k.ix] - traj[:, -2, k.ix]
             dy = last[:, k.iy] - traj[:, -2, k.iy]
-            self._speed = np.where(advance, core.speed_over_ground(dx, dy, k, ARRAY), self._speed)
+            speed = core.speed_over_ground(dx, dy, k, ARRAY)
+            self._speed = speed if moved else np.where(advance, speed, self._speed)
         psi_m0, r_m0 = self._psi_m, self._r_m
-        psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
-        r_m = np.where(advance, last[:, k.ir], self._r_m)
+        if moved:
+            psi_m, r_m = last[:, k.ipsi].copy(), last[:, k.ir].copy()
+        else:
+            psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
+            r_m = np.where(advance, last[:, k.ir], self._r_m)
         samples: dict[int, dict[str, np.ndarray]] = {}
         if self.record_samples:  # every row's at once: views into fresh (N, n_sub) arrays
             start = np.concatenate((x_start[:, None], traj[:, :-1]), axis=1)
@@ -274,14 +290,14 @@ class TrialRowsVectorEnv(VectorEnv):
             t_s = t0[:, None] + self._sample_offsets
             delta_s = start[:, :, k.idelta]
             delta_c_s = np.repeat(delta_c[:, None], k.substeps, axis=1)
-        for i in np.flatnonzero(advance & self._noisy).tolist():
+        for i in (advance & self._noisy).nonzero()[0].tolist():
             tr = trials[i]
             p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
             psi_m[i], r_m[i] = p_i[-1], r_i[-1]
             if self.record_samples:
                 psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
         if self.record_samples:
-            for i in np.flatnonzero(advance).tolist():
+            for i in advance.nonzero()[0].tolist():
                 samples[i] = {
                     "t": t_s[i],
                     "psi": psi_s[i],
@@ -297,6 +313,8 @@ class TrialRowsVectorEnv(VectorEnv):
         reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
         kk = self._kk  # the constants with each row's own max_steps
         reward, goal, corridor, truncated = core.terminate(reward, frame, steps, kk, ARRAY)
+        if moved:
+            return Period(frame, heading_error, reward, goal, corridor, ~live, truncated, samples)
         diverged = live & ~finite
         reward = np.where(diverged, core.diverged_reward(steps, kk), reward)
         return Period(
