@@ -258,14 +258,18 @@ class _Episodes(Protocol):
     """The episodes of a lockstep run: per episode its observation, info, end and result."""
 
     seeds: list[int]
-    obs: list[np.ndarray]
+    obs: Sequence[np.ndarray]
     done: list[bool]
 
     def info(self, i: int) -> dict[str, Any]: ...
 
+    def stacked_obs(self, live: list[int]) -> np.ndarray: ...
+
     def contexts(self) -> list[Any]: ...
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None: ...
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None: ...
 
     def result(self, i: int, policy: Policy) -> EpisodeResult: ...
 
@@ -289,8 +293,8 @@ class _VectorEpisodes:
             row_infos="end" if lean else "all",
         )
         self.seeds = seeds
-        obs, info = self.env.reset()
-        self.obs = list(obs)
+        #: the rows' latest observations (n_rows, n_obs): a finished row's is its last
+        self.obs, info = self.env.reset()
         self.records = [
             _Record(sc.name, seed, row)
             for sc, seed, row in zip(self.env.scenarios, seeds, info["rows"], strict=True)
@@ -304,14 +308,21 @@ class _VectorEpisodes:
     def contexts(self) -> list[Any]:
         return [self.env.controller_context(i) for i in range(self.env.num_envs)]
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+    def stacked_obs(self, live: list[int]) -> np.ndarray:
+        return self.obs[live]
+
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None:
         width = self._actions.shape[1]
-        for i, action in zip(live, actions, strict=True):
-            self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
-        obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
+        if isinstance(actions, np.ndarray):  # a batch policy's (len(live), width) array
+            self._actions[live] = np.asarray(actions, dtype=np.float64).reshape(len(live), width)
+        else:
+            for i, action in zip(live, actions, strict=True):
+                self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
+        self.obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
         rows = info["rows"]
         for i, act_time in zip(live, times, strict=True):
-            self.obs[i] = obs[i]
             record = self.records[i]
             if self.lean:  # an info only at the row's last step
                 record.act_times.append(act_time)
@@ -350,7 +361,12 @@ class _SingleEpisodes:
     def contexts(self) -> list[Any]:
         return [e.base.controller_context for e in self.episodes]
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+    def stacked_obs(self, live: list[int]) -> np.ndarray:
+        return np.stack([self.obs[i] for i in live])
+
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None:
         for i, action, act_time in zip(live, actions, times, strict=True):
             episode = self.episodes[i]
             episode.step(action, act_time)
@@ -397,9 +413,9 @@ def _run_lockstep(policy: BatchPolicy | list[Policy], episodes: _Episodes) -> li
         live = [i for i in range(n) if not episodes.done[i]]
         while live:
             if batch:
-                obs = np.stack([episodes.obs[i] for i in live])
+                obs = episodes.stacked_obs(live)
                 start = _clock()
-                actions = list(policy.act_batch(obs, live))
+                actions = np.asarray(policy.act_batch(obs, live))
                 times = [(_clock() - start) / len(live)] * len(live)
             else:
                 actions, times = [], []
