@@ -70,27 +70,32 @@ class EpisodeResult:
 
 
 class _Record:
-    """One episode's record as the loop keeps it: the trajectory rows of its infos, the
-    time each ``act`` took and the last info.  ``info=None``: a lean record (no per-step
-    info; the trajectory is given to :meth:`result` and the last info to :meth:`end`)."""
+    """One episode's record as the loop keeps it: the time each ``act`` took, the last
+    info and (``rows``) the trajectory rows of its infos; without rows (the rows of an
+    evaluation env, which keeps the trajectory itself) :meth:`result` is given the
+    trajectory, and ``info`` may be None at the steps a lean env gives none."""
 
-    def __init__(self, scenario_name: str, seed: int, info: dict[str, Any] | None) -> None:
+    def __init__(
+        self, scenario_name: str, seed: int, info: dict[str, Any] | None, rows: bool = True
+    ) -> None:
         self.scenario_name = scenario_name
         self.seed = seed
         self.info = info
-        self.rows: list[tuple[float, ...]] | None = None if info is None else [_traj_row(info)]
+        self.rows: list[tuple[float, ...]] | None = [_traj_row(info)] if rows else None
         self.act_times: list[float] = []
 
-    def add(self, info: dict[str, Any], act_time: float) -> None:
-        """The info of a step whose action took the policy ``act_time`` [s]."""
+    def add(self, info: dict[str, Any] | None, act_time: float) -> None:
+        """The info (None: none this step) of a step whose action took ``act_time`` [s]."""
         self.act_times.append(act_time)
-        self.info = info
-        self.rows.append(_traj_row(info))
+        if info is not None:
+            self.info = info
+            if self.rows is not None:
+                self.rows.append(_traj_row(info))
 
     def result(
         self, policy: Policy, trajectory: dict[str, np.ndarray] | None = None
     ) -> EpisodeResult:
-        """The episode's result; ``trajectory``: a lean record's (the env's columns)."""
+        """The episode's result; ``trajectory``: a record without rows (the env's)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
         metrics.update(compute_time_metrics(self.act_times))
@@ -277,9 +282,9 @@ class _Episodes(Protocol):
 
 
 class _VectorEpisodes:
-    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`; ``lean`` (a
-    batch policy, which reads observations only): the rows give no per-step info
-    (``row_infos="end"``, no samples) and the trajectories are the env's columns."""
+    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`, the
+    trajectories the env's columns; ``lean`` (a batch policy, which reads observations
+    only): the rows give no per-step info (``row_infos="end"``, no samples)."""
 
     def __init__(
         self, scenarios: list[Scenario], seeds: list[int], action_mode: str, lean: bool = False
@@ -296,7 +301,7 @@ class _VectorEpisodes:
         #: the rows' latest observations (n_rows, n_obs): a finished row's is its last
         self.obs, info = self.env.reset()
         self.records = [
-            _Record(sc.name, seed, row)
+            _Record(sc.name, seed, row, rows=False)
             for sc, seed, row in zip(self.env.scenarios, seeds, info["rows"], strict=True)
         ]
         self.done = [False] * len(seeds)
@@ -317,24 +322,17 @@ class _VectorEpisodes:
         width = self._actions.shape[1]
         if isinstance(actions, np.ndarray):  # a batch policy's (len(live), width) array
             self._actions[live] = np.asarray(actions, dtype=np.float64).reshape(len(live), width)
-        else:
+        else:  # one action per controller
             for i, action in zip(live, actions, strict=True):
                 self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
         self.obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
         rows = info["rows"]
         for i, act_time in zip(live, times, strict=True):
-            record = self.records[i]
-            if self.lean:  # an info only at the row's last step
-                record.act_times.append(act_time)
-                if rows[i] is not None:
-                    record.info = rows[i]
-            else:
-                record.add(rows[i], act_time)
+            self.records[i].add(rows[i], act_time)  # lean: an info at the last step only
         self.done = self.env.finished.tolist()
 
     def result(self, i: int, policy: Policy) -> EpisodeResult:
-        trajectory = self.env.trajectory(i) if self.lean else None
-        return self.records[i].result(policy, trajectory)
+        return self.records[i].result(policy, self.env.trajectory(i))
 
     def close(self) -> None:
         self.env.close()
