@@ -165,6 +165,10 @@ class TrialRowsVectorEnv(VectorEnv):
         self._event_start = np.full(num_envs, np.inf)  # first event time [s]
         self._event_end = np.full(num_envs, -np.inf)  # last event end [s]
         self._time_varying = np.zeros(num_envs, dtype=bool)
+        #: per row: its disturbances settle from this period start [s] (Disturbances.steady_from)
+        self._steady_from = np.full(num_envs, np.inf)
+        #: rows whose block holds their settled disturbances (no refill needed)
+        self._w_steady = np.zeros(num_envs, dtype=bool)
         self._state = np.zeros((num_envs, first.model.n_states))
         self._steps = np.zeros(num_envs, dtype=np.int64)
         self._t = np.zeros(num_envs)
@@ -193,6 +197,8 @@ class TrialRowsVectorEnv(VectorEnv):
         self._event_end[i] = max((e.end_time() for e in events), default=-np.inf)
         self._p_dirty[i] = False
         self._time_varying[i] = tr.disturbances.time_varying
+        self._steady_from[i] = tr.disturbances.steady_from
+        self._w_steady[i] = False
         self._steps[i] = 0
         self._t[i] = 0.0
         self._delta_c[i] = 0.0
@@ -251,8 +257,10 @@ class TrialRowsVectorEnv(VectorEnv):
                 self._p_block[i],
                 bool(self._p_dirty[i]),
             )
-        for i in (live & self._time_varying).nonzero()[0].tolist():  # disturbances
+        # disturbances: a settled block (filled at a start ≥ steady_from) is not refilled
+        for i in (live & self._time_varying & ~self._w_steady).nonzero()[0].tolist():
             trials[i].disturbances.fill_one(self._w_block[i], float(t0[i]), trials[i].rng)
+            self._w_steady[i] = t0[i] >= self._steady_from[i]
         x_start = self._state
         traj = self._integrator.substep_states(x_start, delta_c, self._w_block, self._p_block)
         last = traj[:, -1]

@@ -79,14 +79,16 @@ def batching(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) ->
     return request.param
 
 
-# a PCHIP curve with a parameter jump (Mariner) and a polyline with a parameter jump
-# (nomoto2), both with noisy sensors; the route groups batched and per row
+# a PCHIP curve with a parameter jump (Mariner), a polyline with a parameter jump (nomoto2)
+# and a curve with a current shift (Blanke), with noisy sensors; the route groups batched
+# and per row
 @pytest.mark.parametrize(
     ("name", "mode"),
     [
         ("mariner_maneuverability_change_curved", "rudder"),
         ("mariner_maneuverability_change_curved", "guidance"),
         ("rudder_aging", "rudder"),
+        ("blanke_current_shift_curved", "rudder"),  # a current shift: settled blocks kept
     ],
 )
 def test_rows_of_a_route_tracked_together_are_the_single_env_episodes(
