@@ -85,6 +85,12 @@ class RouteGroups:
                 for j, (i, x_j, y_j) in enumerate(positions):
                     tracking.install(j, trackers[i], x_j, y_j)
             self.groups.append((rows, tracking))
+        #: per row: the scalar trackers holding it and its index there (None: batched)
+        self._scalar: list[tuple[RowTrackers, int] | None] = [None] * self.n
+        for rows, tracking in self.groups:
+            if isinstance(tracking, RowTrackers):
+                for j, i in enumerate(rows.tolist()):
+                    self._scalar[i] = (tracking, j)
         self._gather()
 
     def _take(self, a: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -117,6 +123,9 @@ class RouteGroups:
 
     def row_frame(self, i: int) -> TrackFrame:
         """Row i's frame in the single env's types (float, int leg, bool at_goal)."""
+        scalar = self._scalar[i]
+        if scalar is not None:  # its own tracker's frame
+            return scalar[0].row_frame(scalar[1])
         if self._lists is None:
             self._lists = tuple(np.asarray(c).tolist() for c in _FRAME_ROW(self.frame))
         return TrackFrame(*(column[i] for column in self._lists))
