@@ -15,8 +15,9 @@ read (its ``info``, the guidance-mode command), as the single env's Python types
 
 A batched tracker costs a fixed ≈ 20 µs (polyline) / ≈ 240 µs (PCHIP curve) of CPU per
 update whatever the number of rows; a scalar one ≈ 2 µs / ≈ 20 µs per row (numpy's per-call
-overhead against Python floats; issue 18, measured with ``time.process_time``): the batched
-curve tracker pays off from about 14 rows, the polyline one from about 8.
+overhead against Python floats; issue 18, measured with ``time.process_time`` on whole
+evaluation episodes): the batched curve tracker pays off from about 16 rows, the polyline
+one from about 10.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from shipgym.tracking import PathTracker, TrackFrame
 _FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
 #: the fewest rows of one route a batched tracker follows (fewer: one scalar tracker each),
 #: by path kind (the measured break-even, module doc)
-MIN_BATCHED_ROWS = {"polyline": 8, "curve": 16}
+MIN_BATCHED_ROWS = {"polyline": 10, "curve": 16}
 
 #: the dtype of each TrackFrame field over rows (leg: index, at_goal: flag)
 _FIELD_DTYPES = tuple(
