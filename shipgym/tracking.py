@@ -108,6 +108,11 @@ def _select(mask: np.ndarray, new: Any, old: Any) -> Any:
     )
 
 
+def _item(record: Any, i: int) -> Any:
+    """Entry i of a dataclass of arrays, as a dataclass of Python scalars."""
+    return type(record)(*(getattr(record, f.name)[i].item() for f in dataclasses.fields(record)))
+
+
 class PathTracker:
     """Active-leg bookkeeping with the scenario's waypoint switching rule, for one ship
     (``batch=None``: floats) or N ships (``batch=N``: arrays, updates masked per ship).
@@ -165,6 +170,18 @@ class PathTracker:
         leg = advance_legs(x, y, self.leg, self._legs, self.radius, self.switching, xp)
         self.leg = self._masked(mask, leg, self.leg)
         return self._store(polyline_frame(x, y, self.leg, self._legs, self.radius, xp), mask)
+
+    def ship(self, i: int) -> PathTracker:
+        """Ship i of a batched tracker as a one-ship tracker in its state (frame, leg and
+        closest point, as Python floats, ints and bools): its updates go on with the bits
+        the batched tracker would give it."""
+        one = PathTracker(self.path, self.radius, self.switching)
+        if self.frame is not None:
+            one.frame = _item(self.frame, i)
+            one.leg = one.frame.leg
+        if self.is_curve and self.point is not None:
+            one.point = _item(self.point, i)
+        return one
 
     def _curve(self, x: Any, y: Any, window: float | None, mask: Any) -> TrackFrame:
         hint = 0.0 if window is None else self.point.s

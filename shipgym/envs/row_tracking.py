@@ -9,7 +9,9 @@ read (its ``info``, the guidance-mode command), as the single env's Python types
   whose trials follow the same route (:func:`route_key`: trials of one scenario move the
   start, not the waypoints) are tracked by ONE batched
   :class:`~shipgym.tracking.PathTracker` (``batch=n``, masked to the advancing rows) when
-  the group has at least :data:`MIN_BATCHED_ROWS` rows, else by one scalar tracker each;
+  the group has at least :data:`MIN_BATCHED_ROWS` rows, else by one scalar tracker each (a
+  batched group moves on to scalar trackers, :meth:`PathTracker.ship`, once fewer of its
+  rows advance: the rows that ended cost nothing then);
 * :class:`RowTrackers` (the training env, whose rows draw a new trial, a new route, at each
   autoreset): one scalar tracker per row.
 
@@ -41,6 +43,11 @@ _FIELD_DTYPES = tuple(
     np.int64 if f.name == "leg" else bool if f.name == "at_goal" else np.float64
     for f in dataclasses.fields(TrackFrame)
 )
+
+
+def _kind(tracker: PathTracker) -> str:
+    """The :data:`MIN_BATCHED_ROWS` key of a tracker's path."""
+    return "curve" if tracker.is_curve else "polyline"
 
 
 def route_key(tracker: PathTracker) -> tuple[Any, ...]:
@@ -76,8 +83,7 @@ class RouteGroups:
             rows = np.array(members)
             xs, ys = self._take(x, rows), self._take(y, rows)
             first = trackers[members[0]]
-            kind = "curve" if first.is_curve else "polyline"
-            if len(members) >= MIN_BATCHED_ROWS[kind]:
+            if len(members) >= MIN_BATCHED_ROWS[_kind(first)]:
                 tracking = PathTracker(first.path, first.radius, first.switching, len(members))
                 tracking.reset(xs, ys)
             else:
@@ -99,11 +105,25 @@ class RouteGroups:
 
     def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
         """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
-        for rows, tracker in self.groups:  # a PathTracker(batch) or RowTrackers
+        for g, (rows, tracker) in enumerate(self.groups):  # PathTracker(batch) or RowTrackers
             mask = self._take(advance, rows)
-            if mask.any():
-                tracker.update(self._take(x, rows), self._take(y, rows), mask)
+            moving = int(mask.sum())
+            if not moving:
+                continue
+            if isinstance(tracker, PathTracker) and moving < MIN_BATCHED_ROWS[_kind(tracker)]:
+                tracker = self._to_scalar(g)
+            tracker.update(self._take(x, rows), self._take(y, rows), mask)
         self._gather()
+
+    def _to_scalar(self, g: int) -> RowTrackers:
+        """Group g's batched tracker as one scalar tracker per row, in the same state."""
+        rows, batched = self.groups[g]
+        scalar = RowTrackers(len(rows))
+        for j, i in enumerate(rows.tolist()):
+            scalar.adopt(j, batched.ship(j))  # type: ignore[union-attr]
+            self._scalar[i] = (scalar, j)
+        self.groups[g] = (rows, scalar)
+        return scalar
 
     def _gather(self) -> None:
         """The groups' frames as one TrackFrame over all rows."""
@@ -154,6 +174,12 @@ class RowTrackers:
         """Row i follows ``tracker``'s route, started at (x, y) [m]."""
         self._trackers[i] = tracker
         self._frames[i] = tracker.reset(x, y)
+        self._frame = None
+
+    def adopt(self, i: int, tracker: PathTracker) -> None:
+        """Row i follows ``tracker`` (one ship) from its current frame on."""
+        self._trackers[i] = tracker
+        self._frames[i] = tracker.frame
         self._frame = None
 
     def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:

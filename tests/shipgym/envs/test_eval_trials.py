@@ -71,10 +71,11 @@ def test_each_row_is_the_single_env_episode_of_its_trial(name: str, mode: str) -
     _assert_rows_are_single_episodes(_variants(name), mode)
 
 
-@pytest.fixture(params=["batched", "per_row"])
+@pytest.fixture(params=["batched", "per_row", "to_scalar"])
 def batching(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    """Every route group on one batched tracker, or on one scalar tracker per row."""
-    least = 1 if request.param == "batched" else 10**6
+    """Every route group on one batched tracker, or on one scalar tracker per row, or on a
+    batched tracker until fewer than 2 of its rows advance (then scalar trackers)."""
+    least = {"batched": 1, "per_row": 10**6, "to_scalar": 2}[request.param]
     monkeypatch.setattr(row_tracking, "MIN_BATCHED_ROWS", {"polyline": least, "curve": least})
     return request.param
 
@@ -94,7 +95,10 @@ def batching(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) ->
 def test_rows_of_a_route_tracked_together_are_the_single_env_episodes(
     name: str, mode: str, batching: str
 ) -> None:
-    _assert_rows_are_single_episodes(_variants(name, NOISY), mode, batched=batching == "batched")
+    trials = _variants(name, NOISY)
+    env = _assert_rows_are_single_episodes(trials, mode, batched=batching != "per_row")
+    if batching == "to_scalar":  # the last row went on alone, on a scalar tracker
+        assert env._tracks.batched_rows == 0
 
 
 @pytest.mark.parametrize("mode", ["rudder", "guidance"])
@@ -104,9 +108,7 @@ def test_rows_of_two_routes_are_the_single_env_episodes(mode: str, batching: str
     curve = _variants("rudder_aging_smooth", NOISY)
     polyline = [t.with_overrides({"path": {"type": "waypoints"}}) for t in curve]
     trials = [curve[0], polyline[1], curve[2]]
-    env = _assert_rows_are_single_episodes(
-        trials, mode, batched=batching == "batched", ends_apart=False
-    )
+    env = _assert_rows_are_single_episodes(trials, mode, batched=None, ends_apart=False)
     assert len(env._tracks.groups) == 2
 
 

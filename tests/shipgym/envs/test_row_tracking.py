@@ -52,10 +52,11 @@ def _assert_rows_equal(groups: RouteGroups, refs: list[PathTracker], where: str)
             assert _bits(getattr(groups.frame, name)[i]) == _bits(theirs), (where, i, name)
 
 
-@pytest.fixture(params=["batched", "per_row"])
+@pytest.fixture(params=["batched", "per_row", "to_scalar"])
 def batching(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    """Force every group onto one batched tracker, or onto scalar trackers per row."""
-    least = 1 if request.param == "batched" else 10**6
+    """Force every group onto one batched tracker, or onto scalar trackers per row, or onto
+    a batched tracker that moves on to scalar trackers once fewer than 3 rows advance."""
+    least = {"batched": 1, "per_row": 10**6, "to_scalar": 3}[request.param]
     monkeypatch.setattr(row_tracking, "MIN_BATCHED_ROWS", {"polyline": least, "curve": least})
     return request.param
 
@@ -79,7 +80,7 @@ def test_route_groups_give_each_row_its_scalar_trackers_frame(
         ref.reset(float(xs[0, i]), float(ys[0, i]))
     groups = RouteGroups([_tracker(sc) for sc in scenarios], xs[0], ys[0])
     assert len(groups.groups) == len(names)
-    assert groups.batched_rows == (n if batching == "batched" else 0)
+    assert groups.batched_rows == (0 if batching == "per_row" else n)
     _assert_rows_equal(groups, refs, "reset")
     stop = np.random.default_rng(7).integers(50, 260, n)  # rows end at different steps
     stop[0] = 200  # one row to the end
@@ -97,6 +98,8 @@ def test_route_groups_give_each_row_its_scalar_trackers_frame(
             refs[i].update(float(xs[step, i]), float(ys[step, i]))
         groups.update(xs[step], ys[step], advance)
         _assert_rows_equal(groups, refs, f"step {step}")
+        if batching == "to_scalar" and advance.sum() < 3 * len(names):
+            assert groups.batched_rows < n  # a group went on with scalar trackers
     assert any(bool(groups.row_frame(i).at_goal) for i in range(n))  # the goal was reached
 
 
