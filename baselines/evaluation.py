@@ -320,11 +320,13 @@ class _VectorEpisodes:
         self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
     ) -> None:
         width = self._actions.shape[1]
-        if isinstance(actions, np.ndarray):  # a batch policy's (len(live), width) array
-            self._actions[live] = np.asarray(actions, dtype=np.float64).reshape(len(live), width)
-        else:  # one action per controller
+        try:  # a batch policy's array, or the controllers' actions of one shape: one call
+            stacked = np.asarray(actions, dtype=np.float64).reshape(len(live), width)
+        except ValueError:  # shapes that differ: one by one (a bad one names its shape)
             for i, action in zip(live, actions, strict=True):
                 self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
+        else:
+            self._actions[live] = stacked
         self.obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
         rows = info["rows"]
         for i, act_time in zip(live, times, strict=True):
