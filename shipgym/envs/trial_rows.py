@@ -1,10 +1,11 @@
 """The row machinery of the batched trial envs: N single-env episodes as the rows of arrays.
 
-Each row runs one trial (its own :class:`~shipgym.scenarios.Scenario`, path tracker,
-parameter schedule, disturbance processes, sensors and episode generator); the plant of
-all rows is one call of the ship's compiled period function (the true parameters and
-disturbances are per-row inputs), and reward, observation and termination are the step
-core's functions (:mod:`shipgym.envs.core`) on arrays.  Row i's episode is that of a
+Each row runs one trial (its own :class:`~shipgym.scenarios.Scenario`, route, parameter
+schedule, disturbance processes, sensors and episode generator); the plant of all rows is
+one call of the ship's compiled period function (the true parameters and disturbances are
+per-row inputs), reward, observation and termination are the step core's functions
+(:mod:`shipgym.envs.core`) on arrays, and the path tracking is
+:mod:`shipgym.envs.row_tracking`'s (one tracker per row, or one per route).  Row i's episode is that of a
 :class:`~shipgym.envs.path_follow.ShipPathFollowEnv` on its trial reset with its episode
 seed, bit for bit (tested).
 
