@@ -5,9 +5,9 @@ schedule, disturbance processes, sensors and episode generator); the plant of al
 one call of the ship's compiled period function (the true parameters and disturbances are
 per-row inputs), reward, observation and termination are the step core's functions
 (:mod:`shipgym.envs.core`) on arrays, and the path tracking is
-:mod:`shipgym.envs.row_tracking`'s (one tracker per row, or one per route).  Row i's episode is that of a
-:class:`~shipgym.envs.path_follow.ShipPathFollowEnv` on its trial reset with its episode
-seed, bit for bit (tested).
+:mod:`shipgym.envs.row_tracking`'s (one tracker per row, or one per route).  Row i's
+episode is that of a :class:`~shipgym.envs.path_follow.ShipPathFollowEnv` on its trial
+reset with its episode seed, bit for bit (tested).
 
 Two envs are built on it: the training env
 :class:`~shipgym.envs.ship_batch.ShipTrialsVectorEnv` (a fresh drawn trial per reset,
