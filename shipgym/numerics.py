@@ -91,7 +91,10 @@ class ArrayOps:
     logical_not = staticmethod(np.logical_not)
     maximum = staticmethod(np.maximum)
     where = staticmethod(np.where)
-    any = staticmethod(np.ndarray.any)  # of a bool array (the method: no dispatch)
+
+    @staticmethod
+    def any(cond: Any) -> Any:
+        return np.asarray(cond).any()  # the array method: no dispatch of np.any
 
     @staticmethod
     def searchsorted_right(table: Any, value: Any) -> Any:
