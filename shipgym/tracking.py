@@ -98,7 +98,7 @@ def curve_frame(x: Any, y: Any, point: CurvePoint, path: PchipPath, radius: floa
 
 def _select(mask: np.ndarray, new: Any, old: Any) -> Any:
     """Field by field: ``new`` where ``mask``, else ``old`` (dataclasses of arrays)."""
-    if mask.all():
+    if np.asarray(mask).all():
         return new
     return type(new)(
         *(
@@ -194,7 +194,7 @@ class PathTracker:
         return self._store(frame, mask)
 
     def _masked(self, mask: Any, new: Any, old: Any) -> Any:
-        return new if mask is None or mask.all() else np.where(mask, new, old)
+        return new if mask is None or np.asarray(mask).all() else np.where(mask, new, old)
 
     def _store(self, frame: TrackFrame, mask: Any) -> TrackFrame:
         if mask is not None and self.frame is not None:
