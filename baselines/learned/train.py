@@ -148,7 +148,7 @@ class _Curves:
         values = (
             selection if rule.metric == "selection" else [float(sum(r) / len(r)) for r in returns]
         )
-        if rule.plateaued(steps, values):
+        if rule.plateaued(steps, values, self.config.n_timesteps):
             self.stopped_at = int(steps[-1])
             return False
         return True

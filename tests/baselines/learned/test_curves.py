@@ -62,6 +62,10 @@ def test_plateau_rule_on_synthetic_curves() -> None:
     by_cost = PlateauRule(metric="selection")
     assert not by_cost.plateaued(steps, [3.0 - s / 50_000 for s in steps])
     assert by_cost.plateaued(steps, [1.0] * 10)
+    # not before min_fraction of the budget: flat at 100 k of a 300 k budget goes on
+    floor = PlateauRule(metric="selection", min_fraction=0.34)
+    assert not floor.plateaued(steps, [1.0] * 10, budget=300_000)
+    assert floor.plateaued(steps, [1.0] * 10, budget=290_000)
 
 
 def test_geometric_mean_ratio_counts_every_trial_equally() -> None:
