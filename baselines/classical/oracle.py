@@ -77,7 +77,7 @@ from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
-ORACLE_REVISION = 1
+ORACLE_REVISION = 2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -89,6 +89,7 @@ class OracleSettings:
     legs: int = 4  # path segments ahead in the prediction
     smooth_abs: float = 1e-3  # ε of √(z² + ε²) on e/L and ψ̃ [rad]
     switch_width_L: float = 0.1  # width of the smooth leg switch [L]
+    turn_fraction: float = 1.0  # share of the intervals at full rudder in a hard-turn start
     max_iter: int = 10  # generalised Gauss–Newton iterations per control step
     step_tolerance: float = 1e-4  # rad: stop when the accepted step is smaller
     cost_tolerance: float = 1e-3  # stop when an iteration lowers the cost by less (relative)
@@ -340,6 +341,8 @@ class OracleSolver:
             ]
         )
         self.is_abs = np.concatenate([np.ones(2 * steps, bool), np.zeros(2 * n_u, bool)])
+        self._base_weight = self.weight.copy()
+        self._terminal = np.array([steps - 1, 2 * steps - 1])  # e/L and ψ̃ at the horizon's end
         self.n_z, self.n_u, self.n_p = z.shape[0], n_u, n_p
         tag = (
             f"{model.name}_b{grid.blocks}x{grid.block}_s{grid.substeps}_l{n_legs}"
@@ -381,9 +384,20 @@ class OracleSolver:
         self._value[1]()
         return self._outer(self._z)[0]
 
-    def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
-        """Plan (one command per interval, rad), success flag, iterations."""
+    def set_tail(self, steps: float) -> None:
+        """Weigh the terminal |e|/L and w_ψ|ψ̃| stage terms ``steps`` [control periods] more:
+        the tail, the stage cost at the horizon's end held for the steps still to go
+        (module doc)."""
+        self.weight = self._base_weight.copy()
+        self.weight[self._terminal] *= 1.0 + max(0.0, float(steps))
+
+    def solve(
+        self, p: np.ndarray, guess: np.ndarray, tail: float = 0.0
+    ) -> tuple[np.ndarray, bool, int]:
+        """Plan (one command per interval, rad), success flag, iterations; ``tail``: the
+        steps the terminal stage cost is held for (:meth:`set_tail`)."""
         self._p[:] = p
+        self.set_tail(tail)
 
         def direction(u: np.ndarray) -> np.ndarray | None:
             self._u[:] = u
@@ -405,6 +419,29 @@ class OracleSolver:
             s.step_tolerance,
             s.cost_tolerance,
         )
+
+    def turn_guesses(self) -> list[np.ndarray]:
+        """The two hard-turn starts: full rudder to one side over the first half of the
+        horizon's intervals, midships after [rad]."""
+        half = np.arange(self.n_u) < max(1, round(self.settings.turn_fraction * self.n_u))
+        return [np.where(half, sign * self.rudder_limit, 0.0) for sign in (1.0, -1.0)]
+
+    def solve_multistart(
+        self, p: np.ndarray, guess: np.ndarray, tail: float = 0.0
+    ) -> tuple[np.ndarray, bool, int]:
+        """:meth:`solve` from ``guess`` (the warm start) and from the cheaper of the two
+        hard-turn starts (:meth:`turn_guesses`); the plan of lower objective is kept."""
+        self.set_tail(tail)
+        turns = self.turn_guesses()
+        turn = min(turns, key=lambda u: self.cost(u, p))
+        best, best_cost, ok_any, total = None, math.inf, False, 0
+        for start in (guess, turn):
+            plan, ok, iterations = self.solve(p, start, tail)
+            total += iterations
+            value = self.cost(plan, p) if ok else math.inf
+            if ok and value < best_cost:
+                best, best_cost, ok_any = plan, value, True
+        return (best if best is not None else plan), ok_any, total
 
     def parameters(
         self,
@@ -500,6 +537,27 @@ def legs_ahead(
     return np.array(rows), context.acceptance_radius
 
 
+def remaining_path(context: ControllerContext, tracker: Any, frame: Any) -> float:
+    """The path still to go to the goal [m] from the tracker's point: the rest of the active
+    leg and the legs after it, or the arc length left on a PCHIP route."""
+    if tracker.is_curve:
+        return max(0.0, float(tracker.path.length) - float(frame.along_track))
+    wp = np.asarray(context.waypoints, dtype=float)
+    lengths = np.hypot(*np.diff(wp, axis=0).T)
+    leg = int(frame.leg)
+    return max(0.0, float(lengths[leg]) - float(frame.along_track)) + float(
+        lengths[leg + 1 :].sum()
+    )
+
+
+def tail_steps(
+    remaining_m: float, speed: float, control_period: float, horizon_steps: int
+) -> float:
+    """The control steps still to go after the horizon [-]: the time to cover the remaining
+    path [m] at cruise speed U [m/s], less the horizon's steps, at least 0."""
+    return max(0.0, remaining_m / (speed * control_period) - horizon_steps)
+
+
 @register_controller("oracle")
 class Oracle:
     """``oracle``: NMPC on the true plant through the privileged channel (module doc)."""
@@ -561,7 +619,13 @@ class Oracle:
         )
         guess = np.concatenate([[self.plan[1]], self.plan[1:]])  # shifted by one period
         start, cpu = time.perf_counter(), time.thread_time()
-        plan, ok, _ = self.solver.solve(p, guess)
+        tail = tail_steps(
+            remaining_path(ctx, self.tracker, frame),
+            ctx.nominal_speed,
+            ctx.control_period,
+            grid.steps,
+        )
+        plan, ok, _ = self.solver.solve_multistart(p, guess, tail)
         self.solve_times.append(time.perf_counter() - start)
         self.solve_cpu_times.append(time.thread_time() - cpu)  # not inflated by a busy machine
         if ok:
