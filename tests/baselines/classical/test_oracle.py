@@ -21,6 +21,8 @@ from shipgym_baselines.classical.oracle import (
     OracleSolver,
     horizon_seconds,
     oracle_grid,
+    remaining_path,
+    tail_steps,
 )
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import evaluate, run_episode
@@ -109,6 +111,44 @@ def test_the_horizon_rule_by_ship() -> None:
         ctx = ControllerContext.of(load_scenario(name), "rudder")
         grid = oracle_grid(ctx, OracleSettings())
         assert grid.steps * ctx.control_period >= grid.horizon_s - 1e-9
+
+
+# ------------------------------------------------------------------ the tail and the turns
+def test_the_tail_counts_the_steps_still_to_go_after_the_horizon() -> None:
+    """N_tail = max(0, S/(U·Ts) − N_H); S the rest of the active leg and the legs after it."""
+    assert tail_steps(40.0, 0.8, 0.5, 21) == pytest.approx(100.0 - 21.0)
+    assert tail_steps(4.0, 0.8, 0.5, 21) == 0.0
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    tracker = ctx.new_tracker()
+    wp = np.asarray(ctx.waypoints, dtype=float)
+    total = float(np.hypot(*np.diff(wp, axis=0).T).sum())
+    frame = tracker.reset(float(wp[0, 0]) + 3.0, float(wp[0, 1]) + 0.5)  # 3 m along leg 0
+    assert remaining_path(ctx, tracker, frame) == pytest.approx(total - 3.0)
+
+
+def _default_trial(scenario: str, seed: int) -> Any:
+    spec = load_suite("default")
+    (trial,) = trials(
+        Job("oracle", scenario, (seed,), None, spec.randomize.model_dump(mode="json"))
+    )
+    return trial
+
+
+@pytest.mark.parametrize(
+    ("scenario", "seed"),
+    [("nominal", 10009), ("current_shift", 10000), ("maneuverability_change", 10002)],
+)
+def test_the_oracle_reaches_the_goal_where_revision_1_turned_the_wrong_way(
+    scenario: str, seed: int
+) -> None:
+    """Default-suite trials that the oracle of revision 1 lost to the time limit: on
+    nominal 10009 it turned the wrong way onto the last leg, on current_shift 10000 onto
+    the second (a U-turn back was outside its local SQP's reach), on
+    maneuverability_change 10002 it spun after the jump; competitors reach the goal on
+    all three.  With the tail and the hard-turn starts the oracle reaches it too."""
+    (result,) = evaluate("oracle", _default_trial(scenario, seed), seeds=[seed])
+    assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
+    assert result.metrics["solver_failures"] == 0
 
 
 # ------------------------------------------------------------------ the privileged channel
