@@ -369,9 +369,10 @@ class OracleSolver:
         self._base_weight = self.weight.copy()
         self._terminal = np.array([steps - 1, 2 * steps - 1])  # e/L and ψ̃ at the horizon's end
         self.n_z, self.n_u, self.n_p = z.shape[0], n_u, n_p
+        key = (control_period, rudder_limit, weights, length, s.switch_width_L)
         tag = (
             f"{model.name}_b{grid.blocks}x{grid.block}_s{grid.substeps}_l{n_legs}"
-            f"_{abs(hash((control_period, rudder_limit, weights, length, s.switch_width_L))) % 10**8}"
+            f"_{abs(hash(key)) % 10**8}"
         )
         value = ca.Function(f"oracle_z_{tag}", [u, p], [z])
         both = ca.Function(f"oracle_zj_{tag}", [u, p], [z_s, ca.densify(jac)])
