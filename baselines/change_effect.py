@@ -24,7 +24,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -37,6 +37,12 @@ from shipgym_baselines.suite import load_suite
 
 #: the factor by which a change must raise the after-change cost per step (issue 18)
 MATTERS = 1.3
+#: the non-adaptive reference's construction: ``pid_los``'s paper design (pole placement on
+#: the nominal model's Nomoto fit, never re-tuned).  Issue 21's tuned settings were chosen
+#: on validation trials that include these change families, and on the Mariner and Esso
+#: Osaka manoeuvrability changes they no longer degrade by 1.3x: the measurement of whether
+#: a change matters keeps the design that was never tuned for it.
+REFERENCE_SETTINGS: dict[str, Any] = {"preset": "paper"}
 SHIPS = ("esso_osaka", "mariner", "blanke")
 FAMILIES = ("rudder_aging", "current_shift", "maneuverability_change")
 
@@ -63,9 +69,12 @@ def twin(scenario: Scenario) -> Scenario:
     return scenario.with_overrides(name=scenario.name, drop=("events", "disturbances.current"))
 
 
-def step_costs(scenario: Scenario, controller: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """(start time of each control step [s], its cost) of one episode (module doc)."""
-    policy, mode = make_controller(controller)
+def step_costs(
+    scenario: Scenario, controller: str, seed: int, settings: Mapping[str, Any] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(start time of each control step [s], its cost) of one episode (module doc);
+    ``settings``: the controller's construction settings (e.g. ``{"preset": "paper"}``)."""
+    policy, mode = make_controller(controller, **dict(settings or {}))
     logs: list[Any] = []
     run_episode(
         policy, scenario, seed, mode, after_episode=lambda env: logs.append(env.episode_log())
@@ -104,9 +113,14 @@ def change_effect(
     controller: str = "pid_los",
     seeds: Sequence[int] = (EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1, EVAL_SEED_OFFSET + 2),
     randomize: TrialRandomization | None = None,
+    settings: Mapping[str, Any] | None = None,
 ) -> ChangeEffect:
     """The costs of ``controller`` on the trials of scenario ``name`` that ``seeds`` draw
-    with ``randomize`` (None: the default suite's ranges) and on their twins."""
+    with ``randomize`` (None: the default suite's ranges) and on their twins.
+    ``settings``: the controller's construction settings; None gives ``pid_los`` its paper
+    design (:data:`REFERENCE_SETTINGS`), any other controller its default."""
+    if settings is None:
+        settings = REFERENCE_SETTINGS if controller == "pid_los" else {}
     if randomize is None:
         randomize = load_suite("default").randomize
     base = load_scenario(name)
@@ -116,8 +130,8 @@ def change_effect(
         t_star = change_time(trial)
         if t_star is None:
             raise ValueError(f"scenario {name!r} has no change")
-        t, cost = step_costs(trial, controller, seed)
-        tt, tcost = step_costs(twin(trial), controller, seed)
+        t, cost = step_costs(trial, controller, seed, settings)
+        tt, tcost = step_costs(twin(trial), controller, seed, settings)
         after = t >= t_star - 1e-9
         sums["before"].append(float(cost[~after].mean()))
         sums["after"].append(float(cost[after].mean()))

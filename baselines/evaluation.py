@@ -1,20 +1,24 @@
 """The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9).
 
-:func:`run_episode` runs one episode; :func:`evaluate_batch` runs several (a learned
-policy's in lockstep, one network forward per step for all, with the same bits).
+:func:`run_episode` runs one episode; :func:`evaluate_batch` runs several in lockstep, as
+the rows of one :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (a learned
+policy with one network forward per step for all), with the same bits.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
+from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
+from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
@@ -24,6 +28,21 @@ from shipgym_baselines.registry import make_controller
 ENV_ID = "ShipPathFollow-v0"
 #: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
 EVAL_SEED_OFFSET = 10_000
+
+#: the clock [s] that times each ``act`` call (``compute_ms``): wall time, unless
+#: :func:`act_clock` swaps it (the run-cost profile reads CPU time)
+_clock: Callable[[], float] = time.perf_counter
+
+
+@contextlib.contextmanager
+def act_clock(clock: Callable[[], float]) -> Iterator[None]:
+    """Time the ``act`` calls with ``clock`` [s] (e.g. :func:`time.process_time`) inside."""
+    global _clock
+    saved, _clock = _clock, clock
+    try:
+        yield
+    finally:
+        _clock = saved
 
 
 @dataclasses.dataclass
@@ -49,29 +68,22 @@ class EpisodeResult:
         }
 
 
-class _Episode:
-    """One env's episode as the evaluation loop runs it: made and reset with ``seed``, then
-    stepped with the policy's actions and the time each took, then its result."""
+class _Record:
+    """One episode's record as the loop keeps it: the trajectory rows of its infos, the
+    time each ``act`` took and the last info."""
 
-    def __init__(self, env_id: str, scenario: Any, seed: int, action_mode: str) -> None:
-        self.env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+    def __init__(self, scenario_name: str, seed: int, info: dict[str, Any]) -> None:
+        self.scenario_name = scenario_name
         self.seed = seed
-        try:
-            self.obs, self.info = self.env.reset(seed=seed)
-        except BaseException:
-            self.env.close()
-            raise
-        self.base = self.env.unwrapped
-        self.rows: list[tuple[float, ...]] = [_traj_row(self.info)]
+        self.info = info
+        self.rows: list[tuple[float, ...]] = [_traj_row(info)]
         self.act_times: list[float] = []
-        self.done = False
 
-    def step(self, action: np.ndarray, act_time: float) -> None:
-        """Step with ``action``, which took the policy ``act_time`` [s]."""
+    def add(self, info: dict[str, Any], act_time: float) -> None:
+        """The info of a step whose action took the policy ``act_time`` [s]."""
         self.act_times.append(act_time)
-        self.obs, _reward, terminated, truncated, self.info = self.env.step(action)
-        self.rows.append(_traj_row(self.info))
-        self.done = terminated or truncated
+        self.info = info
+        self.rows.append(_traj_row(info))
 
     def result(self, policy: Policy) -> EpisodeResult:
         metrics = dict(self.info["episode_metrics"])
@@ -84,12 +96,42 @@ class _Episode:
         return EpisodeResult(
             controller=policy.name,
             kind=policy.kind,
-            scenario=self.base.scenario.name,
+            scenario=self.scenario_name,
             seed=self.seed,
             metrics=metrics,
             trajectory={k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)},
             training_seed=training_seed(policy),
         )
+
+
+class _Episode:
+    """One env's episode as the evaluation loop runs it: made and reset with ``seed``, then
+    stepped with the policy's actions and the time each took, then its result."""
+
+    def __init__(self, env_id: str, scenario: Any, seed: int, action_mode: str) -> None:
+        self.env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+        self.seed = seed
+        try:
+            self.obs, info = self.env.reset(seed=seed)
+        except BaseException:
+            self.env.close()
+            raise
+        self.base = self.env.unwrapped
+        self.record = _Record(self.base.scenario.name, seed, info)
+        self.done = False
+
+    @property
+    def info(self) -> dict[str, Any]:
+        return self.record.info
+
+    def step(self, action: np.ndarray, act_time: float) -> None:
+        """Step with ``action``, which took the policy ``act_time`` [s]."""
+        self.obs, _reward, terminated, truncated, info = self.env.step(action)
+        self.record.add(info, act_time)
+        self.done = terminated or truncated
+
+    def result(self, policy: Policy) -> EpisodeResult:
+        return self.record.result(policy)
 
 
 def run_episode(
@@ -120,9 +162,9 @@ def run_episode(
         else:
             policy.reset(episode.base.controller_context, seed=seed)
         while not episode.done:
-            start = time.perf_counter()
+            start = _clock()
             action = policy.act(episode.obs, episode.info)
-            episode.step(action, time.perf_counter() - start)
+            episode.step(action, _clock() - start)
         result = episode.result(policy)
         if after_episode is not None:
             after_episode(episode.base)
@@ -134,7 +176,9 @@ def run_episode(
 @runtime_checkable
 class BatchPolicy(Policy, Protocol):
     """A policy that acts for several episodes in lockstep (a learned policy: one network
-    forward for all), each action the one ``act`` would give in that episode alone."""
+    forward for all), each action the one ``act`` would give in that episode alone.  It
+    reads the observations only (``act_batch`` gets no info), so its episodes' rows are
+    stepped without ``samples``."""
 
     def reset_batch(self, contexts: Sequence[Any]) -> None: ...
 
@@ -155,11 +199,21 @@ def evaluate_batch(
 
     ``controller``: a name, spec or long form (made with ``training_seed``, one of
     :func:`~shipgym_baselines.registry.training_seeds`; None: a learned policy's first) or a Policy
-    instance.  A :class:`BatchPolicy` (learned policies) runs all episodes in lockstep, one
-    ``act_batch`` for the live envs per step; its ``compute_ms`` / ``compute_ms_max`` [ms]
-    are the mean and maximum over an episode's steps of that call's time divided by the
-    number of envs it acted for.  Any other controller runs the episodes one by one (made
-    afresh per episode from a spec, as :func:`evaluate` does).
+    instance.  The episodes run in lockstep, as the rows of one
+    :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (one plant call per step
+    for all), when the trials share the ship and its step constants (else one env per
+    episode, still in lockstep):
+
+    * a :class:`BatchPolicy` (learned policies) acts with one ``act_batch`` for the live
+      episodes per step; its ``compute_ms`` / ``compute_ms_max`` [ms] are the mean and
+      maximum over an episode's steps of that call's time divided by the number of
+      episodes it acted for;
+    * a controller given by name or spec is made afresh per episode (as :func:`evaluate`
+      does) and each instance's ``act`` is timed on its own.
+
+    One by one (:func:`run_episode`) run the privileged ``oracle`` (it reads its env's
+    truth) and a non-batch Policy *instance* (one instance cannot act for several
+    episodes at once).
     """
     seeds = list(seeds)
     per_seed = list(scenarios) if isinstance(scenarios, list | tuple) else [scenarios] * len(seeds)
@@ -177,9 +231,15 @@ def evaluate_batch(
         policy, mode = controller, None
     mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
     if isinstance(policy, BatchPolicy):
-        return _run_lockstep(policy, per_seed, seeds, mode, env_id)
-    results = []
+        # a batch policy acts on the observations alone: its rows skip the samples
+        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, samples=False))
     privileged = made and grants_truth(controller)
+    if made and not privileged and seeds:
+        policies = [policy] + [
+            make_controller(controller, training_seed=training_seed)[0] for _ in seeds[1:]
+        ]
+        return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id))
+    results = []
     for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
         if made and i > 0:
             policy, _ = make_controller(controller, training_seed=training_seed)
@@ -187,28 +247,148 @@ def evaluate_batch(
     return results
 
 
-def _run_lockstep(
-    policy: BatchPolicy, scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str
-) -> list[EpisodeResult]:
-    """:func:`evaluate_batch` for a :class:`BatchPolicy`: every env steps in lockstep."""
-    episodes: list[_Episode] = []
-    try:
-        for scenario, seed in zip(scenarios, seeds, strict=True):
-            episodes.append(_Episode(env_id, scenario, seed, action_mode))
-        policy.reset_batch([e.base.controller_context for e in episodes])
-        live = [i for i, e in enumerate(episodes) if not e.done]
-        while live:
-            obs = np.stack([episodes[i].obs for i in live])
-            start = time.perf_counter()
-            actions = policy.act_batch(obs, live)
-            share = (time.perf_counter() - start) / len(live)
-            for i, action in zip(live, actions, strict=True):
-                episodes[i].step(action, share)
-            live = [i for i in live if not episodes[i].done]
-        return [e.result(policy) for e in episodes]
-    finally:
-        for e in episodes:
+class _Episodes(Protocol):
+    """The episodes of a lockstep run: per episode its observation, info, end and result."""
+
+    seeds: list[int]
+    obs: list[np.ndarray]
+    done: list[bool]
+
+    def info(self, i: int) -> dict[str, Any]: ...
+
+    def contexts(self) -> list[Any]: ...
+
+    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None: ...
+
+    def result(self, i: int, policy: Policy) -> EpisodeResult: ...
+
+    def close(self) -> None: ...
+
+
+class _VectorEpisodes:
+    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`."""
+
+    def __init__(
+        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, samples: bool = True
+    ) -> None:
+        self.env = EvaluationTrialsVectorEnv(scenarios, seeds, action_mode, samples=samples)
+        self.seeds = seeds
+        obs, info = self.env.reset()
+        self.obs = list(obs)
+        self.records = [
+            _Record(sc.name, seed, row)
+            for sc, seed, row in zip(self.env.scenarios, seeds, info["rows"], strict=True)
+        ]
+        self.done = [False] * len(seeds)
+        self._actions = np.zeros(self.env.action_space.shape)
+
+    def info(self, i: int) -> dict[str, Any]:
+        return self.records[i].info
+
+    def contexts(self) -> list[Any]:
+        return [self.env.controller_context(i) for i in range(self.env.num_envs)]
+
+    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+        width = self._actions.shape[1]
+        for i, action in zip(live, actions, strict=True):
+            self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
+        obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
+        rows = info["rows"]
+        for i, act_time in zip(live, times, strict=True):
+            self.obs[i] = obs[i]
+            self.records[i].add(rows[i], act_time)
+        self.done = self.env.finished.tolist()
+
+    def result(self, i: int, policy: Policy) -> EpisodeResult:
+        return self.records[i].result(policy)
+
+    def close(self) -> None:
+        self.env.close()
+
+
+class _SingleEpisodes:
+    """The episodes as one single env each (trials that cannot share one env)."""
+
+    def __init__(self, scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str):
+        self.seeds = seeds
+        self.episodes: list[_Episode] = []
+        try:
+            for scenario, seed in zip(scenarios, seeds, strict=True):
+                self.episodes.append(_Episode(env_id, scenario, seed, action_mode))
+        except BaseException:
+            self.close()
+            raise
+        self.obs = [e.obs for e in self.episodes]
+        self.done = [e.done for e in self.episodes]
+
+    def info(self, i: int) -> dict[str, Any]:
+        return self.episodes[i].info
+
+    def contexts(self) -> list[Any]:
+        return [e.base.controller_context for e in self.episodes]
+
+    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+        for i, action, act_time in zip(live, actions, times, strict=True):
+            episode = self.episodes[i]
+            episode.step(action, act_time)
+            self.obs[i], self.done[i] = episode.obs, episode.done
+
+    def result(self, i: int, policy: Policy) -> EpisodeResult:
+        return self.episodes[i].result(policy)
+
+    def close(self) -> None:
+        for e in self.episodes:
             e.env.close()
+
+
+#: the env class the vectorized rows reproduce (other env ids run one env per episode)
+_SINGLE_ENTRY_POINT = "shipgym.envs.path_follow:ShipPathFollowEnv"
+
+
+def _episodes(
+    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, samples: bool = True
+) -> _Episodes:
+    """The episodes as the rows of one vectorized env when they can be (the env is the
+    single ShipPathFollow env and the trials share the ship and its step constants: see
+    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``samples``:
+    whether the rows' infos carry ``samples`` (a batch policy reads observations only)."""
+    if gym.spec(env_id).entry_point == _SINGLE_ENTRY_POINT:
+        loaded = [load_scenario(s) for s in scenarios]
+        if loaded and lockstep_problem(loaded) is None:
+            return _VectorEpisodes(loaded, seeds, action_mode, samples)
+        scenarios = loaded
+    return _SingleEpisodes(scenarios, seeds, action_mode, env_id)
+
+
+def _run_lockstep(policy: BatchPolicy | list[Policy], episodes: _Episodes) -> list[EpisodeResult]:
+    """:func:`evaluate_batch`'s loop: every episode steps in lockstep, acted on by one
+    :class:`BatchPolicy` or by its own policy of a list."""
+    n = len(episodes.obs)
+    batch = not isinstance(policy, list)
+    try:
+        if batch:
+            policy.reset_batch(episodes.contexts())
+        else:
+            for p, context, seed in zip(policy, episodes.contexts(), episodes.seeds, strict=True):
+                p.reset(context, seed=seed)
+        live = [i for i in range(n) if not episodes.done[i]]
+        while live:
+            if batch:
+                obs = np.stack([episodes.obs[i] for i in live])
+                start = _clock()
+                actions = list(policy.act_batch(obs, live))
+                times = [(_clock() - start) / len(live)] * len(live)
+            else:
+                actions, times = [], []
+                for i in live:
+                    start = _clock()
+                    actions.append(policy[i].act(episodes.obs[i], episodes.info(i)))
+                    times.append(_clock() - start)
+            episodes.step(live, actions, times)
+            live = [i for i in live if not episodes.done[i]]
+        return [episodes.result(i, policy if batch else policy[i]) for i in range(n)]
+    finally:
+        episodes.close()
 
 
 def training_seed(policy: Policy) -> int | None:

@@ -2,8 +2,11 @@
 
 Every figure uses :func:`shipgym_baselines.style.controller_style` (one colour and line style per
 controller, the same in every figure), labels its axes with units, keeps legends outside the
-data and is written twice: a PNG at :data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi) and an SVG
-copy beside it (:func:`save_figure`).  Matplotlib runs on the Agg backend.
+data and is written twice (:func:`save_figure`): drawn at
+:data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi), as a palette PNG of at most
+:data:`PAGE_WIDTH` pixels (the page's image), and as a vector copy beside it (SVG; the
+scenario figures, which hold the long trajectories, as gzip-compressed SVGZ).  Matplotlib runs
+on the Agg backend.
 
 What a run hands in:
 
@@ -41,6 +44,9 @@ Functions (each returns the written files, PNG then SVG):
 
 from __future__ import annotations
 
+import gzip
+import io
+import json
 import math
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
@@ -49,17 +55,45 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
 from shipgym_baselines.ranking import ORACLE
+from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
-#: most points of a drawn line (longer trajectories are thinned by a stride, last point kept)
-MAX_POINTS = 2000
 #: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
 #: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)
 PROFILE_REPS = 200
+#: the figures' files: text kept as text in the SVG, a fixed hash salt (reproducible ids),
+#: and lines simplified to 0.5 px (matplotlib drops a vertex that moves its line by less
+#: than this fraction of a pixel; default 1/9): lighter files that look the same
+LIGHT_FIGURES = {
+    "svg.fonttype": "none",
+    "svg.hashsalt": "shipgym",
+    "path.simplify": True,
+    "path.simplify_threshold": 0.5,
+}
+#: widest PNG [px]: a figure drawn at FIGURE_DPI is written at 1/2, 1/3, … of its pixels,
+#: the first that fits (a 200-dpi figure at 100 dpi or less: the page shows no more; the
+#: vector copy keeps every detail; fewer pixels barely lighten a line figure: its
+#: compressed bytes follow the lines' length in pixels, not the area)
+PAGE_WIDTH = 1400
+#: a scenario figure's PNG text chunks for the page (issue 20): its legends as JSON (a list
+#: of [column title, [[controller, label], …]]; the oracle's label ends ", the reference")
+#: and where they start (the fraction of the height from the top); the page shows the
+#: image above that line and the legends as text (crisp at any zoom, and ≈ 15 % of the
+#: image's bytes)
+LEGEND_KEY = "shipgym:legend"
+LEGEND_TOP_KEY = "shipgym:legend-top"
+#: most colours of a page PNG's palette: the figure's own colours (every line, marker, text
+#: and patch, an alpha one as it shows on white), each also half-way to white (the
+#: antialiasing of a thin line on the white axes), and a ramp of PAGE_GREYS greys (text,
+#: grid); every pixel takes its nearest (issue 20: a controller keeps its colour on the
+#: page; an adaptive 64-colour palette spent itself on near-whites and greyed the lines)
+PAGE_COLOURS = 256
+PAGE_GREYS = 9
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
 REFERENCES = ("zero_rudder", "random", ORACLE)
@@ -97,21 +131,122 @@ def figure_stem(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
 
 
-def save_figure(fig: Any, out_dir: str | Path, stem: str, tight: bool = False) -> list[Path]:
-    """Write ``fig`` as ``<stem>.png`` (200 dpi) and ``<stem>.svg`` into ``out_dir`` (made if
-    missing), close it and return both paths.  ``tight``: crop to what is drawn (for a
+def save_figure(
+    fig: Any,
+    out_dir: str | Path,
+    stem: str,
+    tight: bool = False,
+    vector: str | None = None,
+    page_text: Mapping[str, str] | None = None,
+) -> list[Path]:
+    """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and, if
+    asked, its vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for
+    a figure of long trajectories; None: none, the default of a run, issue 20: the page
+    shows the PNG and the copy would double the figures' weight) into ``out_dir`` (made if
+    missing), close it and return the paths.  ``tight``: crop to what is drawn (for a
     figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
-    layout is computed once (the PNG) and kept for the SVG."""
+    layout is computed once (the PNG) and kept for the SVG.  ``page_text``: text chunks
+    of the PNG for the page (:data:`LEGEND_KEY`, :data:`LEGEND_TOP_KEY`)."""
+    from PIL import Image
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [out / f"{stem}.png", out / f"{stem}.svg"]
+    paths = [out / f"{stem}.png"] + ([out / f"{stem}{vector}"] if vector else [])
     bbox = "tight" if tight else None
-    with pyplot().rc_context({"svg.fonttype": "none", "svg.hashsalt": "shipgym"}):
-        fig.savefig(paths[0], dpi=FIGURE_DPI, bbox_inches=bbox)
+    with pyplot().rc_context(LIGHT_FIGURES):
+        if tight:  # the crop is savefig's: through a PNG
+            png = io.BytesIO()
+            fig.savefig(png, format="png", dpi=FIGURE_DPI, bbox_inches=bbox)
+            with Image.open(png) as image:
+                rgb = image.convert("RGB")
+        else:  # the canvas's pixels as drawn (no PNG written and read back)
+            fig.set_dpi(FIGURE_DPI)
+            fig.canvas.draw()
+            rgb = Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3])
+        write_page_png(rgb, paths[0], page_text, figure_colours(fig))
+        if not vector:
+            pyplot().close(fig)
+            return paths
         fig.set_layout_engine("none")
-        fig.savefig(paths[1], bbox_inches=bbox, metadata={"Date": None})
+        svg = io.BytesIO()
+        fig.savefig(svg, format="svg", bbox_inches=bbox, metadata={"Date": None})
+    if vector == ".svgz":  # mtime 0: the same figure gives the same bytes
+        write_bytes(paths[1], gzip.compress(svg.getvalue(), compresslevel=9, mtime=0))
+    else:
+        write_bytes(paths[1], svg.getvalue())
     pyplot().close(fig)
     return paths
+
+
+def figure_colours(fig: Any) -> set[tuple[float, float, float]]:
+    """The RGB colours [0, 1] that ``fig``'s artists draw with (lines, markers, text,
+    patches, collections), an alpha colour as it shows on white."""
+    from matplotlib.collections import Collection
+    from matplotlib.colors import to_rgba, to_rgba_array
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.text import Text
+
+    rgba: list[Any] = []
+    for artist in fig.findobj():
+        if isinstance(artist, Line2D):
+            rgba.append(to_rgba(artist.get_color(), artist.get_alpha()))
+            for marker in (artist.get_markerfacecolor(), artist.get_markeredgecolor()):
+                if not (isinstance(marker, str) and marker == "none"):
+                    rgba.append(to_rgba(marker, artist.get_alpha()))
+        elif isinstance(artist, Text) and artist.get_text():
+            rgba.append(to_rgba(artist.get_color(), artist.get_alpha()))
+        elif isinstance(artist, Patch | Collection):
+            faces = [artist.get_facecolor(), artist.get_edgecolor()]
+            for colours in faces:
+                rgba += list(to_rgba_array(colours))
+    colours = set()
+    for r, g, b, a in rgba:
+        if a > 0.0:
+            colours.add(tuple(float(v) * a + (1.0 - a) for v in (r, g, b)))
+    return colours
+
+
+def page_palette(colours: Iterable[tuple[float, float, float]]) -> list[tuple[int, int, int]]:
+    """The page PNG's palette (:data:`PAGE_COLOURS`, 8-bit RGB): the grey ramp, then
+    ``colours``, each also half-way to white; the first :data:`PAGE_COLOURS` distinct
+    ones."""
+    greys = [(g, g, g) for g in np.linspace(0.0, 1.0, PAGE_GREYS).tolist()]
+    palette = []
+    for c in [*greys, *sorted(colours)]:
+        for t in (0.0, 0.5):
+            palette.append(tuple(round(255.0 * (v * (1.0 - t) + t)) for v in c))
+    return list(dict.fromkeys(palette))[:PAGE_COLOURS]
+
+
+def write_page_png(
+    rgb: Any,
+    path: Path,
+    text: Mapping[str, str] | None = None,
+    colours: Iterable[tuple[float, float, float]] = (),
+) -> None:
+    """``rgb`` (a PIL RGB image of the figure drawn at :data:`FIGURE_DPI`) written as the
+    page shows it (issue 20: the page's weight): reduced by the smallest whole factor that
+    makes it at most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the
+    dpi recorded accordingly), each pixel the nearest colour of :func:`page_palette` of
+    the figure's ``colours`` (:func:`figure_colours`; no dithering), deflated at the
+    highest level; ``text``: its text chunks (key → value)."""
+    from PIL import Image, PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    for key, value in (text or {}).items():
+        info.add_itxt(key, value)
+    factor = math.ceil(rgb.width / PAGE_WIDTH)
+    if factor > 1:
+        rgb = rgb.reduce(factor)
+    entries = page_palette(colours)
+    flat = [v for c in entries for v in c]
+    palette_image = Image.new("P", (1, 1))
+    palette_image.putpalette(flat + flat[:3] * (256 - len(entries)))
+    indexed = rgb.quantize(palette=palette_image, dither=Image.Dither.NONE)
+    page = io.BytesIO()
+    indexed.save(page, format="PNG", optimize=True, dpi=(FIGURE_DPI / factor,) * 2, pnginfo=info)
+    write_bytes(path, page.getvalue())
 
 
 # ------------------------------------------------------------------ which episode to draw
@@ -211,13 +346,6 @@ def family_panels(
 
 
 # ------------------------------------------------------------------------ one scenario
-def _thin(values: Any, step: int) -> np.ndarray:
-    a = np.asarray(values, dtype=np.float64)
-    if step <= 1:
-        return a
-    return np.concatenate([a[::step], a[-1:]]) if (a.size - 1) % step else a[::step]
-
-
 def _episode_label(name: str, ep: DrawnEpisode) -> str:
     if ep.training_seed is None:
         return f"{name} (seed {ep.seed})"
@@ -291,7 +419,6 @@ def _change_line(ax: Any, change_time: float | None) -> None:
 _PANEL_W, _ROWS_H = 2.4, (2.1, 1.6, 1.6)
 _LEFT, _RIGHT, _TOP, _GAP, _ROW_GAP, _OWN_GAP = 0.8, 0.15, 0.65, 0.2, 0.5, 0.55
 _LEGEND_LINE = 0.14  # [in] a legend entry
-_TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
 
 
 def _scales(
@@ -370,6 +497,7 @@ def plot_scenario(
     ship_length: float | None = None,
     kinds: Mapping[str, str] | None = None,
     chosen_by: str = "median-ACE",
+    vector: bool = False,
 ) -> list[Path]:
     """Small multiples of one scenario (module doc) from ``drawn``: controller → episode;
     ``change_time`` [s] (None: no parameter change), ``path_xy`` (N, 2) points of the path
@@ -377,16 +505,19 @@ def plot_scenario(
     outside the shipped names), ``chosen_by``: how the episodes were picked, for the title
     (:func:`median_ace_episode`'s "median-ACE", or e.g. "first").  Every column has the same
     axes, except the references' (zero_rudder, random: their own scale, so a drifting
-    reference does not flatten the rest).  Returns the PNG and SVG paths."""
+    reference does not flatten the rest).  ``vector``: write the SVGZ copy too.  Returns
+    the PNG (and SVGZ) paths."""
     plt = pyplot()
     everything = {name: _as_drawn(ep) for name, ep in drawn.items()}
     episodes = {name: ep for name, ep in everything.items() if name != ORACLE}
     oracle = [ORACLE] if ORACLE in everything else []
     panels = family_panels(episodes, kinds) or [("no episode kept", [])]
-    longest = max((len(ep.trajectory["t"]) for ep in everything.values()), default=1)
-    step = max(1, math.ceil(longest / MAX_POINTS))
-    lines = {
-        n: {k: _thin(ep.trajectory[k], step) for k in _TRACE_KEYS} for n, ep in everything.items()
+    lines = {  # M4: every pixel column keeps its extent (a limit cycle stays one)
+        n: {
+            k: np.asarray(v, dtype=np.float64)
+            for k, v in thin_trajectory(ep.trajectory, DRAWN_KEYS).items()
+        }
+        for n, ep in everything.items()
     }
     path = np.asarray(path_xy, dtype=np.float64) if path_xy is not None else np.empty((0, 2))
     pad = ship_length or 1.0
@@ -396,9 +527,11 @@ def plot_scenario(
     fig = plt.figure()
     most = max(len(members) for _, members in panels) + len(oracle)
     columns = _column_axes(fig, _ROWS_H, own_scale, legend_lines=max(most, 1))
+    legends: list[tuple[str, list[tuple[str, str]]]] = []
     for col, ((title, members), (ax_track, ax_e, ax_d)) in enumerate(
         zip(panels, columns, strict=True)
     ):
+        legend: list[tuple[str, str]] = []
         lim = _scales(lines, members + oracle, path, pad) if own_scale[col] else shared
         handles: list[Any] = []
         if path.size:
@@ -406,6 +539,7 @@ def plot_scenario(
         for name in oracle:  # the reference in every column
             tr = lines[name]
             label = _episode_label(name, everything[name]) + ", the reference"
+            legend.append((name, label))
             handles += ax_track.plot(
                 tr["x"], tr["y"], lw=1.2, label=label, gid=f"{name}/track", **_ORACLE_STYLE
             )
@@ -420,6 +554,7 @@ def plot_scenario(
         for name in members:
             tr, style = lines[name], controller_style(name)
             label = _episode_label(name, episodes[name])
+            legend.append((name, label))
             handles += ax_track.plot(
                 tr["x"], tr["y"], lw=1.0, label=label, gid=f"{name}/track", **style.kwargs()
             )
@@ -457,13 +592,20 @@ def plot_scenario(
                 ax.tick_params(labelleft=False)  # the same scale as the column to its left
         if handles:
             _legend_below(ax_d, handles)
+        legends.append((title + (" (own scale)" if own_scale[col] else ""), legend))
     fig.suptitle(
         _scenario_title(scenario, everything, change_time, ship_length, chosen_by),
         fontsize=10,
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
     )
-    return save_figure(fig, out_dir, "scenario_" + figure_stem(scenario))
+    stem = "scenario_" + figure_stem(scenario)
+    below = _TOP + sum(_ROWS_H) + len(_ROWS_H) * _ROW_GAP  # [in] from the top: the legends
+    page_text = {
+        LEGEND_KEY: json.dumps(legends, ensure_ascii=False),
+        LEGEND_TOP_KEY: f"{below / fig.get_figheight():.6f}",
+    }
+    return save_figure(fig, out_dir, stem, vector=".svgz" if vector else None, page_text=page_text)
 
 
 def _scenario_title(
@@ -500,6 +642,7 @@ def plot_scenarios(
     scenarios: Mapping[str, Any] | None = None,
     kinds: Mapping[str, str] | None = None,
     chosen_by: str = "median-ACE",
+    vector: bool = False,
 ) -> list[Path]:
     """:func:`plot_scenario` for every scenario of ``drawn`` ((scenario, controller) →
     episode), in sorted order; ``scenarios``: name → what
@@ -519,6 +662,7 @@ def plot_scenarios(
             by_scenario[name],
             kinds=kinds,
             chosen_by=chosen_by,
+            vector=vector,
             **scenario_geometry(spec),
         )
     return files
@@ -552,19 +696,20 @@ def plot_ranking(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
     kinds: Mapping[str, str] | None = None,
+    vector: bool = False,
 ) -> list[Path]:
     """Per split of ``aggregate``: ``ranking_<split>`` (rliable's interval estimates, the
     cost ratios on a log axis; a row of the split's partial table is drawn too, its label
     saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
-    ratio from ``episodes``, one panel per family); see the module doc.  Returns every
-    written file."""
+    ratio from ``episodes``, one panel per family); see the module doc; ``vector``: their
+    SVG copies too.  Returns every written file."""
     from shipgym_baselines.ranking import PARTIAL
 
     files: list[Path] = []
     for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in aggregate):
         rows = [r for r in aggregate if r["split"].removesuffix(PARTIAL) == split]
-        files += _plot_intervals(out_dir, split, rows)
-        files += _plot_profiles(out_dir, split, episodes, splits, kinds)
+        files += _plot_intervals(out_dir, split, rows, vector)
+        files += _plot_profiles(out_dir, split, episodes, splits, kinds, vector)
     return files
 
 
@@ -574,7 +719,9 @@ def _ranking_label(row: Mapping[str, Any], common: int) -> str:
     return row["controller"] if n == common else f"{row['controller']} ({n} of {common} scen.)"
 
 
-def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]]) -> list:
+def _plot_intervals(
+    out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]], vector: bool = False
+) -> list:
     from rliable import plot_utils
 
     plt = pyplot()
@@ -614,7 +761,8 @@ def _plot_intervals(out_dir: str | Path, split: str, rows: Sequence[Mapping[str,
         fontsize=10,
         y=1.0 + 0.5 / fig.get_figheight(),  # above the panels' titles, however few rows
     )
-    return save_figure(fig, out_dir, "ranking_" + figure_stem(split), tight=True)
+    stem = "ranking_" + figure_stem(split)
+    return save_figure(fig, out_dir, stem, tight=True, vector=".svg" if vector else None)
 
 
 def _log_ratio_axis(ax: Any, values: Iterable[float]) -> None:
@@ -647,6 +795,7 @@ def _plot_profiles(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
     kinds: Mapping[str, str] | None,
+    vector: bool = False,
 ) -> list[Path]:
     from rliable import plot_utils
 
@@ -701,4 +850,43 @@ def _plot_profiles(
         y=1.0 - 0.15 / fig.get_figheight(),
         va="top",
     )
-    return save_figure(fig, out_dir, "profile_" + figure_stem(split))
+    return save_figure(
+        fig, out_dir, "profile_" + figure_stem(split), vector=".svg" if vector else None
+    )
+
+
+# ------------------------------------------------------------------ learning curves
+#: stem of the learning-curve figure (the page places it with the ranking figures)
+LEARNING_CURVES_STEM = "learning_curves"
+
+
+def plot_learning_curves(
+    out_dir: str | Path, curves: Mapping[str, Sequence[Mapping[str, Any]]], vector: bool = False
+) -> list[Path]:
+    """``learning_curves``: one panel per learned agent, its validation mean return over
+    env steps for each training seed (a band of ± one std over the validation episodes).
+    ``curves``: agent → its seeds' curves (:func:`shipgym_baselines.learned.curves.
+    agent_curves`); agents without curves are left out, nothing is drawn without any."""
+    drawn = {name: cs for name, cs in curves.items() if cs}
+    if not drawn:
+        return []
+    plt = pyplot()
+    n = len(drawn)
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.0 * rows), squeeze=False)
+    for ax, (name, cs) in zip(axes.flat, drawn.items(), strict=False):
+        for curve in cs:
+            steps = np.asarray(curve["env_steps"], dtype=float)
+            mean = np.asarray(curve["mean_return"], dtype=float)
+            std = np.asarray(curve["std_return"], dtype=float)
+            (line,) = ax.plot(steps, mean, marker=".", label=f"seed {curve.get('seed', '?')}")
+            ax.fill_between(steps, mean - std, mean + std, color=line.get_color(), alpha=0.15)
+        ax.set_title(name)
+        ax.set_xlabel("env steps")
+        ax.set_ylabel("validation mean return")
+        ax.legend(fontsize="small")
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    return save_figure(fig, out_dir, LEARNING_CURVES_STEM, vector=".svg" if vector else None)

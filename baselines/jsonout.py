@@ -26,6 +26,17 @@ def finite_or_none(obj: Any) -> Any:
     return obj
 
 
+#: JSON without spaces after separators (a run's record and its long tables: issue 20)
+COMPACT = (",", ":")
+
+
+def dumps_rows(rows: Any) -> str:
+    """A JSON array of ``rows``, one compact row a line (strict JSON as :func:`dumps`): a
+    long table that stays light and readable line by line."""
+    lines = [dumps(row, separators=COMPACT) for row in rows]
+    return "[\n" + ",\n".join(lines) + "\n]\n" if lines else "[]\n"
+
+
 def dumps(obj: Any, **kwargs: Any) -> str:
     """``json.dumps`` of :func:`finite_or_none` (``allow_nan=False``: strict JSON)."""
     return json.dumps(finite_or_none(obj), allow_nan=False, **kwargs)

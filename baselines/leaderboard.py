@@ -7,11 +7,13 @@ seed, and the sensor noise varies with it too.  A learned agent runs once per tr
 evaluation seeds.
 
 The work is cut into jobs (:class:`Job`, names and seeds only: the worker builds each
-seed's trial): a classical controller's job is one (scenario, seed) episode; a learned
-agent's is one training seed on one scenario for all the evaluation seeds, evaluated
-batched (:func:`shipgym_baselines.evaluation.evaluate_batch`: one network forward per step for all
-seeds, equal to the episodes one by one).  ``local`` runs the jobs in a process pool;
-``ray`` submits the same job function to a Ray cluster (``pip install shipgym[ray]``).
+seed's trial): a classical controller's job is one scenario for all the evaluation seeds,
+a learned agent's one training seed on one scenario for all of them, the oracle's one
+(scenario, seed) trial; a job's seeds run in lockstep
+(:func:`shipgym_baselines.evaluation.evaluate_batch`: the rows of one evaluation trials env, one
+network forward per step for a learned agent's, equal to the episodes one by one).
+``local`` runs the jobs in a process pool; ``ray`` submits the same job function to a Ray
+cluster (``pip install shipgym[ray]``).
 The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
 ``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`shipgym_baselines.ranking`: cost over
@@ -47,7 +49,7 @@ from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from shipgym_baselines.figures import median_ace_episode
-from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
@@ -328,9 +330,11 @@ def plan_jobs(
     skip: set[tuple[str, str]],
     references: str = "table",
 ) -> list[Job]:
-    """Every job of a run: per scenario and controller that applies, one job per seed for
-    a classical controller, one job of all seeds per training seed for a learned agent.
-    ``scenarios``: names, or name → recorded settings (the jobs run those)."""
+    """Every job of a run: per scenario and controller that applies, one job of all seeds
+    per training seed (a learned agent's) or of all seeds (a classical controller's: they
+    run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
+    reference table is looked up trial by trial).  ``scenarios``: names, or name →
+    recorded settings (the jobs run those)."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
@@ -341,12 +345,28 @@ def plan_jobs(
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
                     jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
+                elif not grants_truth(c):
+                    jobs.append(
+                        Job(c, scenario, tuple(seed_list), k, randomize, settings, references)
+                    )
                 else:
                     jobs += [
                         Job(c, scenario, (seed,), k, randomize, settings, references)
                         for seed in seed_list
                     ]
     return jobs
+
+
+def longest_first(jobs: list[Job], scenarios: Mapping[str, Scenario]) -> list[Job]:
+    """``jobs`` ordered by their most control steps (the scenario's time limit over its
+    control period, × the job's seeds), longest first: the pool's workers then end
+    together instead of one finishing a long job alone (what a run computes is the same)."""
+
+    def steps(job: Job) -> float:
+        sc = scenarios[job.scenario]
+        return sc.config.time_limit / sc.control_period * len(job.seeds)
+
+    return sorted(jobs, key=steps, reverse=True)  # stable: ties keep the plan's order
 
 
 def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
@@ -373,6 +393,7 @@ def run_leaderboard(
     command: list[str] | None = None,
     on_episode: Callable[[EpisodeResult], None] | None = None,
     recompute_references: bool = False,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -382,7 +403,8 @@ def run_leaderboard(
     ``force`` (clear its earlier outputs); ``command``: the argv recorded in ``run.json``
     (default ``sys.argv``); ``on_episode``: called in this process after each episode is
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
-    its shipped reference table (:mod:`shipgym_baselines.references`).  ``workers``: local processes
+    its shipped reference table (:mod:`shipgym_baselines.references`); ``vector_figures``:
+    the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
@@ -415,7 +437,7 @@ def run_leaderboard(
         force=force,
     )
     with log.recording():  # holds out_dir's lock to the end
-        todo = missing(jobs, log.done)
+        todo = longest_first(missing(jobs, log.done), scenarios)
         rows = row_keys(jobs)
         bar = tqdm(
             total=n_episodes,
@@ -441,7 +463,7 @@ def run_leaderboard(
             keep_drawn(log, rows, row)
         with log.manifest.claiming():  # the tables and figures: listed for --force
             results = load_results(log.folder)
-            return write_results(log.folder, log.record["suite"], results, workers=workers)
+            return write_results(log.folder, log.record["suite"], results, workers, vector_figures)
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -489,6 +511,7 @@ def write_results(
     suite: Mapping[str, Any],
     results: list[EpisodeResult],
     workers: int | None = None,
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """Tables, ranking and figures into ``out`` from episode results and a suite as
     ``run.json`` keeps it (:func:`suite_record`); returns the rows.
@@ -502,7 +525,8 @@ def write_results(
     profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.pages`: all of it on one page).  The
     ranking of each split and each figure are independent tasks, run in a
     pool of ``workers`` processes (default: the cores) when there are
-    :data:`POOLED_FIGURES` scenario figures or more.
+    :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
+    vector copy too (the page shows the PNGs; issue 20).
     """
     from shipgym_baselines import figures, pages
 
@@ -529,6 +553,7 @@ def write_results(
                 {key: ep for key, ep in drawn.items() if key[0] == scenario},
                 suite["scenarios"],
                 kinds,
+                vector=vector_figures,
             )
             for scenario in shown
         }
@@ -544,6 +569,7 @@ def write_results(
                 ranked,
                 splits,
                 kinds,
+                vector_figures,
             )
             for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
         ]
@@ -556,14 +582,22 @@ def write_results(
         )
         scores = score_table(ranked, splits, kinds)
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
-        (out / SCENARIO_SCORES_FILE).write_text(dumps(scores, indent=2) + "\n")
+        (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked)
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
+        files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
     pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
     return rows
+
+
+def learned_curves(kinds: Mapping[str, str]) -> dict[str, list[dict[str, Any]]]:
+    """The shipped learning curves of the suite's learned controllers (by name)."""
+    from shipgym_baselines.learned.curves import agent_curves
+
+    return {name: agent_curves(name) for name, kind in kinds.items() if kind == "learned"}
 
 
 def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:
@@ -588,9 +622,9 @@ POOLED_FIGURES = 4
 class _Inline:
     """An executor that runs each task as it is submitted (a small run needs no pool)."""
 
-    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+    def submit(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Future:
         future: Future = Future()
-        future.set_result(fn(*args))
+        future.set_result(fn(*args, **kwargs))
         return future
 
 
@@ -840,7 +874,7 @@ def _fmt(value: Any, std: Any = None) -> str:
 def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
     before the rows (the ranking)."""
-    (out / "leaderboard.json").write_text(dumps(rows, indent=2))
+    (out / "leaderboard.json").write_text(dumps_rows(rows))  # one row a line
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
     with open(out / "leaderboard.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys, restval="")

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
@@ -73,6 +73,25 @@ class Manifest:
             yield
         finally:
             self.claim(*sorted(snapshot(self.folder) - before))
+
+    def compact(self, keep: Iterable[str] = ()) -> None:
+        """Rewrite the manifest, when a run finishes, to list only the listed paths that
+        exist and ``keep`` (what a later run in the folder may write again, e.g. the run
+        record and its temporary): a run that wrote and removed thousands of trajectory
+        files and their temporaries lists only those it kept (issue 20).  Never lists
+        anything unlisted, so ``--force`` still deletes only what runs wrote.  Atomic
+        (a listed temporary renamed over the manifest); on a full disk left as it was."""
+        file = self.folder / MANIFEST_FILE
+        tmp = f".{MANIFEST_FILE}.tmp"
+        self.claim(tmp)  # a kill while it is written leaves it listed
+        kept = sorted((self.listed & snapshot(self.folder)) | {*keep, tmp} - {MANIFEST_FILE})
+        try:
+            (self.folder / tmp).write_text("".join(f"{p}\n" for p in kept), encoding="utf-8")
+            os.replace(self.folder / tmp, file)
+        except OSError:
+            (self.folder / tmp).unlink(missing_ok=True)
+            return
+        self.listed = {*kept, MANIFEST_FILE}
 
 
 def clear_listed(folder: str | os.PathLike, option: str = "--force") -> None:

@@ -29,13 +29,23 @@ writes the page and returns its path.
 from __future__ import annotations
 
 import base64
+import gzip
 import html
+import io
+import itertools
+import json
 import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
-from shipgym_baselines.figures import figure_stem
+from shipgym_baselines.figures import (
+    LEARNING_CURVES_STEM,
+    LEGEND_KEY,
+    LEGEND_TOP_KEY,
+    figure_stem,
+)
 from shipgym_baselines.ranking import (
     NO_RANKING,
     ORACLE,
@@ -44,9 +54,12 @@ from shipgym_baselines.ranking import (
     is_partial,
     resolution_lines,
 )
+from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import controller_style
 
 PAGE_FILE = "leaderboard.html"
+#: most significant digits of a cell's sort key (``data-sort``)
+SORT_DIGITS = 7
 SPLIT_TITLES = {"catalogue": "Catalogue scenarios", "heldout": "Held-out scenarios"}
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
@@ -72,25 +85,43 @@ table{border-collapse:collapse;font-variant-numeric:tabular-nums}
 th,td{padding:3px 8px;border-bottom:1px solid #eaeef2;text-align:right;white-space:nowrap}
 th{background:#f6f8fa;position:sticky;top:0;cursor:pointer;user-select:none;z-index:1}
 th[aria-sort=ascending]::after{content:" \\25B2"}th[aria-sort=descending]::after{content:" \\25BC"}
-td.name,th.name{text-align:left;position:sticky;left:0;background:#fff;z-index:2}
-th.name{background:#f6f8fa;z-index:3}
-td.text,th.text{text-align:left}
-small.ci{color:#57606a;display:block;font-size:11px}
-table.compact small.ci{display:inline;margin-left:6px}
+td:first-child,th:first-child{text-align:left;position:sticky;left:0;background:#fff;z-index:2}
+th:first-child{background:#f6f8fa;z-index:3}
+th.text,table.ranking td:nth-child(3),#scores td:nth-child(2),#rows td:nth-child(-n+4){
+text-align:left}
+td i{color:#57606a;display:block;font-size:11px;font-style:normal}
+table.compact td i{display:inline;margin-left:6px}
 .splits{display:flex;flex-wrap:wrap;gap:8px 24px;align-items:flex-start}
 td.na{color:#8c959f;font-style:italic}
-span.swatch{display:inline-block;width:22px;height:0;border-top-width:3px;margin-right:6px;
-vertical-align:middle}
+td:first-child span{display:inline-block;width:22px;height:0;border-top-width:3px;
+margin-right:6px;vertical-align:middle}
 figure{margin:10px 0 22px}figure img{max-width:100%;height:auto;border:1px solid #eaeef2}
 figcaption{color:#57606a;font-size:12px}
+.legend{display:flex;flex-wrap:wrap;gap:2px 18px;font-size:12px;margin:4px 0}
+.legend ul{list-style:none;margin:0;padding:0}.legend b{font-weight:600}
+.legend span{display:inline-block;width:22px;height:0;border-top-width:2px;margin-right:6px;
+vertical-align:middle}
 details>summary{cursor:pointer;font-weight:600;margin:8px 0}
 """
 
 _JS = """
 (function () {
-  function key(row, col, numeric) {
-    var v = row.cells[col].getAttribute("data-sort");
-    if (v === null || v === "") return null;
+  // a packed table body (issue 20: the long table deflated): its rows, unpacked in place
+  document.querySelectorAll("tbody[data-gzip]").forEach(function (body) {
+    var bin = atob(body.getAttribute("data-gzip")), bytes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+    var rows = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
+    new Response(rows).text().then(function (text) {
+      body.innerHTML = text;
+      body.removeAttribute("data-gzip");
+    });
+  });
+  function key(row, col, numeric) {  // data-sort, else the cell's text
+    var cell = row.cells[col];
+    if (!cell) return null;
+    var v = cell.getAttribute("data-sort");
+    if (v === null) v = cell.textContent;
+    if (v === "") return null;
     if (!numeric) return v.toLowerCase();
     var x = parseFloat(v);
     return isNaN(x) ? null : x;
@@ -169,16 +200,34 @@ def _interval(ci: Any) -> str:
     return ""
 
 
-def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> str:
+class _Td(NamedTuple):
+    """A body cell: its inner HTML, its sort value (a finite number; None sorts last; for a
+    text cell unused: the script sorts by the text), the number its text starts with (what
+    the script reads without ``data-sort``) and further attributes."""
+
+    html: str
+    value: float | None = None
+    shown: float | None = None
+    attrs: str = ""
+
+
+def _leading_number(text: str) -> float | None:
+    """The number ``parseFloat`` reads at the start of a cell's text (None: NaN)."""
+    match = _LEADING_NUMBER.match(text)
+    return float(match.group(0)) if match else None
+
+
+_LEADING_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> _Td:
     """A numeric cell: the value, its interval (or ± std) below, the value as sort key."""
     sort = _finite(value)
     extra = _interval(ci) or (f"± {std:.3f}" if _finite(std) is not None else "")
     style = f' style="background:{_shade(sort)}"' if shade and sort is not None else ""
-    small = f'<small class="ci">{_e(extra)}</small>' if extra else ""
-    return (
-        f'<td data-sort="{"" if sort is None else repr(sort)}"{style}>'
-        f"{_e(_number(value))}{small}</td>"
-    )
+    small = f"<i>{_e(extra)}</i>" if extra else ""
+    text = _number(value)
+    return _Td(f"{_e(text)}{small}", sort, _leading_number(text), style)
 
 
 def _shade(ratio: float) -> str:
@@ -188,20 +237,27 @@ def _shade(ratio: float) -> str:
     return f"hsl({120 * (1.0 - t):.0f},65%,88%)"
 
 
-def _text_cell(text: Any) -> str:
-    return f'<td class="text" data-sort="{_e(text)}">{_e(text)}</td>'
+def _text_cell(text: Any) -> _Td:
+    return _Td(_e(text))
 
 
-def _name_cell(name: str) -> str:
+def _swatch_class(name: str) -> tuple[str, str]:
+    """(class, CSS rule) of a controller's swatch: its line's colour and style."""
     style = controller_style(name)
     border = {"-": "solid", "--": "dashed", "-.": "dashed", ":": "dotted"}.get(
         style.linestyle, "solid"
     )
-    swatch = (
-        f'<span class="swatch" style="border-top-style:{border};'
-        f'border-top-color:{_e(style.color)}"></span>'
-    )
-    return f'<td class="name" data-sort="{_e(name)}">{swatch}{_e(name)}</td>'
+    cls = "k" + "".join(c for c in style.color if c.isalnum()).lower() + border[:2]
+    return cls, f".{cls}{{border-top-style:{border};border-top-color:{_e(style.color)}}}"
+
+
+def swatch_css(names: Iterable[str]) -> str:
+    """The swatch classes of these controllers, each rule once."""
+    return "".join(sorted({_swatch_class(n)[1] for n in names}))
+
+
+def _name_cell(name: str) -> _Td:
+    return _Td(f'<span class="{_swatch_class(name)[0]}"></span>{_e(name)}')
 
 
 def _head(columns: Iterable[tuple[str, str, str]]) -> str:
@@ -210,33 +266,105 @@ def _head(columns: Iterable[tuple[str, str, str]]) -> str:
     name."""
     cells = []
     for i, (key, text, kind) in enumerate(columns):
-        cls = "name" if i == 0 else ("text" if kind == "text" else "")
         first = ' data-first="ascending"' if kind == "lower" else ""
         cells.append(
             f'<th data-key="{_e(key)}" data-type="{"number" if kind == "lower" else kind}"'
             + first
-            + (f' class="{cls}"' if cls else "")
+            + (' class="text"' if kind == "text" and i else "")
             + f">{text}</th>"
         )
     return "<thead><tr>" + "".join(cells) + "</tr></thead>"
 
 
-def _table(table_id: str, head: str, body: Iterable[str], compact: bool = False) -> str:
-    """A sortable table; ``compact``: intervals beside the values, not below."""
-    rows = "".join(f"<tr>{r}</tr>" for r in body)
-    cls = "sortable compact" if compact else "sortable"
+def _same_order(values: Sequence[float | None], keys: Sequence[float | None]) -> bool:
+    """Whether ``keys`` sort the cells as ``values`` do: equal values equal keys, distinct
+    ones in the same order, None (last) where None."""
+    pairs = sorted({(v, k) for v, k in zip(values, keys, strict=True) if v is not None})
+    if any((v is None) != (k is None) for v, k in zip(values, keys, strict=True)):
+        return False
+    for (v0, k0), (v1, k1) in itertools.pairwise(pairs):
+        if v0 == v1 or k0 is None or k1 is None or not k0 < k1:
+            return False
+    return True
+
+
+def sort_keys(values: Sequence[float | None], shown: Sequence[float | None]) -> list[str] | None:
+    """A numeric column's ``data-sort`` keys: None where the numbers its cells' texts start
+    with sort them as their values do (the script reads the text), else each value at the
+    fewest significant digits that keep the values' order and ties, at most 7 (values that
+    differ only beyond the 7th digit tie, and keep their order in the page; "" for none)."""
+    if _same_order(values, shown):
+        return None
+    for digits in range(1, SORT_DIGITS + 1):
+        keys = ["" if v is None else f"{v:.{digits}g}" for v in values]
+        if _same_order(values, [float(k) if k else None for k in keys]):
+            break
+    return keys
+
+
+def _table(
+    table_id: str,
+    columns: Sequence[tuple[str, str, str]],
+    body: Sequence[Sequence[_Td]],
+    compact: bool = False,
+    cls: str = "",
+) -> str:
+    """A sortable table; ``compact``: intervals beside the values, not below.  A numeric
+    column carries ``data-sort`` keys only where its texts would sort otherwise
+    (:func:`sort_keys`); the script sorts a text column by its texts."""
+    keys: dict[int, list[str]] = {}
+    for col, (_, _, kind) in enumerate(columns):
+        if kind == "text":
+            continue
+        cells = [(row, row[col]) for row in body if col < len(row)]
+        found = sort_keys([c.value for _, c in cells], [c.shown for _, c in cells])
+        if found is not None:
+            keys[col] = found
+    where = {col: 0 for col in keys}
+    rows = []
+    for row in body:
+        tds = []
+        for col, td in enumerate(row):
+            sort = ""
+            if col in keys:
+                sort = f' data-sort="{keys[col][where[col]]}"'
+                where[col] += 1
+            tds.append(f"<td{sort}{td.attrs}>{td.html}</td>")
+        rows.append("<tr>" + "".join(tds) + "</tr>")
+    classes = " ".join(c for c in ("sortable", "compact" if compact else "", cls) if c)
     return (
-        f'<div class="scroll"><table class="{cls}" id="{_e(table_id)}">{head}'
-        f"<tbody>{rows}</tbody></table></div>"
+        f'<div class="scroll"><table class="{classes}" id="{_e(table_id)}">{_head(columns)}'
+        f"<tbody>{''.join(rows)}</tbody></table></div>"
     )
+
+
+def packed_body(table: str) -> str:
+    """``table`` (:func:`_table`'s HTML) with its body's rows deflated into the body's
+    ``data-gzip`` attribute (gzip, base64; the page's script unpacks them with the
+    browser's ``DecompressionStream``): the long table's markup is ≈ 6 times lighter."""
+    head, sep, rest = table.partition("<tbody>")
+    inner, end, tail = rest.partition("</tbody>")
+    if not sep or not end:
+        raise ValueError("packed_body: the table has no <tbody>")
+    packed = gzip.compress(inner.encode("utf-8"), compresslevel=9, mtime=0)
+    data = base64.b64encode(packed).decode("ascii")
+    return f'{head}<tbody data-gzip="{data}"></tbody>{tail}'
+
+
+def unpacked_body(table: str) -> str:
+    """The inverse of :func:`packed_body` (tests, and readers of the page's source)."""
+    match = re.search(r'<tbody data-gzip="([A-Za-z0-9+/=]*)"></tbody>', table)
+    if match is None:
+        return table
+    inner = gzip.decompress(base64.b64decode(match.group(1))).decode("utf-8")
+    return table[: match.start()] + f"<tbody>{inner}</tbody>" + table[match.end() :]
 
 
 # ----------------------------------------------------------------------------- sections
 def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
     cost ratio's IQM, lowest first); a split's partial table is titled as such."""
-    head = _head(
-        [
+    columns = [
             ("controller", "controller", "text"),
             ("rank", "rank", "number"),
             ("kind", "kind", "text"),
@@ -247,8 +375,7 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("cost_ratio_gmean", "geometric mean", "lower"),
             ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
             ("failure_rate", "failure rate", "lower"),
-        ]
-    )
+    ]  # fmt: skip
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):
         rows = [r for r in aggregate if r["split"] == split]
@@ -257,25 +384,27 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             scenarios = r.get("scenarios")
             n = len(scenarios) if isinstance(scenarios, Sequence) else scenarios
             body.append(
-                _name_cell(r["controller"])
-                + f'<td data-sort="{-rank}">{rank}</td>'  # best-first on the first click
-                + _text_cell(r.get("kind", ""))
-                + _cell(n)
-                + _cell(r.get("runs"))
-                + _cell(r.get("training_seeds"))
-                + _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95"))
-                + _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95"))
-                + _cell(
-                    r.get("prob_improvement_over_pid_los"),
-                    r.get("prob_improvement_over_pid_los_ci95"),
-                )
-                + _cell(r.get("failure_rate"), r.get("failure_rate_ci95"))
+                [
+                    _name_cell(r["controller"]),
+                    _Td(str(rank), -rank, rank),  # best-first on the first click
+                    _text_cell(r.get("kind", "")),
+                    _cell(n),
+                    _cell(r.get("runs")),
+                    _cell(r.get("training_seeds")),
+                    _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95")),
+                    _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95")),
+                    _cell(
+                        r.get("prob_improvement_over_pid_los"),
+                        r.get("prob_improvement_over_pid_los_ci95"),
+                    ),
+                    _cell(r.get("failure_rate"), r.get("failure_rate_ci95")),
+                ]
             )
         base = split.removesuffix(PARTIAL)
         title = SPLIT_TITLES.get(base, base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        table = _table(f"ranking-{split}", head, body, compact=True)
+        table = _table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
     notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
@@ -330,14 +459,14 @@ def score_table(
             tds.append(_cell(agg.get("cost_ratio_iqm"), agg.get("cost_ratio_iqm_ci95")))
         for s in scenarios:
             if (name, s) in not_applicable:
-                tds.append('<td class="na" data-sort="" title="does not apply">n/a</td>')
+                tds.append(_Td("n/a", attrs=' class="na" title="does not apply"'))
             else:
                 sc = cell.get((name, s), {})
                 tds.append(
                     _cell(sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True)
                 )
-        body.append("".join(tds))
-    return _table("scores", _head(columns), body)
+        body.append(tds)
+    return _table("scores", columns, body)
 
 
 def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
@@ -366,14 +495,12 @@ def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
         ]
         tds += [_cell(r.get("seeds")), _cell(r.get("training_seeds"))]
         if r.get("applies", True) is False:
-            tds.append(
-                f'<td class="na" colspan="{len(metrics)}" data-sort="" '
-                'style="text-align:left">does not apply</td>'
-            )
+            attrs = f' class="na" colspan="{len(metrics)}" style="text-align:left"'
+            tds.append(_Td("does not apply", attrs=attrs))
         else:
             tds += [_cell(r.get(k), r.get(f"{k}_ci95"), r.get(f"{k}_std")) for k in metrics]
-        body.append("".join(tds))
-    return _table("rows", _head(columns), body)
+        body.append(tds)
+    return _table("rows", columns, body)
 
 
 # ------------------------------------------------------------------------------ figures
@@ -383,49 +510,134 @@ def _anchor(name: str) -> str:
     return "scenario_" + figure_stem(name)
 
 
-def embedded_figures(figures: Iterable[str | Path]) -> dict[str, tuple[str, str]]:
-    """stem → (data URI, file name) of each figure, the SVG where a stem has one, else the
-    PNG; in the order of ``figures``."""
+class PageImage(NamedTuple):
+    """A figure as the page embeds it: MIME type, bytes, and the legends it carries as text
+    (a scenario figure's :data:`~shipgym_baselines.figures.LEGEND_KEY`; None: in the
+    image)."""
+
+    mime: str
+    data: bytes
+    legends: list[tuple[str, list[tuple[str, str]]]] | None = None
+
+
+def page_image(png: Path) -> PageImage:
+    """A PNG as the page embeds it: the same pixels as lossless WebP where that is smaller
+    (a palette figure: ≈ 20 % smaller; every current browser shows WebP; effort 4 of 6:
+    0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the PNG as it is.  A
+    scenario figure whose PNG says where its legends start
+    (:data:`~shipgym_baselines.figures.LEGEND_TOP_KEY`) is cut above them and its legends
+    returned as text (the page writes them under the image, issue 20)."""
+    data = png.read_bytes()
+    from PIL import Image, features
+
+    with Image.open(png) as image:
+        image.load()
+        text = dict(getattr(image, "text", {}))
+        legends = None
+        if LEGEND_KEY in text and LEGEND_TOP_KEY in text:
+            legends = [
+                (t, [tuple(e) for e in entries]) for t, entries in json.loads(text[LEGEND_KEY])
+            ]
+            top = round(float(text[LEGEND_TOP_KEY]) * image.height)
+            image = image.crop((0, 0, image.width, top))
+        if not features.check("webp"):
+            if legends is None:
+                return PageImage("image/png", data)
+            out = io.BytesIO()
+            image.save(out, format="PNG", optimize=True)
+            return PageImage("image/png", out.getvalue(), legends)
+        out = io.BytesIO()
+        image.save(out, format="WEBP", lossless=True, quality=100, method=4)
+    webp = out.getvalue()
+    if legends is None and len(webp) >= len(data):
+        return PageImage("image/png", data)
+    return PageImage("image/webp", webp, legends)
+
+
+class _Embedded(NamedTuple):
+    uri: str
+    file: str
+    legends: list[tuple[str, list[tuple[str, str]]]] | None
+
+
+def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
+    """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
+    page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`, embedded as
+    :func:`page_image` gives it: the page stays light, issue 20), else the SVG; in the
+    order of ``figures``."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
         if f.suffix.lower() not in (".svg", ".png"):
             continue
-        if f.stem not in by_stem or f.suffix.lower() == ".svg":
+        if f.stem not in by_stem or f.suffix.lower() == ".png":
             by_stem[f.stem] = f
     out = {}
     for stem, f in by_stem.items():
-        mime = "image/svg+xml" if f.suffix.lower() == ".svg" else "image/png"
-        data = base64.b64encode(f.read_bytes()).decode("ascii")
-        out[stem] = (f"data:{mime};base64,{data}", f.name)
+        if f.suffix.lower() == ".png":
+            image = page_image(f)
+        else:
+            image = PageImage("image/svg+xml", f.read_bytes())
+        data = base64.b64encode(image.data).decode("ascii")
+        out[stem] = _Embedded(f"data:{image.mime};base64,{data}", f.name, image.legends)
     return out
 
 
-def _figure(stem: str, uri: str, name: str, caption: str) -> str:
+#: the oracle's line in the scenario figures (black, dashed), as a legend swatch
+_REFERENCE_SWATCH = "kref"
+_REFERENCE_CSS = f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
+
+
+def _legend_swatch(name: str, label: str) -> str:
+    """The swatch class of a legend entry: the reference's line, else the controller's."""
+    return _REFERENCE_SWATCH if label.endswith(", the reference") else _swatch_class(name)[0]
+
+
+def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
+    """A scenario figure's legends as text: one block per panel column, each episode's line
+    swatch and label."""
+    blocks = []
+    for title, entries in legends:
+        items = "".join(
+            f'<li><span class="{_legend_swatch(name, label)}"></span>{_e(label)}</li>'
+            for name, label in entries
+        )
+        blocks.append(f"<div><b>{_e(title)}</b><ul>{items}</ul></div>")
+    return f'<div class="legend">{"".join(blocks)}</div>'
+
+
+def _figure(stem: str, fig: _Embedded, caption: str) -> str:
+    legend = _legend_html(fig.legends) if fig.legends else ""
     return (
-        f'<figure id="fig-{_e(stem)}"><img src="{uri}" alt="{_e(caption)}" loading="lazy">'
-        f"<figcaption>{_e(caption)} — <code>{_e(name)}</code></figcaption></figure>"
+        f'<figure id="fig-{_e(stem)}"><img src="{fig.uri}" alt="{_e(caption)}" loading="lazy">'
+        f"{legend}<figcaption>{_e(caption)} — <code>{_e(fig.file)}</code></figcaption></figure>"
     )
 
 
 def figure_sections(
     figures: Iterable[str | Path], scenarios: Iterable[str] = ()
-) -> tuple[str, str]:
-    """(ranking figures, scenario figures) as HTML: per split its interval estimates, then
-    its performance profiles; the scenario figures in the order of ``figures``, captioned
-    with the scenario's name where ``scenarios`` has it."""
+) -> tuple[str, str, list[str]]:
+    """(ranking figures, scenario figures, the controllers their legends name) as HTML: per
+    split its interval estimates, then its performance profiles; the scenario figures in
+    the order of ``figures``, captioned with the scenario's name where ``scenarios`` has
+    it."""
     names = {_anchor(s): s for s in scenarios}
     ranking: list[tuple[str, int, str]] = []
     drawn = []
-    for stem, (uri, file) in embedded_figures(figures).items():
+    legend_names: list[str] = []
+    for stem, fig in embedded_figures(figures).items():
         kind, _, split = stem.partition("_")
-        if kind in ("ranking", "profile"):
+        legend_names += [n for _, entries in fig.legends or () for n, _ in entries]
+        if stem == LEARNING_CURVES_STEM:  # after the ranking figures of every split
+            caption = "learning curves of the learned agents (validation return per seed)"
+            ranking.append(("~", True, _figure(stem, fig, caption)))
+        elif kind in ("ranking", "profile"):
             what = "interval estimates" if kind == "ranking" else "performance profiles"
-            html_ = _figure(stem, uri, file, f"{what}, {split}")
-            ranking.append((split, kind == "profile", html_))
+            ranking.append((split, kind == "profile", _figure(stem, fig, f"{what}, {split}")))
         else:
             label = names.get(stem, stem.removeprefix("scenario_"))
-            drawn.append(_figure(stem, uri, file, f"scenario {label}"))
-    return "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2])), "".join(drawn)
+            drawn.append(_figure(stem, fig, f"scenario {label}"))
+    ranking_html = "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2]))
+    return ranking_html, "".join(drawn), legend_names
 
 
 # --------------------------------------------------------------------------------- page
@@ -438,13 +650,18 @@ def page(
     subtitle: str | None = None,
 ) -> str:
     """The page's HTML (module doc)."""
-    ranking_figs, scenario_figs = figure_sections(figures, (r["scenario"] for r in rows))
+    ranking_figs, scenario_figs, legend_names = figure_sections(
+        figures, (r["scenario"] for r in rows)
+    )
+    names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
+    names += [c["controller"] for s in scores for c in s["controllers"]]
     sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
+        f"<title>{_e(title)}</title><style>{_CSS}{swatch_css(names)}{_REFERENCE_CSS}</style>"
+        "</head><body>"
         f"<h1>{_e(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
@@ -459,7 +676,9 @@ def page(
         f'<h2 id="ranking-figures">Ranking figures</h2>{ranking_figs or "<p>No figures.</p>"}'
         f'<h2 id="figures">Scenarios</h2>{scenario_figs or "<p>No figures.</p>"}'
         '<h2 id="all-rows">All rows</h2><details><summary>One row per scenario and controller '
-        f"({len(rows)} rows): means with 95 % intervals</summary>{row_table(rows)}</details>"
+        f"({len(rows)} rows): means with 95 % intervals</summary>{packed_body(row_table(rows))}"
+        "<noscript><p>The rows need the page's script; they are also in leaderboard.md and "
+        "leaderboard.csv.</p></noscript></details>"
         f"<script>{_JS}</script></body></html>\n"
     )
 
@@ -486,5 +705,5 @@ def write_html(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
-    path.write_text(page(rows, aggregate, scores, figures, title, subtitle), encoding="utf-8")
+    write_bytes(path, page(rows, aggregate, scores, figures, title, subtitle).encode("utf-8"))
     return path

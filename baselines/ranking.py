@@ -118,27 +118,37 @@ def stratified_bootstrap_ci(
     reps: int = ROW_REPS,
     confidence: float = CONFIDENCE,
     seed: int = 0,
+    indices: Sequence[np.ndarray] | None = None,
 ) -> list[float] | None:
     """Percentile-bootstrap interval [low, high] of the mean over all values.
 
     ``strata``: the values grouped by stratum (e.g. one list per training seed); each
     bootstrap sample redraws every stratum's values with replacement, keeping its size.
-    None if a value is not finite (e.g. t_c = ∞) or there are none.
+    None if a value is not finite (e.g. t_c = ∞) or there are none.  ``indices``: the
+    resamples of each non-empty stratum (:func:`bootstrap_indices` of their sizes, ``reps``
+    and ``seed``), to share one draw between the metrics of one set of episodes.
     """
     groups = [np.asarray(g, dtype=np.float64) for g in strata if len(g)]
     if not groups or not all(np.all(np.isfinite(g)) for g in groups):
         return None
-    rng = _rng(seed)
+    if indices is None:
+        indices = bootstrap_indices([g.size for g in groups], reps, seed)
     total = np.zeros(reps)
     count = 0
-    for g in groups:
-        idx = rng.integers(0, g.size, size=(reps, g.size))
+    for g, idx in zip(groups, indices, strict=True):
         total += g[idx].sum(axis=1)
         count += g.size
     means = total / count
     alpha = 0.5 * (1.0 - confidence)
     low, high = np.quantile(means, [alpha, 1.0 - alpha])
     return [float(low), float(high)]
+
+
+def bootstrap_indices(sizes: Sequence[int], reps: int = ROW_REPS, seed: int = 0) -> list:
+    """The resample indices of strata of ``sizes`` (each (reps, size)), drawn in order from
+    one generator seeded with ``seed``: what :func:`stratified_bootstrap_ci` draws."""
+    rng = _rng(seed)
+    return [rng.integers(0, size, size=(reps, size)) for size in sizes]
 
 
 def row_intervals(
@@ -149,13 +159,13 @@ def row_intervals(
     by_run: dict[Any, list[Mapping[str, Any]]] = defaultdict(list)
     for ep in episodes:
         by_run[ep.get("training_seed")].append(ep)
+    runs = sorted(by_run, key=lambda s: (s is None, s))
+    # every metric resamples the same episodes: one draw serves them all (the same numbers)
+    indices = bootstrap_indices([len(by_run[run]) for run in runs if by_run[run]], seed=seed)
     out: dict[str, list[float] | None] = {}
     for metric in metrics:
-        strata = []
-        for run in sorted(by_run, key=lambda s: (s is None, s)):
-            values = [_number(ep.get(metric)) for ep in by_run[run]]
-            strata.append(values)
-        out[f"{metric}_ci95"] = stratified_bootstrap_ci(strata, seed=seed)
+        strata = [[_number(ep.get(metric)) for ep in by_run[run]] for run in runs]
+        out[f"{metric}_ci95"] = stratified_bootstrap_ci(strata, seed=seed, indices=indices)
     return out
 
 

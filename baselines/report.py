@@ -121,10 +121,12 @@ def write_report(
     out: str | os.PathLike,
     force: bool = False,
     command: Sequence[str] = (),
+    vector_figures: bool = False,
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Merge ``folders`` and write the tables, ranking, figures and ``report.json`` into
     ``out`` (which must be empty, or ``force``: its earlier outputs cleared, and none of
-    ``folders``); returns (rows, sources)."""
+    ``folders``; ``vector_figures``: the figures' vector copies too); returns (rows,
+    sources)."""
     if not folders:
         raise RunError("report: give at least one run folder")
     target = check_out_dir(out, force=force)
@@ -138,7 +140,7 @@ def write_report(
         if force:
             clear_listed(target)
         try:
-            rows = _write(target, suite, results, sources, command)
+            rows = _write(target, suite, results, sources, command, vector_figures)
         except (OSError, BrokenProcessPool) as exc:  # a full disk, a killed worker
             problem = outside_problem(exc)
             if problem is None:
@@ -153,13 +155,14 @@ def _write(
     results: list[EpisodeResult],
     sources: list[dict[str, Any]],
     command: Sequence[str],
+    vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """The report's files in the locked ``target``, each listed in its manifest."""
     from shipgym_baselines.leaderboard import write_results
 
     manifest = Manifest(target)
     with manifest.claiming():
-        rows = write_results(target, suite, results)
+        rows = write_results(target, suite, results, vector_figures=vector_figures)
     manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
     document = {
         "command": list(command),
@@ -170,6 +173,7 @@ def _write(
         "suite": suite,
     }
     write_json(target / REPORT_FILE, document)
+    manifest.compact(keep=(REPORT_FILE, temporary_file(target / REPORT_FILE).name))
     return rows
 
 

@@ -6,7 +6,9 @@
                      their training seeds, each scenario's settings), versions, git commit,
                      start/end time (ISO 8601 UTC), status ("running" → "complete" |
                      "interrupted" | "failed"), jobs (the episodes the run holds when
-                     complete), episodes
+                     complete), episodes, wall_s and cpu_s (wall-clock and CPU seconds
+                     of the run, tables and figures included, its process and its
+                     workers; a resumed run adds each invocation's)
     episodes.jsonl   one JSON object per finished episode (scenario, controller, kind, seed,
                      training_seed and every metric), appended and flushed by the parent
                      process as each episode ends: Ctrl-C or a kill keeps them; fsync'd at
@@ -55,7 +57,9 @@ from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
 from shipgym_baselines.signals import signal_number
@@ -283,12 +287,20 @@ def write_json(file: Path, document: Any) -> None:
     """Write atomically (a temporary file renamed over ``file``)."""
     from shipgym_baselines.jsonout import dumps
 
+    write_bytes(file, (dumps(document, indent=2) + "\n").encode())
+
+
+def write_bytes(file: Path, data: bytes) -> None:
+    """Write ``data`` atomically (a temporary file renamed over ``file``): a full disk leaves
+    neither a half-written ``file`` nor its temporary, and its error names ``file``."""
     tmp = temporary_file(file)
     try:
-        tmp.write_text(dumps(document, indent=2) + "\n")
+        tmp.write_bytes(data)
         os.replace(tmp, file)
-    except BaseException:  # no half-written temporary left behind (a full disk)
+    except BaseException as exc:  # no half-written temporary left behind (a full disk)
         tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(file)  # the one-line message names it
         raise
 
 
@@ -518,6 +530,21 @@ def _repair(file: Path) -> None:
         file.write_bytes(data[: data.rfind(b"\n") + 1])
 
 
+def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """A trajectory as its file keeps it (issue 20: the run folder's weight): only the
+    arrays a figure draws (:data:`~shipgym_baselines.decimation.DRAWN_KEYS`), thinned to
+    what a figure can show without aliasing (M4,
+    :func:`~shipgym_baselines.decimation.thin_trajectory`), float arrays as float32 (7
+    significant digits: a millimetre on a 10 km route, far below a figure's pixel; the
+    episode's metrics are computed before, at full precision); the file is deflated
+    (``np.savez_compressed``)."""
+    out = {}
+    for key, value in thin_trajectory(trajectory, DRAWN_KEYS).items():
+        array = np.asarray(value)
+        out[key] = array.astype(np.float32) if array.dtype.kind == "f" else array
+    return out
+
+
 def trajectory_file(key: Key) -> str:
     """Where an episode's trajectory is kept in its run folder: ``trajectories/`` and a
     hash of its key (scenario names may be paths, controller names anything)."""
@@ -590,6 +617,10 @@ class RunLog:
         self._file: IO[bytes] | None = None
         self._synced = time.monotonic()
         self._lock = contextlib.ExitStack()
+        #: this invocation's start: wall clock [s] and CPU time [s] (:func:`cpu_seconds`)
+        self._started = (time.perf_counter(), cpu_seconds())
+        #: ``wall_s`` / ``cpu_s`` of earlier invocations (a resumed run adds to them)
+        self._earlier = (float(record.get("wall_s") or 0.0), float(record.get("cpu_s") or 0.0))
 
     @property
     def episodes_file(self) -> Path:
@@ -686,7 +717,7 @@ class RunLog:
             self.manifest.claim(TRAJECTORY_DIR, name, tmp)
             (self.folder / TRAJECTORY_DIR).mkdir(exist_ok=True)
             try:
-                np.savez(self.folder / tmp, **result.trajectory)  # uncompressed: 6x faster
+                np.savez_compressed(self.folder / tmp, **light_trajectory(result.trajectory))
                 os.replace(self.folder / tmp, self.folder / name)
             except BaseException as exc:  # no half-written file left behind (a full disk)
                 (self.folder / tmp).unlink(missing_ok=True)
@@ -694,7 +725,8 @@ class RunLog:
                     exc.filename = str(self.folder / tmp)  # the message names it
                 raise
         assert self._file is not None, "append after finish"
-        self._write_line((json.dumps(record, allow_nan=False) + "\n").encode())
+        line = json.dumps(record, allow_nan=False, separators=COMPACT)  # no spaces
+        self._write_line((line + "\n").encode())
         if time.monotonic() - self._synced >= FSYNC_INTERVAL_S:
             os.fsync(self._file.fileno())
             self._synced = time.monotonic()
@@ -736,8 +768,22 @@ class RunLog:
                 os.fsync(file.fileno())
             file.close()
         self._count = len(read_episodes(self.folder))  # the file's count: Ctrl-C may cut in
-        self.record.update(status=status, end_time=now(), episodes=self._count)
+        wall, cpu = self.elapsed()
+        self.record.update(
+            status=status,
+            end_time=now(),
+            episodes=self._count,
+            wall_s=self._earlier[0] + wall,
+            cpu_s=self._earlier[1] + cpu,
+        )
         self._write_record(in_place=status != "complete")
+        run_tmp = temporary_file(self.folder / RUN_FILE).name
+        self.manifest.compact(keep=(RUN_FILE, run_tmp, EPISODES_FILE))
+
+    def elapsed(self) -> tuple[float, float]:
+        """Wall-clock and CPU seconds of this invocation so far (:func:`cpu_seconds`)."""
+        wall0, cpu0 = self._started
+        return time.perf_counter() - wall0, cpu_seconds() - cpu0
 
     def kept(self) -> str:
         """What the run kept, and how to finish it."""
@@ -794,6 +840,13 @@ class RunLog:
                 with contextlib.suppress(OSError), open(file, "r+b") as fh:
                     fh.write(data)
                     fh.truncate()
+
+
+def cpu_seconds() -> float:
+    """CPU seconds [s] of this process and of its finished child processes (a process
+    pool's workers count once the pool has shut down), user and system."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
 
 
 def outside_problem(exc: BaseException) -> str | None:

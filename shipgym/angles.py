@@ -16,7 +16,7 @@ from typing import overload
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["TWO_PI", "unwrap_floats", "wrap_angle"]
+__all__ = ["TWO_PI", "unwrap_array", "unwrap_floats", "wrap_angle"]
 
 _PI = math.pi
 TWO_PI = 2.0 * math.pi
@@ -63,3 +63,19 @@ def unwrap_floats(angles: list[float]) -> list[float]:
         correction = correction + step
         out.append(a + correction)
     return out
+
+
+def unwrap_array(angles: NDArray[np.floating]) -> NDArray[np.float64]:
+    """``numpy.unwrap`` of a 1-D array of angles [rad], with the same bits.
+
+    When no step between neighbours reaches π (the usual case: the fine samples of a control
+    period) numpy's corrections are all zero and its result is the input with +0.0 added
+    after the first element; that is computed directly (≈ 5× faster on 50 samples), any
+    other input goes through ``numpy.unwrap``.
+    """
+    p = np.asarray(angles, dtype=np.float64)
+    if p.ndim == 1 and p.shape[0] > 1 and (np.abs(p[1:] - p[:-1]) < _PI).all():
+        out = p.copy()
+        out[1:] += 0.0  # numpy adds the (zero) cumulative corrections: −0.0 becomes +0.0
+        return out
+    return np.unwrap(p)

@@ -37,6 +37,7 @@ KINDS: dict[str, str] = {
     "distributions": "distribution",
     "scenarios": "scenario",
     "suites": "suite",
+    "tuning": "tuning space",
 }
 
 #: a config file: a filesystem path, or a packaged resource

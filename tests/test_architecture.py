@@ -37,6 +37,8 @@ LAYERS: dict[str, int] = {
     "shipgym.codegen": 2,
     # 3 — standard manoeuvres (zig-zag, turning circle) simulated on a model
     "shipgym.manoeuvres": 3,
+    # the IMO manoeuvring criteria (MSC.137(76)) a manoeuvre is measured against
+    "shipgym.manoeuvring_standards": 3,
     # 4 — identification: LS-SVM fits, online identifiers, nominal models from zig-zags
     "shipgym.identification": 4,
     # 5 — guidance laws, heading autopilots, path tracking, disturbances and sensors (and
@@ -51,6 +53,7 @@ LAYERS: dict[str, int] = {
     # 7 — an episode's metrics and rendering
     "shipgym.metrics": 7,
     "shipgym.rendering": 7,
+    "shipgym.animation": 7,
     # 8 — the environments, and the package itself (it registers them)
     "shipgym.envs": 8,
     "shipgym": 8,

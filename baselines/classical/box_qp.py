@@ -47,7 +47,9 @@ def backtrack(
     [lb, ub]) whose cost is not above ``cost``, with that cost; None if there is none."""
     alpha = 1.0
     while alpha > 1e-3:
-        trial = np.clip(u + alpha * step, lb, ub)
+        trial = u + alpha * step
+        np.maximum(trial, lb, out=trial)  # np.clip(·, lb, ub), without its wrappers
+        np.minimum(trial, ub, out=trial)
         trial_cost = evaluate(trial)
         if trial_cost <= cost:
             return trial, trial_cost
@@ -86,6 +88,20 @@ class BoxQP:
         self._eval()
         return self._out[0].copy()
 
+    def solve_gauss_newton(
+        self, jac: np.ndarray, rho: np.ndarray, u: np.ndarray, lb: np.ndarray, ub: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`solve` of the Gauss–Newton step of ‖ρ(u)‖² at u within lb ≤ u + Δ ≤ ub:
+        H = JᵀJ, g = Jᵀρ, bounds lb − u, ub − u, computed straight into the QP's buffers
+        (the same products as ``jac.T @ jac``, ``jac.T @ rho``, without temporaries)."""
+        q, n = self._in, self.n
+        np.matmul(jac.T, jac, out=q["h"].reshape(n, n))
+        np.matmul(jac.T, rho, out=q["g"])
+        np.subtract(lb, u, out=q["lbx"])
+        np.subtract(ub, u, out=q["ubx"])
+        self._eval()
+        return self._out[0].copy()
+
 
 def sqp(
     guess: np.ndarray,
@@ -102,7 +118,7 @@ def sqp(
     and a :func:`backtrack` on ``cost``; stopped when no descent is found, when the accepted
     step moves less than ``step_tolerance`` or (``cost_tolerance`` given) when it lowers the
     cost by less than that fraction.  Returns (plan, success, iterations)."""
-    u = np.clip(guess, lb, ub)
+    u = np.minimum(np.maximum(guess, lb), ub)  # np.clip(guess, lb, ub)
     value = cost(u)
     if not math.isfinite(value):
         return u, False, 0
@@ -115,11 +131,11 @@ def sqp(
         if found is None:
             break  # no descent: converged as far as the (generalised) Gauss–Newton goes
         trial, trial_value = found
-        moved = float(np.max(np.abs(trial - u)))
+        moved = float(np.abs(trial - u).max())
         gain = value - trial_value
         u, value = trial, trial_value
         if moved < step_tolerance:
             break
         if cost_tolerance is not None and gain <= cost_tolerance * value:
             break
-    return u, bool(np.all(np.isfinite(u)) and math.isfinite(value)), iterations
+    return u, bool(np.isfinite(u).all() and math.isfinite(value)), iterations

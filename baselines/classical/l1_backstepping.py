@@ -76,7 +76,6 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.angles import unwrap_floats
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
@@ -95,8 +94,10 @@ from shipgym_baselines.classical.adaptive.settings import (
     Gains,
     L1BacksteppingSettings,
 )
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
+from shipgym_baselines.tuning.chosen import tuned_settings
 
 #: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
 cubic_damping_from_zigzag = ship_cubic_damping
@@ -130,13 +131,29 @@ class L1Backstepping:
     #: C(s) of eq. (39) on the command (off: plain adaptive backstepping)
     low_pass = True
 
-    def __init__(self, settings: L1BacksteppingSettings | None = None, **overrides: Any) -> None:
-        base = settings if settings is not None else L1BacksteppingSettings()
+    def __init__(
+        self,
+        settings: L1BacksteppingSettings | None = None,
+        preset: str = "tuned",
+        **overrides: Any,
+    ) -> None:
+        """``settings`` (default: the paper's) with ``overrides``; ``preset``: "tuned" adds
+        the ship's section of ``configs/tuning/chosen/<name>.yaml`` (``shipgym tune``,
+        docs/tuning.md) under the overrides at reset, "paper" does not."""
+        if preset not in ("tuned", "paper"):
+            raise ValueError(f"preset must be 'tuned' or 'paper', got {preset!r}")
+        self.preset = preset
+        self._base = settings if settings is not None else L1BacksteppingSettings()
+        self._overrides = dict(overrides)
         # L1BacksteppingSettings validates itself, also when replaced with overrides
-        self.settings = dataclasses.replace(base, **overrides) if overrides else base
+        self.settings = dataclasses.replace(self._base, **overrides) if overrides else self._base
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
+        if self.preset == "tuned":  # the ship's chosen settings under the overrides
+            chosen = tuned_settings(type(self).name, context.ship)
+            if chosen:
+                self.settings = dataclasses.replace(self._base, **{**chosen, **self._overrides})
         s = self.settings
         self.ctx = context
         self.model = nominal_design_model(context.nominal_model)
@@ -189,22 +206,13 @@ class L1Backstepping:
 
     def _course(self, info: dict[str, Any]) -> tuple[float, float]:
         """(speed over ground U [m/s], drift angle β [rad]) over the last period."""
-        if not self._started:
-            return self.ctx.nominal_speed, 0.0
-        x, y = info["position"]
-        x0, y0 = self._last["position"]
-        dx, dy = x - x0, y - y0
-        speed = math.hypot(dx, dy) / self.ctx.control_period
-        if not self.settings.drift_compensation or speed < 0.1 * self.ctx.nominal_speed:
-            return max(speed, 0.1 * self.ctx.nominal_speed), 0.0
-        samples = info.get("samples")
-        if samples is not None and len(samples["psi"]) > 0:
-            headings = unwrap_floats([*samples["psi"].tolist(), float(info["heading"])])
-            mean_heading = float(np.mean(np.array(headings)))
-        else:
-            h0 = self._last["psi"]
-            mean_heading = h0 + 0.5 * wrap_angle(info["heading"] - h0)
-        return speed, float(wrap_angle(math.atan2(dy, dx) - mean_heading))
+        return course_and_drift(
+            info,
+            self._last if self._started else None,
+            self.ctx.control_period,
+            self.ctx.nominal_speed,
+            self.settings.drift_compensation,
+        )
 
     def _reference(
         self, ye: float, path_angle: float, psi: float, r: float, speed: float, drift: float

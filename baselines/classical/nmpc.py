@@ -41,6 +41,7 @@ paper) give the identifier the outlier + state-variable-filter front end
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 import zlib
@@ -160,7 +161,7 @@ class NMPCSolver:
 
     def _gauss_newton_step(self, u: np.ndarray, rho: np.ndarray, jac: np.ndarray) -> np.ndarray:
         """Box-constrained Gauss–Newton step Δ (the SQP's QP), solved by qrqp."""
-        return self._qp.solve(jac.T @ jac, jac.T @ rho, self.lb - u, self.ub - u)
+        return self._qp.solve_gauss_newton(jac, rho, u, self.lb, self.ub)
 
     def _bind(self, function: ca.Function, outputs: list[np.ndarray]):
         return bind(function, [self._u, self._p], outputs)
@@ -177,34 +178,42 @@ class NMPCSolver:
 
     def cost(self, plan: np.ndarray, p: np.ndarray) -> float:
         """Cost (16) of a plan; inf when the prediction diverges (e.g. absurd parameters)."""
-        self._u[:], self._p[:] = plan, p
-        self._rho_eval[1]()
+        self._p[:] = p
         with np.errstate(over="ignore", invalid="ignore"):
-            value = float(self._rho @ self._rho)
+            return self._plan_cost(plan)
+
+    def _plan_cost(self, plan: np.ndarray) -> float:
+        """:meth:`cost` with the parameters already in the buffer, inside :meth:`solve`'s
+        ``errstate`` (an overflowing ρ·ρ is inf, not a warning)."""
+        self._u[:] = plan
+        self._rho_eval[1]()
+        value = float(self._rho @ self._rho)
         return value if math.isfinite(value) else math.inf
+
+    def _direction(self, u: np.ndarray) -> np.ndarray | None:
+        """The Gauss–Newton step at u (None: ρ or J not finite); parameters in the buffer."""
+        self._u[:] = u
+        self._jac_eval[1]()
+        rho, jac = self._rho, self._jac.T  # used before the next evaluation overwrites them
+        if not (np.isfinite(rho).all() and np.isfinite(jac).all()):
+            return None
+        return self._gauss_newton_step(u, rho, jac)
 
     def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
         """Optimal plan (N_c commands, rad), success flag, iterations (Gauss–Newton SQP)."""
         s = self.settings
-        self._p[:] = p
-
-        def direction(u: np.ndarray) -> np.ndarray | None:
-            self._u[:] = u
-            self._jac_eval[1]()
-            rho, jac = self._rho.copy(), self._jac.T
-            if not (np.all(np.isfinite(rho)) and np.all(np.isfinite(jac))):
-                return None
-            return self._gauss_newton_step(u, rho, jac)
-
-        return sqp(
-            guess,
-            self.lb,
-            self.ub,
-            lambda u: self.cost(u, p),
-            direction,
-            s.max_iter,
-            s.step_tolerance,
-        )
+        self._p[:] = p  # constant over the solve: written once, not per evaluation
+        # a diverging prediction is handled, not warned about: inf cost, no direction
+        with np.errstate(over="ignore", invalid="ignore"):
+            return sqp(
+                guess,
+                self.lb,
+                self.ub,
+                self._plan_cost,
+                self._direction,
+                s.max_iter,
+                s.step_tolerance,
+            )
 
     def predict(self, plan: np.ndarray, p: np.ndarray) -> np.ndarray:
         """Predicted states (N_p, n_x) at the ends of the control periods."""
@@ -222,15 +231,23 @@ def get_solver(model: ShipModel, settings: NMPCSettings, ts: float, limit: float
     return _SOLVERS[key]
 
 
+@functools.lru_cache(maxsize=64)
+def _slope_times(h: float, n: int) -> tuple[np.ndarray, float]:
+    """Centred sample times t − t̄ [s] of n samples at spacing h, and Σ(t − t̄)² (built once)."""
+    t = h * np.arange(n)
+    t -= t.mean()
+    t.flags.writeable = False
+    return t, float(t @ t)
+
+
 def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) -> float:
     """ṙ estimate [rad/s²]: least-squares slope of the last fine yaw-rate samples and r now."""
     r = np.asarray(samples.get("r", ()), dtype=float)
     if r.size == 0:
         return 0.0
     values = np.append(r[-5:], yaw_rate)
-    t = h * np.arange(values.size)
-    t -= t.mean()
-    return float(t @ (values - values.mean()) / (t @ t))
+    t, tt = _slope_times(h, values.size)
+    return float(t @ (values - values.mean()) / tt)
 
 
 @register_controller("nmpc")
@@ -300,18 +317,43 @@ class NMPC:
         self.solve_times: list[float] = []  # wall clock [s]
         self.solve_cpu_times: list[float] = []  # this thread's CPU time [s] (load-proof)
         self.param_history: list[dict[str, float]] = []
+        # per-step work hoisted: state indices, and what depends only on the parameters
+        model = self.model
+        self._index = tuple(model.state_index(k) for k in ("x", "y", "psi", "r", "r_dot", "delta"))
+        self._identified: Any = None  # the identifier's last params object …
+        self._estimate: Any = None  # … and its prediction-model parameters
+        self._vectors: dict[int, tuple[Any, np.ndarray]] = {}
+        self._dicts: dict[int, tuple[Any, dict[str, float]]] = {}
 
     def _state(self, info: dict[str, Any]) -> np.ndarray:
-        model = self.model
-        x0 = np.zeros(model.n_states)
-        x0[model.state_index("x")], x0[model.state_index("y")] = info["position"]
-        x0[model.state_index("psi")] = info["heading"]
-        x0[model.state_index("r")] = info["yaw_rate"]
-        x0[model.state_index("r_dot")] = yaw_acceleration(
-            info.get("samples", {}), info["yaw_rate"], self.ctx.fine_step
-        )
-        x0[model.state_index("delta")] = info["rudder_angle"]
+        ix, iy, ipsi, ir, irdot, idelta = self._index
+        x0 = np.zeros(self.model.n_states)
+        x0[ix], x0[iy] = info["position"]
+        x0[ipsi] = info["heading"]
+        x0[ir] = info["yaw_rate"]
+        x0[irdot] = yaw_acceleration(info.get("samples", {}), info["yaw_rate"], self.ctx.fine_step)
+        x0[idelta] = info["rudder_angle"]
         return x0
+
+    def _vector(self, params: Any) -> np.ndarray:
+        """``params.to_vector()``, computed once per parameters object (read-only)."""
+        hit = self._vectors.get(id(params))
+        if hit is None or hit[0] is not params:
+            vector = params.to_vector()
+            vector.flags.writeable = False
+            hit = self._vectors[id(params)] = (params, vector)
+            if len(self._vectors) > 8:  # only the current and the last good one are needed
+                self._vectors = {id(params): hit}
+        return hit[1]
+
+    def _as_dict(self, params: Any) -> dict[str, float]:
+        """``params.as_dict()``, computed once per parameters object (do not mutate)."""
+        hit = self._dicts.get(id(params))
+        if hit is None or hit[0] is not params:
+            hit = self._dicts[id(params)] = (params, params.as_dict())
+            if len(self._dicts) > 8:
+                self._dicts = {id(params): hit}
+        return hit[1]
 
     def _warm_start(self) -> np.ndarray:
         """The previous plan shifted by one control period: by one interval when an interval
@@ -321,10 +363,18 @@ class NMPC:
         return self.plan.copy()
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        # prediction_params makes a new parameters object on a reduced ship each time it is
+        # called: the model fallback below treats a step's cached estimate as new, as then
+        fresh = False
         if self.identifier is not None and "samples" in info:
             self.identifier.update(info["samples"])
-            estimate = self.ship_plan.prediction_params(self.identifier.params)
+            identified = self.identifier.params
+            if identified is not self._identified:  # re-identified: a new estimate
+                self._identified = identified
+                self._estimate = self.ship_plan.prediction_params(identified)
+            estimate = self._estimate
             if estimate is not None:
+                fresh = self.ship_plan.reduce
                 self.params = estimate
         x, y = info["position"]
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
@@ -340,20 +390,20 @@ class NMPC:
         start, start_cpu = time.perf_counter(), time.thread_time()
         plan, ok, _ = self.solver.solve(
             self.solver.parameters(
-                x0, leg_start, frame.path_angle, radius, self.params.to_vector()
+                x0, leg_start, frame.path_angle, radius, self._vector(self.params)
             ),
             guess,
         )
         used = self.params
         if ok:
             self._good_params = self.params
-        elif self._good_params is not self.params:
+        elif fresh or self._good_params is not self.params:
             used = self._good_params
             # the identified model makes the prediction diverge: use the last one that worked
             self.model_fallbacks += 1
             plan, ok, _ = self.solver.solve(
                 self.solver.parameters(
-                    x0, leg_start, frame.path_angle, radius, self._good_params.to_vector()
+                    x0, leg_start, frame.path_angle, radius, self._vector(self._good_params)
                 ),
                 guess,
             )
@@ -365,9 +415,10 @@ class NMPC:
         else:  # fall back to the shifted last plan and count it
             self.failures += 1
             self.plan = guess
-        self.param_history.append({"t": info["t"], **used.as_dict()})
+        self.param_history.append({"t": info["t"], **self._as_dict(used)})
         delta_c = self.pe(float(self.plan[0]))
-        return np.array([np.clip(delta_c / self.ctx.rudder_limit, -1.0, 1.0)], dtype=np.float32)
+        command = min(max(delta_c / self.ctx.rudder_limit, -1.0), 1.0)  # np.clip's value
+        return np.array([command], dtype=np.float32)
 
     def episode_stats(self) -> dict[str, float]:
         times = np.array(self.solve_times) if self.solve_times else np.array([math.nan])

@@ -1,4 +1,6 @@
-"""The ``shipgym`` console script (SPEC §9b).
+"""The ``shipgym`` console script: leaderboards, training, evaluation, single runs, reports,
+manoeuvres, the scenario catalogue, benchmarks and the papers' experiments (documentation:
+the docs site, page "Packages and commands").
 
 ``--json`` prints exactly one JSON document on stdout; progress and tables go to stderr.
 """
@@ -21,6 +23,7 @@ from shipgym_baselines.cli import (
     run,
     scenarios,
     train,
+    tune,
 )
 from shipgym_baselines.errors import RunFailed
 from shipgym_baselines.signals import Terminated, signal_number, terminate_as_interrupt
@@ -30,6 +33,7 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     leaderboard.add_leaderboard_parser,
     reproduce.add_parser,
     train.add_parser,
+    tune.add_parser,
     leaderboard.add_evaluate_parser,
     run.add_parser,
     report.add_parser,

@@ -1,4 +1,4 @@
-"""``shipgym bench TARGET``: the benchmarks of SPEC §10."""
+"""``shipgym bench TARGET``: the benchmarks (docs page "Benchmarks")."""
 
 from __future__ import annotations
 
@@ -16,17 +16,44 @@ BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "nmpc": lambda args: benchmarks.bench_nmpc(),
     "identification": lambda args: benchmarks.bench_identification(),
     "training": lambda args: benchmarks.bench_training(repeats=args.repeats),
+    "leaderboard": lambda args: _profile(args),
 }
 
 
+def _profile(args: argparse.Namespace) -> dict[str, Any]:
+    from shipgym_baselines.run_costs import profile_suite
+
+    return profile_suite(
+        args.suite,
+        seeds=args.seeds,
+        controllers=args.controllers,
+        scenarios=args.scenarios,
+        show_progress=True,
+    )
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("bench", help="benchmarks of SPEC §10")
+    p = sub.add_parser("bench", help="benchmarks of speed and throughput (docs: 'Benchmarks')")
     p.add_argument(
         "target",
         choices=list(BENCHES),
-        help="what to benchmark (training: PPO with the batched env vs SubprocVecEnv)",
+        help="what to benchmark (training: the shipped PPO config through the per-ship batched "
+        "envs, DummyVecEnv and SubprocVecEnv; leaderboard: CPU seconds of a suite per "
+        "controller, ship and step)",
     )
     p.add_argument("--repeats", type=int, default=5, help="timed repetitions (≥ 1)")
+    p.add_argument(
+        "--suite", default="default", help="leaderboard: the suite whose CPU time is profiled"
+    )
+    p.add_argument(
+        "--seeds", type=int, default=1, help="leaderboard: evaluation seeds measured (≥ 1)"
+    )
+    p.add_argument(
+        "--controllers", nargs="+", default=None, help="leaderboard: only these controllers"
+    )
+    p.add_argument(
+        "--scenarios", nargs="+", default=None, help="leaderboard: only these suite scenarios"
+    )
     add_json_option(p, "print the figures as a JSON object")
     p.set_defaults(func=run)
 

@@ -12,13 +12,18 @@ import sys
 from pathlib import Path
 
 from shipgym_baselines.cli.options import add_run_options, command_line, emit
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 
 #: ``evaluate`` writes to ``EVALUATE_ROOT/<policy>`` unless given ``--out``
 EVALUATE_ROOT = Path("results/evaluate")
 
 
 def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("leaderboard", help="run every controller on a suite (SPEC §9)")
+    p = sub.add_parser(
+        "leaderboard",
+        help="run every controller on a suite (docs: 'The leaderboard and its statistics')",
+    )
     add_run_options(p, out="results/leaderboard", progress_help="no progress bar on stderr")
     p.add_argument(
         "--controllers",
@@ -27,6 +32,14 @@ def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
         metavar="CONTROLLER",
         help="run these instead of the suite's: names, specs module:Attr / file.py:Attr, "
         "trained agents' folders or SB3 model zips",
+    )
+    p.add_argument(
+        "--name",
+        action="append",
+        default=None,
+        metavar="CONTROLLER=NAME",
+        help="show CONTROLLER (as given to --controllers or in the suite) as NAME in the "
+        "tables; repeat for several (e.g. --name work/ppo_ship.zip=ppo_ship)",
     )
     p.add_argument(
         "--recompute-references",
@@ -45,6 +58,12 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
         help="controller name, spec module:Attr or file.py:Attr, shipped policy name, trained "
         "agent folder or SB3 model zip",
     )
+    p.add_argument(
+        "--name",
+        default=None,
+        help="the policy's name in the tables (default: its own; an SB3 zip: the file's stem, "
+        "a trained agent's folder: the folder's name)",
+    )
     add_run_options(
         p,
         out=None,
@@ -54,12 +73,54 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def evaluate_folder(policy: str) -> Path:
+def evaluate_folder(policy: ControllerSpec) -> Path:
     """``evaluate``'s default folder for ``policy``: one per table name."""
     from shipgym_baselines.registry import controller_label
 
     label = controller_label(policy)
     return EVALUATE_ROOT / "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
+
+
+def named(controller: ControllerSpec, name: str | None) -> ControllerSpec:
+    """``controller`` shown as ``name`` (the long form), itself when ``name`` is None."""
+    if name is None:
+        return controller
+    if not name.strip():
+        raise RunError(f"--name for {controller!r} is empty")
+    if isinstance(controller, ControllerEntry):
+        return controller.model_copy(update={"name": name})
+    return ControllerEntry(controller=controller, name=name)
+
+
+def parse_names(pairs: list[str] | None) -> dict[str, str]:
+    """``--name CONTROLLER=NAME`` options as controller → name (split at the last ``=``);
+    a pair without ``=`` or a controller named twice is an error."""
+    names: dict[str, str] = {}
+    for pair in pairs or []:
+        controller, sep, name = pair.rpartition("=")
+        if not sep or not controller or not name:
+            raise RunError(f"--name {pair!r}: give CONTROLLER=NAME (e.g. work/agent.zip=mine)")
+        if controller in names:
+            raise RunError(f"--name: controller {controller!r} is named twice")
+        names[controller] = name
+    return names
+
+
+def named_controllers(
+    controllers: list[ControllerSpec], pairs: list[str] | None
+) -> list[ControllerSpec]:
+    """``controllers`` with ``--name CONTROLLER=NAME`` applied; a CONTROLLER that is not
+    among them is an error naming the valid ones."""
+    names = parse_names(pairs)
+
+    def key(c: ControllerSpec) -> str:
+        return c if isinstance(c, str) else c.controller
+
+    unknown = sorted(set(names) - {key(c) for c in controllers})
+    if unknown:
+        valid = ", ".join(key(c) for c in controllers)
+        raise RunError(f"--name names {unknown}, not among the run's controllers: {valid}")
+    return [named(c, names.get(key(c))) for c in controllers]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -69,13 +130,18 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.suite import load_suite
 
     policy = getattr(args, "policy", None)
+    if policy is not None:
+        policy = named(policy, args.name)
     out, note = args.out, ""
     if out is None:
         out = evaluate_folder(policy)
-        note = f" (evaluate's folder for {policy!r}; give --out for another)"
+        note = f" (evaluate's folder for {args.policy!r}; give --out for another)"
     # before any work: an unusable --out, then a bad suite, then --out in use or not empty
     check_out_usable(out, resume=args.resume, force=args.force)
-    load_suite(args.suite)
+    spec = load_suite(args.suite)
+    controllers = [policy] if policy is not None else getattr(args, "controllers", None)
+    if policy is None and args.name:
+        controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
     from shipgym_baselines.leaderboard import run_leaderboard, terminal_summary
 
@@ -85,14 +151,21 @@ def run(args: argparse.Namespace) -> int:
         out_dir=out,
         backend=args.backend,
         workers=args.workers,
-        controllers=[policy] if policy else getattr(args, "controllers", None),
+        controllers=controllers,
         show_progress=not args.no_progress,
         resume=args.resume,
         force=args.force,
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
+        vector_figures=args.vector_figures,
     )
     if not args.json:
-        sys.stderr.write(f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes\n")
+        from shipgym_baselines.runs import read_run
+
+        record = read_run(out)
+        sys.stderr.write(
+            f"wrote {out}: leaderboard.md, .csv, .json, plots, run.json, episodes "
+            f"({record['wall_s']:.0f} s wall, {record['cpu_s']:.0f} s CPU)\n"
+        )
     emit(args, rows, terminal_summary(out))  # ends with the ranking and the page's path
     return 0

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Callable
+from typing import Any
 
 from shipgym.manoeuvres import ManoeuvreLog, plot_manoeuvre, turning_circle, zigzag
+from shipgym.manoeuvring_standards import TURNING_RUDDER_DEG, imo_criteria
 from shipgym.models import MODELS, ShipModel
 from shipgym_baselines.cli.options import add_json_option, emit
 from shipgym_baselines.errors import RunError
@@ -15,13 +18,16 @@ Manoeuvre = Callable[[ShipModel, argparse.Namespace], tuple[ManoeuvreLog, dict[s
 
 def _turning(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
     """Turning circle at --rudder [deg] (default 35° or the ship's rudder limit)."""
+    if args.rudder is None:
+        args.rudder = min(TURNING_RUDDER_DEG, math.degrees(model.rudder_limit))
     return turning_circle(model, args.rudder)
 
 
 def _zigzag(model: ShipModel, args: argparse.Namespace) -> tuple[ManoeuvreLog, dict]:
     """--rudder/--switch zig-zag [deg] (default 20/20; the switch defaults to the rudder)."""
-    rudder = args.rudder if args.rudder is not None else 20.0
-    return zigzag(model, rudder, args.switch if args.switch is not None else rudder)
+    args.rudder = args.rudder if args.rudder is not None else 20.0
+    args.switch = args.switch if args.switch is not None else args.rudder
+    return zigzag(model, args.rudder, args.switch)
 
 
 #: manoeuvre kind -> the run on a ship with the parsed options
@@ -38,7 +44,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--switch", type=float, default=None, help="zig-zag heading switch [deg]")
     p.add_argument("--variant", default=None, help="model variant (e.g. esso_osaka literal)")
     p.add_argument("--out", default="results/manoeuvres", help="directory of the plot")
-    add_json_option(p, "print the figures as a JSON object")
+    add_json_option(
+        p,
+        "print the figures as a JSON object, with imo_criteria: the MSC.137(76) criteria the "
+        "manoeuvre measures (turning at 35°/the rudder limit, zig-zag 10/10 and 20/20)",
+    )
     p.set_defaults(func=run)
 
 
@@ -55,6 +65,23 @@ def run(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     plot = out / f"{args.ship}_{args.kind}.png"
     plot_manoeuvre(model, args.kind, log, figures, str(plot))
-    lines = [f"{k:22s} {v:.4g}" for k, v in figures.items()] + [f"plot: {plot}"]
-    emit(args, figures, "\n".join(lines))
+    criteria = imo_criteria(
+        args.kind,
+        figures,
+        length=model.length,
+        speed=model.nominal_speed,
+        rudder_deg=args.rudder,
+        switch_deg=args.switch,
+        max_rudder_deg=math.degrees(model.rudder_limit),
+    )
+    lines = [f"{k:22s} {v:.4g}" for k, v in figures.items()]
+    lines += [_criterion_line(c) for c in criteria] + [f"plot: {plot}"]
+    document: dict[str, Any] = {**figures, "imo_criteria": criteria}
+    emit(args, document, "\n".join(lines))
     return 0
+
+
+def _criterion_line(c: dict[str, Any]) -> str:
+    value = "not reached" if c["value"] is None else f"{c['value']:.4g}"
+    verdict = "pass" if c["passed"] else "FAIL"
+    return f"IMO {c['criterion']:18s} {value} ≤ {c['limit']:.4g} {c['unit']}: {verdict}"

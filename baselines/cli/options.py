@@ -15,6 +15,16 @@ def add_json_option(parser: argparse.ArgumentParser, help: str) -> None:
     parser.add_argument("--json", action="store_true", help=help)
 
 
+def add_vector_option(parser: argparse.ArgumentParser) -> None:
+    """``--vector-figures``: write each figure's vector copy (SVG, a scenario's as SVGZ)
+    beside its PNG (the page shows the PNGs; without the copies a run folder is lighter)."""
+    parser.add_argument(
+        "--vector-figures",
+        action="store_true",
+        help="also write each figure as SVG (scenario figures as SVGZ) beside its PNG",
+    )
+
+
 def add_progress_option(parser: argparse.ArgumentParser, help: str | None = None) -> None:
     """``--no-progress``: no progress bar on stderr."""
     parser.add_argument("--no-progress", action="store_true", help=help)
@@ -62,7 +72,7 @@ def add_run_options(
 ) -> None:
     """The options of a suite run (``leaderboard``, ``evaluate``): --suite, --seeds, --out
     (default ``out``) with --resume / --force, --backend, --workers, --trust-pickle,
-    --no-progress, --json."""
+    --no-progress, --vector-figures, --json."""
     parser.add_argument(
         "--suite", default="default", help="suite name in configs/suites or a YAML path"
     )
@@ -76,6 +86,7 @@ def add_run_options(
     )
     add_trust_pickle_option(parser)
     add_progress_option(parser, progress_help)
+    add_vector_option(parser)
     add_json_option(parser, "print the rows as JSON on stdout")
 
 

@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from shipgym_baselines.cli.options import add_json_option, add_out_options, command_line, emit
+from shipgym_baselines.cli.options import (
+    add_json_option,
+    add_out_options,
+    add_vector_option,
+    command_line,
+    emit,
+)
 
 #: where ``report`` writes unless given ``--out``
 REPORT_OUT = "results/report"
@@ -23,6 +29,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help=f"output directory (default {REPORT_OUT}; refused if not empty: see --force)",
         resume_help=None,
     )
+    add_vector_option(p)
     add_json_option(p, "print the rows as JSON on stdout")
     p.set_defaults(func=run)
 
@@ -32,7 +39,13 @@ def run(args: argparse.Namespace) -> int:
     incomplete."""
     from shipgym_baselines.report import write_report
 
-    rows, sources = write_report(args.runs, args.out, force=args.force, command=command_line(args))
+    rows, sources = write_report(
+        args.runs,
+        args.out,
+        force=args.force,
+        command=command_line(args),
+        vector_figures=args.vector_figures,
+    )
     from shipgym_baselines.leaderboard import terminal_summary
 
     for source in sources:

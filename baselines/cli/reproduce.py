@@ -1,4 +1,5 @@
-"""``shipgym reproduce PAPER``: re-run a source paper's experiment (SPEC §11)."""
+"""``shipgym reproduce PAPER``: re-run a source paper's experiment (docs: "Reproducing the
+papers")."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ from shipgym_baselines.reproduce import PAPERS
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("reproduce", help="re-run a source paper's experiment (SPEC §11)")
+    p = sub.add_parser(
+        "reproduce", help="re-run a source paper's experiment (docs: 'Reproducing the papers')"
+    )
     p.add_argument("paper", choices=list(PAPERS), help="which paper")
     p.add_argument("--out", default=None, help="output directory (default results/reproduce/PAPER)")
     p.add_argument("--seeds", type=int, default=1, help="seeds per case and controller")

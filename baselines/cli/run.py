@@ -2,16 +2,19 @@
 
 Writes ``metrics.json`` (the episode's row: scenario, controller, kind, seed and every
 metric, as ``--json`` prints it) and the leaderboard's figure of the episode (path and
-track, cross-track error, rudder angle) into ``--out``.  The default seed is the
-leaderboard's first evaluation seed, so the episode is that of the leaderboard's first
-seed.
+track, cross-track error, rudder angle) into ``--out``.  The episode is the trial that
+``--seed`` draws with ``--suite``'s randomisation (default suite ``default``), so it equals
+that suite's leaderboard episode of the scenario and seed; the default seed is the
+leaderboard's first evaluation seed.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
+from typing import Any
 
 from shipgym_baselines.cli.options import (
     add_json_option,
@@ -43,7 +46,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--seed",
         type=int,
         default=EVAL_SEED_OFFSET,
-        help=f"env seed (default {EVAL_SEED_OFFSET}, the leaderboard's first)",
+        help=f"evaluation seed (default {EVAL_SEED_OFFSET}, the leaderboard's first; its "
+        f"i-th seed is {EVAL_SEED_OFFSET} + i)",
+    )
+    p.add_argument(
+        "--suite",
+        default="default",
+        help="replay this suite's trial of the scenario and seed (its randomize: block: start "
+        "offset, heading, jump time, current), as its leaderboard ran it; a name in "
+        "configs/suites or a YAML path (default: default)",
     )
     add_out_options(
         p,
@@ -51,6 +62,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help=f"output directory (default {RUN_ROOT}/SCENARIO_CONTROLLER_SEED; refused if not "
         "empty: see --force)",
         resume_help=None,
+    )
+    p.add_argument(
+        "--video",
+        default=None,
+        metavar="FILE",
+        help="also write an animation of the episode: FILE.gif (Pillow) or FILE.mp4 (needs "
+        "ffmpeg: pip install 'shipgym[video]')",
     )
     add_trust_pickle_option(p)
     add_json_option(p, "print the episode's metrics as one JSON object")
@@ -70,15 +88,20 @@ def _file_name(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Check the scenario, the controller and ``--out`` (in that order, before any work),
     run the episode, write its files, print its metrics."""
+    from shipgym.animation import check_video_file
     from shipgym.config import is_path
     from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.trials import trial_scenario
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.registry import applies_to
     from shipgym_baselines.runs import check_out_dir, clear_outputs
+    from shipgym_baselines.suite import load_suite
 
+    suite = load_suite(args.suite)
     scenario = load_scenario(args.scenario)
+    video = None if args.video is None else check_video_file(args.video)
     (label,) = check_controllers([args.controller])
     ship = scenario.model.name
     if not applies_to(label, ship):
@@ -89,17 +112,38 @@ def run(args: argparse.Namespace) -> int:
     out = check_out_dir(args.out or default_out(name, label, args.seed), force=args.force)
     if args.force:
         clear_outputs(out, OUTPUTS)
-    result = evaluate(args.controller, scenario, [args.seed])[0]
+    # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
+    trial = trial_scenario(scenario, suite.randomize, args.seed)
+    result = evaluate(args.controller, trial, [args.seed])[0]
     result.controller, result.scenario = label, args.scenario  # as the leaderboard names them
     row = result.row()
     out.mkdir(parents=True, exist_ok=True)
     (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
-    plot_results([result], out, {args.scenario: scenario})
+    randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
+    plot_results([result], out, {args.scenario: scenario}, randomize)
     plots = sorted(p.name for p in out.glob("*.png"))
+    if video is not None:
+        _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}")
     text = "\n".join(f"{k:24s} {_cell(v)}" for k, v in row.items())
     emit(args, row, text)
-    sys.stderr.write(f"wrote {out}: {METRICS_FILE}, {', '.join(plots)}\n")
+    sys.stderr.write(
+        f"wrote {out}: {METRICS_FILE}, {', '.join(plots)} (suite {suite.name!r}'s trial of "
+        f"seed {args.seed})\n"
+    )
     return 0
+
+
+def _write_video(file: Path, result: Any, trial: Any, title: str) -> None:
+    """The episode's animation as ``file``; its CPU time per frame on stderr."""
+    import numpy as np
+
+    from shipgym.animation import animate_episode
+
+    start = time.process_time()
+    path_xy = trial.path.point(np.linspace(0.0, trial.path.length, 400))
+    frames = animate_episode(result.trajectory, path_xy, trial.ship_length, file, title)
+    cpu = time.process_time() - start
+    sys.stderr.write(f"wrote {file}: {frames} frames, {1000 * cpu / frames:.0f} ms CPU a frame\n")
 
 
 def _cell(value: object) -> str:

@@ -4,6 +4,11 @@
 ``results/agents/<name>/seed_<k>``) and ships each into
 ``baselines/learned/policies/<name>/seed_<k>``; with ``--resume`` a finished run is not
 trained again, so the same command on finished runs only exports them.
+
+``--settings tuned`` trains with the study's chosen settings and the tuning config's
+``final`` block (:mod:`shipgym_baselines.tuning.tuned`; without ``--seeds``, the final
+block's seeds); with ``--resume`` a re-run after a kill exports finished seeds, resumes
+unfinished ones from their checkpoint and starts the ones that reached none afresh.
 """
 
 from __future__ import annotations
@@ -49,6 +54,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_backend_option(p)
     p.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
     p.add_argument(
+        "--settings",
+        choices=("config", "tuned"),
+        default="config",
+        help="config: the agent config as written; tuned: with the chosen settings of its "
+        "study (configs/tuning/chosen/AGENT.yaml) and the final block of "
+        "configs/tuning/AGENT.yaml (budget, plateau, selection, seeds)",
+    )
+    p.add_argument(
+        "--chosen-dir",
+        default=None,
+        help="folder of the chosen settings read by --settings tuned "
+        "(default configs/tuning/chosen)",
+    )
+    p.add_argument(
         "--ship",
         action="store_true",
         help="export each run's best model to baselines/learned/policies/NAME/seed_K "
@@ -72,10 +91,17 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
         names = list_agent_configs()
     else:
         names = [args.agent]
-    seeds = args.seeds or [None]
+    settings = getattr(args, "settings", "config")
     jobs = []
     for name in names:
         config = load_agent_config(args.config or name)
+        tuned_from = None
+        seeds = args.seeds or [None]
+        if settings == "tuned":
+            from shipgym_baselines.tuning.tuned import tuned_agent
+
+            config, tuned_from = tuned_agent(config, getattr(args, "chosen_dir", None))
+            seeds = args.seeds or tuned_from["final"]["seeds"]
         for seed in seeds:
             out = args.out or "results/agents"
             if len(names) > 1 or args.out is None:
@@ -94,6 +120,8 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
                     "force": args.force,
                     "progress": not args.no_progress and len(names) * len(seeds) == 1,
                     "ship": args.ship,
+                    "tuned_from": tuned_from,
+                    "fresh_if_unstarted": True,
                 }
             )
     return jobs

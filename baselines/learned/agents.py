@@ -18,6 +18,7 @@ from pydantic_core import PydanticCustomError
 
 from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
 from shipgym_baselines.errors import ConfigError
+from shipgym_baselines.learned.curves import PlateauRule
 
 ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
 
@@ -27,15 +28,30 @@ class AgentEnvConfig(StrictModel):
     scenario: str | None = None  # or one fixed scenario (needed by vec_env: batched)
     action_mode: Literal["rudder", "guidance"] = "rudder"
     n_envs: int = Field(8, ge=1)
+    #: batched: one batched env (a fixed scenario), or on a distribution one
+    #: ShipTrialsVectorEnv per ship (n_envs split equally; a fresh trial per reset)
     vec_env: Literal["dummy", "subproc", "batched"] = "subproc"
     normalize_reward: bool = True  # VecNormalize(norm_obs=False): the obs is already scaled
+    #: append the controller-context features to the observation (core.CONTEXT_NAMES)
+    context_features: bool = False
+    #: discount in physical time: γ = exp(−Ts/τ) per ship with τ = gamma_seconds [s]
+    #: (PPO and RecurrentPPO on vec_env batched over a distribution); None: hyperparams.gamma
+    gamma_seconds: float | None = Field(None, gt=0)
+    #: reward normalisation per ship (each ship's own running return scale) instead of one
+    #: VecNormalize over all ships (vec_env batched over a distribution, normalize_reward)
+    normalize_per_ship: bool = False
 
     @model_validator(mode="after")
     def _one_source(self) -> AgentEnvConfig:
         if (self.distribution is None) == (self.scenario is None):
             raise ValueError("env: give exactly one of 'distribution' and 'scenario'")
-        if self.vec_env == "batched" and self.scenario is None:
-            raise ValueError("env.vec_env 'batched' steps one fixed scenario: set env.scenario")
+        per_ship = [key for key in ("gamma_seconds", "normalize_per_ship") if getattr(self, key)]
+        if per_ship and not (self.vec_env == "batched" and self.distribution is not None):
+            raise ValueError(
+                f"env.{per_ship[0]} is per ship: it needs vec_env 'batched' on a distribution"
+            )
+        if self.normalize_per_ship and not self.normalize_reward:
+            raise ValueError("env.normalize_per_ship needs env.normalize_reward: true")
         if self.distribution is not None:
             from shipgym.scenarios.sampling import load_distribution
 
@@ -44,6 +60,8 @@ class AgentEnvConfig(StrictModel):
                     f"env.distribution {self.distribution!r} is a test split: agents train on "
                     "a train split only"
                 )
+            if self.vec_env == "batched":
+                ship_env_counts(self.n_envs, len(load_distribution(self.distribution).config.ships))
         if self.scenario is not None and ":" in self.scenario:
             raise ValueError(f"env.scenario {self.scenario!r}: never train on test scenarios")
         return self
@@ -53,6 +71,9 @@ class EvalConfig(StrictModel):
     distribution: str = "validation"
     freq: int = Field(20_000, ge=1)  # env steps between evaluations
     n_episodes: int = Field(8, ge=1)
+    #: what picks the best model: the mean validation return, or the geometric mean of the
+    #: per-trial cost over a reference's (shipgym_baselines.learned.selection)
+    select_on: Literal["return", "relative_cost"] = "return"
 
     @model_validator(mode="after")
     def _not_the_test_set(self) -> EvalConfig:
@@ -75,6 +96,21 @@ class AgentConfig(StrictModel):
     policy_kwargs: dict[str, Any] = Field(default_factory=dict)
     eval: EvalConfig = EvalConfig()
     checkpoint_freq: int = Field(50_000, ge=1)  # env steps between checkpoints
+    #: stop early once validation plateaus (shipgym_baselines.learned.curves.PlateauRule);
+    #: None: train all n_timesteps
+    plateau: PlateauRule | None = None
+
+    @model_validator(mode="after")
+    def _per_ship_discount(self) -> AgentConfig:
+        if self.env.gamma_seconds is not None and self.algo not in ("ppo", "recurrent_ppo"):
+            raise ValueError(
+                f"env.gamma_seconds: a per-env discount is built for the on-policy rollout "
+                f"buffer (ppo, recurrent_ppo), not {self.algo}"
+            )
+        if self.plateau is not None and self.plateau.metric == "selection":
+            if self.eval.select_on != "relative_cost":
+                raise ValueError("plateau.metric 'selection' needs eval.select_on: relative_cost")
+        return self
 
     @field_validator("hyperparams")
     @classmethod
@@ -155,7 +191,7 @@ def algo_class(algo: str) -> type:
     return classes[algo]
 
 
-def _single_env_factory(source: dict[str, Any], action_mode: str):
+def _single_env_factory(source: dict[str, Any], action_mode: str, context_features: bool = False):
     def make() -> Any:
         import gymnasium as gym
 
@@ -163,32 +199,74 @@ def _single_env_factory(source: dict[str, Any], action_mode: str):
 
         if source.get("scenario") is not None:
             return gym.make(
-                "ShipPathFollow-v0", scenario=source["scenario"], action_mode=action_mode
+                "ShipPathFollow-v0",
+                scenario=source["scenario"],
+                action_mode=action_mode,
+                context_features=context_features,
             )
         return gym.make(
             shipgym.RANDOMIZED_ENV_ID,
             distribution=source["distribution"],
             action_mode=action_mode,
+            context_features=context_features,
         )
 
     return make
+
+
+def ship_env_counts(n_envs: int, n_ships: int) -> list[int]:
+    """Envs per ship when ``n_envs`` are split over ``n_ships`` batched envs: equal shares
+    (each ship then gets the same share of env steps); a ValueError (in a config: its
+    ConfigError naming the key) unless ``n_envs`` is a positive multiple of ``n_ships``."""
+    if n_envs < n_ships or n_envs % n_ships:
+        raise ValueError(
+            f"env.n_envs {n_envs}: vec_env 'batched' on a distribution of {n_ships} ships "
+            f"needs a multiple of {n_ships} (one batched env per ship, equal shares)"
+        )
+    return [n_envs // n_ships] * n_ships
+
+
+def make_ship_envs(config: AgentEnvConfig) -> list[Any]:
+    """One :class:`~shipgym.envs.ship_batch.ShipTrialsVectorEnv` per ship of the config's
+    distribution (in the distribution's ship order), ``n_envs`` split equally."""
+    from shipgym.envs.ship_batch import ShipTrialsVectorEnv
+    from shipgym.scenarios.sampling import load_distribution
+
+    dist = load_distribution(config.distribution)
+    counts = ship_env_counts(config.n_envs, len(dist.config.ships))
+    return [
+        ShipTrialsVectorEnv(
+            n, dist, k, config.action_mode, context_features=config.context_features
+        )
+        for k, n in enumerate(counts)
+    ]
 
 
 def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
     """The SB3 VecEnv of a config (DummyVecEnv / SubprocVecEnv / batched), seeded."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecMonitor
 
-    if config.vec_env == "batched":
+    if config.vec_env == "batched" and config.distribution is not None:
+        from shipgym_baselines.learned.vec_env import SB3ShipsVecEnv
+
+        venv = SB3ShipsVecEnv(make_ship_envs(config))
+    elif config.vec_env == "batched":
         from shipgym.envs.vector import ShipPathFollowVectorEnv
         from shipgym_baselines.learned.vec_env import SB3BatchedVecEnv
 
         venv = SB3BatchedVecEnv(
-            ShipPathFollowVectorEnv(config.n_envs, config.scenario, config.action_mode)
+            ShipPathFollowVectorEnv(
+                config.n_envs,
+                config.scenario,
+                config.action_mode,
+                context_features=config.context_features,
+            )
         )
     else:
         factory = _single_env_factory(
             {"scenario": config.scenario, "distribution": config.distribution},
             config.action_mode,
+            config.context_features,
         )
         cls = SubprocVecEnv if config.vec_env == "subproc" and config.n_envs > 1 else DummyVecEnv
         venv = cls([factory] * config.n_envs)
@@ -196,12 +274,16 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
     return VecMonitor(venv)
 
 
-def make_eval_env(config: EvalConfig, action_mode: str, seed: int) -> Any:
+def make_eval_env(
+    config: EvalConfig, action_mode: str, seed: int, context_features: bool = False
+) -> Any:
     """One env cycling through the validation scenarios in order, seeded (reproducible
     model selection)."""
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    factory = _single_env_factory({"distribution": config.distribution}, action_mode)
+    factory = _single_env_factory(
+        {"distribution": config.distribution}, action_mode, context_features
+    )
     venv = DummyVecEnv([factory])
     venv.seed(seed)
     return venv

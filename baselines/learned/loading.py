@@ -59,7 +59,9 @@ def is_pickled(value: Any) -> bool:
     return False
 
 
-def load_data_only(path: Path, algorithm: type, action_mode: str) -> Any:
+def load_data_only(
+    path: Path, algorithm: type, action_mode: str, context_features: bool = False
+) -> Any:
     """The SB3 model of the zip ``path`` saved by ``algorithm`` (an SB3 / sb3-contrib
     class), built without unpickling, on the CPU, for the env's spaces in ``action_mode``."""
     import torch
@@ -81,7 +83,7 @@ def load_data_only(path: Path, algorithm: type, action_mode: str) -> Any:
     if not isinstance(kwargs, dict) or is_pickled(kwargs):
         raise refuse_unpickling(path, "its policy_kwargs hold pickled objects")
     kwargs = {k: v for k, v in kwargs.items() if k != "device"}
-    obs_space, act_space = observation_space(), action_space(action_mode)
+    obs_space, act_space = observation_space(context_features), action_space(action_mode)
     for key, space in (("observation_space", obs_space), ("action_space", act_space)):
         _check_bounds(path, key, data.get(key), space)
     model = algorithm(alias, env=None, device="cpu", _init_setup_model=False)

@@ -49,7 +49,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from shipgym.config import validate_model
 from shipgym.envs.context import ControllerContext
-from shipgym.envs.core import OBS_NAMES
+from shipgym.envs.core import OBS_NAMES, observation_names
 from shipgym_baselines.errors import ControllerError, UnsafeFileError
 from shipgym_baselines.learned.loading import load_data_only
 from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
@@ -157,6 +157,8 @@ class SavedModel:
     path: Path
     algo: str | None
     action_mode: str
+    #: it observes the controller-context features too (trained with context_features)
+    context_features: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -243,15 +245,20 @@ def _folder_model(path: Path) -> Path:
 
 def policy_label(name_or_path: str | Path) -> str:
     """The table name of a learned policy: a shipped policy's name; a folder's name (a
-    ``seed_<k>`` folder with its parent's: ``ppo/seed_1``); for a zip the folder holding it,
-    plus the zip's stem unless it is ``model``."""
+    ``seed_<k>`` folder with its parent's: ``ppo/seed_1``); for an SB3 zip its file's stem
+    (``work/ppo_ship.zip`` → ``ppo_ship``), except a trained agent's own model file
+    (``model.zip``, ``best_model.zip``), which is named as its folder.  ``--name`` (the long
+    form's ``name``) gives any other."""
     path = Path(name_or_path).expanduser()
     if path.suffix == ".zip":
-        stem = "" if path.stem == "model" else f"/{path.stem}"
-        return f"{path.resolve().parent.name}{stem}"
+        return _folder_label(path.resolve().parent) if path.name in MODEL_FILES else path.stem
     if not path.exists():
         return str(name_or_path)
-    path = path.resolve()
+    return _folder_label(path.resolve())
+
+
+def _folder_label(path: Path) -> str:
+    """A trained agent's folder's name (a ``seed_<k>`` folder with its parent's)."""
     return f"{path.parent.name}/{path.name}" if SEED_FOLDER.fullmatch(path.name) else path.name
 
 
@@ -288,10 +295,12 @@ def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
             f"{path}: corrupt model zip: its 'data' is not JSON ({exc})"
         ) from None
     observed = _box_shape(data.get("observation_space"))
-    if observed != (len(OBS_NAMES),):
+    sizes = {(len(observation_names(flag)),): flag for flag in (False, True)}
+    if observed not in sizes:
         raise ControllerError(
             f"{path}: the model observes {_describe(data.get('observation_space'))}; the "
-            f"ShipPathFollow envs observe shape ({len(OBS_NAMES)},) ({', '.join(OBS_NAMES)})"
+            f"ShipPathFollow envs observe shape ({len(OBS_NAMES)},) ({', '.join(OBS_NAMES)}), "
+            f"or ({len(observation_names(True))},) with context_features"
         )
     shape = _box_shape(data.get("action_space"))
     mode = ACTION_MODE_OF_SIZE.get(shape[0]) if shape is not None and len(shape) == 1 else None
@@ -300,7 +309,9 @@ def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
             f"{path}: the model acts in {_describe(data.get('action_space'))}; the env takes "
             "a Box of shape (1,) (action_mode rudder) or (2,) (guidance)"
         )
-    return SavedModel(path=path, algo=detect_algorithm(data), action_mode=mode)
+    return SavedModel(
+        path=path, algo=detect_algorithm(data), action_mode=mode, context_features=sizes[observed]
+    )
 
 
 def _box_shape(space: Any) -> tuple[int, ...] | None:
@@ -402,7 +413,7 @@ def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> P
     )
 
 
-def load_model(path: Path, algo: str, action_mode: str) -> Any:
+def load_model(path: Path, algo: str, action_mode: str, context_features: bool = False) -> Any:
     """The SB3 model of a zip, on the CPU, read as data (:func:`load_data_only`); a zip
     that only unpickling can read is refused unless the command trusts pickles, then
     loaded by SB3; a zip that does not load is a clear error."""
@@ -415,7 +426,7 @@ def load_model(path: Path, algo: str, action_mode: str) -> Any:
             f"{path}: a {name} model needs {package} (pip install {package}): {exc}"
         ) from exc
     try:
-        return load_data_only(path, algorithm, action_mode)
+        return load_data_only(path, algorithm, action_mode, context_features)
     except UnsafeFileError:
         if not pickle_trusted():
             raise
@@ -475,7 +486,11 @@ class LearnedPolicy:
         import torch
 
         torch.set_num_threads(1)  # one small MLP per episode; leaderboard workers share cores
-        self.model = load_model(self.model_path, self.algo, self.action_mode)
+        #: the model reads the controller-context features after the observation: the
+        #: policy appends them from the context at reset (shipgym.envs.core.CONTEXT_NAMES)
+        self.context_features = files.model.context_features
+        self._context_rows: list[np.ndarray] = []
+        self.model = load_model(self.model_path, self.algo, self.action_mode, self.context_features)
         _eval_mode_once(self.model.policy)
         self.obs_normalizer: ObsNormalizer | None = (
             load_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
@@ -487,21 +502,32 @@ class LearnedPolicy:
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
         self._memory = _Memory()
+        self._context_rows = [context.feature_row] if self.context_features else []
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        return self._act_rows(np.asarray(obs)[None], [self._memory])[0]
+        rows = self._with_context(np.asarray(obs)[None], [0])
+        return self._act_rows(rows, [self._memory])[0]
 
     def reset_batch(self, contexts: Sequence[ControllerContext]) -> None:
         """Start one episode per context (envs in lockstep, :meth:`act_batch`)."""
         for context in contexts:
             check_action_mode(self, context)
         self._batch = [_Memory() for _ in contexts]
+        self._context_rows = [c.feature_row for c in contexts] if self.context_features else []
 
     def act_batch(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
         """The actions (one row each) for the observations ``obs`` (one row each) of the
         episodes ``episodes`` (indices into :meth:`reset_batch`'s contexts); each is the
         action :meth:`act` would give in that episode alone, bit for bit."""
-        return self._act_rows(np.asarray(obs), [self._batch[i] for i in episodes])
+        rows = self._with_context(np.asarray(obs), episodes)
+        return self._act_rows(rows, [self._batch[i] for i in episodes])
+
+    def _with_context(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
+        """The env's observations, with the episodes' context features appended when the
+        model reads them (the env's own observation without them)."""
+        if not self.context_features or obs.shape[1] != len(OBS_NAMES):
+            return obs
+        return np.concatenate([obs, np.stack([self._context_rows[i] for i in episodes])], axis=1)
 
     def _act_rows(self, obs: np.ndarray, memories: list[_Memory]) -> np.ndarray:
         if self.obs_normalizer is not None:

@@ -33,6 +33,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from shipgym.limits import worker_count
 from shipgym_baselines.errors import BackendError, RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
@@ -56,17 +58,15 @@ TRAINING_OUTPUTS = (
     "checkpoints",
     "eval",
     "tb",
+    "learning_curve.json",
+    "tuned_from.json",
 )
+#: the chosen settings a run was started with (``--settings tuned``; null: the config's)
+TUNED_FROM_FILE = "tuned_from.json"
 
 
 def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
-    from stable_baselines3.common.callbacks import (
-        BaseCallback,
-        CallbackList,
-        CheckpointCallback,
-        EvalCallback,
-    )
-    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+    from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 
     class _Progress(BaseCallback):
         """tqdm bar on stderr, and the wall-time counter saved beside each checkpoint."""
@@ -119,10 +119,66 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         save_replay_buffer=off_policy,
         save_vecnormalize=True,
     )
-    eval_env = make_eval_env(config.eval, config.env.action_mode, seed=config.seed)
+    if config.eval.select_on == "relative_cost":
+        evaluation = _relative_cost_callback(config, out, n_envs, wall_offset > 0)
+    else:
+        evaluation = _return_callback(config, out, n_envs, wall_offset > 0)
+    callbacks = CallbackList([progress_cb, checkpoint, evaluation])
+    return callbacks, progress_cb, evaluation.curves
+
+
+class _Curves:
+    """Bookkeeping of the periodic validation: the learning curve it writes after every
+    evaluation (``learning_curve.json``) and the plateau rule's verdict."""
+
+    def __init__(self, config: AgentConfig, out: Path) -> None:
+        self.config, self.out = config, out
+        self.stopped_at: int | None = None
+
+    def after_evaluation(
+        self, steps: list[int], returns: list[list[float]], selection: list[float] | None
+    ) -> bool:
+        """Write the curve; False (stop training) when the plateau rule says so."""
+        from shipgym_baselines.learned.curves import write_curve
+
+        write_curve(self.out, steps, returns, selection)
+        rule = self.config.plateau
+        if rule is None:
+            return True
+        values = (
+            selection if rule.metric == "selection" else [float(sum(r) / len(r)) for r in returns]
+        )
+        if rule.plateaued(steps, values):
+            self.stopped_at = int(steps[-1])
+            return False
+        return True
+
+
+def _return_callback(config: AgentConfig, out: Path, n_envs: int, resuming: bool):
+    """SB3's EvalCallback on the validation env (best model by mean return), writing the
+    learning curve and applying the plateau rule after each evaluation."""
+    from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    curves = _Curves(config, out)
+
+    class _AfterEval(BaseCallback):
+        def _on_step(self) -> bool:
+            parent = self.parent
+            return curves.after_evaluation(
+                parent.evaluations_timesteps, parent.evaluations_results, None
+            )
+
+    eval_env = make_eval_env(
+        config.eval,
+        config.env.action_mode,
+        seed=config.seed,
+        context_features=config.env.context_features,
+    )
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
     evaluation = EvalCallback(
         eval_env,
+        callback_after_eval=_AfterEval(),
         best_model_save_path=str(out),
         log_path=str(out / "eval"),
         eval_freq=max(config.eval.freq // n_envs, 1),
@@ -130,8 +186,9 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         deterministic=True,
         verbose=0,
     )
+    evaluation.curves = curves
     previous = out / "eval" / "evaluations.npz"
-    if wall_offset > 0 and previous.is_file():  # resuming: keep the history and the best
+    if resuming and previous.is_file():  # resuming: keep the history and the best
         import numpy as np
 
         data = np.load(previous)
@@ -139,7 +196,79 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         evaluation.evaluations_results = data["results"].tolist()
         evaluation.evaluations_length = data["ep_lengths"].tolist()
         evaluation.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
-    return CallbackList([progress_cb, checkpoint, evaluation]), progress_cb
+    return evaluation
+
+
+def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resuming: bool):
+    """Every ``eval.freq`` env steps: the agent on the fixed validation trials, scored by
+    the geometric-mean cost ratio to the reference (:mod:`shipgym_baselines.learned.
+    selection`); the best (lowest) model saved as ``best_model.zip``."""
+    import numpy as np
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from shipgym_baselines.learned.selection import (
+        evaluate_relative,
+        reference_costs,
+        validation_trials,
+    )
+
+    trials = validation_trials(config.eval.distribution, config.eval.n_episodes)
+    references = reference_costs(trials, out / "eval")  # once per run
+    curves = _Curves(config, out)
+    history = out / "eval" / "selection.json"
+
+    class _RelativeCostEval(BaseCallback):
+        def __init__(self) -> None:
+            super().__init__()
+            self.freq = max(config.eval.freq // n_envs, 1)
+            self.steps: list[int] = []
+            self.returns: list[list[float]] = []
+            self.selection: list[float] = []
+            self.best = float("inf")
+            if resuming and history.is_file():
+                data = json.loads(history.read_text())
+                self.steps, self.returns = data["env_steps"], data["returns"]
+                self.selection = data["selection"]
+                self.best = min(self.selection, default=float("inf"))
+            self.curves = curves
+
+        def _on_step(self) -> bool:
+            if self.n_calls % self.freq:
+                return True
+            found = evaluate_relative(
+                self.model,
+                trials,
+                references,
+                config.env.action_mode,
+                config.env.context_features,
+            )
+            self.steps.append(int(self.num_timesteps))
+            self.returns.append(found["returns"])
+            self.selection.append(found["selection"])
+            history.parent.mkdir(parents=True, exist_ok=True)
+            history.write_text(
+                json.dumps(
+                    {
+                        "env_steps": self.steps,
+                        "returns": self.returns,
+                        "selection": self.selection,
+                        "trials": [list(t) for t in trials],
+                        "references": references,
+                    }
+                )
+            )
+            np.savez(
+                out / "eval" / "evaluations.npz",
+                timesteps=np.array(self.steps),
+                results=np.array(self.returns),
+                ep_lengths=np.zeros_like(np.array(self.returns)),
+            )
+            if found["selection"] < self.best:
+                self.best = found["selection"]
+                self.model.save(str(out / "best_model.zip"))
+            return curves.after_evaluation(self.steps, self.returns, self.selection)
+
+    return _RelativeCostEval()
 
 
 def latest_checkpoint(out: Path) -> tuple[Path, int] | None:
@@ -160,11 +289,14 @@ def train(
     progress: bool = True,
     tensorboard: bool = True,
     force: bool = False,
+    tuned_from: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Train (or resume) an agent; returns the meta written to ``out_dir/meta.json``.
 
     Without ``resume``, an ``out_dir`` that is not empty is refused (:class:`RunError`)
-    unless ``force`` (its earlier outputs are removed first)."""
+    unless ``force`` (its earlier outputs are removed first).  ``tuned_from``: the study
+    settings applied to ``config`` (:func:`shipgym_baselines.tuning.tuned.tuned_agent`),
+    recorded in the meta; a resumed run must be resumed with the settings it started with."""
     import stable_baselines3
     import torch
     from stable_baselines3.common.vec_env import VecNormalize
@@ -193,6 +325,7 @@ def train(
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
         raise RunError(f"--resume: no checkpoint in {out / 'checkpoints'}")
+    _check_tuned_from(out, tuned_from, resuming=previous is not None)
     if previous is not None and previous[1] >= config.n_timesteps:
         raise RunError(
             f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
@@ -212,11 +345,23 @@ def train(
             f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed"
         )
     venv = make_training_env(config.env, env_seed)
-    gamma = float(config.hyperparams.get("gamma", 0.99))
+    gamma: Any = float(config.hyperparams.get("gamma", 0.99))
+    groups = None
+    if config.env.gamma_seconds is not None or config.env.normalize_per_ship:
+        from shipgym_baselines.learned.per_ship import env_gammas, ship_groups
+
+        ship_envs = venv.venv.envs  # VecMonitor(SB3ShipsVecEnv): one env per ship
+        groups = ship_groups(ship_envs)
+        if config.env.gamma_seconds is not None:
+            gamma = env_gammas(ship_envs, config.env.gamma_seconds)
     wall_offset = 0.0
     if previous is not None:
         ckpt, steps = previous
-        if config.env.normalize_reward:
+        if config.env.normalize_per_ship:  # its statistics are not checkpointed: re-estimated
+            from shipgym_baselines.learned.per_ship import VecNormalizePerShip
+
+            venv = VecNormalizePerShip(venv, groups, gamma)
+        elif config.env.normalize_reward:
             venv = VecNormalize.load(
                 str(out / "checkpoints" / f"ckpt_vecnormalize_{steps}_steps.pkl"), venv
             )
@@ -228,7 +373,12 @@ def train(
         if state_file.is_file():
             wall_offset = float(json.loads(state_file.read_text())["wall_time_s"])
     else:
-        if config.env.normalize_reward:
+        if config.env.normalize_per_ship:
+            from shipgym_baselines.learned.per_ship import VecNormalizePerShip
+
+            venv = VecNormalizePerShip(venv, groups, gamma)
+        elif config.env.normalize_reward:
+            # an array γ (gamma_seconds) broadcasts over the envs in VecNormalize's returns
             venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
         tb = None
         if tensorboard:
@@ -247,7 +397,13 @@ def train(
             verbose=0,
             **build_hyperparams(config, venv.action_space.shape[0]),
         )
-    callbacks, progress_cb = _callbacks(config, out, config.env.n_envs, progress, wall_offset)
+    if config.env.gamma_seconds is not None:
+        # the rollout buffer's GAE broadcasts an (n_envs,) γ: each env its ship's
+        # exp(−Ts/τ); SB3's time-limit bootstrap keeps the scalar hyperparams γ
+        model.rollout_buffer.gamma = np.asarray(gamma)
+    callbacks, progress_cb, curves = _callbacks(
+        config, out, config.env.n_envs, progress, wall_offset
+    )
     remaining = config.n_timesteps - model.num_timesteps
     if remaining > 0:
         model.learn(
@@ -266,6 +422,10 @@ def train(
         "seed": config.seed,
         "training": config.env.distribution or config.env.scenario,
         "config": config.model_dump(),
+        "selection": config.eval.select_on,
+        "plateau": None if config.plateau is None else config.plateau.model_dump(),
+        "stopped_on_plateau_at": curves.stopped_at,
+        "tuned_from": tuned_from,
         "versions": {
             "shipgym": shipgym.__version__,
             "stable_baselines3": stable_baselines3.__version__,
@@ -276,6 +436,30 @@ def train(
     save_obs_statistics(venv, out)
     venv.close()
     return meta
+
+
+def _check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bool) -> None:
+    """A fresh run records the settings it starts with (``tuned_from.json``); a resumed one
+    is refused if they changed since (e.g. a study rewrote the chosen settings)."""
+    file = out / TUNED_FROM_FILE
+    record = json.loads(json.dumps(tuned_from))  # as JSON reads it back
+    if resuming and file.is_file():
+        started = json.loads(file.read_text())
+        if _substance(started) != _substance(record):
+            raise RunError(
+                f"--resume: {out} was started with other settings ({file}); train it "
+                "afresh with --force, or resume with the settings it started with"
+            )
+        return
+    file.write_text(json.dumps(record, indent=2))
+
+
+def _substance(tuned_from: dict[str, Any] | None) -> Any:
+    """What a resumed run must share with its start: the applied settings and final block
+    (not where the files lie: a moved checkout resumes)."""
+    if tuned_from is None:
+        return None
+    return {key: tuned_from.get(key) for key in ("settings", "final")}
 
 
 def save_obs_statistics(venv: Any, out: Path) -> Path | None:
@@ -308,9 +492,16 @@ def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:
     check_out_dir(out, force=force, note=f" (agent folder of {name})")
 
 
-#: the files of a policy folder (what LearnedPolicy reads), written by export_policy (and
-#: the pickled statistics an earlier version exported, removed on export)
-POLICY_FILES = ("model.zip", "meta.json", "vecnormalize.json", "vecnormalize.pkl")
+#: the files of a policy folder (what LearnedPolicy reads, and the run's learning curve),
+#: written by export_policy (and the pickled statistics an earlier version exported,
+#: removed on export)
+POLICY_FILES = (
+    "model.zip",
+    "meta.json",
+    "vecnormalize.json",
+    "learning_curve.json",
+    "vecnormalize.pkl",
+)
 
 
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
@@ -329,9 +520,9 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     shutil.copyfile(src / "meta.json", target / "meta.json")
     for name in POLICY_FILES[2:]:
         (target / name).unlink(missing_ok=True)  # not a stale one
-    statistics = src / POLICY_FILES[2]
-    if statistics.is_file():
-        shutil.copyfile(statistics, target / statistics.name)
+    for name in POLICY_FILES[2:4]:  # the observation statistics and the learning curve
+        if (src / name).is_file():
+            shutil.copyfile(src / name, target / name)
     return target
 
 
@@ -360,20 +551,30 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
 
     ``job``: ``config`` (name, path or AgentConfig), ``out_dir``, optional ``seed``,
     ``n_timesteps``, ``resume``, ``force``, ``progress``, ``ship`` (export to the shipped
-    policies, :func:`ship_policy`).
+    policies, :func:`ship_policy`), ``tuned_from`` (recorded in the meta),
+    ``fresh_if_unstarted`` (with ``resume``: a run without a checkpoint, killed before its
+    first one or never started, is trained afresh instead of refused).
     """
     config = job["config"]
     if not isinstance(config, AgentConfig):
         config = load_agent_config(config)
+    resume, force = job.get("resume", False), job.get("force", False)
+    if resume and job.get("fresh_if_unstarted"):
+        # a sweep re-run after a kill: a run that reached no checkpoint (and saved no
+        # model) starts afresh; its partial logs are all it had
+        out = Path(job["out_dir"])
+        if latest_checkpoint(out) is None and not (out / "model.zip").is_file():
+            resume, force = False, True
     meta = train(
         config,
         out_dir=job["out_dir"],
         seed=job.get("seed"),
         n_timesteps=job.get("n_timesteps"),
-        resume=job.get("resume", False),
+        resume=resume,
         progress=job.get("progress", False),
         tensorboard=job.get("tensorboard", True),
-        force=job.get("force", False),
+        force=force,
+        tuned_from=job.get("tuned_from"),
     )
     if job.get("ship"):
         meta["shipped_to"] = str(ship_policy(job["out_dir"]))

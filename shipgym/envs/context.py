@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.envs.core import scenario_context_row
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios import Scenario
@@ -40,6 +41,9 @@ class ControllerContext:
     #: the scenario's reward weights (``reward:`` block: w_ψ, w_δ, w_Δ, goal bonus): the task's
     #: objective, public like the path
     reward: Any
+    #: the observation's optional context features of this context (core.CONTEXT_NAMES,
+    #: scaled as the env's ``context_features=True`` gives them): from the nominal model
+    feature_row: np.ndarray
 
     @classmethod
     def of(cls, scenario: Scenario, action_mode: str) -> ControllerContext:
@@ -64,6 +68,7 @@ class ControllerContext:
             action_mode=action_mode,
             guidance=sc.config.guidance,
             reward=sc.config.reward,
+            feature_row=scenario_context_row(sc),
         )
 
     @property

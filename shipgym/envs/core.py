@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.utils import seeding
 
 from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains, pid_step
@@ -36,6 +37,7 @@ from shipgym.disturbances import Disturbances
 from shipgym.guidance import desired_heading
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
+from shipgym.numerics import ARRAY
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.events import ParameterSchedule
 from shipgym.scenarios.loader import nominal_nomoto
@@ -61,6 +63,21 @@ OBS_NAMES = (
 )
 OBS_LOW = np.array([-1, -1, -1, -1, -1, -1, 0, -1, 0], dtype=np.float32)
 OBS_HIGH = np.array([1, 1, 1, 1, 1, 1, 2, 1, 1], dtype=np.float32)
+
+#: the optional controller-context features (``context_features=True``), appended after
+#: :data:`OBS_NAMES`: what a classical controller is designed from (the nominal model's
+#: first-order Nomoto K, T; L, U0, Ts, δmax), never the truth (docs/observation.md)
+CONTEXT_NAMES = (
+    "nominal_gain",
+    "nominal_time_constant",
+    "time_constant_steps",
+    "ship_length",
+    "nominal_speed",
+    "control_period",
+    "rudder_limit",
+)
+CONTEXT_LOW = np.zeros(len(CONTEXT_NAMES), dtype=np.float32)
+CONTEXT_HIGH = np.full(len(CONTEXT_NAMES), 2.0, dtype=np.float32)
 
 #: guidance action: a0 scales the law's length scale (LOS R_LOS = nL, look-ahead / TVVF Δ,
 #: VF τ) by 2^a0 ∈ [½, 2]; a1 → course offset a1·30°.
@@ -112,9 +129,24 @@ class StepConstants:
         )
 
 
-def observation_space() -> spaces.Box:
-    """The envs' observation space: :data:`OBS_NAMES`, scaled to [OBS_LOW, OBS_HIGH]."""
-    return spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
+def observation_bounds(context_features: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) of the observation: :data:`OBS_NAMES`, then :data:`CONTEXT_NAMES` when
+    ``context_features``."""
+    if not context_features:
+        return OBS_LOW, OBS_HIGH
+    return np.concatenate([OBS_LOW, CONTEXT_LOW]), np.concatenate([OBS_HIGH, CONTEXT_HIGH])
+
+
+def observation_space(context_features: bool = False) -> spaces.Box:
+    """The envs' observation space: :data:`OBS_NAMES` (and :data:`CONTEXT_NAMES` when
+    ``context_features``), scaled to their bounds."""
+    low, high = observation_bounds(context_features)
+    return spaces.Box(low, high, dtype=np.float32)
+
+
+def observation_names(context_features: bool = False) -> tuple[str, ...]:
+    """The names of the observation's entries, in order."""
+    return OBS_NAMES + (CONTEXT_NAMES if context_features else ())
 
 
 def action_space(action_mode: str) -> spaces.Box:
@@ -125,7 +157,8 @@ def action_space(action_mode: str) -> spaces.Box:
 
 @dataclasses.dataclass
 class EnvParts:
-    """Everything an env builds from its scenario, for one ship (``batch=None``) or N."""
+    """Everything an env builds from its scenario, for one ship (``batch=None``) or N
+    (the plant mapped over them on ``threads`` threads, :class:`PeriodIntegrator`)."""
 
     scenario: Scenario
     action_mode: str
@@ -135,12 +168,20 @@ class EnvParts:
     tracker: PathTracker
     observation_space: spaces.Box
     action_space: spaces.Box
+    #: the controller-context features (CONTEXT_NAMES, scaled), or an empty array when off
+    context_row: np.ndarray
     metric_settings: MetricSettings
     autopilot_gains: PIDGains | None  # guidance mode: the heading PID's gains
 
     @classmethod
     def build(
-        cls, scenario: Scenario, action_mode: str, compile: bool, batch: int | None = None
+        cls,
+        scenario: Scenario,
+        action_mode: str,
+        compile: bool,
+        batch: int | None = None,
+        context_features: bool = False,
+        threads: int = 2,
     ) -> EnvParts:
         if action_mode not in ACTION_MODES:
             raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
@@ -148,7 +189,12 @@ class EnvParts:
         k = StepConstants.of(sc)
         model = sc.model
         integrator = PeriodIntegrator(
-            model, k.fine_step, k.substeps, compile=compile, batch=1 if batch is None else batch
+            model,
+            k.fine_step,
+            k.substeps,
+            compile=compile,
+            batch=1 if batch is None else batch,
+            threads=threads,
         )
         disturbances = Disturbances(
             sc.config.disturbances,
@@ -170,9 +216,10 @@ class EnvParts:
             integrator=integrator,
             disturbances=disturbances,
             tracker=tracker,
-            observation_space=observation_space(),
+            observation_space=observation_space(context_features),
             action_space=action_space(action_mode),
-            metric_settings=MetricSettings(convergence_threshold=sc.config.convergence_threshold),
+            context_row=scenario_context_row(sc) if context_features else _NO_CONTEXT,
+            metric_settings=metric_settings(sc),
             autopilot_gains=gains,
         )
 
@@ -301,6 +348,113 @@ def observation_columns(
     )
 
 
+def reseed_rows(
+    rngs: list[np.random.Generator | None],
+    seed: int | list[int | None] | None,
+    options: dict | None,
+) -> np.ndarray:
+    """A batched env's ``reset(seed=…, options=…)`` arguments applied to its per-env
+    generators ``rngs`` (in place), as SyncVectorEnv does: an int seeds env i with
+    ``seed + i``, a list one seed per env, None keeps a seeded generator (and seeds a
+    missing one from entropy); ``options["reset_mask"]`` resets only the masked envs.
+    Returns the mask of the envs to reset."""
+    n = len(rngs)
+    if seed is None or isinstance(seed, int):
+        seeds = [None if seed is None else seed + i for i in range(n)]
+    else:
+        if len(seed) != n:
+            raise ValueError(f"need {n} seeds, got {len(seed)}")
+        seeds = list(seed)
+    mask = np.ones(n, dtype=bool)
+    if options and "reset_mask" in options:  # as SyncVectorEnv: reset only these envs
+        mask = np.asarray(options["reset_mask"], dtype=bool)
+        if mask.shape != (n,):
+            raise ValueError(f"reset_mask must have shape ({n},)")
+    for i, s in enumerate(seeds):
+        if mask[i] and (s is not None or rngs[i] is None):
+            rngs[i], _ = seeding.np_random(s)
+    return mask
+
+
+def batch_observation(
+    frame: TrackFrame,
+    heading: np.ndarray,
+    yaw_rate: np.ndarray,
+    rudder_angle: np.ndarray,
+    rudder_command: np.ndarray,
+    speed: np.ndarray,
+    k: StepConstants,
+    context: np.ndarray | None = None,
+) -> np.ndarray:
+    """The (N, 9) float32 observations of N envs (:func:`observation_columns` on arrays,
+    clipped to the observation bounds), with ``context`` ((N, C) or (C,): the
+    controller-context features, float32) appended when given: the batched envs' one
+    observation."""
+    columns = observation_columns(
+        frame, heading, yaw_rate, rudder_angle, rudder_command, speed, k, ARRAY
+    )
+    obs = np.stack(columns, axis=1).astype(np.float32)
+    np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+    if context is None:
+        return obs
+    return np.concatenate(
+        [obs, np.broadcast_to(context, (obs.shape[0], context.shape[-1]))], axis=1
+    )
+
+
+def context_columns(
+    gain: float,
+    time_constant: float,
+    ship_length: float,
+    nominal_speed: float,
+    control_period: float,
+    rudder_limit: float,
+) -> tuple[float, ...]:
+    """The 7 context features (CONTEXT_NAMES) from the nominal first-order Nomoto model
+    K [1/s], T [s], the ship length L [m], nominal speed U0 [m/s], control period Ts [s] and
+    rudder limit δmax [rad]; each scaled into [0, 2] over the suite's ships (clipped by the
+    caller; docs/observation.md):
+
+    0 K'/2 = K·L/U0 / 2, 1 T'/2 = T·U0/L / 2 (Nomoto's non-dimensional gain and time
+    constant), 2 log10(T/Ts)/2 (T in control periods), 3 log10(L / 0.1 m)/4,
+    4 log10(U0 / 0.1 m/s)/2, 5 2·Ts·U0/L (ship lengths run per control period),
+    6 δmax / (π/4).
+    """
+    length_time = ship_length / nominal_speed  # L/U0 [s]
+    return (
+        gain * length_time / 2.0,
+        time_constant / length_time / 2.0,
+        math.log10(max(time_constant / control_period, 1.0)) / 2.0,
+        math.log10(max(ship_length / 0.1, 1.0)) / 4.0,
+        math.log10(max(nominal_speed / 0.1, 1.0)) / 2.0,
+        2.0 * control_period / length_time,
+        rudder_limit / (math.pi / 4.0),
+    )
+
+
+def scenario_context_row(scenario: Scenario) -> np.ndarray:
+    """The context features of a scenario (float32, clipped): from its *nominal* model and
+    timing only (:func:`context_columns`), so that trials differing only in their true
+    parameters or event schedule give the same row."""
+    sc = scenario
+    gain, time_constant = nominal_nomoto(sc)
+    row = np.array(
+        context_columns(
+            gain,
+            time_constant,
+            sc.ship_length,
+            sc.model.nominal_speed,
+            sc.control_period,
+            sc.model.rudder_limit,
+        ),
+        dtype=np.float32,
+    )
+    return np.clip(row, CONTEXT_LOW, CONTEXT_HIGH, out=row)
+
+
+_NO_CONTEXT = np.zeros(0, dtype=np.float32)
+
+
 def info_values(
     t: Any,
     frame: TrackFrame,
@@ -336,3 +490,21 @@ def episode_log(
         goal_bonus=scenario.config.reward.goal_bonus,
         dt=scenario.control_period,
     )
+
+
+def metric_settings(scenario: Scenario) -> MetricSettings:
+    """The episode metrics' settings of ``scenario`` (its convergence threshold)."""
+    return MetricSettings(convergence_threshold=scenario.config.convergence_threshold)
+
+
+def batch_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """A batched env's actions (n_envs, n_act) as float64, clipped to [-1, 1]; NaN or inf
+    in any env's row is an error naming those envs (before anything steps)."""
+    a = np.asarray(actions, dtype=np.float64).reshape(shape)
+    bad = ~np.all(np.isfinite(a), axis=1)
+    if np.any(bad):
+        raise ValueError(
+            f"actions of envs {np.flatnonzero(bad).tolist()} contain NaN or inf; "
+            "the env state is unchanged"
+        )
+    return np.clip(a, -1.0, 1.0)

@@ -17,6 +17,11 @@ Observation (float32, 9 entries, each within its documented bound):
     7  Δψ_next / π                     path-angle change to the next leg
     8  d_next / (d_next + 10 L)        distance to the next waypoint, squashed to [0, 1)
 
+With ``context_features=True`` (a ``gym.make`` argument, default off) 7 entries follow: the
+controller context a classical controller is designed from (the nominal model's first-order
+Nomoto K and T, L, U0, Ts, δmax; :func:`shipgym.envs.core.context_columns`, table in
+docs/observation.md), constant over an episode, never the true parameters or the schedule.
+
 Reward, termination, observation and info are the step core of :mod:`shipgym.envs.core`
 (the same functions as the batched env); its docstring gives the reward.
 
@@ -53,7 +58,151 @@ __all__ = ["GUIDANCE_OFFSET_MAX", "OBS_NAMES", "ShipPathFollowEnv"]
 
 
 class ShipPathFollowEnv(gym.Env):
-    """Path following of one ship under scheduled parameter changes (see module doc)."""
+    """Path following of one ship under scheduled parameter changes.
+
+    The single source of every ``ShipPathFollow-*`` env id's documentation page (the docs
+    add each id's numbers: ship, default scenario, Ts, h, δmax, L, U0, e_max).
+
+    .. rubric:: Description
+
+    One ship (a 2nd-order Nomoto model or a 3-DOF manoeuvring model, :mod:`shipgym.models`)
+    follows a reference path (waypoints with leg switching, or a PCHIP curve) while its
+    dynamics change at scheduled times (rudder aging, a current shift, a manoeuvrability
+    change: the scenario's ``events``).  One ``step`` is one control period Ts; inside it the
+    plant is integrated with RK4 at the fine step h, with the servo and rudder limits, the
+    disturbances and the true parameters acting now.  The agent sees measurements only; the
+    reward is computed from the true state.
+
+    .. rubric:: Action space
+
+    ``action_mode="rudder"`` (default): ``Box(-1, 1, (1,), float32)``; the rudder command is
+    δc = a·δmax [rad].
+
+    ``action_mode="guidance"``: ``Box(-1, 1, (2,), float32)``; a0 scales the guidance law's
+    length scale (LOS radius R_LOS = n·L, look-ahead / TVVF Δ, VF τ) by 2^a0 ∈ [½, 2], a1 adds
+    a course offset a1·30°; the heading loop is closed inside the env by the PID autopilot
+    of :mod:`shipgym.autopilot`, pole-placed (ωn = 1 rad/s, ζ = 1) on the nominal model's
+    first-order Nomoto approximation.  With a = 0 and the LOS law it is the ``pid_los``
+    baseline.
+
+    .. rubric:: Observation space
+
+    ``Box(low, high, (9,), float32)``, from measurements (sensor noise included) only; ψ̃ is
+    the heading error, the path angle minus the measured heading:
+
+    .. list-table::
+       :header-rows: 1
+
+       * - index
+         - name
+         - quantity and scaling
+         - unit before scaling
+         - bounds
+       * - 0
+         - ``cross_track``
+         - ``e / e_max``
+         - m
+         - [-1, 1]
+       * - 1
+         - ``sin_heading_error``
+         - ``sin ψ̃``
+         - rad
+         - [-1, 1]
+       * - 2
+         - ``cos_heading_error``
+         - ``cos ψ̃``
+         - rad
+         - [-1, 1]
+       * - 3
+         - ``yaw_rate``
+         - ``r / (2 u0 / L)``, clipped
+         - rad/s
+         - [-1, 1]
+       * - 4
+         - ``rudder_angle``
+         - ``δ / δmax``
+         - rad
+         - [-1, 1]
+       * - 5
+         - ``last_rudder_command``
+         - ``δc_prev / δmax``
+         - rad
+         - [-1, 1]
+       * - 6
+         - ``speed``
+         - ``U / U0``, clipped
+         - m/s
+         - [0, 2]
+       * - 7
+         - ``next_angle_change``
+         - ``Δψ_next / π``, path-angle change to the next leg
+         - rad
+         - [-1, 1]
+       * - 8
+         - ``next_distance``
+         - ``d_next / (d_next + 10 L)``, distance to the next waypoint
+         - m
+         - [0, 1)
+
+    .. rubric:: Reward
+
+    Per step, from the true state (the score, the same for every controller)::
+
+        r = −(|e|/L + w_ψ·|ψ̃| + w_δ·(δc/δmax)² + w_Δ·(Δδc/δmax)²)
+
+    with defaults w_ψ = 0.1, w_δ = 0.01, w_Δ = 0.05 (the scenario's ``reward:``).  While the
+    ship is inside the corridor each term is bounded: ``0 ≤ |e|/L ≤ e_max/L`` (10 by
+    default), ``0 ≤ w_ψ·|ψ̃| ≤ w_ψ·π``, ``0 ≤ w_δ·(δc/δmax)² ≤ w_δ``,
+    ``0 ≤ w_Δ·(Δδc/δmax)² ≤ 4·w_Δ``, so ``r ∈ [−(e_max/L + w_ψ·π + w_δ + 4·w_Δ), 0]``.
+    Reaching the last waypoint adds ``goal_bonus`` (+10).  Leaving the corridor adds a
+    penalty equal to staying at its edge for the rest of the time limit,
+    ``−(e_max/L)·(steps left)``, so that leaving is never cheaper than staying; a
+    non-finite plant state is charged the same from the step before.
+
+    .. rubric:: Starting state
+
+    The scenario's ``initial_state`` (x, y [m], heading [deg], other states SI; default: the
+    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.  A
+    suite's ``randomize:`` block (:class:`shipgym.scenarios.trials.TrialRandomization`) moves
+    it per evaluation seed; the env's seed draws sensor noise and stochastic currents and
+    waves.
+
+    .. rubric:: Episode end
+
+    Terminated: the last waypoint is reached (``termination_reason = "goal"``), the ship
+    leaves the corridor ``|e| > e_max`` (``"corridor"``, e_max = 10 L by default), or the
+    plant state is not finite (``"non_finite_state"``).  Truncated: the scenario's
+    ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last
+    step ``info`` also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).
+
+    .. rubric:: Arguments
+
+    ``gym.make(ENV_ID, scenario=..., action_mode="rudder", render_mode=None, compile=True)``
+
+    * ``scenario``: a catalogue name (``shipgym scenarios``), a held-out test scenario
+      (``"heldout:3"``), a path to a YAML file or a :class:`shipgym.scenarios.Scenario`;
+      default: the id's scenario.
+    * ``action_mode``: ``"rudder"`` or ``"guidance"``.
+    * ``render_mode``: None, ``"rgb_array"`` or ``"human"``.
+    * ``compile``: compile the CasADi period function to C (cached per machine); False
+      uses CasADi's VM (the same bits, slower).
+
+    ``gym.make_vec(ENV_ID, num_envs=N)`` returns the batched
+    :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit).
+    Processes that have not imported ``shipgym`` use ``gym.make("shipgym:ENV_ID")``.
+
+    .. rubric:: Version history
+
+    What ``gym.make(id)`` returns never changes under an id; a new default is a new version.
+
+    * ``-v0``: ``ShipPathFollow-v0`` (nomoto2, ``rudder_aging``);
+      ``ShipPathFollow-EssoOsaka-v0``, ``-Mariner-v0``, ``-Blanke-v0`` (defaults
+      ``osaka_stochastic_current``, ``mariner_track``, ``blanke_current_shift``:
+      disturbances only, no change of dynamics; kept, Gymnasium warns that a ``-v1``
+      exists).
+    * ``-v1`` (EssoOsaka, Mariner, Blanke; issue 18): the same env, defaulting to the ship's
+      ``{ship}_rudder_aging`` (a changing plant).
+    """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
 
@@ -63,6 +212,7 @@ class ShipPathFollowEnv(gym.Env):
         action_mode: str = "rudder",
         render_mode: str | None = None,
         compile: bool = True,
+        context_features: bool = False,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
@@ -70,8 +220,12 @@ class ShipPathFollowEnv(gym.Env):
                 f"got {render_mode!r}"
             )
         self.scenario: Scenario = load_scenario(scenario)
-        parts = core.EnvParts.build(self.scenario, action_mode, compile)
+        parts = core.EnvParts.build(
+            self.scenario, action_mode, compile, context_features=context_features
+        )
         self._parts = parts
+        #: the observation ends with the controller-context features (core.CONTEXT_NAMES)
+        self.context_features = context_features
         self.action_mode = action_mode
         self.render_mode = render_mode
         self.model = self.scenario.model
@@ -229,7 +383,10 @@ class ShipPathFollowEnv(gym.Env):
             ),
             dtype=np.float32,
         )
-        return np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        if self.context_features:
+            return np.concatenate([obs, self._parts.context_row])
+        return obs
 
     def _info(self, frame: Any) -> dict[str, Any]:
         x, k = self._state, self._k

@@ -29,7 +29,37 @@ from shipgym.scenarios.sampling import (
 
 
 class ShipPathFollowRandomizedEnv(gym.Env):
-    """A new scenario from ``distribution`` at every reset (module doc)."""
+    """A new scenario from ``distribution`` at every reset: the training env of learned agents.
+
+    .. rubric:: Description
+
+    Every ``reset`` draws a scenario from a scenario distribution (``configs/distributions``:
+    ``train``, ``validation``, ``heldout``) with the env's own seeded generator and runs it in
+    an ordinary :class:`~shipgym.envs.path_follow.ShipPathFollowEnv`; ``reset(seed=s)`` is
+    reproducible.
+
+    .. rubric:: Action space, observation space, reward, episode end
+
+    Those of :class:`~shipgym.envs.path_follow.ShipPathFollowEnv` (see any
+    ``ShipPathFollow-*`` page): they do not depend on the scenario, so one policy serves the
+    whole distribution.  ``info`` has no ``samples`` (their number per step, Ts/h, differs
+    between the ships of a distribution).
+
+    .. rubric:: Starting state
+
+    The drawn scenario's ``initial_state``.
+
+    .. rubric:: Arguments
+
+    ``gym.make("ShipPathFollowRandomized-v0", distribution="train", action_mode="rudder",
+    render_mode=None, compile=True)``; ``distribution``: a name in ``configs/distributions``
+    or a :class:`~shipgym.scenarios.sampling.ScenarioDistribution`; on a test split
+    ``reset(options={"index": i})`` picks the i-th test scenario.
+
+    .. rubric:: Version history
+
+    ``-v0``: the only version.
+    """
 
     metadata: ClassVar[dict[str, Any]] = ShipPathFollowEnv.metadata
 
@@ -39,6 +69,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         action_mode: str = "rudder",
         render_mode: str | None = None,
         compile: bool = True,
+        context_features: bool = False,
     ) -> None:
         self.distribution = (
             distribution
@@ -48,6 +79,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         self.action_mode = action_mode
         self.render_mode = render_mode
         self._compile = compile
+        self.context_features = context_features
         self._next_test_index = 0
         self._env = self._make_env(self._first_config())
         self.action_space = self._env.action_space
@@ -64,6 +96,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             action_mode=self.action_mode,
             render_mode=self.render_mode,
             compile=self._compile,
+            context_features=self.context_features,
         )
 
     def reset(

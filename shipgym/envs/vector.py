@@ -28,14 +28,13 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import numpy as np
-from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from shipgym.angles import wrap_angle
 from shipgym.disturbances import SensorModel
 from shipgym.envs import core
-from shipgym.envs.core import LOG_FIELDS, OBS_HIGH, OBS_LOW
+from shipgym.envs.core import LOG_FIELDS
 from shipgym.metrics import compute_metrics
 from shipgym.numerics import ARRAY
 from shipgym.scenarios import load_scenario
@@ -58,6 +57,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         render_mode: str | None = None,
         episode_metrics: bool = True,
         max_episode_steps: int | None = None,
+        context_features: bool = False,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be ≥ 1, got {num_envs}")
@@ -68,8 +68,12 @@ class ShipPathFollowVectorEnv(VectorEnv):
         if render_mode is not None:
             raise ValueError("the batched env does not render; use a single env for that")
         sc = load_scenario(scenario)
-        parts = core.EnvParts.build(sc, action_mode, compile, batch=num_envs)
+        parts = core.EnvParts.build(
+            sc, action_mode, compile, batch=num_envs, context_features=context_features
+        )
         self._parts = parts
+        #: the observation ends with the controller-context features (as the single env)
+        self.context_features = context_features
         self.num_envs = num_envs
         self.scenario = sc
         self.action_mode = action_mode
@@ -115,20 +119,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        if seed is None or isinstance(seed, int):
-            seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
-        else:
-            if len(seed) != self.num_envs:
-                raise ValueError(f"need {self.num_envs} seeds, got {len(seed)}")
-            seeds = list(seed)
-        mask = np.ones(self.num_envs, dtype=bool)
-        if options and "reset_mask" in options:  # as SyncVectorEnv: reset only these envs
-            mask = np.asarray(options["reset_mask"], dtype=bool)
-            if mask.shape != (self.num_envs,):
-                raise ValueError(f"reset_mask must have shape ({self.num_envs},)")
-        for i, s in enumerate(seeds):
-            if mask[i] and (s is not None or self._rngs[i] is None):
-                self._rngs[i], _ = seeding.np_random(s)
+        mask = core.reseed_rows(self._rngs, seed, options)
         self._reset_envs(mask)
         self._autoreset[mask] = False
         self._started = True
@@ -139,14 +130,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        a = np.asarray(actions, dtype=np.float64).reshape(self.action_space.shape)
-        bad = ~np.all(np.isfinite(a), axis=1)
-        if np.any(bad):
-            raise ValueError(
-                f"actions of envs {np.flatnonzero(bad).tolist()} contain NaN or inf; "
-                "the env state is unchanged"
-            )
-        a = np.clip(a, -1.0, 1.0)
+        a = core.batch_actions(actions, self.action_space.shape)
         k = self._k
         n = self.num_envs
         reasons = np.full(n, None, dtype=object)
@@ -287,7 +271,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
 
     def _observation(self) -> np.ndarray:
         k = self._k
-        columns = core.observation_columns(
+        return core.batch_observation(
             self._tracker.frame,
             self._psi_m,
             self._r_m,
@@ -295,10 +279,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
             self._delta_c,
             self._speed,
             k,
-            ARRAY,
+            self._parts.context_row if self.context_features else None,
         )
-        obs = np.stack(columns, axis=1).astype(np.float32)
-        return np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
 
     def _info(self) -> dict[str, Any]:
         k = self._k

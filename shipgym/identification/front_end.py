@@ -41,6 +41,7 @@ from typing import Any, ClassVar, Protocol
 import numpy as np
 from scipy.linalg import expm
 
+from shipgym.angles import unwrap_array
 from shipgym.identification.errors import (
     IdentificationError,
     check_log_arrays,
@@ -150,6 +151,15 @@ class FrontEnd(Protocol):
 def _columns(psi: Any, delta: Any, delta_c: Any) -> np.ndarray:
     """The samples as (n, 3) columns; arrays of different lengths are an error naming them
     (non-finite samples are dropped samples here: each front end says what it did)."""
+    if (
+        type(psi) is type(delta) is type(delta_c) is np.ndarray
+        and psi.dtype == delta.dtype == delta_c.dtype == np.float64
+        and psi.ndim == delta.ndim == delta_c.ndim == 1
+        and psi.shape == delta.shape == delta_c.shape
+    ):  # the usual case (the env's samples): no conversion or check needed
+        out = np.empty((psi.shape[0], 3))
+        out[:, 0], out[:, 1], out[:, 2] = psi, delta, delta_c
+        return out
     arrays = [np.asarray(a, float).ravel() for a in (psi, delta, delta_c)]
     return np.column_stack(check_log_arrays(arrays, finite=False))
 
@@ -169,6 +179,8 @@ class DifferencesFrontEnd:
         self, psi: np.ndarray, delta: np.ndarray, delta_c: np.ndarray
     ) -> tuple[RegressionSignals, str | None]:
         new = _columns(psi, delta, delta_c)
+        if new.shape[0] and np.isfinite(new).all():  # the usual case: one unbroken run
+            return self._run(new), None
         finite = np.all(np.isfinite(new), axis=1)
         note = (
             None
@@ -189,7 +201,7 @@ class DifferencesFrontEnd:
     def _run(self, new: np.ndarray) -> RegressionSignals:
         raw = np.vstack([self._tail, new])
         if self._tail.shape[0]:  # keep heading continuous across calls
-            raw[:, 0] = np.unwrap(raw[:, 0])
+            raw[:, 0] = unwrap_array(raw[:, 0])
         if raw.shape[0] < 4:
             self._tail = raw
             return RegressionSignals.empty()
@@ -224,6 +236,7 @@ class HampelFilter:
         self._buffer = np.zeros(0)  # raw samples from (next centre − delay) to the newest
         self._past = 0  # samples in the buffer before the next centre (< delay at the start)
         self.replaced = 0
+        self._offsets: dict[int, np.ndarray] = {}  # window gather index per window count
 
     def push(self, x: np.ndarray) -> np.ndarray:
         """Cleaned samples of every centre completed by ``x`` (in order)."""
@@ -234,20 +247,51 @@ class HampelFilter:
             self._buffer = buf
             return np.zeros(0)
         centre = buf[start:stop]
-        med, mad = np.empty_like(centre), np.empty_like(centre)
         cut = min(max(half - start, 0), stop - start)  # stream start: windows cut at buf[0]
+        if cut == 0:  # every window full (after the stream's first samples)
+            med, mad = self._full_median_mad(buf, start - half, centre.shape[0])
+            return self._replace(buf, centre, med, mad, stop)
+        med, mad = np.empty_like(centre), np.empty_like(centre)
         for i in range(cut):
             m_i, d_i = _median_mad(buf[: start + i + half + 1][None, :])
             med[i], mad[i] = m_i[0], d_i[0]
         if cut < centre.shape[0]:
-            full = np.lib.stride_tricks.sliding_window_view(buf, self.window)
-            med[cut:], mad[cut:] = _median_mad(full[start + cut - half : stop - half])
+            first = start + cut - half  # buf index of the first full window
+            med[cut:], mad[cut:] = self._full_median_mad(buf, first, centre.shape[0] - cut)
+        return self._replace(buf, centre, med, mad, stop)
+
+    def _replace(
+        self, buf: np.ndarray, centre: np.ndarray, med: np.ndarray, mad: np.ndarray, stop: int
+    ) -> np.ndarray:
+        """The centres with the outliers replaced by their window's median; keeps the
+        samples the next windows need."""
         bad = ~np.isfinite(centre) | (np.abs(centre - med) > self.threshold * MAD_TO_SIGMA * mad)
         out = np.where(bad, med, centre)
         self.replaced += int(np.count_nonzero(bad & np.isfinite(med)))
-        keep = max(stop - half, 0)
+        keep = max(stop - self.delay, 0)
         self._buffer, self._past = buf[keep:], stop - keep
         return out
+
+    def _full_median_mad(
+        self, buf: np.ndarray, first: int, count: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Median and MAD of the ``count`` full windows buf[first + i : first + i + window]:
+        an odd window's median is its middle order statistic, picked by one in-place
+        partition of a gathered copy (the value ``np.median`` returns, without its overhead);
+        a window with a non-finite entry goes through :func:`_median_mad`."""
+        index = self._offsets.get(count)
+        if index is None:
+            index = np.arange(count)[:, None] + np.arange(self.window)[None, :]
+            self._offsets = {count: index}  # one count per control period, in practice
+        windows = buf[index + first]
+        if not np.isfinite(windows).all():
+            return _median_mad(windows)
+        k = self.delay  # middle of an odd window
+        windows.partition(k, axis=1)
+        med = windows[:, k].copy()
+        deviation = np.abs(windows - med[:, None])  # the same multiset, in another order
+        deviation.partition(k, axis=1)
+        return med, deviation[:, k]
 
 
 def _median_mad(windows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -399,8 +443,15 @@ class _Cleaner:
     def push(self, new: np.ndarray) -> tuple[np.ndarray, str | None]:
         """Aligned cleaned samples (k, 3) completed by ``new`` (m, 3), and a note."""
         new = new.copy()
-        note = None
         finite = np.isfinite(new)
+        if new.shape[0] and finite.all():  # the usual case: nothing to replace or hold
+            if not self._started:
+                self._last = new[0].copy()
+                self._started = True
+            new[:, 0] = unwrap_array(np.concatenate(((self._last[0],), new[:, 0])))[1:]
+            self._last = new[-1].copy()
+            return self._filtered(new), None
+        note = None
         if not self._started and new.shape[0]:
             first = [new[finite[:, j], j][:1] for j in range(3)]
             self._last = np.array([f[0] if f.size else 0.0 for f in first])
@@ -423,9 +474,13 @@ class _Cleaner:
             good = np.isfinite(new[:, j])
             if np.any(good):
                 self._last[j] = new[good, j][-1]
+        return self._filtered(new), note
+
+    def _filtered(self, new: np.ndarray) -> np.ndarray:
+        """The outlier filter's output for unwrapped samples (k, 3), δ and δc delayed alike."""
         if self.hampel is None:
-            return new, note
-        cleaned = self.hampel.push(psi)
+            return new
+        cleaned = self.hampel.push(new[:, 0])
         waiting = np.vstack([self._waiting, new[:, 1:]])
         k = cleaned.shape[0]
         for i in np.flatnonzero(~np.isfinite(cleaned)):  # a window without a finite sample
@@ -433,7 +488,9 @@ class _Cleaner:
         if k:
             self._held = cleaned[-1]
         self._waiting = waiting[k:]
-        return np.column_stack([cleaned, waiting[:k]]), note
+        out = np.empty((k, 3))
+        out[:, 0], out[:, 1:] = cleaned, waiting[:k]
+        return out
 
 
 class SVFFrontEnd:

@@ -163,11 +163,12 @@ def _primal(
     # [XᵀVX + I/γ, XᵀV1; 1ᵀVX, 1ᵀV1 + pb/γ] [w; b] = [XᵀVy; 1ᵀVy]
     zv = z * v[:, None]
     m = z.T @ zv
-    m.flat[:: d + 2] += 1.0 / gamma  # ridge on w (the last diagonal entry is undone below)
+    diagonal = m.ravel()[:: d + 2]  # a view of m's diagonal
+    diagonal += 1.0 / gamma  # ridge on w (the last diagonal entry is undone below)
     m[d, d] += (pb - 1.0) / gamma
     rhs = zv.T @ y
-    scale = 1.0 / np.sqrt(np.abs(np.diag(m)))
-    sol = scale * np.linalg.solve(m * np.outer(scale, scale), rhs * scale)
+    scale = 1.0 / np.sqrt(np.abs(diagonal))
+    sol = scale * np.linalg.solve(m * (scale[:, None] * scale), rhs * scale)
     theta, b = sol[:d], float(sol[d])
     return LSSVMSolution(theta, b, y - z @ sol)
 

@@ -76,17 +76,13 @@ def regression_rows(signals: RegressionSignals, h: float) -> NomotoRegression:
     """The rows of eq. (35)–(37) from a front end's signals at spacing h [s] (one definition
     for every front end; with the differences these are the paper's rows bit for bit)."""
     s = signals
-    n = len(s)
-    x1 = np.column_stack(
-        [
-            -h * s.psi2,
-            h**3 * s.delta,
-            np.full(n, h**3),
-            -(h**2) * s.psi1,
-            -(s.psi1**3),
-            h**2 * s.delta1,
-        ]
-    )
+    x1 = np.empty((len(s), 6))
+    x1[:, 0] = -h * s.psi2
+    x1[:, 1] = h**3 * s.delta
+    x1[:, 2] = h**3
+    x1[:, 3] = -(h**2) * s.psi1
+    x1[:, 4] = -(s.psi1**3)
+    x1[:, 5] = h**2 * s.delta1
     y2 = (s.servo_command - s.servo_delta) * h
     return NomotoRegression(s.psi3, x1, y2, s.servo_delta1[:, None])
 

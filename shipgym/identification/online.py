@@ -85,6 +85,41 @@ class PersistentExcitation:
         return u + self._noise
 
 
+class _RowWindow:
+    """Rows appended at the end and dropped at the front of one preallocated array: the
+    window is a view of it (no copy of the whole window per append); the rows are moved to
+    the front only when the array's end is reached.  ``width`` None: one value per row."""
+
+    def __init__(self, width: int | None, capacity: int) -> None:
+        self._tail = () if width is None else (width,)
+        self._buf = np.empty((capacity, *self._tail))
+        self._start = self._end = 0
+
+    def __len__(self) -> int:
+        return self._end - self._start
+
+    def view(self) -> np.ndarray:
+        """The rows in the window, oldest first (a view: valid until the next append)."""
+        return self._buf[self._start : self._end]
+
+    def append(self, rows: np.ndarray) -> None:
+        k, n = rows.shape[0], self._end - self._start
+        if self._end + k > self._buf.shape[0]:
+            if n + k > self._buf.shape[0]:  # more than the array holds: a larger one
+                grown = np.empty((2 * (n + k), *self._tail))
+                grown[:n] = self.view()
+                self._buf = grown
+            else:
+                self._buf[:n] = self.view().copy()  # to the front (the ranges may overlap)
+            self._start, self._end = 0, n
+        self._buf[self._end : self._end + k] = rows
+        self._end += k
+
+    def drop(self, k: int) -> None:
+        """Drop the k oldest rows."""
+        self._start += min(k, self._end - self._start)
+
+
 @dataclasses.dataclass
 class _SubModel:
     """θ̂ and bias of one regression (θ1: Nomoto, θ2: servo)."""
@@ -136,16 +171,39 @@ class _SlidingWindowNomoto:
         self._base = self.params
         self.sub1 = _SubModel(theta1_from_params(self.params))
         self.sub2 = _SubModel(np.array([self._theta2_of(self.params.Tc)]))
-        self._rows1 = np.zeros((0, 6))
-        self._y1 = np.zeros(0)
-        self._rows2 = np.zeros((0, 1))
-        self._y2 = np.zeros(0)
+        capacity = 4 * (window + update_every)  # rows moved to the front every ~3 windows
+        self._windows = (
+            _RowWindow(6, capacity),
+            _RowWindow(None, capacity),
+            _RowWindow(1, capacity),
+            _RowWindow(None, capacity),
+        )
         self.identified = False
         self._window_full = False
         self.updates = 0
         self.last_reason: str | None = None
         self.history: list[dict[str, Any]] = []
         self.t = 0.0
+
+    @property
+    def _rows1(self) -> np.ndarray:
+        """Regressors of eq. (36) in the window (n, 6)."""
+        return self._windows[0].view()
+
+    @property
+    def _y1(self) -> np.ndarray:
+        """Targets of eq. (36) in the window (n,)."""
+        return self._windows[1].view()
+
+    @property
+    def _rows2(self) -> np.ndarray:
+        """Regressors of eq. (37) in the window (n, 1)."""
+        return self._windows[2].view()
+
+    @property
+    def _y2(self) -> np.ndarray:
+        """Targets of eq. (37) in the window (n,)."""
+        return self._windows[3].view()
 
     @property
     def delay(self) -> int:
@@ -182,20 +240,19 @@ class _SlidingWindowNomoto:
     def _feed_rows(self, reg: Any) -> bool:
         updated = False
         pos, n_new = 0, reg.y1.shape[0]
+        windows = self._windows
         while pos < n_new:
-            n = self._y1.shape[0]
+            n = len(windows[1])
             # rows still needed before the next identification (§3.2.1): N_w the first time,
             # then N_u at a time (also after a skipped, degenerate window)
             full = self.identified or self._window_full
             need = self.window + self.update_every - n if full else self.window - n
             take = max(1, min(need, n_new - pos))
             part = slice(pos, pos + take)
-            self._rows1 = np.vstack([self._rows1, reg.x1[part]])
-            self._y1 = np.concatenate([self._y1, reg.y1[part]])
-            self._rows2 = np.vstack([self._rows2, reg.x2[part]])
-            self._y2 = np.concatenate([self._y2, reg.y2[part]])
+            for window, rows in zip(windows, (reg.x1, reg.y1, reg.x2, reg.y2), strict=True):
+                window.append(rows[part])
             pos += take
-            n = self._y1.shape[0]
+            n = len(windows[1])
             if not full and n >= self.window:
                 self._trim(n - self.window)
                 self._window_full = True
@@ -218,8 +275,8 @@ class _SlidingWindowNomoto:
         return excitation_problem(self._rows1, self._rows2)
 
     def _trim(self, k: int) -> None:
-        self._rows1, self._y1 = self._rows1[k:], self._y1[k:]
-        self._rows2, self._y2 = self._rows2[k:], self._y2[k:]
+        for window in self._windows:
+            window.drop(k)
 
     # -- identification ---------------------------------------------------------------
     def _identify(self) -> None:

@@ -108,12 +108,12 @@ class ParameterRecord:
         """Every rule of a valid record this one breaks, one message each (empty: valid)."""
         cls = type(self).__name__
         out = []
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
+        for name in self.names():
+            value = getattr(self, name)
             if not isinstance(value, int | float) or isinstance(value, bool):
-                out.append(f"{cls}.{f.name} must be a number, got {value!r}")
+                out.append(f"{cls}.{name} must be a number, got {value!r}")
             elif not math.isfinite(value):
-                out.append(f"{cls}.{f.name} must be finite, got {value}")
+                out.append(f"{cls}.{name} must be finite, got {value}")
         if out:
             return out
         out += self._sign_problems(self.positive, self.nonnegative)
@@ -160,7 +160,11 @@ class ParameterRecord:
 
     @classmethod
     def names(cls) -> tuple[str, ...]:
-        return tuple(f.name for f in dataclasses.fields(cls))
+        names = cls.__dict__.get("_names")  # a class's own (not a base class's), built once
+        if names is None:
+            names = tuple(f.name for f in dataclasses.fields(cls))
+            type.__setattr__(cls, "_names", names)
+        return names
 
     def to_vector(self) -> np.ndarray:
         return np.array([float(getattr(self, n)) for n in self.names()])

@@ -18,17 +18,17 @@ import numpy as np
 from shipgym.codegen import compiled
 from shipgym.models.base import ShipModel
 
-#: (model class, variant, h, n_sub, compile, batch) -> period Function.  The function
+#: (model class, variant, h, n_sub, compile, batch, threads) -> period Function.  The function
 #: depends only on the model's equations (parameters are inputs), so envs that are rebuilt
 #: for new scenarios of the same ship (training distributions) share it.
 _FUNCTIONS: dict[tuple, ca.Function] = {}
 
 
 def _period_function(
-    model: ShipModel, h: float, n_sub: int, compile: bool, batch: int
+    model: ShipModel, h: float, n_sub: int, compile: bool, batch: int, threads: int = 2
 ) -> ca.Function:
     """The unrolled RK4 period of ``model`` (see :class:`PeriodIntegrator`), cached."""
-    key = (type(model), model.variant, h, n_sub, compile, batch)
+    key = (type(model), model.variant, h, n_sub, compile, batch, threads)
     cached = _FUNCTIONS.get(key)
     if cached is not None:
         return cached
@@ -47,7 +47,7 @@ def _period_function(
     if compile:
         function = compiled(function)
     if batch > 1:  # the same function per ship: results bit-identical to the single call
-        function = function.map(batch, "thread", 2)
+        function = function.map(batch, "thread", threads) if threads > 1 else function.map(batch)
     _FUNCTIONS[key] = function
     return function
 
@@ -58,16 +58,26 @@ class PeriodIntegrator:
     Call with the initial state, the command, and (n_sub, n_w) disturbances and
     (n_sub, n_p) parameters (row i acts on substep i); returns the (n_sub + 1, n_x) states
     at t0, t0 + h, …, t0 + n_sub·h (row 0 is the initial state).  A fresh copy.
+
+    ``batch`` > 1 maps the function over that many ships, on ``threads`` threads (1: one
+    after the other in the calling thread; the least CPU time, e.g. 37 µs vs 74 µs for 10
+    nomoto2 periods of 50 substeps, where the threads help wall time only on idle cores).
     """
 
     def __init__(
-        self, model: ShipModel, h: float, n_sub: int, compile: bool = False, batch: int = 1
+        self,
+        model: ShipModel,
+        h: float,
+        n_sub: int,
+        compile: bool = False,
+        batch: int = 1,
+        threads: int = 2,
     ) -> None:
         if h <= 0 or n_sub < 1:
             raise ValueError(f"need h > 0 and n_sub ≥ 1, got h={h}, n_sub={n_sub}")
         self.model, self.h, self.n_sub = model, float(h), int(n_sub)
-        self.compile, self.batch = compile, int(batch)
-        function = _period_function(model, self.h, self.n_sub, compile, self.batch)
+        self.compile, self.batch, self.threads = compile, int(batch), int(threads)
+        function = _period_function(model, self.h, self.n_sub, compile, self.batch, self.threads)
         nx, nw, npar = model.n_states, model.n_disturbances, model.n_params
         b = self.batch
         nu = len(model.input_names)
@@ -131,6 +141,7 @@ class PeriodIntegrator:
             "n_sub": self.n_sub,
             "compile": self.compile,
             "batch": self.batch,
+            "threads": self.threads,
         }
 
     def __setstate__(self, state: dict) -> None:

@@ -185,6 +185,12 @@ class DistributionConfig(StrictModel):
     #: in the test seed space), ``count_per_ship`` named scenarios of each ship
     ranges_of: str | None = None
     count_per_ship: int | None = Field(None, ge=1)
+    #: with ``ranges_of``: every ship's ``jumps.order`` (``cycle``: the named scenarios step
+    #: through the change kinds, so that a few cover every family; None: the train split's)
+    jump_order: Literal["random", "cycle"] | None = None
+    #: with ``ranges_of``: every ship's ``jumps.probability`` (1: every named scenario has
+    #: its change; None: the train split's)
+    jump_probability: float | None = Field(None, ge=0, le=1)
     ships: list[ShipSampling] = Field(default_factory=lambda: [ShipSampling()])
     path: PathSampling = PathSampling()
     sensors: SensorSampling = SensorSampling()
@@ -212,6 +218,13 @@ class DistributionConfig(StrictModel):
             {**ship.model_dump(exclude={"weight", "count"}), "count": data["count_per_ship"]}
             for ship in base.ships
         ]
+        jumps = {
+            key: data[field]
+            for key, field in (("order", "jump_order"), ("probability", "jump_probability"))
+            if data.get(field) is not None
+        }
+        for ship in ships:
+            ship["jumps"] = {**ship["jumps"], **jumps}
         return {
             **data,
             "ships": ships,
@@ -237,6 +250,9 @@ class DistributionConfig(StrictModel):
     def _check_split(self) -> None:
         if self.count_per_ship is not None and self.ranges_of is None:
             raise ValueError("count_per_ship: only with ranges_of (else each ship's 'count')")
+        for field in ("jump_order", "jump_probability"):
+            if getattr(self, field) is not None and self.ranges_of is None:
+                raise ValueError(f"{field}: only with ranges_of (else each ship's jumps)")
         if self.split == "train":
             for i, ship in enumerate(self.ships):
                 if ship.count is not None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -42,8 +43,16 @@ def test_pid_los_follows_nominal_path_to_the_goal() -> None:
     assert m["ace"] < 0.5 * zero.metrics["ace"]
 
 
-def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
-    rows = run_leaderboard("smoke", seeds=2, out_dir=tmp_path, workers=2, show_progress=False)
+@pytest.fixture(scope="module")
+def smoke(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[dict]]:
+    """The smoke suite's leaderboard, run once: (its folder, its rows)."""
+    out = tmp_path_factory.mktemp("smoke")
+    rows = run_leaderboard("smoke", seeds=2, out_dir=out, workers=2, show_progress=False)
+    return out, rows
+
+
+def test_leaderboard_writes_tables_with_contract_keys(smoke: tuple[Path, list[dict]]) -> None:
+    tmp_path, rows = smoke
     for name in ("leaderboard.md", "leaderboard.csv", "leaderboard.json", "generalisation.json"):
         assert (tmp_path / name).is_file()
     on_disk = json.loads((tmp_path / "leaderboard.json").read_text())
@@ -74,12 +83,64 @@ def test_leaderboard_writes_tables_with_contract_keys(tmp_path) -> None:
     # the NMPC family runs on every ship (issue 17): a row with numbers on the Mariner too
     nmpc = {r["scenario"]: r for r in on_disk if r["controller"] == "nmpc_lambda_lssvm"}
     assert all(row["applies"] is True for row in nmpc.values())
-    assert nmpc["mariner_track"]["ace"] < pid["mariner_track"]["ace"]
+    assert nmpc["mariner_track"]["ace"] < zero["mariner_track"]["ace"]
     ppo = next(r for r in on_disk if r["controller"] == "ppo")
     assert ppo["kind"] == "learned" and ppo["train_env_steps"] > 0
     assert {r["split"] for r in on_disk} == {"catalogue", "heldout"}
     assert (tmp_path / "scenario_rudder_aging.png").is_file()
     assert_equals_golden(on_disk, GOLDEN / "smoke_leaderboard.json")
+
+
+#: the smoke suite's run before issue 20 (main 195f895): leaderboard.html and the folder's
+#: files [bytes]; the default suite's were 9.6 MB and 51 MB, the targets 3 MB and 15 MB
+SMOKE_PAGE_BEFORE, SMOKE_FOLDER_BEFORE = 1_072_283, 3_720_279
+DEFAULT_PAGE_BEFORE, DEFAULT_FOLDER_BEFORE = 9.6e6, 51e6
+PAGE_TARGET, FOLDER_TARGET = 3e6, 15e6
+
+
+def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -> None:
+    """issue 20: the page and the folder shrink on the smoke suite as the targets ask of
+    the default suite (page ≤ 3 / 9.6, folder ≤ 15 / 51 of their size before), the page
+    still showing every figure (as a PNG) and table."""
+    out, rows = smoke
+    page = (out / "leaderboard.html").stat().st_size
+    folder = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
+    assert page <= SMOKE_PAGE_BEFORE * PAGE_TARGET / DEFAULT_PAGE_BEFORE, page
+    assert folder <= SMOKE_FOLDER_BEFORE * FOLDER_TARGET / DEFAULT_FOLDER_BEFORE, folder
+    html = (out / "leaderboard.html").read_text()
+    for png in out.glob("*.png"):
+        assert f"<code>{png.name}</code>" in html, png.name
+    embedded = re.findall("data:image/(?:png|webp);base64,", html)  # lossless, the PNG's pixels
+    assert len(embedded) == len(list(out.glob("*.png"))) == 7
+    assert "data:image/svg" not in html
+    assert all(row["controller"] in html for row in rows)
+
+
+def test_run_replays_the_leaderboards_trial(
+    smoke: tuple[Path, list[dict]], tmp_path: Path, capsys
+) -> None:
+    """issue 20: ``shipgym run SCENARIO CONTROLLER --seed S --suite smoke`` is the smoke
+    leaderboard's episode of that scenario and seed, its randomised trial included: ACE and
+    cost equal bit for bit."""
+    from shipgym_baselines.cli import main
+
+    out, _ = smoke
+    records = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    (board,) = [
+        r
+        for r in records
+        if (r["scenario"], r["controller"], r["seed"]) == ("rudder_aging", "pid_los", 10_001)
+    ]
+    args = ["run", "rudder_aging", "pid_los", "--seed", "10001", "--json"]
+    assert main([*args, "--suite", "smoke", "--out", str(tmp_path / "smoke")]) == 0
+    replay = json.loads(capsys.readouterr().out)
+    assert (replay["ace"], replay["cost"]) == (board["ace"], board["cost"])
+    assert replay["steps"] == board["steps"]
+    # a suite without randomize: the catalogue scenario itself, another episode
+    plain = tmp_path / "plain.yaml"
+    plain.write_text("name: plain\nscenarios: [rudder_aging]\ncontrollers: [pid_los]\n")
+    assert main([*args, "--suite", str(plain), "--out", str(tmp_path / "plain")]) == 0
+    assert json.loads(capsys.readouterr().out)["ace"] != board["ace"]
 
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
@@ -111,10 +172,11 @@ def test_default_suite_has_every_controller_and_learned_agent() -> None:
 
 
 def test_guidance_mode_with_zero_action_is_pid_los() -> None:
-    """The env's autopilot (guidance mode, a = 0) is the pid_los baseline, step for step."""
+    """The env's autopilot (guidance mode, a = 0) is the pid_los baseline's paper design,
+    step for step."""
     import gymnasium as gym
 
-    pid = run_episode(PIDLOS(), "rudder_aging", seed=3)
+    pid = run_episode(PIDLOS(preset="paper"), "rudder_aging", seed=3)
     env = gym.make("ShipPathFollow-v0", scenario="rudder_aging", action_mode="guidance")
     env.reset(seed=3)
     commands = []

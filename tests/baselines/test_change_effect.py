@@ -48,7 +48,7 @@ def test_the_twin_has_no_change_and_the_same_route() -> None:
 
 @pytest.mark.parametrize("name", matrix_scenarios())
 def test_each_change_matters_to_a_non_adaptive_controller(name: str) -> None:
-    """pid_los (pole-placed on the nominal model's Nomoto fit, never re-tuned: it applies to
-    every ship and is the ranking's reference) after the change vs on the twin."""
+    """pid_los's paper design (pole-placed on the nominal model's Nomoto fit, never re-tuned:
+    it applies to every ship) after the change vs on the twin."""
     effect = change_effect(name, "pid_los")
     assert effect.ratio >= MATTERS, effect.row()

@@ -36,6 +36,7 @@ def test_every_subcommand_is_listed() -> None:
         "leaderboard",
         "reproduce",
         "train",
+        "tune",
         "evaluate",
         "run",
         "report",
@@ -272,3 +273,15 @@ def test_finding11_a_bad_suite_is_named_before_the_state_of_out(
         assert "smok" in message and "valid: default" in message and "not empty" not in message
     assert main(["leaderboard", "--suite", "smoke", "--no-progress"]) == 2  # then the folder
     assert "--out results/leaderboard is not empty" in _error_line(capsys, "leaderboard")
+
+
+def test_no_help_text_points_to_the_unshipped_spec(capsys) -> None:
+    """issue 20: help texts cite no "SPEC §…" (the spec is not shipped)."""
+    from shipgym_baselines.cli import SUBCOMMANDS, build_parser
+
+    parser = build_parser()
+    texts = [parser.format_help()]
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    texts += [p.format_help() for p in sub.choices.values()]
+    assert len(texts) == len(SUBCOMMANDS) + 1  # the top level and each subcommand
+    assert not [t for t in texts if "SPEC" in t]

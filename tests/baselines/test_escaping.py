@@ -67,6 +67,7 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
     )
     out = tmp_path / "out"
     args = ["leaderboard", "--suite", str(suite), "--out", str(out), "--workers", "1"]
+    args.append("--vector-figures")  # the SVG keeps the drawn text as characters
     assert main([*args, "--no-progress", "--json"]) == 0, capsys.readouterr().err
     rows = json.loads(capsys.readouterr().out)
     assert {r["controller"] for r in rows} == {

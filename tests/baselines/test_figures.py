@@ -1,7 +1,9 @@
-"""The leaderboard's figures: 200 dpi PNG + SVG, one look per controller, what is drawn."""
+"""The leaderboard's figures: page-sized palette PNG + SVG (SVGZ), one look per controller."""
 
 from __future__ import annotations
 
+import gzip
+import json
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -12,6 +14,10 @@ from PIL import Image
 
 from shipgym_baselines import figures
 from shipgym_baselines.figures import (
+    LEGEND_KEY,
+    LEGEND_TOP_KEY,
+    PAGE_COLOURS,
+    PAGE_WIDTH,
     DrawnEpisode,
     episodes_to_draw,
     family_panels,
@@ -40,9 +46,17 @@ def trajectory(offset: float, n: int = 120) -> dict[str, np.ndarray]:
     }
 
 
+def parse(svg: Path) -> ET.ElementTree:
+    """An SVG or SVGZ (gzip-compressed SVG) file's tree."""
+    if svg.suffix == ".svgz":
+        with gzip.open(svg) as file:
+            return ET.parse(file)
+    return ET.parse(svg)
+
+
 def stroke(svg: Path, gid: str) -> str:
     """The colour (stroke, else fill) of the first drawn path in the SVG group ``gid``."""
-    group = next(g for g in ET.parse(svg).iter(f"{SVG}g") if g.get("id") == gid)
+    group = next(g for g in parse(svg).iter(f"{SVG}g") if g.get("id") == gid)
     style = next(p.get("style") for p in group.iter(f"{SVG}path") if p.get("style"))
     props = dict(part.split(":", 1) for part in style.replace(" ", "").split(";") if part)
     colour = props["stroke"] if props.get("stroke", "none") != "none" else props["fill"]
@@ -50,7 +64,7 @@ def stroke(svg: Path, gid: str) -> str:
 
 
 def svg_text(svg: Path) -> str:
-    return " ".join(t.text or "" for t in ET.parse(svg).iter(f"{SVG}text"))
+    return " ".join(t.text or "" for t in parse(svg).iter(f"{SVG}text"))
 
 
 @pytest.fixture(scope="module")
@@ -64,16 +78,39 @@ def scenario_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
     }
     path = np.array([[0.0, 0.0], [240.0, 0.0]])
     out = tmp_path_factory.mktemp("figures")
-    return plot_scenario(out, "heldout:0", drawn, change_time=60.0, path_xy=path, ship_length=3.25)
+    return plot_scenario(
+        out, "heldout:0", drawn, change_time=60.0, path_xy=path, ship_length=3.25, vector=True
+    )
 
 
-def test_a_scenario_figure_is_a_200_dpi_png_and_an_svg(scenario_files: list[Path]) -> None:
+def test_a_scenario_figure_is_a_page_sized_png_and_an_svgz(scenario_files: list[Path]) -> None:
+    """issue 20: drawn at 200 dpi, written at half (≤ PAGE_WIDTH px) as a palette PNG; the
+    vector copy deflated."""
     png, svg = scenario_files
-    assert (png.name, svg.name) == ("scenario_heldout_0.png", "scenario_heldout_0.svg")
+    assert (png.name, svg.name) == ("scenario_heldout_0.png", "scenario_heldout_0.svgz")
     with Image.open(png) as image:
-        assert image.info["dpi"] == pytest.approx((FIGURE_DPI, FIGURE_DPI), abs=0.01)
-        assert min(image.size) > 1000  # inches × 200, not a thumbnail
-    assert ET.parse(svg).getroot().tag == f"{SVG}svg"
+        assert image.info["dpi"] == pytest.approx((FIGURE_DPI / 2, FIGURE_DPI / 2), abs=0.01)
+        assert PAGE_WIDTH / 2 < image.width <= PAGE_WIDTH  # not a thumbnail
+        assert image.mode == "P" and len(image.getcolors()) <= PAGE_COLOURS
+    assert parse(svg).getroot().tag == f"{SVG}svg"
+
+
+def test_the_page_png_keeps_each_controllers_colour(scenario_files: list[Path]) -> None:
+    """issue 20: the page PNG's palette holds each drawn controller's exact colour (an
+    adaptive palette had turned them grey), and those pixels are there; the legends' text
+    and where they start ride in the PNG for the page."""
+    with Image.open(scenario_files[0]) as image:
+        palette = image.getpalette()
+        used = {tuple(palette[3 * i : 3 * i + 3]) for _, i in image.getcolors()}
+        text = dict(image.text)
+    for name in ("pid_los", "lqr", "ppo"):
+        colour = controller_style(name).color.lstrip("#")
+        assert tuple(int(colour[k : k + 2], 16) for k in (0, 2, 4)) in used, name
+    legends = json.loads(text[LEGEND_KEY])
+    labels = [label for _, entries in legends for _, label in entries]
+    assert "ppo (seed 10003, training seed 1)" in labels
+    assert "oracle (seed 10003), the reference" in labels
+    assert 0.5 < float(text[LEGEND_TOP_KEY]) < 1.0
 
 
 def test_the_figure_says_what_is_drawn_with_units(scenario_files: list[Path]) -> None:
@@ -101,7 +138,7 @@ def test_a_controller_has_its_colour_in_every_figure(
     ]
     splits = {"a": "catalogue", "b": "catalogue"}
     aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
-    files = plot_ranking(tmp_path, aggregate, episodes, splits)
+    files = plot_ranking(tmp_path, aggregate, episodes, splits, vector=True)
     assert [f.name for f in files] == [
         "ranking_catalogue.png",
         "ranking_catalogue.svg",
@@ -114,8 +151,9 @@ def test_a_controller_has_its_colour_in_every_figure(
         assert stroke(scenario_files[1], f"{name}/e") == colour
         assert stroke(files[1], f"{name}/interval/cost_ratio_iqm") == colour
         assert stroke(files[3], f"{name}/profile") == colour
-    with Image.open(files[0]) as image:
-        assert image.info["dpi"] == pytest.approx((FIGURE_DPI, FIGURE_DPI), abs=0.01)
+    with Image.open(files[0]) as image:  # 200 dpi reduced by a whole factor to fit PAGE_WIDTH
+        factor = FIGURE_DPI / image.info["dpi"][0]
+        assert factor == pytest.approx(round(factor), abs=1e-3) and image.width <= PAGE_WIDTH
     ranking = svg_text(files[1])
     assert "cost ratio C / C_oracle [–] (log)" in ranking and "zero_rudder" not in ranking
 
@@ -123,7 +161,7 @@ def test_a_controller_has_its_colour_in_every_figure(
 def test_the_oracle_is_drawn_in_every_column_as_the_reference(scenario_files: list[Path]) -> None:
     """The oracle's track, e(t) and δ(t) in each family's column (PID, LQR, learned,
     references), named in the legends; it has no column of its own."""
-    root = ET.parse(scenario_files[1]).getroot()
+    root = parse(scenario_files[1]).getroot()
     tracks = [g for g in root.iter(f"{SVG}g") if g.get("id") == "oracle/track"]
     assert len(tracks) == 4
     assert stroke(scenario_files[1], "oracle/track") == "#000000"

@@ -122,7 +122,11 @@ def test_rows_carry_an_interval_for_every_metric(randomised: Path) -> None:
         for metric in ("ace", "return", "rudder_travel", "J", "mean_abs_cross_track"):
             low, high = row[f"{metric}_ci95"]
             values = [float(e[metric]) for e in mine]
-            assert min(values) <= low <= row[metric] <= high <= max(values), (row, metric)
+            eps = 1e-12 * max(1.0, max(abs(v) for v in values))  # a resample mean's last bit
+            assert min(values) - eps <= low <= row[metric] <= high <= max(values) + eps, (
+                row,
+                metric,
+            )
         for metric in ("ace", "return"):  # three different trials: a spread
             assert row[f"{metric}_ci95"][0] < row[metric] < row[f"{metric}_ci95"][1]
         low, high = row["success_ci95"]
@@ -165,8 +169,9 @@ def test_aggregate_json_ranks_by_cost_over_the_oracle(randomised: Path, ranked: 
         cells = {c["controller"]: c for c in entry["controllers"]}
         assert cells["pid_los"]["cost_ratio_gmean"] == pytest.approx(1 / STAND_IN)
         assert cells["zero_rudder"]["cost_ratio_gmean"] > 2.0  # doing nothing costs
-    for name in ("ranking_catalogue.png", "profile_catalogue.png", "ranking_catalogue.svg"):
+    for name in ("ranking_catalogue.png", "profile_catalogue.png"):
         assert (ranked / name).is_file(), name
+    assert not list(ranked.glob("*.svg*"))  # vector copies only with --vector-figures
 
 
 def test_the_same_episodes_give_the_same_aggregate_json_bit_for_bit(
@@ -235,9 +240,10 @@ def test_a_learned_job_is_one_training_seed_on_all_seeds(agent: Path) -> None:
     assert [(j.seeds, j.training_seed) for j in jobs] == [
         ((7, 8), 0),
         ((7, 8), 1),
-        ((7,), None),
-        ((8,), None),
+        ((7, 8), None),  # a classical controller's seeds in lockstep too
     ]
+    oracle = plan_jobs(["oracle"], ["nominal"], [7, 8], {"oracle": [None]}, None, set())
+    assert [j.seeds for j in oracle] == [(7,), (8,)]  # the reference table, trial by trial
     # batched through evaluate_batch: the episodes run_job gives one by one, trial by trial
     batch = run_batch(Job(str(agent), "rudder_aging", (10_000, 10_001), 1, RANDOMIZE))
     for result in batch:

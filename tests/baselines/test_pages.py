@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from shipgym_baselines.figures import DrawnEpisode, plot_scenario
-from shipgym_baselines.pages import PAGE_FILE, page, write_html
+from shipgym_baselines.pages import PAGE_FILE, page, unpacked_body, write_html
 
 CONTROLLERS = [
     "pid_los",
@@ -157,7 +157,8 @@ def test_a_cell_shows_the_interval_and_n_a_where_a_controller_does_not_apply() -
     assert "An episode&#x27;s cost is the sum of its step costs" in text
     assert "Resolution, catalogue: median width of the cost-ratio IQM intervals 0.080" in text
     assert 'title="does not apply">n/a</td>' in text
-    assert ">never<" in text  # t_c = inf in the long table
+    assert ">never<" not in text  # the long table's rows are packed …
+    assert ">never<" in unpacked_body(text)  # … t_c = inf in the long table
 
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -211,8 +212,17 @@ def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page
     assert len(colours) > 50  # text, swatches, shaded cells: not a blank page
     assert (rgb < 200).any(axis=2).mean() > 0.01  # ink on at least 1 % of the pixels
 
-    dom = chromium(built_page.as_uri(), tmp, "--dump-dom")  # the DOM after the script ran
+    # the DOM after the script ran (and its promises: the long table unpacks asynchronously)
+    dom = chromium(built_page.as_uri(), tmp, "--virtual-time-budget=10000", "--dump-dom")
     assert sorted(score_rows(dom).names) == sorted(CONTROLLERS)
+    cells = _Cells()  # the long table's rows, unpacked by the script (issue 20)
+    cells.feed(dom)
+    rows, _, _ = synthetic_tables()
+    assert len(cells.rows["rows"]) == len(rows)
+    shown = [(r[0][1], r[1][1]) for r in cells.rows["rows"]]
+    assert shown == [(r["controller"], r["scenario"]) for r in rows]
+    # the scenario figure's legends as text under its image, the oracle's swatch aside
+    assert "pid_los (seed 10000)" in dom and 'class="legend"' in dom
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
@@ -235,3 +245,85 @@ def test_the_table_sorts_by_a_clicked_header(built_page: Path, fragment: str, or
     ranked = sorted(value, key=value.__getitem__, reverse=order == "descending")
     missing = [n for n in CONTROLLERS if n not in value]  # n/a: last in either order
     assert shown.names == ranked + missing
+
+
+class _Cells(HTMLParser):
+    """Per table id: its header kinds and, per body row, each cell's (data-sort, text)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.kinds: dict[str, list[str]] = {}
+        self.rows: dict[str, list[list[tuple[str | None, str]]]] = {}
+        self._table, self._body = "", False
+        self._cell: list[Any] | None = None
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if tag == "table":
+            self._table = a.get("id") or ""
+            self.kinds[self._table], self.rows[self._table] = [], []
+        elif tag == "th" and self._table:
+            self.kinds[self._table].append(a.get("data-type") or "")
+        elif tag == "tbody" and self._table:
+            self._body = True
+        elif tag == "tr" and self._table and self._body:
+            self.rows[self._table].append([])
+        elif tag == "td" and self._table and self._body:
+            self._cell = [a.get("data-sort"), ""]
+            self.rows[self._table][-1].append(self._cell)  # type: ignore[arg-type]
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "td":
+            self._cell = None
+        elif tag == "table":
+            self._table, self._body = "", False
+
+    def handle_data(self, data: str) -> None:
+        if self._cell is not None:
+            self._cell[1] += data
+
+
+def _script_key(cell: list[Any] | None, numeric: bool) -> Any:
+    """The page script's sort key of a cell (data-sort, else the text; parseFloat)."""
+    if cell is None:
+        return None
+    v = cell[0] if cell[0] is not None else cell[1]
+    if v == "":
+        return None
+    if not numeric:
+        return v.lower()
+    match = re.match(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", v.strip())
+    return float(match.group(0)) if match else None
+
+
+def test_every_numeric_column_of_the_long_table_sorts_as_its_values() -> None:
+    """issue 20: with data-sort at ≤ 7 digits, or none where a column's texts sort the same,
+    every column of the long table sorts its rows as the full-precision values do."""
+    rows, aggregate, scores = synthetic_tables()
+    for i, r in enumerate(rows):  # values that tie at the 3 decimals shown, differ after
+        if "ace" in r:
+            r["ace"] = round(r["ace"], 1) + 1e-5 * (i % 7)
+    parser = _Cells()
+    parser.feed(unpacked_body(page(rows, aggregate, scores)))
+    kinds, body = parser.kinds["rows"], parser.rows["rows"]
+    assert len(body) == len(rows)
+    for col, key in enumerate(["controller", "scenario", "split", "kind", "seeds"]):
+        numeric = kinds[col] == "number"
+        shown = [_script_key(cells[col] if col < len(cells) else None, numeric) for cells in body]
+        truth = [r.get(key) for r in rows]
+        if not numeric:
+            truth = [str(t).lower() for t in truth]
+        assert _order(shown) == _order(truth), key
+    metric_cols = {"ace": 6, "return": 8}
+    for key, col in metric_cols.items():
+        shown = [_script_key(cells[col] if col < len(cells) else None, True) for cells in body]
+        truth = [r.get(key) if r.get("applies", True) else None for r in rows]
+        assert _order(shown) == _order(truth), key
+    assert any(cells[6][0] for cells in body if len(cells) > 6)  # ace needs its keys
+    assert all(cells[4][0] is None for cells in body)  # seeds: the text sorts the same
+
+
+def _order(keys: list[Any]) -> list[int]:
+    """The row order a stable ascending sort gives (None last), as the script does."""
+    present = sorted((i for i, k in enumerate(keys) if k is not None), key=lambda i: keys[i])
+    return present + [i for i, k in enumerate(keys) if k is None]

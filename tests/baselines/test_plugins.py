@@ -1,6 +1,6 @@
 """Anyone's controller enters the benchmark (issue 12 item 2, SPEC §13 "Enter a controller"):
 specs ``module:Attr`` / ``file.py:Attr``, installed entry points, a suite's long form, in
-worker processes too, and the README's "Enter your controller" example as written."""
+worker processes too, and the "Enter your controller" example of docs/plugins.md as written."""
 
 from __future__ import annotations
 
@@ -35,7 +35,8 @@ from shipgym_baselines.registry import (
 )
 from shipgym_baselines.suite import load_suite
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+#: the docs page of plug-ins, whose example blocks run as written
+PLUGINS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "plugins.md"
 
 #: a user's controller file: a Policy class, a factory function, a Policy instance
 POLICY_FILE = """
@@ -460,27 +461,27 @@ def test_a_spec_resolves_in_a_fresh_worker_process(
     assert remote.metrics["ace"] == local.metrics["ace"]
 
 
-# ------------------------------------------------------------------ the README example
+# ------------------------------------------------------------------ the docs page example
 
 
-def readme_blocks() -> list[tuple[str, str]]:
-    """The README's "Enter your controller" code blocks: (marker, code), in order."""
-    section = README.read_text().split("## Enter your controller", 1)[1].split("\n## ", 1)[0]
-    pattern = r"<!-- readme-test: ([^>]+?) -->\s*```\w+\n(.*?)```"
+def page_blocks() -> list[tuple[str, str]]:
+    """The code blocks of the docs page "Enter your controller": (marker, code), in order."""
+    section = PLUGINS_PAGE.read_text()
+    pattern = r"<!-- docs-test: ([^>]+?) -->\s*```\w+\n(.*?)```"
     return [(m[1], m[2]) for m in re.finditer(pattern, section, flags=re.DOTALL)]
 
 
-def test_the_readme_example_runs(
+def test_the_plugins_page_example_runs(
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
     scratch_registry: None,
     forget_modules: list[str],
 ) -> None:
-    """Every block of the README section, as written: files written, Python executed,
+    """Every block of docs/plugins.md, as written: files written, Python executed,
     ``shipgym`` lines run through the CLI (one seed, into tmp folders), the entry point
     installed as pip would."""
-    blocks = readme_blocks()
+    blocks = page_blocks()
     kinds = [marker.split()[0] for marker, _ in blocks]
     assert {"file", "python", "shell", "entry"} <= set(kinds), kinds
     monkeypatch.chdir(tmp_path)
@@ -492,7 +493,7 @@ def test_the_readme_example_runs(
         if kind == "file":
             (tmp_path / arg).write_text(code)
         elif kind == "python":
-            exec(compile(code, f"README.md:{marker}", "exec"), {"__name__": "readme"})
+            exec(compile(code, f"docs/plugins.md:{marker}", "exec"), {"__name__": "plugins_page"})
         elif kind == "entry":
             points = tomllib.loads(code)["project"]["entry-points"]["shipgym.controllers"]
             _install(tmp_path / "site", "my-controller", points, {})
@@ -509,7 +510,7 @@ def test_the_readme_example_runs(
                 commands += 1
                 assert (out / "leaderboard.json").is_file()
         else:
-            raise AssertionError(f"unknown README block {marker!r}")
+            raise AssertionError(f"unknown docs block {marker!r}")
     assert commands >= 3
     assert "my_policy" in capsys.readouterr().out
     suite = load_suite(str(tmp_path / "my_suite.yaml"))

@@ -108,3 +108,44 @@ def test_report_writes_results_report_by_default_and_never_over_it(
     assert main(["report", str(evaluated["both"])]) == 2
     assert "results/report is not empty" in capsys.readouterr().err
     assert main(["report", str(evaluated["both"]), "--force", "--json"]) == 0
+
+
+def test_a_renamed_run_merges_with_the_one_of_its_own_name(
+    evaluated: dict[str, Path], tmp_path: Path, capsys
+) -> None:
+    """issue 20: ``--name`` shows a controller under another name, so ``report`` merges it
+    with a run of the controller under its own (a trained agent beside the shipped one)."""
+    suite = str(evaluated["pid_los"].parent / "tiny.yaml")
+    again = tmp_path / "again"
+    args = ["leaderboard", "--suite", suite, "--out", str(again), "--workers", "1"]
+    args += ["--controllers", "pid_los", "--name", "pid_los=pid_again", "--no-progress"]
+    assert main([*args, "--json"]) == 0
+    assert {r["controller"] for r in json.loads(capsys.readouterr().out)} == {"pid_again"}
+    assert read_run(again)["suite"]["controllers"][0]["controller"] == {
+        "controller": "pid_los",
+        "name": "pid_again",
+        "settings": {},
+    }
+    out = tmp_path / "report"
+    assert main(["report", str(evaluated["pid_los"]), str(again), "--out", str(out)]) == 0
+    rows = json.loads((out / "leaderboard.json").read_text())
+    by_name = {r["controller"]: untimed([r])[0] for r in rows}
+    assert set(by_name) == {"pid_los", "pid_again"}
+    mine, shipped = by_name.pop("pid_again"), by_name.pop("pid_los")
+    mine.pop("controller"), shipped.pop("controller")
+    assert mine == shipped  # the same controller's episodes under two names
+
+
+def test_evaluate_name_and_its_errors(evaluated: dict[str, Path], tmp_path: Path, capsys) -> None:
+    suite = str(evaluated["pid_los"].parent / "tiny.yaml")
+    out = ["--suite", suite, "--workers", "1", "--no-progress", "--json"]
+    assert main(["evaluate", "zero_rudder", "--name", "still", "--out", str(tmp_path), *out]) == 0
+    assert {r["controller"] for r in json.loads(capsys.readouterr().out)} == {"still"}
+    bad = ["leaderboard", "--controllers", "pid_los", "--out", str(tmp_path / "x"), *out]
+    assert main([*bad, "--name", "pid_los"]) == 2
+    assert "--name 'pid_los': give CONTROLLER=NAME" in capsys.readouterr().err
+    assert main([*bad, "--name", "lqr=mine"]) == 2
+    assert "--name names ['lqr'], not among the run's controllers: pid_los" in (
+        capsys.readouterr().err
+    )
+    assert not (tmp_path / "x").exists()

@@ -82,6 +82,9 @@ def test_run_json_records_command_suite_versions_times_and_status(clean_run: Pat
     assert start.utcoffset() == datetime.timedelta(0) and start <= end
     assert record["status"] == "complete"
     assert record["jobs"] == record["episodes"] == 8
+    # the run's own wall-clock and CPU seconds (tables and figures included)
+    assert 0 < record["wall_s"] <= (end - start).total_seconds() + 1.0
+    assert record["cpu_s"] > 0
 
 
 def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) -> None:
@@ -277,7 +280,7 @@ def test_a_killed_run_keeps_its_episodes_and_resumes(tmp_path: Path, clean_run: 
 
 def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> None:
     calls: list[object] = []
-    real = shipgym_baselines.leaderboard.run_job
+    real = shipgym_baselines.leaderboard.run_batch  # a controller's 2 seeds in lockstep
 
     def third_is_interrupted(job: tuple) -> object:
         calls.append(job)
@@ -285,12 +288,12 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
             raise KeyboardInterrupt
         return real(job)
 
-    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_job", third_is_interrupted)
+    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_batch", third_is_interrupted)
     out = tmp_path / "out"
     args = ["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out), "--workers", "1"]
     assert main([*args, "--no-progress"]) == 130
     assert capsys.readouterr().err == (
-        f"shipgym leaderboard: interrupted: 2 of 8 episodes kept in {out / 'episodes.jsonl'}; "
+        f"shipgym leaderboard: interrupted: 4 of 8 episodes kept in {out / 'episodes.jsonl'}; "
         "resume with --resume\n"
     )
     assert read_run(out)["command"] == ["shipgym", *args, "--no-progress"]
@@ -311,7 +314,7 @@ def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
 
 def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> None:
     calls: list[object] = []
-    real = shipgym_baselines.leaderboard.run_job
+    real = shipgym_baselines.leaderboard.run_batch  # a controller's 2 seeds in lockstep
 
     def second_fails(job: tuple) -> object:
         calls.append(job)
@@ -319,13 +322,13 @@ def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> Non
             raise RuntimeError("a bug in a controller")
         return real(job)
 
-    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_job", second_fails)
+    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_batch", second_fails)
     out = tmp_path / "out"
     with pytest.raises(RuntimeError, match="a bug"):  # a bug keeps its traceback
         run_leaderboard(write_suite(tmp_path), out_dir=out, workers=1, show_progress=False)
     record = read_run(out)
     assert record["status"] == "failed" and record["error"] == "RuntimeError: a bug in a controller"
-    assert record["episodes"] == len(read_episodes(out)) == 1
+    assert record["episodes"] == len(read_episodes(out)) == 2
 
 
 def test_sigint_stops_the_workers_without_tracebacks(tmp_path: Path) -> None:

@@ -28,11 +28,11 @@ class _RecordsDesiredHeading:
 
 
 class _LookaheadLOS(_RecordsDesiredHeading, PIDLookaheadLOS):
-    pass
+    default_preset = "paper"  # the paper's design, never the tuned settings
 
 
 class _VF(_RecordsDesiredHeading, PIDVF):
-    pass
+    default_preset = "paper"
 
 
 CONTROLLERS = (_LookaheadLOS, _VF)  # names: pid_lookahead_los, pid_vf

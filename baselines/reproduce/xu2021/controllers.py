@@ -18,12 +18,12 @@ AB = "adaptive_backstepping"
 PID = "pid_tvvf"
 
 
-#: label -> factory
+#: label -> factory (the papers' designs, never the tuned settings)
 CONTROLLERS: dict[str, Callable[[], Any]] = {
-    L1: L1Backstepping,
-    L1_ADAPTIVE: lambda: L1Backstepping(filter_placement="adaptive"),
-    AB: AdaptiveBackstepping,
-    PID: PIDTVVF,
+    L1: lambda: L1Backstepping(preset="paper"),
+    L1_ADAPTIVE: lambda: L1Backstepping(preset="paper", filter_placement="adaptive"),
+    AB: lambda: AdaptiveBackstepping(preset="paper"),
+    PID: lambda: PIDTVVF(preset="paper"),
 }
 L1_VARIANTS = (L1, L1_ADAPTIVE)
 

@@ -72,7 +72,7 @@ def linear_analysis(scenario: Any) -> dict[str, dict[str, float]]:
         poles = linearised_closed_loop_poles(model, gains, w, s.filter_damping)
         wc, pm = loop_margins(num, den)
         out[label] = {"max_pole_real": float(poles.real.max()), "crossover": wc, "phase_margin": pm}
-    pid = PIDTVVF()
+    pid = PIDTVVF(preset="paper")
     pid.reset(ctx)
     K, T = first_order_nomoto(ctx.nominal_model)
     g = pid.gains

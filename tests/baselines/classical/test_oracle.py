@@ -251,13 +251,20 @@ def test_a_sample_of_the_shipped_references_recomputes_to_the_same_cost() -> Non
 
 
 def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
-    """What is achievable: on every smoke trial the oracle's cost is below pid_los's."""
+    """What is achievable: on every smoke trial the oracle's cost is below that of pid_los's
+    paper design, and below the tuned pid_los's on the nomoto2 trials.  Known exception
+    (issue 17, open): on ``mariner_track`` the tuned pid_los (issue 21) costs less than this
+    revision of the oracle, whose 21 blocked intervals over a 268 s horizon are too coarse
+    for the Mariner — the test pins it so that a better oracle revision shows."""
     table = shipped_table()
     for scenario in load_suite("smoke").all_scenarios():
         for job, trial in _smoke_trials(scenario):
-            (pid,) = evaluate("pid_los", trial, seeds=list(job.seeds))
             oracle = table.lookup(trial, job.seeds[0])["metrics"]["cost"]
-            assert oracle < pid.metrics["cost"], (scenario, job.seeds, oracle)
+            (paper,) = evaluate("pid_los", trial, seeds=list(job.seeds), preset="paper")
+            assert oracle < paper.metrics["cost"], (scenario, job.seeds, oracle)
+            (tuned,) = evaluate("pid_los", trial, seeds=list(job.seeds))
+            beaten = oracle >= tuned.metrics["cost"]
+            assert beaten == (trial.config.ship.model == "mariner"), (scenario, job.seeds, oracle)
 
 
 def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:

@@ -163,7 +163,7 @@ def test_field_laws_use_the_scenario_parameters() -> None:
             "time_limit": 5.0,
         }
     )
-    vf, tvvf = PIDVF(), PIDTVVF()
+    vf, tvvf = PIDVF(preset="paper"), PIDTVVF(preset="paper")  # tuned: the chosen settings
     evaluate(vf, scenario, [0])
     evaluate(tvvf, scenario, [0])
     L = vf.ctx.ship_length
@@ -194,9 +194,10 @@ def test_controllers_follow_the_nominal_path(cls: type, tuning: str) -> None:
 @pytest.mark.parametrize("tuning", ["pole_placement", "vyshnegradsky"])
 @pytest.mark.parametrize("cls", CONTROLLERS, ids=lambda c: c.name)
 def test_controllers_reach_the_mariner_track(cls: type, tuning: str) -> None:
-    """mariner_track, first 300 s from 500 m off the first leg: the ship reaches the path
-    within 160 s and |e| stays below twice the initial offset."""
-    (result,) = evaluate(cls(tuning=tuning), _mariner_track(300.0), [0])
+    """mariner_track, first 300 s from 500 m off the first leg: the paper's design reaches
+    the path within 160 s and |e| stays below twice the initial offset (the tuned
+    lookahead, 2.6 L = 450 m, approaches a 500 m offset more gently)."""
+    (result,) = evaluate(cls(tuning=tuning, preset="paper"), _mariner_track(300.0), [0])
     t = result.trajectory["t"]
     e = result.trajectory["cross_track_error"]
     assert np.all(np.isfinite(e))
@@ -206,6 +207,39 @@ def test_controllers_reach_the_mariner_track(cls: type, tuning: str) -> None:
 
 
 def test_pid_los_pole_placement_numbers_unchanged() -> None:
-    """pid_los keeps the leaderboard's numbers: ωn = 1 rad/s, ζ = 1 pole placement."""
-    (result,) = evaluate(PIDLOS(), "nominal", [0])
+    """pid_los's paper preset keeps the old leaderboard numbers: ωn = 1 rad/s, ζ = 1."""
+    (result,) = evaluate(PIDLOS(preset="paper"), "nominal", [0])  # the paper's design
     assert result.metrics["ace"] == pytest.approx(1.0298, abs=1e-3)
+
+
+def test_every_guidance_parameter_and_design_setting_is_a_keyword() -> None:
+    """The PID's keywords are exactly the design settings and the scenario's guidance
+    parameters (so a misspelt setting is named before anything runs: the registry binds
+    settings to the signature)."""
+    import inspect
+
+    from shipgym_baselines.classical.pid import GUIDANCE_SETTINGS, SETTINGS
+
+    params = set(inspect.signature(PIDLOS).parameters) - {"preset"}
+    assert params == set(SETTINGS) | set(GUIDANCE_SETTINGS)
+    with pytest.raises(ValueError, match="preset"):
+        PIDLOS(preset="best")
+
+
+def test_paper_preset_is_the_literal_design_and_guidance_settings_reach_the_law() -> None:
+    """preset='paper' ignores chosen settings; an explicit los_radius_L replaces the
+    scenario's R_LOS in the controller's own reference, ψd = γp − arcsin(ye / R_LOS) (Liu et al.
+    2019 eq. (9))."""
+    import math
+
+    from shipgym.envs.context import ControllerContext
+    from shipgym.scenarios import load_scenario
+
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    pid = PIDLOS(preset="paper", los_radius_L=5.0)
+    pid.reset(ctx)
+    paper = PIDLOS(preset="paper")
+    paper.reset(ctx)
+    assert pid.gains == paper.gains
+    ye = 0.4 * ctx.ship_length
+    assert pid.desired_heading(ye, 0.0) == pytest.approx(-math.asin(ye / (5.0 * ctx.ship_length)))

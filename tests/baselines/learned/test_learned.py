@@ -211,7 +211,7 @@ def test_agent_configs_load_and_bad_ones_name_the_key(tmp_path: Path) -> None:
         config = load_agent_config(name)
         assert config.name == name
     data = yaml.safe_load(Path("configs/agents/ppo.yaml").read_text())
-    data["env"]["vec_env"] = "batched"  # batched needs a fixed scenario
+    data["env"].update(vec_env="batched", n_envs=6)  # batched: one env per ship, 4 ships
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(data))
     with pytest.raises(ValueError, match="env"):
@@ -333,7 +333,11 @@ def test_train_seeds_ship_lays_out_a_folder_per_training_seed(
     assert [m["shipped_to"] for m in shipped] == [str(agent / "seed_1"), str(agent / "seed_2")]
     assert sorted(p.name for p in agent.iterdir()) == ["seed_1", "seed_2"]
     for s in (1, 2):
-        assert sorted(p.name for p in (agent / f"seed_{s}").iterdir()) == ["meta.json", "model.zip"]
+        assert sorted(p.name for p in (agent / f"seed_{s}").iterdir()) == [
+            "learning_curve.json",
+            "meta.json",
+            "model.zip",
+        ]
     assert training_seeds("ppo_tiny") == [1, 2]
     assert training_seeds(str(out)) == [1, 2]  # the run folder resolves the same way
     policy = LearnedPolicy("ppo_tiny", training_seed=2)

@@ -101,12 +101,12 @@ def test_a_plain_sb3_zip_is_scored_by_its_path(
     path = trained[algo]
     policy, mode = make_controller(str(path))
     assert isinstance(policy, LearnedPolicy) and (policy.algo, mode) == (algo, "rudder")
-    assert policy.name == f"{algo}/agent" and controller_kind(policy.name) == "learned"
+    assert policy.name == "agent" and controller_kind(policy.name) == "learned"  # the stem
     model = getattr(sb3, cls).load(str(path), device="cpu")
     for obs in _observations():  # the policy acts as the model does, deterministically
         np.testing.assert_array_equal(policy.act(obs, {}), _predict(model, obs))
     (result,) = evaluate(str(path), "nominal", [EVAL_SEED_OFFSET])
-    assert (result.controller, result.kind) == (f"{algo}/agent", "learned")
+    assert (result.controller, result.kind) == ("agent", "learned")
     assert np.isfinite(result.metrics["return"])
     assert "train_env_steps" not in result.metrics  # no meta.json: no training cost shown
 
@@ -369,3 +369,13 @@ def test_every_shipped_agent_loads_each_of_its_training_seeds() -> None:
             policy, _ = make_controller(name, training_seed=seed)
             assert (policy.name, policy.training_seed) == (name, seed)
             assert policy.episode_stats()["train_env_steps"] > 0
+
+
+def test_an_sb3_zip_is_named_by_its_file_stem(tmp_path: Path) -> None:
+    """issue 20: ``work/ppo_ship.zip`` is ``ppo_ship``, not its folder's name; a trained
+    agent's own model file is its folder's."""
+    from shipgym_baselines.learned.policy import policy_label
+
+    assert policy_label(tmp_path / "work" / "ppo_ship.zip") == "ppo_ship"
+    assert policy_label(tmp_path / "work" / "model.zip") == "work"
+    assert policy_label(tmp_path / "agent" / "seed_1" / "best_model.zip") == "agent/seed_1"

@@ -268,18 +268,69 @@ def test_training_never_draws_a_catalogue_or_heldout_trial() -> None:
 
 def test_validation_is_the_training_ranges_in_the_test_seed_space() -> None:
     validation, train = load_distribution("validation"), load_distribution("train")
-    assert validation.split == "test" and len(validation) == 8
+    assert validation.split == "test" and len(validation) == 32
     assert validation.config.path == train.config.path
     for v, t in zip(validation.config.ships, train.config.ships, strict=True):
-        assert v.count == 2
-        assert v.model_dump(exclude={"weight", "count"}) == t.model_dump(
-            exclude={"weight", "count"}
+        assert v.count == 8 and v.jumps.order == "cycle"
+        assert v.model_dump(exclude={"weight", "count", "jumps"}) == t.model_dump(
+            exclude={"weight", "count", "jumps"}
+        )
+        assert v.jumps.probability == 1.0
+        assert v.jumps.model_dump(exclude={"order", "probability"}) == t.jumps.model_dump(
+            exclude={"order", "probability"}
         )
     assert [validation.test_scenario(i).ship.model for i in range(4)] == list(SHIPS)
 
 
+def test_validation_covers_every_ship_and_family_inside_the_training_ranges() -> None:
+    """The 32 validation trials: 8 per ship, each ship every family it is trained on (the
+    three families: aging, a current / d0 shift, a manoeuvrability change — gain or
+    loading), each size inside the documented training range, hence (by
+    test_training_never_draws_a_catalogue_or_heldout_trial) apart from every catalogue and
+    held-out scenario's."""
+    validation, train = load_distribution("validation"), load_distribution("train").config
+    ranges = {ship.model: _training_ranges(ship) for ship in train.ships}
+    seen: dict[str, set[str]] = collections.defaultdict(set)
+    per_ship: collections.Counter[str] = collections.Counter()
+    for config in (validation.test_scenario(i) for i in range(len(validation))):
+        per_ship[config.ship.model] += 1
+        for family, (lo, hi) in _families(config).items():
+            low, high = ranges[config.ship.model][family]
+            factor = CURRENT_FACTOR if family == "current" else (1.0, 1.0)
+            assert low * factor[0] - 1e-9 <= lo and hi <= high * factor[1] + 1e-9
+            seen[config.ship.model].add(family)
+    assert per_ship == dict.fromkeys(SHIPS, 8)
+    assert seen["nomoto2"] == {"aging", "d0_shift", "gain"}
+    for ship in SHIPS[1:]:
+        assert seen[ship] == {"aging", "current", "gain", "loading"}, ship
+
+
+def test_validation_seeds_are_apart_from_training_and_heldout() -> None:
+    """Validation draws from the test seed space under its own name: its generators'
+    entropy differs from the held-out split's and from every training scenario seed's (a
+    different salt), and no validation trial equals a held-out or catalogue one."""
+    import zlib
+
+    from shipgym.scenarios.sampling import TEST_SALT, TRAIN_SALT
+
+    assert TEST_SALT != TRAIN_SALT  # SeedSequence([salt, …]): training never meets test
+    assert zlib.crc32(b"validation") != zlib.crc32(b"heldout")  # [TEST_SALT, crc32(name), j]
+    validation, heldout = load_distribution("validation"), load_distribution("heldout")
+    ours = {_content(validation.test_scenario(i)) for i in range(len(validation))}
+    theirs = {_content(heldout.test_scenario(i)) for i in range(len(heldout))}
+    theirs |= {_content(load_scenario(name).config) for name in list_scenarios()}
+    assert len(ours) == 32 and not ours & theirs
+
+
+def _content(config: Any) -> str:
+    """A scenario's settings without its name and description."""
+    data = config.model_dump(mode="json", exclude={"name", "description", "source"})
+    return repr(sorted(data.items()))
+
+
 def test_pid_los_finishes_every_validation_scenario() -> None:
-    """Feasibility: every ship's in-range scenarios can be finished in their time limits."""
+    """Feasibility: every ship's in-range scenarios can be finished in their time limits
+    (by pid_los as tuned on them)."""
     validation = load_distribution("validation")
     for name in validation.test_names():
         policy, mode = make_controller("pid_los")

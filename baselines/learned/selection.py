@@ -1,0 +1,136 @@
+"""Model selection on the cost relative to a reference, so that every ship counts.
+
+Raw mean validation return is decided by the long full-scale episodes (their returns are
+10²–10³ times nomoto2's).  Instead, with ``eval.select_on: relative_cost``, each periodic
+evaluation runs the agent on fixed validation trials (validation scenario i with env seed
+``EVAL_SEED_OFFSET + i``, the same trials every time) and scores it by
+
+    R = exp( mean_i log(C_i / C_ref,i) )        (geometric mean; lower is better)
+
+with C the episode cost (:func:`shipgym.metrics.episode_cost`) and C_ref the ``oracle``'s
+cost on the same trial from the shipped reference table
+(:mod:`shipgym_baselines.references`) where present, else ``pid_los``'s, computed once per
+run (``eval/reference_costs.json`` in the run folder).  Both are never the held-out set.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+
+#: the fallback reference where the oracle's table has no entry for a trial
+FALLBACK_REFERENCE = "pid_los"
+#: costs below this are floored in the ratio (a perfect episode costs > 0 anyway)
+COST_FLOOR = 1e-9
+REFERENCE_FILE = "reference_costs.json"
+
+
+def validation_trials(distribution: str, n_episodes: int) -> list[tuple[str, int]]:
+    """(scenario name, env seed) of the selection's trials: the first ``n_episodes``
+    scenarios of the (test-split) validation distribution, scenario i with seed
+    EVAL_SEED_OFFSET + i."""
+    from shipgym.scenarios.sampling import load_distribution
+
+    dist = load_distribution(distribution)
+    if dist.split != "test":
+        raise RunError(f"eval.distribution {distribution!r} is not a test split")
+    if n_episodes > len(dist):
+        raise RunError(
+            f"eval.n_episodes {n_episodes}: {distribution!r} has {len(dist)} scenarios; "
+            "relative-cost selection runs each once"
+        )
+    return [(name, EVAL_SEED_OFFSET + i) for i, name in enumerate(dist.test_names()[:n_episodes])]
+
+
+def geometric_mean_ratio(costs: Sequence[float], references: Sequence[float]) -> float:
+    """exp(mean log(C / C_ref)) over trials, each cost floored at :data:`COST_FLOOR`."""
+    if len(costs) != len(references) or not costs:
+        raise ValueError("need one reference cost per cost, and at least one")
+    logs = [
+        math.log(max(c, COST_FLOOR)) - math.log(max(r, COST_FLOOR))
+        for c, r in zip(costs, references, strict=True)
+    ]
+    return math.exp(sum(logs) / len(logs))
+
+
+def reference_cost(scenario_name: str, seed: int, action_mode: str = "rudder") -> dict[str, Any]:
+    """{"cost": C_ref, "reference": "oracle" | "pid_los"} of one trial (module doc)."""
+    from shipgym.scenarios import load_scenario
+    from shipgym_baselines.evaluation import evaluate
+    from shipgym_baselines.references import shipped_table
+
+    entry = shipped_table().lookup(load_scenario(scenario_name), seed)
+    if entry is not None:
+        return {"cost": float(entry["metrics"]["cost"]), "reference": "oracle"}
+    result = evaluate(FALLBACK_REFERENCE, scenario_name, [seed])[0]
+    return {"cost": float(result.metrics["cost"]), "reference": FALLBACK_REFERENCE}
+
+
+def reference_costs(
+    trials: Sequence[tuple[str, int]], cache_dir: str | Path | None = None
+) -> list[dict[str, Any]]:
+    """The reference cost of every trial, read from / written to ``cache_dir`` (once per
+    run: a cache for other trials is recomputed)."""
+    cache = None if cache_dir is None else Path(cache_dir) / REFERENCE_FILE
+    wanted = [[name, seed] for name, seed in trials]
+    if cache is not None and cache.is_file():
+        data = json.loads(cache.read_text())
+        if data.get("trials") == wanted:
+            return data["references"]
+    refs = [reference_cost(name, seed) for name, seed in trials]
+    if cache is not None:
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        cache.write_text(json.dumps({"trials": wanted, "references": refs}, indent=1))
+    return refs
+
+
+def run_agent_episode(
+    model: Any, scenario_name: str, seed: int, action_mode: str, context_features: bool
+) -> tuple[float, float]:
+    """(episode return, episode cost C) of an SB3 model acting deterministically on one
+    trial (RecurrentPPO's memory carried through the episode)."""
+    from shipgym.envs.path_follow import ShipPathFollowEnv
+
+    env = ShipPathFollowEnv(
+        scenario_name, action_mode=action_mode, context_features=context_features
+    )
+    try:
+        obs, _ = env.reset(seed=seed)
+        state, start, total = None, True, 0.0
+        while True:
+            action, state = model.predict(
+                obs[None], state=state, episode_start=np.array([start]), deterministic=True
+            )
+            start = False
+            obs, reward, terminated, truncated, info = env.step(action[0])
+            total += reward
+            if terminated or truncated:
+                return total, float(info["episode_metrics"]["cost"])
+    finally:
+        env.close()
+
+
+def evaluate_relative(
+    model: Any,
+    trials: Sequence[tuple[str, int]],
+    references: Sequence[dict[str, Any]],
+    action_mode: str,
+    context_features: bool,
+) -> dict[str, Any]:
+    """The agent on every trial: {"returns", "costs", "selection" (the geometric-mean cost
+    ratio)}."""
+    returns, costs = [], []
+    for name, seed in trials:
+        ret, cost = run_agent_episode(model, name, seed, action_mode, context_features)
+        returns.append(ret)
+        costs.append(cost)
+    ratio = geometric_mean_ratio(costs, [r["cost"] for r in references])
+    return {"returns": returns, "costs": costs, "selection": ratio}

@@ -1,0 +1,405 @@
+"""Run a study: Optuna (TPE sampler seeded, median pruner), SQLite storage, resumable.
+
+A study is one (tuning config, ship) pair — ``<name>:<ship>`` for a per-ship config, else
+``<name>`` — in the folder ``<out>/<ship>`` (or ``<out>``), its storage
+``sqlite:///<folder>/study.db`` unless ``--storage`` names another.  An existing study is
+continued only with ``resume=True`` (else refused: nothing is overwritten silently), and a
+resumed study runs until it holds ``n_trials`` finished trials (complete, pruned or failed;
+a trial left running by a killed process is marked failed).  The sampler's seed is the
+config's ``sampler_seed`` plus the number of trials already finished, so a resumed study
+draws new points and the same history gives the same suggestions.
+
+Before its first trial a study scores the *default* settings (the config's ``default``:
+the registry's construction before tuning — for a classical controller its paper-literal
+design, ``preset: paper``; for a learned agent its agent config unchanged) and keeps the
+ratios in the study, so the report can compare best and default on the same trials.  When the study
+ends, its ``tuning_report.json`` is (re)written and the chosen settings — the best trial's,
+or none (the default kept) when the best is not below the default — go into
+``configs/tuning/chosen/<controller>.yaml`` (:mod:`~shipgym_baselines.tuning.chosen`).
+
+``backend="ray"`` runs the trials as Ray tasks, ``workers`` at a time, each loading the
+study from the shared storage.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.tuning import chosen as chosen_settings
+from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
+from shipgym_baselines.tuning.report import best_vs_default, trial_rows
+from shipgym_baselines.tuning.space import TuningConfig, load_tuning
+from shipgym_baselines.tuning.validation import ValidationTrial, oracle_costs, validation_trials
+
+REPORT_FILE = "tuning_report.json"
+STORAGE_FILE = "study.db"
+BACKENDS = ("local", "ray")
+#: Optuna's states of a finished trial
+FINISHED = ("COMPLETE", "PRUNED", "FAIL")
+
+Progress = Callable[[str], object]
+
+
+@dataclasses.dataclass
+class StudyPlan:
+    """What one study runs: config, ship (None: every ship), folder, storage, name."""
+
+    tuning: str  # the config's name or path (what a Ray worker reloads)
+    config: TuningConfig
+    ship: str | None
+    folder: Path
+    storage: str
+    study_name: str
+    chosen_dir: Path | None = None
+
+    @property
+    def section(self) -> str:
+        return self.ship or chosen_settings.ALL_SHIPS
+
+
+def plan_studies(
+    tuning: str,
+    ship: str | None = None,
+    out: str | os.PathLike | None = None,
+    storage: str | None = None,
+    chosen_dir: str | os.PathLike | None = None,
+) -> list[StudyPlan]:
+    """The studies ``shipgym tune`` runs: one per ship for a per-ship config (only ``ship``
+    when given), else one."""
+    config = load_tuning(tuning)
+    base = Path(out) if out is not None else Path("results") / "tuning" / config.name
+    chosen = Path(chosen_dir) if chosen_dir is not None else None
+    if not config.per_ship:
+        if ship is not None:
+            raise RunError(f"--ship: {config.name} is one setting for every ship (per_ship false)")
+        return [_plan(tuning, config, None, base, storage, chosen)]
+    ships = _ships(config)
+    if ship is not None:
+        if ship not in ships:
+            raise RunError(f"--ship {ship!r}: {config.name} is tuned on {', '.join(ships)}")
+        ships = [ship]
+    if storage is not None and len(ships) > 1:
+        raise RunError("--storage names one study's storage: give --ship too")
+    return [_plan(tuning, config, s, base / s, storage, chosen) for s in ships]
+
+
+def _ships(config: TuningConfig) -> list[str]:
+    """The ships a per-ship config is tuned on: its ``ships`` or every ship of the
+    validation split the controller applies to."""
+    from shipgym.scenarios.sampling import load_distribution
+    from shipgym_baselines.registry import resolve_controller
+
+    models = [s.model for s in load_distribution(config.validation.distribution).config.ships]
+    applies = resolve_controller(config.controller).applies_to
+    wanted = config.ships or models
+    return [m for m in models if m in wanted and (applies is None or m in applies)]
+
+
+def _plan(
+    tuning: str,
+    config: TuningConfig,
+    ship: str | None,
+    folder: Path,
+    storage: str | None,
+    chosen: Path | None,
+) -> StudyPlan:
+    url = storage or f"sqlite:///{(folder / STORAGE_FILE).absolute()}"
+    name = f"{config.name}:{ship}" if ship else config.name
+    return StudyPlan(tuning, config, ship, folder, url, name, chosen)
+
+
+def study_exists(plan: StudyPlan) -> bool:
+    import optuna
+
+    if plan.storage.startswith("sqlite:///"):
+        db = Path(plan.storage[len("sqlite:///") :])
+        if not db.is_file():
+            return False
+    return plan.study_name in optuna.study.get_all_study_names(plan.storage)
+
+
+def plan_trials(plan: StudyPlan) -> list[ValidationTrial]:
+    v = plan.config.validation
+    return validation_trials(v.distribution, plan.ship, v.per_ship, plan.config.ships)
+
+
+class Scorer:
+    """Scores settings on a study's validation trials: ``score(overrides, report)`` ->
+    per-trial cost ratios (classical: evaluated a chunk at a time; learned: trained, then
+    evaluated, :mod:`~shipgym_baselines.tuning.learned`)."""
+
+    def __init__(self, plan: StudyPlan, progress: Progress | None = None) -> None:
+        self.plan = plan
+        self.run_name: str | None = None  # a learned trial's run folder name
+        self.trials = plan_trials(plan)
+        plan.folder.mkdir(parents=True, exist_ok=True)
+        self.oracle = oracle_costs(
+            self.trials, plan.folder.parent if plan.ship else plan.folder, progress
+        )
+
+    def score(
+        self, settings: dict[str, Any], report: Callable[[float, int], None] | None = None
+    ) -> list[float]:
+        """Per-trial ratios of the controller made with ``settings`` (all of them: the
+        study's ``fixed`` are not added here)."""
+        config = self.plan.config
+        if config.kind == "learned":
+            from shipgym_baselines.tuning.learned import train_and_score
+
+            run = self.plan.folder / "runs" / (self.run_name or "default")
+            return train_and_score(config, settings, self.trials, self.oracle, run, report)
+        return chunked_ratios(
+            lambda trials, oracle: controller_ratios(config.controller, settings, trials, oracle),
+            self.trials,
+            self.oracle,
+            config.chunk,
+            report,
+        )
+
+    def objective(self, trial: Any) -> float:
+        """The Optuna objective: sample, score with pruning reports, return the gmean."""
+        import optuna
+
+        params = {k: spec.suggest(trial, k) for k, spec in self.plan.config.params.items()}
+        start = time.process_time()
+        self.run_name = f"trial_{trial.number}"
+
+        def report(value: float, step: int) -> None:
+            trial.report(value, step)
+            if trial.should_prune():
+                trial.set_user_attr("cpu_s", time.process_time() - start)
+                raise optuna.TrialPruned()
+
+        ratios = self.score({**self.plan.config.fixed, **params}, report)
+        trial.set_user_attr("ratios", ratios)
+        trial.set_user_attr("cpu_s", time.process_time() - start)
+        return geometric_mean(ratios)
+
+
+def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool = True) -> Any:
+    """The plan's Optuna study: created (refused if it exists and not ``resume``) or
+    loaded (``resume``: refused if there is none).  ``driver``: the process that runs the
+    study marks the trials a killed process left running as failed; a Ray task (False) must
+    not, or it would fail another task's trial that is running now."""
+    import optuna
+
+    exists = study_exists(plan)
+    if exists and not resume:
+        raise RunError(
+            f"study {plan.study_name!r} exists in {plan.storage}: pass --resume to continue "
+            "it, or another --out / --storage for a new one (nothing is overwritten)"
+        )
+    if resume and not exists:
+        raise RunError(f"--resume: no study {plan.study_name!r} in {plan.storage}")
+    plan.folder.mkdir(parents=True, exist_ok=True)
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    finished = 0
+    if exists:
+        study = optuna.load_study(study_name=plan.study_name, storage=plan.storage)
+        if driver:
+            _fail_stale(study)
+        finished = sum(t.state.name in FINISHED for t in study.trials)
+    sampler = optuna.samplers.TPESampler(
+        seed=plan.config.sampler_seed + finished,
+        n_startup_trials=plan.config.startup_trials,
+    )
+    pruner = optuna.pruners.MedianPruner(n_startup_trials=plan.config.startup_trials)
+    if not exists and create:
+        return optuna.create_study(
+            study_name=plan.study_name,
+            storage=plan.storage,
+            sampler=sampler,
+            pruner=pruner,
+            direction="minimize",
+        )
+    return optuna.load_study(
+        study_name=plan.study_name, storage=plan.storage, sampler=sampler, pruner=pruner
+    )
+
+
+def _fail_stale(study: Any) -> None:
+    """Mark trials a killed process left running as failed (a resumed study re-runs them)."""
+    from optuna.trial import TrialState
+
+    for t in study.trials:
+        if t.state == TrialState.RUNNING:
+            study._storage.set_trial_state_values(t._trial_id, state=TrialState.FAIL)
+
+
+def run_study(
+    plan: StudyPlan,
+    n_trials: int | None = None,
+    resume: bool = False,
+    backend: str = "local",
+    workers: int = 1,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
+    """Run (or continue) one study to ``n_trials`` finished trials (default: the config's
+    budget), then write its report and chosen settings; returns the report."""
+    if backend not in BACKENDS:
+        raise RunError(f"--backend {backend!r}: valid: {', '.join(BACKENDS)}")
+    total = int(n_trials if n_trials is not None else plan.config.budget)
+    if total < 1:
+        raise RunError(f"--trials {total}: at least 1")
+    study = open_study(plan, resume)
+    scorer = Scorer(plan, progress)
+    if "default_ratios" not in study.user_attrs:
+        say(progress, f"{plan.study_name}: scoring the default settings")
+        start = time.process_time()
+        study.set_user_attr("default_ratios", scorer.score(dict(plan.config.default)))
+        study.set_user_attr("default_cpu_s", time.process_time() - start)
+    remaining = total - sum(t.state.name in FINISHED for t in study.trials)
+    if remaining > 0:
+        say(progress, f"{plan.study_name}: {remaining} trial(s) to run ({backend})")
+        if backend == "ray":
+            _run_on_ray(plan, total, workers)
+        else:
+            study.optimize(
+                scorer.objective,
+                n_trials=remaining,
+                callbacks=[_progress_callback(plan, progress)],
+            )
+    study = open_study(plan, resume=True, create=False)
+    return write_report(plan, study, scorer.trials, scorer.oracle)
+
+
+def _progress_callback(plan: StudyPlan, progress: Progress | None) -> Callable[..., None]:
+    def callback(study: Any, trial: Any) -> None:
+        best = study.best_value if any(t.value is not None for t in study.trials) else None
+        say(
+            progress,
+            f"{plan.study_name}: trial {trial.number} {trial.state.name} value {trial.value} "
+            f"params {trial.params} (best {best})",
+        )
+
+    return callback
+
+
+def say(progress: Progress | None, text: str) -> None:
+    if progress is not None:
+        progress(text)
+
+
+def write_report(
+    plan: StudyPlan, study: Any, trials: list[ValidationTrial], oracle: list[float]
+) -> dict[str, Any]:
+    """Write ``tuning_report.json`` and the chosen settings (module doc); returns the
+    report."""
+    config = plan.config
+    default = list(study.user_attrs["default_ratios"])
+    complete = [t for t in study.trials if t.state.name == "COMPLETE"]
+    best = min(complete, key=lambda t: t.value) if complete else None
+    names = [t.name for t in trials]
+    report: dict[str, Any] = {
+        "name": config.name,
+        "controller": config.controller,
+        "kind": config.kind,
+        "ship": plan.ship,
+        "study": plan.study_name,
+        "storage": plan.storage,
+        "objective": config.objective,
+        "sampler": {
+            "type": "TPESampler",
+            "seed": config.sampler_seed,
+            "n_startup_trials": config.startup_trials,
+        },
+        "pruner": {
+            "type": "MedianPruner",
+            "n_startup_trials": config.startup_trials,
+            "report_every_trials": config.chunk,
+        },
+        "budget": config.budget,
+        "validation": {
+            "distribution": config.validation.distribution,
+            "trials": names,
+            "seeds": [t.seed for t in trials],
+            "oracle_costs": oracle,
+        },
+        "fixed": dict(config.fixed),
+        "default_settings": dict(config.default),
+        "search_space": {k: v.model_dump(exclude_none=True) for k, v in config.params.items()},
+        "trials": trial_rows(study),
+        "best_params": dict(best.params) if best else None,
+        "best_value": best.value if best else None,
+        "default_value": geometric_mean(default),
+        "cpu_s": {
+            "default": study.user_attrs.get("default_cpu_s"),
+            "trials": sum(t.user_attrs.get("cpu_s") or 0.0 for t in study.trials),
+        },
+    }
+    if best is not None:
+        report["best_vs_default"] = best_vs_default(best.user_attrs["ratios"], default, names)
+        improved = best.value < report["default_value"]
+        settings = (
+            {**{k: v for k, v in config.fixed.items() if k != "preset"}, **best.params}
+            if improved
+            else {}
+        )
+        summary = {
+            "study": plan.study_name,
+            "report": str(plan.folder / REPORT_FILE),
+            "best_value": best.value,
+            "default_value": report["default_value"],
+            "trials": len(study.trials),
+        }
+        file, replaced = chosen_settings.write_chosen(
+            config.controller, plan.section, settings, summary, plan.chosen_dir
+        )
+        report["chosen"] = {
+            "file": str(file),
+            "section": plan.section,
+            "settings": settings,
+            "kept_default": not improved,
+            "replaced": replaced,
+        }
+    plan.folder.mkdir(parents=True, exist_ok=True)
+    staged = plan.folder / f"{REPORT_FILE}.{os.getpid()}.tmp"
+    staged.write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
+    os.replace(staged, plan.folder / REPORT_FILE)
+    return report
+
+
+def _jsonable(value: Any) -> Any:
+    if hasattr(value, "item"):
+        return value.item()
+    raise TypeError(f"not JSON: {value!r}")
+
+
+def _run_on_ray(plan: StudyPlan, total: int, workers: int) -> None:
+    """The remaining trials as Ray tasks, ``workers`` at once, sharing the storage."""
+    import ray
+
+    started = not ray.is_initialized()
+    if started:
+        ray.init(num_cpus=max(1, workers), include_dashboard=False, log_to_driver=False)
+    try:
+        task = ray.remote(num_cpus=1)(_ray_worker)
+        args = (plan.tuning, plan.ship, str(plan.folder), plan.storage, total)
+        ray.get([task.remote(*args) for _ in range(max(1, workers))])
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def _ray_worker(tuning: str, ship: str | None, folder: str, storage: str, total: int) -> int:
+    """One Ray task: load the study and run trials until it holds ``total`` finished."""
+    from optuna.study import MaxTrialsCallback
+    from optuna.trial import TrialState
+
+    config = load_tuning(tuning)
+    name = f"{config.name}:{ship}" if ship else config.name
+    plan = StudyPlan(tuning, config, ship, Path(folder), storage, name)
+    study = open_study(plan, resume=True, create=False, driver=False)
+    scorer = Scorer(plan)
+    states = (TrialState.COMPLETE, TrialState.PRUNED, TrialState.FAIL)
+    if sum(t.state in states for t in study.trials) >= total:
+        return 0
+    study.optimize(scorer.objective, callbacks=[MaxTrialsCallback(total, states=states)])
+    return len(study.trials)

@@ -1,0 +1,119 @@
+"""The trials a study scores on: the validation split only, and the oracle's cost on each.
+
+A validation trial is a named scenario of a validation distribution (``validation:k``, the
+training ranges in the test seed space: ``configs/distributions/validation.yaml``) with one
+evaluation seed, :data:`~shipgym_baselines.evaluation.EVAL_SEED_OFFSET` + k.  Every
+scenario a study runs comes from :func:`validation_trials`, which refuses any distribution
+that is not the training ranges in the test seed space (so never the held-out split, never
+a catalogue scenario).
+
+The denominator of the cost ratio is the ``oracle``'s cost on the same trial
+(:mod:`shipgym_baselines.references`): read from the shipped table if it holds the trial,
+else run once with the privileged oracle (the built-in channel,
+:mod:`shipgym_baselines.privileged`; the tuned controller never sees the truth) and cached in
+the study folder, ``oracle.json.gz``, whose header carries the env and oracle revisions and
+settings (a cache of another revision is ignored as a whole).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.sampling import load_distribution
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+
+#: the oracle cache's file name in a study folder
+ORACLE_CACHE = "oracle.json.gz"
+
+
+@dataclasses.dataclass(frozen=True)
+class ValidationTrial:
+    """One validation trial: its name (``validation:k``), ship, scenario and env seed."""
+
+    name: str
+    ship: str
+    scenario: Scenario
+    seed: int
+
+
+def check_validation_split(distribution: str) -> None:
+    """Raise unless ``distribution`` is a validation split: a test split drawn from a train
+    split's ranges (``ranges_of``), never the held-out one."""
+    dist = load_distribution(distribution)
+    if dist.split != "test" or dist.config.ranges_of is None or dist.name == "heldout":
+        raise RunError(
+            f"validation distribution {distribution!r}: tuning scores on a validation split "
+            "only (a test split with 'ranges_of' a train split), never the held-out or "
+            "catalogue scenarios"
+        )
+
+
+def validation_trials(
+    distribution: str = "validation",
+    ship: str | None = None,
+    per_ship: int | None = None,
+    ships: Sequence[str] | None = None,
+) -> list[ValidationTrial]:
+    """The trials of ``distribution`` in its interleaved order: only ``ship``'s (None:
+    every ship's, or those in ``ships``), at most ``per_ship`` of each ship."""
+    check_validation_split(distribution)
+    dist = load_distribution(distribution)
+    models = [s.model for s in dist.config.ships]
+    if ship is not None and ship not in models:
+        raise RunError(f"--ship {ship!r}: not in {distribution!r}; valid: {', '.join(models)}")
+    trials, taken = [], dict.fromkeys(models, 0)
+    for index, (k, _) in enumerate(dist.test_layout):
+        model = models[k]
+        if (ship is not None and model != ship) or (ships is not None and model not in ships):
+            continue
+        if per_ship is not None and taken[model] >= per_ship:
+            continue
+        taken[model] += 1
+        name = f"{dist.name}:{index}"
+        scenario = load_scenario(dist.test_scenario(index))
+        trials.append(ValidationTrial(name, model, scenario, EVAL_SEED_OFFSET + index))
+    if not trials:
+        raise RunError(f"no validation trials in {distribution!r} for ship {ship!r}")
+    return trials
+
+
+def oracle_costs(
+    trials: Sequence[ValidationTrial],
+    cache_dir: str | os.PathLike,
+    progress: Callable[[str], object] | None = None,
+) -> list[float]:
+    """The oracle's cost on each trial (module doc: shipped table, else the study folder's
+    cache, else run now and cached)."""
+    from shipgym_baselines.evaluation import evaluate
+    from shipgym_baselines.privileged import ORACLE
+    from shipgym_baselines.references import ReferenceTable, shipped_table
+
+    shipped = shipped_table()
+    cache = ReferenceTable.load(Path(cache_dir) / ORACLE_CACHE)
+    costs = []
+    for trial in trials:
+        entry = shipped.lookup(trial.scenario, trial.seed) or cache.lookup(
+            trial.scenario, trial.seed
+        )
+        if entry is None:
+            if progress is not None:
+                progress(f"oracle reference for {trial.name} (seed {trial.seed}): computing")
+            (result,) = evaluate(ORACLE, trial.scenario, [trial.seed])
+            cache.add(trial.scenario, result)
+            cache.save()
+            entry = cache.lookup(trial.scenario, trial.seed)
+        costs.append(_cost(entry["metrics"].get("cost")))
+    return costs
+
+
+def _cost(value: object) -> float:
+    cost = float(value)  # type: ignore[arg-type]
+    if not math.isfinite(cost) or cost <= 0:
+        raise RunError(f"the oracle's reference cost {value!r} is not a positive number")
+    return cost

@@ -1,0 +1,308 @@
+"""shipgym tune: the study machinery (toy optimum, resume, refusal), its report's shape,
+the chosen settings reaching the registry's default construction, and the trial source."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import optuna
+import pytest
+import yaml
+
+from shipgym.scenarios.sampling import ScenarioDistribution
+from shipgym_baselines.classical.pid import PIDLOS
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.tuning import chosen
+from shipgym_baselines.tuning.objective import controller_ratios, geometric_mean
+from shipgym_baselines.tuning.space import ParamSpec, TuningConfig, load_tuning
+from shipgym_baselines.tuning.study import open_study, plan_studies, run_study
+from shipgym_baselines.tuning.validation import (
+    check_validation_split,
+    oracle_costs,
+    validation_trials,
+)
+
+#: a tiny per-ship pid_los study: nomoto2's first validation trial, 3 trials
+TINY = {
+    "name": "pid_los_tiny",
+    "controller": "pid_los",
+    "per_ship": True,
+    "ships": ["nomoto2"],
+    "budget": 3,
+    "validation": {"distribution": "validation", "per_ship": 1},
+    "chunk": 1,
+    "startup_trials": 2,
+    "fixed": {"preset": "paper", "tuning": "pole_placement"},
+    "default": {"preset": "paper"},
+    "params": {
+        "natural_frequency_T": {"low": 0.5, "high": 4.0, "log": True},
+        "los_radius_L": {"low": 1.5, "high": 6.0},
+    },
+}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The tiny config as a YAML file (its out folder shares one oracle cache)."""
+    folder = tmp_path_factory.mktemp("tiny")
+    file = folder / "pid_los_tiny.yaml"
+    file.write_text(yaml.safe_dump(TINY))
+    return file
+
+
+def test_a_seeded_tpe_study_finds_a_toy_optimum(tmp_path: Path) -> None:
+    """The sampler and pruner of every study (open_study) on f(x, y) = (log x − log 2)² +
+    (y − 3)², optimum x = 2, y = 3, with the config's parameter specs."""
+    config = TuningConfig.model_validate({**TINY, "budget": 60, "startup_trials": 10})
+    from shipgym_baselines.tuning.study import StudyPlan
+
+    plan = StudyPlan("toy", config, None, tmp_path, f"sqlite:///{tmp_path}/toy.db", "toy")
+    study = open_study(plan, resume=False)
+    x_spec = ParamSpec(low=0.1, high=20.0, log=True)
+    y_spec = ParamSpec(low=-5.0, high=5.0)
+
+    def objective(trial: Any) -> float:
+        x, y = x_spec.suggest(trial, "x"), y_spec.suggest(trial, "y")
+        return (math.log(x) - math.log(2.0)) ** 2 + (y - 3.0) ** 2
+
+    study.optimize(objective, n_trials=60)
+    assert study.best_params["x"] == pytest.approx(2.0, rel=0.15)
+    assert study.best_params["y"] == pytest.approx(3.0, abs=0.3)
+    again = open_study(plan, resume=True)  # the same study, from its SQLite storage
+    assert len(again.trials) == 60 and again.best_value == study.best_value
+
+
+def test_tuning_reads_only_validation_trials(
+    tiny: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A spy on the trial sources: a study draws test scenarios only from the validation
+    split and never loads a catalogue scenario file."""
+    import shipgym.scenarios.loader as loader
+
+    drawn: list[str] = []
+    files: list[str] = []
+    real_test, real_file = ScenarioDistribution.test_scenario, loader.load_scenario_file
+
+    def spy_test(self: ScenarioDistribution, index: int) -> Any:
+        drawn.append(f"{self.name}:{index}")
+        return real_test(self, index)
+
+    def spy_file(path: Any) -> Any:
+        files.append(str(path))
+        return real_file(path)
+
+    monkeypatch.setattr(ScenarioDistribution, "test_scenario", spy_test)
+    monkeypatch.setattr(loader, "load_scenario_file", spy_file)
+    (plan,) = plan_studies(str(tiny), out=tiny.parent / "out_spy", chosen_dir=tmp_path)
+    run_study(plan, n_trials=2)
+    assert drawn and {name.split(":")[0] for name in drawn} == {"validation"}
+    assert files == []
+    for bad in ("heldout", "train"):
+        with pytest.raises(RunError, match="validation split"):
+            check_validation_split(bad)
+
+
+def test_a_study_reports_resumes_and_refuses_to_overwrite(tiny: Path, tmp_path: Path) -> None:
+    out = tiny.parent / "out_main"
+    (plan,) = plan_studies(str(tiny), out=out, chosen_dir=tmp_path)
+    report = run_study(plan, n_trials=2)
+    on_disk = json.loads((out / "nomoto2" / "tuning_report.json").read_text())
+    assert on_disk["best_value"] == report["best_value"]
+    for key in ("trials", "best_params", "best_value", "best_vs_default", "default_value"):
+        assert key in on_disk, key
+    assert len(on_disk["trials"]) == 2
+    assert {"number", "params", "value", "state"} <= set(on_disk["trials"][0])
+    assert set(on_disk["best_params"]) == {"natural_frequency_T", "los_radius_L"}
+    block = on_disk["best_vs_default"]
+    for side in ("best", "default"):
+        low, high = block[side]["ci95"]
+        assert low <= block[side]["cost_ratio_gmean"] <= high
+    assert block["best"]["cost_ratio_gmean"] == pytest.approx(on_disk["best_value"])
+    assert on_disk["validation"]["trials"] == ["validation:0"]
+    with pytest.raises(RunError, match="--resume"):
+        run_study(plan, n_trials=3)
+    resumed = run_study(plan, n_trials=3, resume=True)
+    assert len(resumed["trials"]) == 3
+    assert resumed["trials"][:2] == on_disk["trials"]  # the same study, continued
+    written = chosen.read_chosen("pid_los", tmp_path)
+    assert written["studies"]["nomoto2"]["study"] == "pid_los_tiny:nomoto2"
+    if not resumed["chosen"]["kept_default"]:
+        assert written["ships"]["nomoto2"]["los_radius_L"] == resumed["best_params"]["los_radius_L"]
+    # the best value is the objective of its settings, re-scored through the evaluation loop
+    trials = validation_trials("validation", "nomoto2", 1)
+    oracle = oracle_costs(trials, out)
+    settings = {**TINY["fixed"], **resumed["best_params"]}
+    ratios = controller_ratios("pid_los", settings, trials, oracle)
+    assert geometric_mean(ratios) == pytest.approx(resumed["best_value"], rel=1e-12)
+    with pytest.raises(RunError, match="no study"):
+        (other,) = plan_studies(str(tiny), out=tmp_path / "none", chosen_dir=tmp_path)
+        run_study(other, resume=True)
+
+
+def test_chosen_settings_reach_the_default_construction(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """PIDLOS() and L1Backstepping() read the ship's chosen section at reset (explicit
+    settings win); preset='paper' ignores it; a ship without a section keeps the paper's
+    design."""
+    from shipgym.envs.context import ControllerContext
+    from shipgym.scenarios import load_scenario
+
+    chosen.write_chosen("pid_los", "nomoto2", {"natural_frequency_T": 2.9}, {}, tmp_path)
+    monkeypatch.setattr(chosen, "chosen_dir", lambda: tmp_path)
+    chosen._packaged.cache_clear()
+    try:
+        ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+        tuned, paper = PIDLOS(), PIDLOS(preset="paper")
+        tuned.reset(ctx)
+        paper.reset(ctx)
+        from shipgym.identification import first_order_nomoto
+
+        _, T = first_order_nomoto(ctx.nominal_model)
+        assert tuned.gains.kp == pytest.approx(paper.gains.kp * (2.9 / T) ** 2)
+        explicit = PIDLOS(natural_frequency_T=T)  # explicit settings win over chosen ones
+        explicit.reset(ctx)
+        assert explicit.gains.kp == pytest.approx(paper.gains.kp)
+        other = PIDLOS()
+        other.reset(ControllerContext.of(load_scenario("blanke_nominal"), "rudder"))
+        assert other.natural_frequency_T is None  # no blanke section: the paper's ωn
+        from shipgym_baselines.classical.l1_backstepping import L1Backstepping
+
+        chosen.write_chosen("l1_backstepping", "nomoto2", {"K2": 30.0, "K1": 0.05}, {}, tmp_path)
+        chosen._packaged.cache_clear()
+        l1, l1_paper, l1_given = (
+            L1Backstepping(),
+            L1Backstepping(preset="paper"),
+            L1Backstepping(K1=0.01),
+        )
+        for policy in (l1, l1_paper, l1_given):
+            policy.reset(ctx)
+        assert (l1.settings.K1, l1.settings.K2) == (0.05, 30.0)
+        assert (l1_paper.settings.K1, l1_paper.settings.K2) == (0.02, 15.0)
+        assert (l1_given.settings.K1, l1_given.settings.K2) == (0.01, 30.0)
+    finally:
+        chosen._packaged.cache_clear()
+
+
+def test_bad_tuning_configs_name_the_key(tmp_path: Path) -> None:
+    from shipgym.config import ConfigError
+
+    for edit, match in [
+        ({"params": {"x": {"low": 2.0, "high": 1.0}}}, "low < high"),
+        ({"kind": "learned"}, "training"),
+        (
+            {
+                "fixed": {"los_radius_L": 3.0},
+                "params": TINY["params"] | {"los_radius_L": {"low": 1.0, "high": 2.0}},
+            },
+            "tuned",
+        ),
+    ]:
+        file = tmp_path / "bad.yaml"
+        file.write_text(yaml.safe_dump({**TINY, **edit}))
+        with pytest.raises(ConfigError, match=match):
+            load_tuning(str(file))
+
+
+def test_the_cli_runs_a_study_and_refuses_to_rerun_it(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tiny.parent / "out_cli"
+    argv = ["tune", str(tiny), "--out", str(out), "--chosen-dir", str(tmp_path), "--trials", "1"]
+    assert main([*argv, "--json"]) == 0
+    (report,) = json.loads(capsys.readouterr().out)
+    assert report["study"] == "pid_los_tiny:nomoto2" and len(report["trials"]) == 1
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--resume" in err[0]
+
+
+def test_a_learned_study_trains_scores_and_prunes_through_the_same_command(
+    tmp_path: Path,
+) -> None:
+    """``shipgym tune`` on a learned config: each trial trains a tiny PPO in two parts and
+    reports the validation cost ratio after each (the pruner's intermediate values)."""
+    config = {
+        "name": "ppo_tiny",
+        "controller": "ppo",
+        "kind": "learned",
+        "per_ship": False,
+        "ships": ["nomoto2"],
+        "budget": 1,
+        "validation": {"distribution": "validation", "per_ship": 1},
+        "startup_trials": 1,
+        "training": {"agent": "ppo", "n_timesteps": 256, "evaluations": 2},
+        "fixed": {"env.n_envs": 1, "hyperparams.n_steps": 64, "hyperparams.batch_size": 64},
+        "default": {"env.n_envs": 1, "hyperparams.n_steps": 64, "hyperparams.batch_size": 64},
+        "params": {"hyperparams.learning_rate": {"low": 1e-4, "high": 1e-3, "log": True}},
+    }
+    file = tmp_path / "ppo_tiny.yaml"
+    file.write_text(yaml.safe_dump(config))
+    (plan,) = plan_studies(str(file), out=tmp_path / "out", chosen_dir=tmp_path / "chosen")
+    report = run_study(plan)
+    (trial,) = report["trials"]
+    assert trial["state"] == "COMPLETE" and list(trial["intermediate"]) == ["128", "256"]
+    assert report["validation"]["trials"] == ["validation:0"]
+    assert report["best_value"] == pytest.approx(trial["value"])
+    assert report["chosen"]["section"] == "all"
+
+
+def test_every_packaged_tuning_config_loads() -> None:
+    from shipgym_baselines.tuning.space import list_tuning
+
+    names = list_tuning()
+    assert "pid_los" in names and "ppo" in names
+    for name in names:
+        load_tuning(name)
+    assert optuna.__version__
+
+
+def test_only_the_driver_fails_a_running_trial(tmp_path: Path) -> None:
+    """A trial left RUNNING is failed when the driver resumes the study (a killed process's
+    trial), but not when a Ray task opens it (another task's trial that is running now: the
+    race that made a task's ``tell`` fail with "Cannot tell a FAIL trial")."""
+    from shipgym_baselines.tuning.study import StudyPlan
+
+    config = TuningConfig.model_validate(TINY)
+    plan = StudyPlan("toy", config, None, tmp_path, f"sqlite:///{tmp_path}/toy.db", "toy")
+    running = open_study(plan, resume=False).ask()
+    open_study(plan, resume=True, create=False, driver=False)
+    assert open_study(plan, resume=True).trials[running.number].state.name == "FAIL"
+    plan2 = StudyPlan("toy2", config, None, tmp_path, f"sqlite:///{tmp_path}/toy2.db", "toy2")
+    running = open_study(plan2, resume=False).ask()
+    task_view = open_study(plan2, resume=True, create=False, driver=False)
+    assert task_view.trials[running.number].state.name == "RUNNING"
+
+
+@pytest.mark.slow
+def test_ray_tasks_share_the_study_storage(tiny: Path, tmp_path: Path) -> None:
+    """--backend ray: two Ray tasks run the trials of one study through its SQLite storage
+    (Ray starts in ≈ 16 s on the 2-core machine)."""
+    pytest.importorskip("ray")
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "ray", chosen_dir=tmp_path)
+    report = run_study(plan, n_trials=3, backend="ray", workers=2)
+    finished = [t for t in report["trials"] if t["state"] in ("COMPLETE", "PRUNED")]
+    assert 3 <= len(finished) <= 4  # each task stops at the budget (one may overshoot by 1)
+    assert report["best_value"] == min(t["value"] for t in finished if t["state"] == "COMPLETE")
+
+
+@pytest.mark.parametrize(
+    ("argv", "match"),
+    [
+        (["tune", "no_such_space"], "unknown tuning space 'no_such_space'"),
+        (["tune", "pid_los", "--ship", "titanic"], "--ship 'titanic'"),
+        (["tune", "ppo", "--ship", "mariner"], "--ship"),
+        (["tune", "pid_los", "--storage", "sqlite:///x.db"], "--storage"),
+        (["tune", "pid_los", "--ship", "nomoto2", "--trials", "0"], "--trials 0"),
+    ],
+)
+def test_bad_tune_input_is_one_line_naming_it(
+    argv: list[str], match: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main([*argv, "--out", str(tmp_path / "out"), "--chosen-dir", str(tmp_path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and match in err[0], err
