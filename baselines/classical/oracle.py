@@ -110,6 +110,7 @@ class OracleSettings:
 
     horizon_factor: float = 2.0  # k in H = k(T + (L + R0)/U) + δmax/δ̇max
     blocks: int = 20  # command intervals after the first (move blocking)
+    geometric_blocks: bool = True  # intervals growing geometrically from one period (rev. 3)
     legs: int = 4  # path segments ahead in the prediction
     smooth_abs: float = 1e-3  # ε of √(z² + ε²) on e/L and ψ̃ [rad]
     switch_width_L: float = 0.1  # width of the smooth leg switch [L]
@@ -126,19 +127,51 @@ class OracleGrid:
     """The time grid of one ship's prediction (module doc), all in control periods Ts."""
 
     horizon_s: float  # H [s]
-    block: int  # m: control periods per interval after the first
-    blocks: int  # intervals after the first
+    lengths: tuple[int, ...]  # control periods of each command interval (the first: 1)
     substeps: int  # RK4 steps per control period (h_p = Ts / substeps)
 
     @property
     def steps(self) -> int:
         """Control steps in the horizon."""
-        return 1 + self.block * self.blocks
+        return sum(self.lengths)
 
     @property
-    def lengths(self) -> list[int]:
-        """Control periods of each command interval."""
-        return [1] + [self.block] * self.blocks
+    def blocks(self) -> int:
+        """Command intervals after the first."""
+        return len(self.lengths) - 1
+
+
+def growth_ratio(periods: int, blocks: int) -> float:
+    """r ≥ 1 with 1 + r + … + r^(blocks−1) = ``periods`` (bisection): the ratio of the
+    geometric intervals that fill ``periods`` control periods with ``blocks`` intervals, the
+    first one period long; 1 when ``periods`` ≤ ``blocks``."""
+    if periods <= blocks:
+        return 1.0
+    lo, hi = 1.0, 2.0
+    while sum(hi**j for j in range(blocks)) < periods:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if sum(mid**j for j in range(blocks)) < periods else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def block_lengths(periods: int, blocks: int, geometric: bool = True) -> tuple[int, ...]:
+    """Control periods of the command intervals of a horizon of ``periods`` + 1 steps: the
+    applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
+    ``geometric``: the intervals ⌊r^j⌋, j = 0 … blocks − 1, r from :func:`growth_ratio`, the
+    periods lost to the rounding added one each to the last intervals (one period first,
+    non-decreasing, the total exactly ``periods``); otherwise ``blocks`` equal intervals
+    of ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of
+    one period."""
+    if periods <= blocks:
+        return (1,) * (1 + blocks)
+    if not geometric:
+        return (1,) + (math.ceil(periods / blocks),) * blocks
+    r = growth_ratio(periods, blocks)
+    lengths = [math.floor(r**j + 1e-9) for j in range(blocks)]
+    short = periods - sum(lengths)  # < blocks: one more period to each of the last ones
+    return (1, *(n + (j >= blocks - short) for j, n in enumerate(lengths)))
 
 
 def horizon_seconds(
@@ -184,9 +217,10 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
         settings.horizon_factor,
     )
     ts = context.control_period
-    block = max(1, math.ceil((h / ts - 1.0) / settings.blocks))
+    periods = max(1, math.ceil(h / ts - 1.0 - 1e-9))  # control periods after the first
+    lengths = block_lengths(periods, settings.blocks, settings.geometric_blocks)
     substeps = prediction_substeps(model, ts, context.fine_step)
-    return OracleGrid(horizon_s=h, block=block, blocks=settings.blocks, substeps=substeps)
+    return OracleGrid(horizon_s=h, lengths=lengths, substeps=substeps)
 
 
 def _smooth_step(z: Any) -> Any:
@@ -369,9 +403,9 @@ class OracleSolver:
         self._base_weight = self.weight.copy()
         self._terminal = np.array([steps - 1, 2 * steps - 1])  # e/L and ψ̃ at the horizon's end
         self.n_z, self.n_u, self.n_p = z.shape[0], n_u, n_p
-        key = (control_period, rudder_limit, weights, length, s.switch_width_L)
+        key = (control_period, rudder_limit, weights, length, s.switch_width_L, grid.lengths)
         tag = (
-            f"{model.name}_b{grid.blocks}x{grid.block}_s{grid.substeps}_l{n_legs}"
+            f"{model.name}_b{grid.blocks}x{grid.steps}_s{grid.substeps}_l{n_legs}"
             f"_{abs(hash(key)) % 10**8}"
         )
         value = ca.Function(f"oracle_z_{tag}", [u, p], [z])
@@ -586,6 +620,16 @@ def tail_steps(
     return max(0.0, remaining_m / (speed * control_period) - horizon_steps)
 
 
+def shifted_plan(plan: np.ndarray, lengths: tuple[int, ...]) -> np.ndarray:
+    """The warm start: ``plan`` [rad, one command per interval of ``lengths`` control
+    periods] one control period later, its last command held, each interval given the mean
+    of the shifted commands it covers (exact for intervals of one period)."""
+    per_step = np.repeat(plan, lengths)
+    shifted = np.append(per_step[1:], per_step[-1])
+    edges = np.cumsum((0, *lengths))
+    return np.add.reduceat(shifted, edges[:-1]) / np.asarray(lengths, dtype=float)
+
+
 @register_controller("oracle")
 class Oracle:
     """``oracle``: NMPC on the true plant through the privileged channel (module doc)."""
@@ -645,7 +689,7 @@ class Oracle:
             truth.params.to_vector(),
             truth.disturbance_forecast(mids),
         )
-        guess = np.concatenate([[self.plan[1]], self.plan[1:]])  # shifted by one period
+        guess = shifted_plan(self.plan, grid.lengths)
         start, cpu = time.perf_counter(), time.thread_time()
         tail = tail_steps(
             remaining_path(ctx, self.tracker, frame),
