@@ -141,35 +141,47 @@ class OracleGrid:
         return len(self.lengths) - 1
 
 
-def growth_ratio(periods: int, blocks: int) -> float:
-    """r ≥ 1 with 1 + r + … + r^(blocks−1) = ``periods`` (bisection): the ratio of the
-    geometric intervals that fill ``periods`` control periods with ``blocks`` intervals, the
-    first one period long; 1 when ``periods`` ≤ ``blocks``."""
+def _geometric_sum(r: float, blocks: int, cap: float) -> float:
+    return sum(min(r**j, cap) for j in range(blocks))
+
+
+def growth_ratio(periods: int, blocks: int, cap: float = math.inf) -> float:
+    """r ≥ 1 with Σ_{j<blocks} min(r^j, cap) = ``periods`` (bisection): the ratio of the
+    geometric intervals, the first one period long and none longer than ``cap`` periods,
+    that fill ``periods`` control periods with ``blocks`` intervals; 1 when ``periods`` ≤
+    ``blocks``.  Needs cap·blocks ≥ periods."""
     if periods <= blocks:
         return 1.0
+    if cap * blocks < periods:
+        raise ValueError(f"{blocks} intervals of at most {cap} periods cannot fill {periods}")
     lo, hi = 1.0, 2.0
-    while sum(hi**j for j in range(blocks)) < periods:
+    while _geometric_sum(hi, blocks, cap) < periods:
         lo, hi = hi, 2.0 * hi
     for _ in range(100):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if sum(mid**j for j in range(blocks)) < periods else (lo, mid)
-    return 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _geometric_sum(mid, blocks, cap) < periods else (lo, mid)
+    return hi
 
 
-def block_lengths(periods: int, blocks: int, geometric: bool = True) -> tuple[int, ...]:
+def block_lengths(
+    periods: int, blocks: int, longest: float = math.inf, geometric: bool = True
+) -> tuple[int, ...]:
     """Control periods of the command intervals of a horizon of ``periods`` + 1 steps: the
     applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
-    ``geometric``: the intervals ⌊r^j⌋, j = 0 … blocks − 1, r from :func:`growth_ratio`, the
-    periods lost to the rounding added one each to the last intervals (one period first,
-    non-decreasing, the total exactly ``periods``); otherwise ``blocks`` equal intervals
-    of ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of
-    one period."""
+    ``geometric``: the intervals ⌊min(r^j, cap)⌋, j = 0 … blocks − 1, with the cap
+    max(``longest``, ⌈periods/blocks⌉) and r from :func:`growth_ratio`, the periods lost to
+    the rounding added one each to the last intervals (one period first, non-decreasing,
+    the total exactly ``periods``); otherwise ``blocks`` equal intervals of
+    ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of one
+    period."""
     if periods <= blocks:
         return (1,) * (1 + blocks)
+    even = math.ceil(periods / blocks)
     if not geometric:
-        return (1,) + (math.ceil(periods / blocks),) * blocks
-    r = growth_ratio(periods, blocks)
-    lengths = [math.floor(r**j + 1e-9) for j in range(blocks)]
+        return (1,) + (even,) * blocks
+    cap = max(float(math.floor(longest)), float(even))
+    r = growth_ratio(periods, blocks, cap)
+    lengths = [math.floor(min(r**j, cap) + 1e-9) for j in range(blocks)]
     short = periods - sum(lengths)  # < blocks: one more period to each of the last ones
     return (1, *(n + (j >= blocks - short) for j, n in enumerate(lengths)))
 
@@ -218,7 +230,9 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
     )
     ts = context.control_period
     periods = max(1, math.ceil(h / ts - 1.0 - 1e-9))  # control periods after the first
-    lengths = block_lengths(periods, settings.blocks, settings.geometric_blocks)
+    lengths = block_lengths(
+        periods, settings.blocks, time_constant / ts, settings.geometric_blocks
+    )
     substeps = prediction_substeps(model, ts, context.fine_step)
     return OracleGrid(horizon_s=h, lengths=lengths, substeps=substeps)
 
