@@ -49,11 +49,29 @@ nomoto2 10.0 s (21 steps of 0.5 s), Esso Osaka (1:100) 32 s on its curved route,
 268 s on its waypoint route, Blanke 51 s.
 
 **Decisions and grid.**  Move blocking: the first command acts for one control period Ts
-(the one applied); the horizon's rest is split into ``blocks`` equal intervals of m·Ts
-(m = ⌈(H/Ts − 1)/blocks⌉), one command each.  The stage cost is evaluated at every control
-step end, as the env does.  Prediction step h_p = Ts/n with n the smallest integer such that
-h_p·|λ_max| ≤ 2 (λ_max the fastest eigenvalue of the nominal model linearised at cruise;
-RK4 is stable to 2.79 on the negative real axis), never finer than the env's own h.
+(the one applied); the P = ⌈H/Ts − 1⌉ control periods after it are split into ``blocks``
+= B intervals, one command each, that grow geometrically (revision 3): ⌊min(r^j, T/Ts)⌋
+periods, j = 0 … B − 1, the first one period long and none longer than the ship's yaw time
+constant T (at least ⌈P/B⌉), r ≥ 1 chosen so that they fill P (the periods lost to the
+rounding go one each to the last intervals).  Reason: the plan is applied one period at a
+time and re-planned, so the near commands decide what the ship does (the rudder's rate
+limit and the turn's onset act within seconds), while far ahead only where the ship
+settles matters, and a command interval longer than T no longer resolves a turn.
+Catalogue grids (command intervals in periods): nomoto2 21 × 1 (P ≤ B: unchanged); the
+Mariner on ``mariner_track`` (Ts = 1 s, T = 44 s, P = 267) 1, 1, 1, 1, 1, 1, 2, 2, 3, 4,
+5, 6, 8, 9, 13, 16, 19, 24, 29, 35, 44, 44 (revision 2: 1 then 20 × 14); Blanke (Ts =
+0.2 s, T = 2.9 s, P = 256) 1, 1, 1, 3, 13, 15 × 14, 15 (revision 2: 1 then 20 × 13); Esso
+Osaka on a waypoint route (Ts = 0.5 s, T = 7.4 s, P = 127) 1 × 6, 2, 2, 3, 3, … 14, 15,
+15, 15.  Measured (quick suite's Mariner trials and ``mariner_track``'s smoke seeds,
+scenario means): revision 2's equal intervals of 12–14 s cost 330, 193, 163 and 1180 on
+``mariner_rudder_aging``, ``_current_shift``, ``_maneuverability_change`` and
+``mariner_track``; the geometric ones 193, 108, 121 and 578, all below the tuned
+``pid_los`` (368, 193, 177, 734), at the same solve time; uncapped (the last interval 3.4 T
+on Blanke) ``blanke_rudder_aging`` cost 244 against 179 before, capped 161.  The stage
+cost is evaluated at every control step end, as the env does.  Prediction step h_p = Ts/n
+with n the smallest integer such that h_p·|λ_max| ≤ 2 (λ_max the fastest eigenvalue of the
+nominal model linearised at cruise; RK4 is stable to 2.79 on the negative real axis), never
+finer than the env's own h.
 
 **Solver.**  Generalised Gauss–Newton SQP (Messerer, Baumgärtner & Diehl 2021): the cost
 is Σ φ_i(z_i(u)) with convex outer φ (smooth |·| or square) of a smooth inner z; each
@@ -62,11 +80,16 @@ the squares and the curvature 1/√(z² + ε²) of the quadratic majoriser for t
 (iteratively reweighted least squares: φ'' itself vanishes away from 0), then a
 backtracking line search on the cost; stopped when an iteration gains less than
 ``cost_tolerance`` (relative) or moves less than ``step_tolerance``; warm-started from the
-shifted previous plan.  **Multiple starts**: the objective is not convex in the turn's
-direction (left and right round a corner, or a U-turn back onto the path, are separate
-basins the local SQP does not leave), so when the warm start's plan ends the horizon
-heading backwards along the path (|ψ̃_N| > ``reverse_heading`` = π/2) the step also solves
-from the cheaper (by the objective) of two hard-turn starts, full rudder to either side
+previous plan shifted by one control period (:func:`shifted_plan`; revisions 1–2 shifted it
+by one interval but kept the first command, one period off on nomoto2's one-period
+intervals: on the agile, yaw-unstable nomoto2 after its manoeuvrability jump that start
+sent the SQP to a spin, 17 of the first 20 default ``maneuverability_change`` /
+``_long`` trials lost to the time limit, all 20 reached with the true shift).
+**Multiple starts**: the objective is not convex in the turn's direction (left and right
+round a corner, or a U-turn back onto the path, are separate basins the local SQP does
+not leave), so when the warm start's plan ends the horizon heading backwards along the
+path (|ψ̃_N| > ``reverse_heading`` = π/2) the step also solves from the cheaper (by the
+objective) of two hard-turn starts, full rudder to either side
 over the whole horizon (``turn_fraction``), and keeps the plan of lower objective.
 Measured: with the tail alone 9 of the 16 lost nomoto2 path-1 trials (nominal,
 rudder_aging, current_shift) were still lost, by turns the warm start could not undo;
@@ -101,7 +124,7 @@ from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
-ORACLE_REVISION = 2
+ORACLE_REVISION = 3
 
 
 @dataclasses.dataclass(frozen=True)
@@ -230,9 +253,7 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
     )
     ts = context.control_period
     periods = max(1, math.ceil(h / ts - 1.0 - 1e-9))  # control periods after the first
-    lengths = block_lengths(
-        periods, settings.blocks, time_constant / ts, settings.geometric_blocks
-    )
+    lengths = block_lengths(periods, settings.blocks, time_constant / ts, settings.geometric_blocks)
     substeps = prediction_substeps(model, ts, context.fine_step)
     return OracleGrid(horizon_s=h, lengths=lengths, substeps=substeps)
 
