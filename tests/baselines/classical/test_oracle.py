@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import sys
 from pathlib import Path
@@ -19,9 +20,12 @@ from shipgym_baselines.classical.oracle import (
     Oracle,
     OracleSettings,
     OracleSolver,
+    block_lengths,
+    growth_ratio,
     horizon_seconds,
     oracle_grid,
     remaining_path,
+    shifted_plan,
     tail_steps,
 )
 from shipgym_baselines.errors import ControllerError
@@ -111,6 +115,59 @@ def test_the_horizon_rule_by_ship() -> None:
         ctx = ControllerContext.of(load_scenario(name), "rudder")
         grid = oracle_grid(ctx, OracleSettings())
         assert grid.steps * ctx.control_period >= grid.horizon_s - 1e-9
+
+
+# ------------------------------------------------------------------ the move blocking
+@pytest.mark.parametrize(
+    ("periods", "blocks", "longest"),
+    [(267, 20, 43.8), (228, 20, 43.8), (256, 20, 14.3), (127, 20, 14.7), (64, 20, 14.7)],
+)
+def test_the_intervals_grow_geometrically_from_one_period_to_at_most_t(
+    periods: int, blocks: int, longest: float
+) -> None:
+    """Revision 3's rule: the applied command, then ``blocks`` intervals that start at one
+    period, never shrink, end at most one period over T/Ts (or the even share), and sum to
+    the horizon's periods exactly."""
+    lengths = block_lengths(periods, blocks, longest)
+    assert len(lengths) == 1 + blocks and sum(lengths) == 1 + periods
+    assert lengths[:2] == (1, 1)
+    assert all(a <= b for a, b in itertools.pairwise(lengths))
+    assert max(lengths) <= max(math.floor(longest), math.ceil(periods / blocks)) + 1
+    even = block_lengths(periods, blocks, longest, geometric=False)  # revision 2
+    assert even == (1,) + (math.ceil(periods / blocks),) * blocks
+
+
+def test_the_growth_ratio_fills_the_horizon() -> None:
+    """Uncapped, 1 + r + … + r^(B−1) = (r^B − 1)/(r − 1) = P; P ≤ B: one-period intervals."""
+    r = growth_ratio(267, 20)
+    assert (r**20 - 1.0) / (r - 1.0) == pytest.approx(267.0, rel=1e-9)
+    assert growth_ratio(20, 20) == 1.0
+    assert block_lengths(20, 20, 3.0) == (1,) * 21
+    with pytest.raises(ValueError, match="cannot fill"):
+        growth_ratio(100, 4, 10.0)
+
+
+def test_the_catalogue_grids() -> None:
+    """nomoto2 keeps one-period intervals; the Mariner's first four intervals after the
+    applied command are one period (1 s: revision 2 had 14 s) and its last is T (44 s)."""
+    nominal = oracle_grid(
+        ControllerContext.of(load_scenario("nominal"), "rudder"), OracleSettings()
+    )
+    assert nominal.lengths == (1,) * 21
+    mariner = oracle_grid(
+        ControllerContext.of(load_scenario("mariner_track"), "rudder"), OracleSettings()
+    )
+    assert mariner.lengths[:5] == (1,) * 5 and mariner.lengths[-1] == 44
+    assert mariner.steps - 1 == math.ceil(mariner.horizon_s - 1.0)
+
+
+def test_the_warm_start_is_the_plan_one_period_later() -> None:
+    """One-period intervals: the plan shifted by one, the last command held (revisions 1–2
+    kept the first command: one period off); longer intervals: the mean of the shifted
+    commands they cover."""
+    plan = np.array([0.1, 0.2, 0.3, 0.4])
+    assert shifted_plan(plan, (1, 1, 1, 1)) == pytest.approx([0.2, 0.3, 0.4, 0.4])
+    assert shifted_plan(plan, (1, 1, 2, 4)) == pytest.approx([0.2, 0.3, 0.35, 0.4])
 
 
 # ------------------------------------------------------------------ the tail and the turns
