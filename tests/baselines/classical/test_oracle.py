@@ -183,8 +183,8 @@ def test_the_tail_counts_the_steps_still_to_go_after_the_horizon() -> None:
     assert remaining_path(ctx, tracker, frame) == pytest.approx(total - 3.0)
 
 
-def _default_trial(scenario: str, seed: int) -> Any:
-    spec = load_suite("default")
+def _default_trial(scenario: str, seed: int, suite: str = "default") -> Any:
+    spec = load_suite(suite)
     (trial,) = trials(
         Job("oracle", scenario, (seed,), None, spec.randomize.model_dump(mode="json"))
     )
@@ -205,6 +205,32 @@ def test_the_oracle_reaches_the_goal_where_revision_1_turned_the_wrong_way(
     (result,) = evaluate("oracle", _default_trial(scenario, seed), seeds=[seed])
     assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
     assert result.metrics["solver_failures"] == 0
+
+
+@pytest.mark.parametrize(
+    ("scenario", "seed"),
+    [("maneuverability_change", 10001), ("maneuverability_change_long", 10000)],
+)
+def test_the_oracle_does_not_spin_after_the_manoeuvrability_jump(scenario: str, seed: int) -> None:
+    """Default trials revision 2 lost to the time limit (the yaw-unstable ship spun after
+    its jump: the warm start was one period off): revision 3 reaches the goal, at a cost
+    below that of the best adaptive NMPC, ``nmpc_lambda_lssvm_svf`` (measured 31.5 vs 141,
+    19.5 vs 146)."""
+    trial = _default_trial(scenario, seed)
+    (result,) = evaluate("oracle", trial, seeds=[seed])
+    (svf,) = evaluate("nmpc_lambda_lssvm_svf", trial, seeds=[seed])
+    assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
+    assert result.metrics["cost"] < svf.metrics["cost"]
+
+
+def test_the_oracle_costs_less_than_the_tuned_pid_los_on_a_mariner_trial() -> None:
+    """quick ``mariner_rudder_aging`` seed 10000: revision 2's 20 equal intervals of 12 s
+    cost 344, near the tuned pid_los's 398; revision 3's geometric intervals 137."""
+    trial = _default_trial("mariner_rudder_aging", 10000, "quick")
+    (oracle,) = evaluate("oracle", trial, seeds=[10000])
+    (pid,) = evaluate("pid_los", trial, seeds=[10000])
+    assert oracle.metrics["termination_reason"] == "goal"
+    assert oracle.metrics["cost"] < 0.5 * pid.metrics["cost"]
 
 
 # ------------------------------------------------------------------ the privileged channel
@@ -308,11 +334,10 @@ def test_a_sample_of_the_shipped_references_recomputes_to_the_same_cost() -> Non
 
 
 def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
-    """What is achievable: on every smoke trial the oracle's cost is below that of pid_los's
-    paper design, and below the tuned pid_los's on the nomoto2 trials.  Known exception
-    (issue 17, open): on ``mariner_track`` the tuned pid_los (issue 21) costs less than this
-    revision of the oracle, whose 21 blocked intervals over a 268 s horizon are too coarse
-    for the Mariner — the test pins it so that a better oracle revision shows."""
+    """What is achievable: on every smoke trial the oracle's cost is below that of pid_los,
+    its paper design and its tuned settings (issue 21).  Revision 2 lost to the tuned
+    pid_los on ``mariner_track`` (its 20 equal intervals of 14 s were too coarse for the
+    Mariner); revision 3's geometric intervals beat it."""
     table = shipped_table()
     for scenario in load_suite("smoke").all_scenarios():
         for job, trial in _smoke_trials(scenario):
@@ -320,8 +345,7 @@ def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
             (paper,) = evaluate("pid_los", trial, seeds=list(job.seeds), preset="paper")
             assert oracle < paper.metrics["cost"], (scenario, job.seeds, oracle)
             (tuned,) = evaluate("pid_los", trial, seeds=list(job.seeds))
-            beaten = oracle >= tuned.metrics["cost"]
-            assert beaten == (trial.config.ship.model == "mariner"), (scenario, job.seeds, oracle)
+            assert oracle < tuned.metrics["cost"], (scenario, job.seeds, oracle)
 
 
 def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:
