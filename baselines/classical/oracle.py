@@ -60,7 +60,7 @@ settles matters, and a command interval longer than T no longer resolves a turn.
 Catalogue grids (command intervals in periods): nomoto2 21 × 1 (P ≤ B: unchanged); the
 Mariner on ``mariner_track`` (Ts = 1 s, T = 44 s, P = 267) 1, 1, 1, 1, 1, 2, 2, 3, 4,
 5, 6, 8, 9, 13, 16, 19, 24, 29, 35, 44, 44 (revision 2: 1 then 20 × 14); Blanke (Ts =
-0.2 s, T = 2.9 s, P = 256) 1, 1, 1, 3, 13, 15 × 14, 15 (revision 2: 1 then 20 × 13); Esso
+0.2 s, T = 2.9 s, P = 256) 1, 1, 1, 3, 13, fifteen 14, 15 (revision 2: 1 then 20 × 13); Esso
 Osaka on a waypoint route (Ts = 0.5 s, T = 7.4 s, P = 127) 1 × 6, 2, 2, 3, 3, … 14, 15,
 15, 15.  Measured (quick suite's Mariner trials and ``mariner_track``'s smoke seeds,
 scenario means): revision 2's equal intervals of 12–14 s cost 330, 193, 163 and 1180 on
