@@ -52,7 +52,7 @@ nomoto2 10.0 s (21 steps of 0.5 s), Esso Osaka (1:100) 32 s on its curved route,
 (the one applied); the P = ⌈H/Ts − 1⌉ control periods after it are split into ``blocks``
 = B intervals, one command each, that grow geometrically (revision 3): ⌊min(r^j, T/Ts)⌋
 periods, j = 0 … B − 1, the first one period long and none longer than the ship's yaw time
-constant T (at least ⌈P/B⌉), r ≥ 1 chosen so that they fill P (the periods lost to the
+constant T (at least ⌈(P − 1)/(B − 1)⌉), r ≥ 1 chosen so that they fill P (the periods lost to the
 rounding go one each to the last intervals).  Reason: the plan is applied one period at a
 time and re-planned, so the near commands decide what the ship does (the rudder's rate
 limit and the turn's onset act within seconds), while far ahead only where the ship
@@ -172,10 +172,10 @@ def growth_ratio(periods: int, blocks: int, cap: float = math.inf) -> float:
     """r ≥ 1 with Σ_{j<blocks} min(r^j, cap) = ``periods`` (bisection): the ratio of the
     geometric intervals, the first one period long and none longer than ``cap`` periods,
     that fill ``periods`` control periods with ``blocks`` intervals; 1 when ``periods`` ≤
-    ``blocks``.  Needs cap·blocks ≥ periods."""
+    ``blocks``.  Needs 1 + cap·(blocks − 1) ≥ periods (the sum's limit as r grows)."""
     if periods <= blocks:
         return 1.0
-    if cap * blocks < periods:
+    if 1.0 + cap * (blocks - 1) < periods:
         raise ValueError(f"{blocks} intervals of at most {cap} periods cannot fill {periods}")
     lo, hi = 1.0, 2.0
     while _geometric_sum(hi, blocks, cap) < periods:
@@ -192,17 +192,17 @@ def block_lengths(
     """Control periods of the command intervals of a horizon of ``periods`` + 1 steps: the
     applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
     ``geometric``: the intervals ⌊min(r^j, cap)⌋, j = 0 … blocks − 1, with the cap
-    max(``longest``, ⌈periods/blocks⌉) and r from :func:`growth_ratio`, the periods lost to
+    max(⌊``longest``⌋, ⌈(periods − 1)/(blocks − 1)⌉) and r from :func:`growth_ratio`, the periods lost to
     the rounding added one each to the last intervals (one period first, non-decreasing,
     the total exactly ``periods``); otherwise ``blocks`` equal intervals of
     ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of one
     period."""
     if periods <= blocks:
         return (1,) * (1 + blocks)
-    even = math.ceil(periods / blocks)
     if not geometric:
-        return (1,) + (even,) * blocks
-    cap = max(float(math.floor(longest)), float(even))
+        return (1,) + (math.ceil(periods / blocks),) * blocks
+    # at least the cap that one period and blocks − 1 capped intervals need to fill P
+    cap = max(float(math.floor(longest)), float(math.ceil((periods - 1) / (blocks - 1))))
     r = growth_ratio(periods, blocks, cap)
     lengths = [math.floor(min(r**j, cap) + 1e-9) for j in range(blocks)]
     short = periods - sum(lengths)  # < blocks: one more period to each of the last ones

@@ -120,25 +120,33 @@ def test_the_horizon_rule_by_ship() -> None:
 # ------------------------------------------------------------------ the move blocking
 @pytest.mark.parametrize(
     ("periods", "blocks", "longest"),
-    [(267, 20, 43.8), (228, 20, 43.8), (256, 20, 14.3), (127, 20, 14.7), (64, 20, 14.7)],
+    [
+        (267, 20, 43.8),
+        (228, 20, 43.8),
+        (256, 20, 14.3),
+        (127, 20, 14.7),
+        (64, 20, 14.7),
+        (300, 20, 2.0),  # T short against the horizon: the cap is what filling P needs
+    ],
 )
 def test_the_intervals_grow_geometrically_from_one_period_to_at_most_t(
     periods: int, blocks: int, longest: float
 ) -> None:
     """Revision 3's rule: the applied command, then ``blocks`` intervals that start at one
-    period, never shrink, end at most one period over T/Ts (or the even share), and sum to
-    the horizon's periods exactly."""
+    period, never shrink, end at most one period over T/Ts (or over the cap that filling
+    the horizon needs), and sum to the horizon's periods exactly."""
     lengths = block_lengths(periods, blocks, longest)
     assert len(lengths) == 1 + blocks and sum(lengths) == 1 + periods
     assert lengths[:2] == (1, 1)
     assert all(a <= b for a, b in itertools.pairwise(lengths))
-    assert max(lengths) <= max(math.floor(longest), math.ceil(periods / blocks)) + 1
+    assert max(lengths) <= max(math.floor(longest), math.ceil((periods - 1) / (blocks - 1))) + 1
     even = block_lengths(periods, blocks, longest, geometric=False)  # revision 2
     assert even == (1,) + (math.ceil(periods / blocks),) * blocks
 
 
 def test_the_growth_ratio_fills_the_horizon() -> None:
-    """Uncapped, 1 + r + … + r^(B−1) = (r^B − 1)/(r − 1) = P; P ≤ B: one-period intervals."""
+    """Uncapped, 1 + r + … + r^(B−1) = (r^B − 1)/(r − 1) = P; P ≤ B: one-period intervals;
+    a cap too low to fill P is an error."""
     r = growth_ratio(267, 20)
     assert (r**20 - 1.0) / (r - 1.0) == pytest.approx(267.0, rel=1e-9)
     assert growth_ratio(20, 20) == 1.0
