@@ -192,8 +192,8 @@ def block_lengths(
     """Control periods of the command intervals of a horizon of ``periods`` + 1 steps: the
     applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
     ``geometric``: the intervals ⌊min(r^j, cap)⌋, j = 0 … blocks − 1, with the cap
-    max(⌊``longest``⌋, ⌈(periods − 1)/(blocks − 1)⌉) and r from :func:`growth_ratio`, the periods lost to
-    the rounding added one each to the last intervals (one period first, non-decreasing,
+    max(⌊``longest``⌋, ⌈(periods − 1)/(blocks − 1)⌉) and r from :func:`growth_ratio`, the
+    periods lost to the rounding added one each to the last intervals (one period first, non-decreasing,
     the total exactly ``periods``); otherwise ``blocks`` equal intervals of
     ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of one
     period."""
