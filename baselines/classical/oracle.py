@@ -193,8 +193,8 @@ def block_lengths(
     applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
     ``geometric``: the intervals ⌊min(r^j, cap)⌋, j = 0 … blocks − 1, with the cap
     max(⌊``longest``⌋, ⌈(periods − 1)/(blocks − 1)⌉) and r from :func:`growth_ratio`, the
-    periods lost to the rounding added one each to the last intervals (one period first, non-decreasing,
-    the total exactly ``periods``); otherwise ``blocks`` equal intervals of
+    periods lost to the rounding added one each to the last intervals (one period first,
+    non-decreasing, the total exactly ``periods``); otherwise ``blocks`` equal intervals of
     ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of one
     period."""
     if periods <= blocks:
