@@ -64,4 +64,53 @@ def thin_trajectory(
     return {k: np.asarray(trajectory[k])[index] for k in keys}
 
 
-__all__ = ["DRAWN_KEYS", "TRACE_BUCKETS", "m4_indices", "thin_trajectory"]
+#: levels of a packed array: 16-bit codes over its finite range, the top code for a
+#: non-finite value (a finite value is within range / 131068 of what was drawn: 0.05 m on a
+#: 6 km track, 10⁻⁵ rad of rudder, far below a figure's pixel)
+_LEVELS = 65534
+_NON_FINITE = 65535
+
+
+def pack_trajectory(arrays: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """Equal-length float arrays (a thinned trajectory) as a kept file holds them (issue
+    20: the run folder's weight): ``keys`` (their names), ``ranges`` (per array its finite
+    [min, max], float64) and ``codes`` (per array 16-bit codes over that range, each the
+    difference from the previous one, mod 2¹⁶: a smooth series has small steps, which
+    deflate well).  :func:`unpack_trajectory` inverts it to within range / 131068."""
+    keys = list(arrays)
+    codes = np.zeros((len(keys), len(arrays[keys[0]]) if keys else 0), dtype=np.uint16)
+    ranges = np.zeros((len(keys), 2))
+    for row, key in enumerate(keys):
+        a = np.asarray(arrays[key], dtype=np.float64)
+        finite = np.isfinite(a)
+        if finite.any():
+            ranges[row] = a[finite].min(), a[finite].max()
+        low, high = ranges[row]
+        scale = (high - low) / _LEVELS if high > low else 1.0
+        level = np.round((np.where(finite, a, low) - low) / scale)
+        q = np.where(finite, level, _NON_FINITE).astype(np.uint16)
+        codes[row] = np.diff(q, prepend=np.uint16(0))  # uint16 arithmetic wraps
+    return {"keys": np.array(keys, dtype=str), "ranges": ranges, "codes": codes}
+
+
+def unpack_trajectory(packed: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """The arrays of :func:`pack_trajectory`'s fields (float64; NaN where a value was not
+    finite)."""
+    out = {}
+    for key, (low, high), steps in zip(
+        packed["keys"].tolist(), packed["ranges"], packed["codes"], strict=True
+    ):
+        q = np.cumsum(steps, dtype=np.uint16)  # wraps as the differences did
+        scale = (high - low) / _LEVELS if high > low else 1.0
+        out[str(key)] = np.where(q == _NON_FINITE, np.nan, low + q * scale)
+    return out
+
+
+__all__ = [
+    "DRAWN_KEYS",
+    "TRACE_BUCKETS",
+    "m4_indices",
+    "pack_trajectory",
+    "thin_trajectory",
+    "unpack_trajectory",
+]

@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
+from shipgym.envs.core import TRAJECTORY_KEYS
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError
@@ -69,37 +70,48 @@ class EpisodeResult:
 
 
 class _Record:
-    """One episode's record as the loop keeps it: the trajectory rows of its infos, the
-    time each ``act`` took and the last info."""
+    """One episode's record as the loop keeps it: the time each ``act`` took, the last
+    info and (``rows``) the trajectory rows of its infos; without rows (the rows of an
+    evaluation env, which keeps the trajectory itself) :meth:`result` is given the
+    trajectory, and ``info`` may be None at the steps a lean env gives none."""
 
-    def __init__(self, scenario_name: str, seed: int, info: dict[str, Any]) -> None:
+    def __init__(
+        self, scenario_name: str, seed: int, info: dict[str, Any] | None, rows: bool = True
+    ) -> None:
         self.scenario_name = scenario_name
         self.seed = seed
         self.info = info
-        self.rows: list[tuple[float, ...]] = [_traj_row(info)]
+        self.rows: list[tuple[float, ...]] | None = [_traj_row(info)] if rows else None
         self.act_times: list[float] = []
 
-    def add(self, info: dict[str, Any], act_time: float) -> None:
-        """The info of a step whose action took the policy ``act_time`` [s]."""
+    def add(self, info: dict[str, Any] | None, act_time: float) -> None:
+        """The info (None: none this step) of a step whose action took ``act_time`` [s]."""
         self.act_times.append(act_time)
-        self.info = info
-        self.rows.append(_traj_row(info))
+        if info is not None:
+            self.info = info
+            if self.rows is not None:
+                self.rows.append(_traj_row(info))
 
-    def result(self, policy: Policy) -> EpisodeResult:
+    def result(
+        self, policy: Policy, trajectory: dict[str, np.ndarray] | None = None
+    ) -> EpisodeResult:
+        """The episode's result; ``trajectory``: a record without rows (the env's)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
         metrics.update(compute_time_metrics(self.act_times))
         stats = getattr(policy, "episode_stats", None)
         if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
             metrics.update(stats())
-        traj = np.array(self.rows)
+        if trajectory is None:
+            traj = np.array(self.rows)
+            trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
         return EpisodeResult(
             controller=policy.name,
             kind=policy.kind,
             scenario=self.scenario_name,
             seed=self.seed,
             metrics=metrics,
-            trajectory={k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)},
+            trajectory=trajectory,
             training_seed=training_seed(policy),
         )
 
@@ -231,8 +243,8 @@ def evaluate_batch(
         policy, mode = controller, None
     mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
     if isinstance(policy, BatchPolicy):
-        # a batch policy acts on the observations alone: its rows skip the samples
-        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, samples=False))
+        # a batch policy acts on the observations alone: its rows skip the per-step infos
+        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, lean=True))
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
@@ -251,14 +263,18 @@ class _Episodes(Protocol):
     """The episodes of a lockstep run: per episode its observation, info, end and result."""
 
     seeds: list[int]
-    obs: list[np.ndarray]
+    obs: Sequence[np.ndarray]
     done: list[bool]
 
     def info(self, i: int) -> dict[str, Any]: ...
 
+    def stacked_obs(self, live: list[int]) -> np.ndarray: ...
+
     def contexts(self) -> list[Any]: ...
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None: ...
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None: ...
 
     def result(self, i: int, policy: Policy) -> EpisodeResult: ...
 
@@ -266,17 +282,26 @@ class _Episodes(Protocol):
 
 
 class _VectorEpisodes:
-    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`."""
+    """The episodes as the rows of one :class:`EvaluationTrialsVectorEnv`, the
+    trajectories the env's columns; ``lean`` (a batch policy, which reads observations
+    only): the rows give no per-step info (``row_infos="end"``, no samples)."""
 
     def __init__(
-        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, samples: bool = True
+        self, scenarios: list[Scenario], seeds: list[int], action_mode: str, lean: bool = False
     ) -> None:
-        self.env = EvaluationTrialsVectorEnv(scenarios, seeds, action_mode, samples=samples)
+        self.lean = lean
+        self.env = EvaluationTrialsVectorEnv(
+            scenarios,
+            seeds,
+            action_mode,
+            samples=not lean,
+            row_infos="end" if lean else "all",
+        )
         self.seeds = seeds
-        obs, info = self.env.reset()
-        self.obs = list(obs)
+        #: the rows' latest observations (n_rows, n_obs): a finished row's is its last
+        self.obs, info = self.env.reset()
         self.records = [
-            _Record(sc.name, seed, row)
+            _Record(sc.name, seed, row, rows=False)
             for sc, seed, row in zip(self.env.scenarios, seeds, info["rows"], strict=True)
         ]
         self.done = [False] * len(seeds)
@@ -288,19 +313,28 @@ class _VectorEpisodes:
     def contexts(self) -> list[Any]:
         return [self.env.controller_context(i) for i in range(self.env.num_envs)]
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+    def stacked_obs(self, live: list[int]) -> np.ndarray:
+        return self.obs[live]
+
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None:
         width = self._actions.shape[1]
-        for i, action in zip(live, actions, strict=True):
-            self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
-        obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
+        try:  # a batch policy's array, or the controllers' actions of one shape: one call
+            stacked = np.asarray(actions, dtype=np.float64).reshape(len(live), width)
+        except ValueError:  # shapes that differ: one by one (a bad one names its shape)
+            for i, action in zip(live, actions, strict=True):
+                self._actions[i] = np.asarray(action, dtype=np.float64).reshape(width)
+        else:
+            self._actions[live] = stacked
+        self.obs, _rewards, _term, _trunc, info = self.env.step(self._actions)
         rows = info["rows"]
         for i, act_time in zip(live, times, strict=True):
-            self.obs[i] = obs[i]
-            self.records[i].add(rows[i], act_time)
+            self.records[i].add(rows[i], act_time)  # lean: an info at the last step only
         self.done = self.env.finished.tolist()
 
     def result(self, i: int, policy: Policy) -> EpisodeResult:
-        return self.records[i].result(policy)
+        return self.records[i].result(policy, self.env.trajectory(i))
 
     def close(self) -> None:
         self.env.close()
@@ -327,7 +361,12 @@ class _SingleEpisodes:
     def contexts(self) -> list[Any]:
         return [e.base.controller_context for e in self.episodes]
 
-    def step(self, live: list[int], actions: list[np.ndarray], times: list[float]) -> None:
+    def stacked_obs(self, live: list[int]) -> np.ndarray:
+        return np.stack([self.obs[i] for i in live])
+
+    def step(
+        self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
+    ) -> None:
         for i, action, act_time in zip(live, actions, times, strict=True):
             episode = self.episodes[i]
             episode.step(action, act_time)
@@ -346,16 +385,16 @@ _SINGLE_ENTRY_POINT = "shipgym.envs.path_follow:ShipPathFollowEnv"
 
 
 def _episodes(
-    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, samples: bool = True
+    scenarios: list[Any], seeds: list[int], action_mode: str, env_id: str, lean: bool = False
 ) -> _Episodes:
     """The episodes as the rows of one vectorized env when they can be (the env is the
     single ShipPathFollow env and the trials share the ship and its step constants: see
-    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``samples``:
-    whether the rows' infos carry ``samples`` (a batch policy reads observations only)."""
+    :func:`~shipgym.envs.eval_trials.lockstep_problem`), else one env each.  ``lean``: the
+    rows give no per-step info and no samples (a batch policy reads observations only)."""
     if gym.spec(env_id).entry_point == _SINGLE_ENTRY_POINT:
         loaded = [load_scenario(s) for s in scenarios]
         if loaded and lockstep_problem(loaded) is None:
-            return _VectorEpisodes(loaded, seeds, action_mode, samples)
+            return _VectorEpisodes(loaded, seeds, action_mode, lean)
         scenarios = loaded
     return _SingleEpisodes(scenarios, seeds, action_mode, env_id)
 
@@ -374,9 +413,9 @@ def _run_lockstep(policy: BatchPolicy | list[Policy], episodes: _Episodes) -> li
         live = [i for i in range(n) if not episodes.done[i]]
         while live:
             if batch:
-                obs = np.stack([episodes.obs[i] for i in live])
+                obs = episodes.stacked_obs(live)
                 start = _clock()
-                actions = list(policy.act_batch(obs, live))
+                actions = np.asarray(policy.act_batch(obs, live))
                 times = [(_clock() - start) / len(live)] * len(live)
             else:
                 actions, times = [], []
@@ -409,7 +448,7 @@ def compute_time_metrics(act_times: list[float]) -> dict[str, float]:
     }
 
 
-_TRAJ_KEYS = ("t", "x", "y", "cross_track_error", "heading", "rudder_angle", "rudder_command")
+_TRAJ_KEYS = TRAJECTORY_KEYS
 
 
 def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:

@@ -57,7 +57,12 @@ from typing import IO, TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
+from shipgym_baselines.decimation import (
+    DRAWN_KEYS,
+    pack_trajectory,
+    thin_trajectory,
+    unpack_trajectory,
+)
 from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
@@ -534,15 +539,22 @@ def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
     """A trajectory as its file keeps it (issue 20: the run folder's weight): only the
     arrays a figure draws (:data:`~shipgym_baselines.decimation.DRAWN_KEYS`), thinned to
     what a figure can show without aliasing (M4,
-    :func:`~shipgym_baselines.decimation.thin_trajectory`), float arrays as float32 (7
-    significant digits: a millimetre on a 10 km route, far below a figure's pixel; the
-    episode's metrics are computed before, at full precision); the file is deflated
-    (``np.savez_compressed``)."""
-    out = {}
-    for key, value in thin_trajectory(trajectory, DRAWN_KEYS).items():
-        array = np.asarray(value)
-        out[key] = array.astype(np.float32) if array.dtype.kind == "f" else array
-    return out
+    :func:`~shipgym_baselines.decimation.thin_trajectory`), packed as 16-bit codes over
+    each array's range (:func:`~shipgym_baselines.decimation.pack_trajectory`: within
+    range / 131068, far below a figure's pixel; the episode's metrics are computed
+    before, at full precision); the file is deflated (``np.savez_compressed``).
+    :func:`read_trajectory` reads it back."""
+    return pack_trajectory(thin_trajectory(trajectory, DRAWN_KEYS))
+
+
+def read_trajectory(file: Path) -> dict[str, np.ndarray]:
+    """A kept trajectory's arrays (:func:`light_trajectory`'s file, or an earlier
+    version's file of plain arrays)."""
+    with np.load(file, allow_pickle=False) as data:
+        fields = {k: data[k] for k in data.files}
+    if set(fields) == {"keys", "ranges", "codes"}:
+        return unpack_trajectory(fields)
+    return fields
 
 
 def trajectory_file(key: Key) -> str:
@@ -575,8 +587,7 @@ def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> Epis
     if name:
         file = _inside(Path(folder), name)
         if file.is_file():
-            with np.load(file) as data:
-                trajectory = {k: data[k] for k in data.files}
+            trajectory = read_trajectory(file)
     return EpisodeResult(
         controller=record["controller"],
         kind=record["kind"],

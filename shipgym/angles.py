@@ -36,9 +36,12 @@ def wrap_angle(a):
         # Float modulo can round up to exactly 2π for tiny negative inputs (e.g. −1e-20).
         return w - TWO_PI if w >= _PI else w
     arr = np.asarray(a, dtype=np.float64)
+    inside = (arr >= -_PI) & (arr < _PI)
+    if inside.all():  # the identity (a copy: the result never aliases the argument)
+        return float(arr) if arr.ndim == 0 else arr.copy()
     w = np.mod(arr + _PI, TWO_PI) - _PI
     w = np.where(w >= _PI, w - TWO_PI, w)
-    w = np.where((arr >= -_PI) & (arr < _PI), arr, w)
+    w = np.where(inside, arr, w)
     return float(w) if w.ndim == 0 else w
 
 

@@ -313,6 +313,18 @@ class Disturbances:
         self._x_dir = np.zeros(self.batch)  # direction deviation [rad]
         self._zi = np.zeros((self.batch, 2))  # wave filter state (lfilter's DF-II-T)
 
+    @property
+    def steady_from(self) -> float:
+        """The period start [s] from which :meth:`fill` writes the same block every period
+        (inf: never): no noise and no waves, and a constant mean or a two-phase one past its
+        switch (its ramp: with a margin of one ramp).  A batched env need not refill a block
+        filled at such a start (issue 18)."""
+        if self.n_noise or self._waves is not None:
+            return math.inf
+        if self._kind != "two_phase":
+            return 0.0
+        return self._switch - _TIME_EPS if self._ramp == 0 else self._switch + 2.0 * self._ramp
+
     # ------------------------------------------------------------------ constant part
     def constant_row(self) -> np.ndarray:
         """(n_w,) disturbances of the mean current (the whole block if not time-varying)."""

@@ -91,7 +91,10 @@ class ArrayOps:
     logical_not = staticmethod(np.logical_not)
     maximum = staticmethod(np.maximum)
     where = staticmethod(np.where)
-    any = staticmethod(np.any)
+
+    @staticmethod
+    def any(cond: Any) -> Any:
+        return np.asarray(cond).any()  # the array method: no dispatch of np.any
 
     @staticmethod
     def searchsorted_right(table: Any, value: Any) -> Any:
@@ -99,7 +102,7 @@ class ArrayOps:
 
     @staticmethod
     def clip_index(i: Any, lo: int, hi: int) -> Any:
-        return np.clip(i, lo, hi)
+        return np.minimum(np.maximum(i, lo), hi)  # np.clip's values, without its overhead
 
 
 SCALAR = ScalarOps()

@@ -307,6 +307,8 @@ class PchipPath:
 
         # Parameter grid, containing every knot exactly.
         n = int(samples_per_segment)
+        #: grid subintervals per waypoint interval
+        self.samples_per_segment: int = n
         frac = np.linspace(0.0, 1.0, n + 1)[:-1]
         tg = (knots[:-1, None] + chords[:, None] * frac[None, :]).ravel()
         tg = np.concatenate((tg, knots[-1:]))
@@ -508,8 +510,9 @@ class _CurveCells:
             cells += [c[0], c[1], c[2], c[3], 3.0 * c[0], 2.0 * c[1], 6.0 * c[0]]
         self.arrays = dict(tables)
         self.lists = {k: v.tolist() for k, v in tables.items()}
-        #: per cell: (origin, c0x, c1x, c2x, c3x, d0x, d1x, e0x, c0y, …, e0y)
-        self.cell_arrays = tuple(cells)
+        #: per cell: (origin, c0x, c1x, c2x, c3x, d0x, d1x, e0x, c0y, …, e0y); as a
+        #: (15, cells) array (N ships: one gather of the 15 coefficients) and as tuples
+        self.cell_table = np.stack(cells)
         self.cell_tuples = list(zip(*(c.tolist() for c in cells), strict=True))
         self.grid_ux = np.cos(tables["grid_angle"])
         self.grid_uy = np.sin(tables["grid_angle"])
@@ -532,7 +535,7 @@ class _CurveCells:
     def _cell(self, j: Any, xp: Any) -> tuple[Any, ...]:
         """Cell coefficients: a tuple of floats (one ship) or of arrays gathered by j."""
         if xp.batched:
-            return tuple(c[j] for c in self.cell_arrays)
+            return tuple(self.cell_table.take(j, axis=1))
         return self.cell_tuples[j]
 
     def follow(self, x: Any, y: Any, s_hint: Any, window: float | None, xp: Any) -> CurvePoint:
@@ -545,7 +548,16 @@ class _CurveCells:
         else:
             lo = xp.clip_index(xp.searchsorted_right(tab["sg"], s_hint - window) - 1, 0, last)
             hi = xp.clip_index(xp.searchsorted_right(tab["sg"], s_hint + window), 0, last)
-        if xp.batched:
+        if xp.batched and window is not None and 2 * self._window_width(window) > self.n_grid:
+            # windows spanning most of the grid: all grid points, those outside a ship's
+            # window at +inf (the same candidates' distances, the same first minimum)
+            dx = a["px"] - x[:, None]
+            dy = a["py"] - y[:, None]
+            d2 = dx * dx + dy * dy
+            grid = np.arange(self.n_grid)
+            d2[(grid < lo[:, None]) | (grid > hi[:, None])] = np.inf
+            k = np.argmin(d2, axis=1)
+        elif xp.batched:
             width = self.n_grid if window is None else self._window_width(window)
             idx = (
                 np.minimum(lo + np.arange(width), hi)
@@ -592,9 +604,17 @@ class _CurveCells:
         half = 0.5 * (t - t_j)
         mid = 0.5 * (t + t_j)
         acc = 0.0
-        for node, weight in self.gl:
-            qx, qy = _velocity(cell, mid + half * node)
-            acc = acc + weight * xp.sqrt(qx * qx + qy * qy)
+        if xp.batched:  # the nodes as columns of one (N, 8) array; the sum in node order
+            qx, qy = _velocity(
+                tuple(c[:, None] for c in cell), mid[:, None] + half[:, None] * _GL_NODES
+            )
+            terms = _GL_WEIGHTS * np.sqrt(qx * qx + qy * qy)
+            for column in terms.T:
+                acc = acc + column
+        else:
+            for node, weight in self.gl:
+                qx, qy = _velocity(cell, mid + half * node)
+                acc = acc + weight * xp.sqrt(qx * qx + qy * qy)
         s = tab["sg"][j] + half * acc
         # -- tangent: P'/|P'| (the grid direction where P' vanishes, at corners)
         speed = xp.sqrt(dpx * dpx + dpy * dpy)
@@ -660,6 +680,14 @@ class LegTable:
     arrays: dict[str, np.ndarray]
     last_leg: int
     goal: tuple[float, float]
+
+    #: the order of the rows of :attr:`matrix`
+    COLUMNS = ("x0", "y0", "x1", "y1", "c", "s", "length", "angle", "change")
+
+    @cached_property
+    def matrix(self) -> np.ndarray:
+        """The arrays as one (len(COLUMNS), legs) array: N ships' constants in one gather."""
+        return np.stack([self.arrays[name] for name in self.COLUMNS])
 
     @classmethod
     def of(cls, path: WaypointPath) -> LegTable:

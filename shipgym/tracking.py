@@ -49,21 +49,24 @@ def polyline_frame(x: Any, y: Any, leg: Any, table: LegTable, radius: float, xp:
     The goal counts as reached on the last leg inside the acceptance circle of the final
     waypoint or once abeam of it.
     """
-    tab = table.arrays if xp.batched else table.lists
-    rx, ry = x - tab["x0"][leg], y - tab["y0"][leg]
-    c, s = tab["c"][leg], tab["s"][leg]
+    if xp.batched:  # the active legs' constants in one gather
+        x0, y0, x1, y1, c, s, length, angle, change = table.matrix.take(leg, axis=1)
+    else:
+        tab = table.lists
+        x0, y0, x1, y1 = tab["x0"][leg], tab["y0"][leg], tab["x1"][leg], tab["y1"][leg]
+        c, s, length = tab["c"][leg], tab["s"][leg], tab["length"][leg]
+        angle, change = tab["angle"][leg], tab["change"][leg]
+    rx, ry = x - x0, y - y0
     along = along_track(rx, ry, c, s)
     gx, gy = x - table.goal[0], y - table.goal[1]
-    nx, ny = x - tab["x1"][leg], y - tab["y1"][leg]
-    at_goal = (leg == table.last_leg) & (
-        (xp.sqrt(gx * gx + gy * gy) <= radius) | (along >= tab["length"][leg])
-    )
+    nx, ny = x - x1, y - y1
+    at_goal = (leg == table.last_leg) & ((xp.sqrt(gx * gx + gy * gy) <= radius) | (along >= length))
     return TrackFrame(
         cross_track(rx, ry, c, s),
-        tab["angle"][leg],
+        angle,
         along,
         leg,
-        tab["change"][leg],
+        change,
         xp.sqrt(nx * nx + ny * ny),
         at_goal,
     )
@@ -95,12 +98,19 @@ def curve_frame(x: Any, y: Any, point: CurvePoint, path: PchipPath, radius: floa
 
 def _select(mask: np.ndarray, new: Any, old: Any) -> Any:
     """Field by field: ``new`` where ``mask``, else ``old`` (dataclasses of arrays)."""
+    if np.asarray(mask).all():
+        return new
     return type(new)(
         *(
             np.where(mask, getattr(new, f.name), getattr(old, f.name))
             for f in dataclasses.fields(new)
         )
     )
+
+
+def _item(record: Any, i: int) -> Any:
+    """Entry i of a dataclass of arrays, as a dataclass of Python scalars."""
+    return type(record)(*(getattr(record, f.name)[i].item() for f in dataclasses.fields(record)))
 
 
 class PathTracker:
@@ -161,6 +171,18 @@ class PathTracker:
         self.leg = self._masked(mask, leg, self.leg)
         return self._store(polyline_frame(x, y, self.leg, self._legs, self.radius, xp), mask)
 
+    def ship(self, i: int) -> PathTracker:
+        """Ship i of a batched tracker as a one-ship tracker in its state (frame, leg and
+        closest point, as Python floats, ints and bools): its updates go on with the bits
+        the batched tracker would give it."""
+        one = PathTracker(self.path, self.radius, self.switching)
+        if self.frame is not None:
+            one.frame = _item(self.frame, i)
+            one.leg = one.frame.leg
+        if self.is_curve and self.point is not None:
+            one.point = _item(self.point, i)
+        return one
+
     def _curve(self, x: Any, y: Any, window: float | None, mask: Any) -> TrackFrame:
         hint = 0.0 if window is None else self.point.s
         point = self.path.follow(x, y, hint, window, self.xp)
@@ -172,7 +194,7 @@ class PathTracker:
         return self._store(frame, mask)
 
     def _masked(self, mask: Any, new: Any, old: Any) -> Any:
-        return new if mask is None else np.where(mask, new, old)
+        return new if mask is None or np.asarray(mask).all() else np.where(mask, new, old)
 
     def _store(self, frame: TrackFrame, mask: Any) -> TrackFrame:
         if mask is not None and self.frame is not None:
@@ -180,15 +202,29 @@ class PathTracker:
         self.frame = frame
         return frame
 
+    def origin(self) -> tuple[Any, Any]:
+        """The point [m] of the path the current frame is measured from: the active leg's
+        start (polyline) or the closest point (curve); floats, or arrays over the ships."""
+        if self.is_curve:
+            return self.point.x, self.point.y
+        tab = self._legs.arrays if self.batch is not None else self._legs.lists
+        return tab["x0"][self.leg], tab["y0"][self.leg]
+
     def cross_track_of(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-        """Cross-track errors [m] of sample positions of one ship relative to its frame.
+        """Cross-track errors [m] of sample positions relative to the current frame: of one
+        ship (xs, ys of shape (n,)), or of N ships (shape (N, n): row i relative to ship i's
+        frame).
 
         Exact for a polyline (the active leg); for a curve, relative to the tangent line at
-        the current closest point (accurate over one control period of travel).
+        the current closest point (accurate over one control period of travel).  The unit
+        direction is libm's cos / sin of the path angle for one ship and for N alike (the
+        same bits per ship).
         """
-        f = self.frame
-        if self.is_curve:
-            x0, y0 = self.point.x, self.point.y
-        else:
-            x0, y0 = self._legs.lists["x0"][self.leg], self._legs.lists["y0"][self.leg]
-        return cross_track(xs - x0, ys - y0, math.cos(f.path_angle), math.sin(f.path_angle))
+        angle = self.frame.path_angle
+        x0, y0 = self.origin()
+        if self.batch is None:
+            return cross_track(xs - x0, ys - y0, math.cos(angle), math.sin(angle))
+        angles = angle.tolist()
+        c = np.fromiter(map(math.cos, angles), np.float64, len(angles))[:, None]
+        s = np.fromiter(map(math.sin, angles), np.float64, len(angles))[:, None]
+        return cross_track(xs - x0[:, None], ys - y0[:, None], c, s)

@@ -68,8 +68,10 @@ from scipy.linalg import solve_continuous_are
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
+from shipgym_baselines.tuning.chosen import tuned_settings
 
 #: Borkowski (2018) §5: initial estimates on the Mariner (a0 [1/s], c0 [1/s²])
 PAPER_INITIAL_GUESS = {"mariner": (0.02, 0.002)}
@@ -179,8 +181,13 @@ class LQR:
 
     ``a0`` [1/s], ``c0`` [1/s²]: initial guess (None: see :func:`initial_guess`);
     ``lambda_y`` [1/m²] (None: :func:`length_scaled_lambda_y`), ``lambda_psi``,
-    ``lambda_delta``: the weights of eq. (29); ``speed``: "measured" | "nominal";
-    ``resolve_tolerance``: relative change of (a, c, U) that triggers a new Riccati solve.
+    ``lambda_delta``: the weights of eq. (29) (None: the ship's chosen weights with
+    ``preset="tuned"``, else the paper's); ``speed``: "measured" | "nominal";
+    ``resolve_tolerance``: relative change of (a, c, U) that triggers a new Riccati solve;
+    ``preset``: "tuned" reads the ship's section of ``configs/tuning/chosen/<name>.yaml``
+    (``shipgym tune lqr``, docs/tuning.md) under the weights given here, "paper" does not;
+    ``drift_compensation``: the state's heading error as the course error ψ + β − ψp with
+    the measured drift angle β (None: the chosen setting, else off, the paper's).
     """
 
     kind = "classical"
@@ -191,10 +198,12 @@ class LQR:
         a0: float | None = None,
         c0: float | None = None,
         lambda_y: float | None = None,
-        lambda_psi: float = PAPER_LAMBDA_PSI,
-        lambda_delta: float = PAPER_LAMBDA_DELTA,
+        lambda_psi: float | None = None,
+        lambda_delta: float | None = None,
         speed: str = "measured",
         resolve_tolerance: float = 0.01,
+        preset: str = "tuned",
+        drift_compensation: bool | None = None,
     ) -> None:
         if (a0 is None) != (c0 is None):
             raise ValueError("give both a0 and c0, or neither (default initial guess)")
@@ -206,9 +215,22 @@ class LQR:
             raise ValueError(f"speed must be 'measured' or 'nominal', got {speed!r}")
         if not resolve_tolerance >= 0:
             raise ValueError(f"resolve_tolerance must be ≥ 0, got {resolve_tolerance!r}")
+        if preset not in ("tuned", "paper"):
+            raise ValueError(f"preset must be 'tuned' or 'paper', got {preset!r}")
         self.a0, self.c0 = a0, c0
-        self.lambda_y = lambda_y
-        self.lambda_psi, self.lambda_delta = lambda_psi, lambda_delta
+        self.preset = preset
+        #: the weights given here (over the chosen ones at reset)
+        self.explicit = {
+            k: float(v)
+            for k, v in (
+                ("lambda_y", lambda_y),
+                ("lambda_psi", lambda_psi),
+                ("lambda_delta", lambda_delta),
+            )
+            if v is not None
+        }
+        if drift_compensation is not None:
+            self.explicit["drift_compensation"] = bool(drift_compensation)
         self.speed_source = speed
         self.resolve_tolerance = resolve_tolerance
 
@@ -218,10 +240,17 @@ class LQR:
         self.ctx = context
         a0, c0 = (self.a0, self.c0) if self.a0 is not None else initial_guess(context)
         self.guess = (float(a0), float(c0))
-        lam_y = (
-            length_scaled_lambda_y(context.ship_length) if self.lambda_y is None else self.lambda_y
+        chosen = tuned_settings(type(self).name, context.ship) if self.preset == "tuned" else {}
+        given = {**chosen, **self.explicit}
+        self.weights = LQRWeights(
+            given.get("lambda_y", length_scaled_lambda_y(context.ship_length)),
+            given.get("lambda_psi", PAPER_LAMBDA_PSI),
+            given.get("lambda_delta", PAPER_LAMBDA_DELTA),
         )
-        self.weights = LQRWeights(lam_y, self.lambda_psi, self.lambda_delta)
+        #: the heading error of eq. (25) as the course error ψ + β − ψp (β measured,
+        #: classical.drift, as the PID family and L1 compensate it); off: the paper's ψ − ψp
+        self.drift_compensation = bool(given.get("drift_compensation", False))
+        self._last: dict[str, Any] | None = None
         self.rate_limit = float(getattr(context.nominal_model, "rudder_rate_limit", math.inf))
         self.tracker = context.new_tracker()
         self._started = False
@@ -264,13 +293,14 @@ class LQR:
         frame = self.tracker.update(x, y) if self._started else self.tracker.reset(x, y)
         self._started = True
         # Borkowski (2018) eq. (25): state in the frame of the active leg
-        state = np.array(
-            [
-                frame.cross_track,
-                wrap_angle(info["heading"] - frame.path_angle),
-                info["yaw_rate"],
-            ]
-        )
+        heading_error = wrap_angle(info["heading"] - frame.path_angle)
+        if self.drift_compensation:  # the course error: ė = U sin(ψ + β − ψp)
+            _, drift = course_and_drift(
+                info, self._last, self.ctx.control_period, self.ctx.nominal_speed
+            )
+            heading_error = wrap_angle(heading_error + drift)
+            self._last = {"position": (float(x), float(y)), "psi": float(info["heading"])}
+        state = np.array([frame.cross_track, heading_error, info["yaw_rate"]])
         a, c = self._model(info)
         speed = self._speed(info)
         K = self._gain(a, c, speed)

@@ -444,6 +444,57 @@ def load_model(path: Path, algo: str, action_mode: str, context_features: bool =
         raise ControllerError(f"{path}: cannot load it as a {name} model: {exc}") from exc
 
 
+def lean_forward(policy: Any) -> Any:
+    """The deterministic action of an SB3 policy as ``policy.predict(obs,
+    deterministic=True)`` computes it, bit for bit, for a batch of observations (n, d),
+    without what ``predict`` adds per call (the API checks, ``obs_to_tensor``'s shape
+    handling, the action distribution object and its argument validation): a PPO
+    ``ActorCriticPolicy`` with a diagonal Gaussian (the mean of ``action_net``, clipped
+    to the action space), a SAC actor (deterministic) or a TD3 actor (rescaled from the
+    squashed [-1, 1]); None for any other policy (it keeps ``predict``).  The shipped
+    agents' actions are a golden file (``tests/golden/shipped_policy_actions.npz``)."""
+    import torch
+    from gymnasium import spaces
+    from stable_baselines3.common.distributions import DiagGaussianDistribution
+    from stable_baselines3.common.policies import ActorCriticPolicy
+    from stable_baselines3.sac.policies import SACPolicy
+    from stable_baselines3.td3.policies import TD3Policy
+
+    box = policy.action_space
+    if not isinstance(box, spaces.Box):
+        return None
+    shape = (-1, *box.shape)
+    if (
+        type(policy) is ActorCriticPolicy
+        and type(policy.action_dist) is DiagGaussianDistribution
+        and not policy.squash_output
+    ):
+
+        def actor(obs: Any) -> Any:
+            features = policy.extract_features(obs, policy.pi_features_extractor)
+            return policy.action_net(policy.mlp_extractor.forward_actor(features))
+
+    elif type(policy) is SACPolicy:
+
+        def actor(obs: Any) -> Any:
+            return policy.actor(obs, True)
+
+    elif type(policy) is TD3Policy:
+        actor = policy.actor
+    else:
+        return None
+
+    def forward(obs: np.ndarray) -> np.ndarray:
+        with torch.no_grad():
+            actions = actor(torch.as_tensor(obs, device=policy.device)).cpu().numpy()
+        actions = actions.reshape(shape)
+        if policy.squash_output:
+            return policy.unscale_action(actions)
+        return np.clip(actions, box.low, box.high)
+
+    return forward
+
+
 def _eval_mode_once(policy: Any) -> None:
     """Put the network in evaluation mode once, for good: SB3's ``predict`` calls
     ``set_training_mode(False)`` on every call, which walks every module (≈ 30 % of a
@@ -496,6 +547,9 @@ class LearnedPolicy:
             load_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
         )
         self.recurrent = self.algo in RECURRENT
+        #: the deterministic action without ``predict``'s per-call checks and distribution
+        #: object (None: ``predict``, e.g. a recurrent or another policy class)
+        self._lean = None if self.recurrent else lean_forward(self.model.policy)
         self._memory = _Memory()
         self._batch: list[_Memory] = []
 
@@ -544,6 +598,8 @@ class LearnedPolicy:
         padded = np.zeros((BATCH_ROWS, *obs.shape[1:]), dtype=obs.dtype)
         padded[:n] = obs
         if not self.recurrent:
+            if self._lean is not None:
+                return self._lean(padded)[:n]
             actions, _ = self.model.predict(padded, deterministic=True)
             return actions[:n]
         layers, _, hidden = self.model.policy.lstm_hidden_state_shape

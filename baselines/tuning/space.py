@@ -148,6 +148,14 @@ class TuningConfig(StrictModel):
         both = sorted(set(self.fixed) & set(self.params))
         if both:
             raise ValueError(f"fixed: {both} are tuned (params), not fixed")
+        if self.kind == "learned":  # the default trains as every trial does (env, rollout)
+            unequal = sorted(k for k, v in self.fixed.items() if self.default.get(k, v) != v)
+            missing = sorted(set(self.fixed) - set(self.default))
+            if unequal or missing:
+                raise ValueError(
+                    f"default: a learned study's default is trained with the fixed settings "
+                    f"of every trial; give {sorted(set(unequal) | set(missing))} as in fixed"
+                )
         if self.ships is not None:
             from shipgym.models import MODELS
 

@@ -337,11 +337,12 @@ def write_report(
     if best is not None:
         report["best_vs_default"] = best_vs_default(best.user_attrs["ratios"], default, names)
         improved = best.value < report["default_value"]
-        settings = (
-            {**{k: v for k, v in config.fixed.items() if k != "preset"}, **best.params}
-            if improved
-            else {}
-        )
+        # the settings the winner was scored with: the best trial's (under the fixed ones),
+        # or the default's (a learned study's default names its env and rollout settings,
+        # the same as every trial's; a classical default, the paper's preset, is the
+        # controller's construction without chosen settings)
+        winner = {**config.fixed, **best.params} if improved else dict(config.default)
+        settings = {k: v for k, v in winner.items() if k != "preset"}
         summary = {
             "study": plan.study_name,
             "report": str(plan.folder / REPORT_FILE),

@@ -85,6 +85,17 @@ GUIDANCE_OFFSET_MAX = math.radians(30.0)
 
 #: the per-control-step columns both envs log for the episode metrics (true values)
 LOG_FIELDS = ("t", "cross_track_error", "heading_error", "rudder_angle", "rudder_command", "reward")
+#: an episode's trajectory as the evaluation keeps it: per control step (the reset's
+#: included) these ``info`` values, ``position`` split into x and y [m]
+TRAJECTORY_KEYS = (
+    "t",
+    "x",
+    "y",
+    "cross_track_error",
+    "heading",
+    "rudder_angle",
+    "rudder_command",
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -501,8 +512,9 @@ def batch_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
     """A batched env's actions (n_envs, n_act) as float64, clipped to [-1, 1]; NaN or inf
     in any env's row is an error naming those envs (before anything steps)."""
     a = np.asarray(actions, dtype=np.float64).reshape(shape)
-    bad = ~np.all(np.isfinite(a), axis=1)
-    if np.any(bad):
+    finite = np.isfinite(a)
+    if not finite.all():
+        bad = ~finite.all(axis=1)
         raise ValueError(
             f"actions of envs {np.flatnonzero(bad).tolist()} contain NaN or inf; "
             "the env state is unchanged"

@@ -9,7 +9,11 @@ finished row stays done (:attr:`finished`), its action is ignored and it is not 
 
 ``info`` holds ``"rows"``: per row the single env's ``info`` dict of that step (every key:
 ``t``, ``cross_track_error``, …, ``samples``; ``termination_reason`` and
-``episode_metrics`` at the row's last step), None for a row not stepped.  The rows must
+``episode_metrics`` at the row's last step), None for a row not stepped; with
+``row_infos="end"`` (a policy that reads observations only) a row's ``info`` only at its
+last step, and :meth:`~EvaluationTrialsVectorEnv.trajectory` gives its episode's
+trajectory columns.  Rows of one route share one batched path tracker
+(:class:`~shipgym.envs.row_tracking.RouteGroups`).  The rows must
 share the ship and its step constants (:func:`~shipgym.envs.trial_rows.shared_constants_problem`;
 :func:`lockstep_problem` says why they do not).  Not registered with ``gym.make``; the
 evaluation loop (``shipgym_baselines.evaluation.evaluate_batch``) builds it.
@@ -24,6 +28,7 @@ import numpy as np
 
 from shipgym.envs import core
 from shipgym.envs.context import ControllerContext
+from shipgym.envs.row_tracking import RouteGroups
 from shipgym.envs.trial_rows import Trial, TrialRowsVectorEnv, shared_constants_problem
 from shipgym.errors import ShipgymError
 from shipgym.metrics import compute_metrics
@@ -32,6 +37,20 @@ from shipgym.scenarios import Scenario, load_scenario
 
 class LockstepError(ShipgymError):
     """Trials that cannot be the rows of one env (different ships or step constants)."""
+
+
+class RowInfosError(ShipgymError, ValueError):
+    """An unknown ``row_infos`` choice, or one the ``samples`` setting contradicts."""
+
+
+#: which steps give a row its ``info`` dict: every step, or its last step only
+ROW_INFOS = ("all", "end")
+
+#: the episode columns the env keeps per row and step (column 0: the reset): the
+#: trajectory's and the metrics' (core.LOG_FIELDS) values
+_COLUMNS = core.TRAJECTORY_KEYS + tuple(f for f in core.LOG_FIELDS if f not in core.TRAJECTORY_KEYS)
+_TRAJECTORY = [_COLUMNS.index(name) for name in core.TRAJECTORY_KEYS]
+_LOG = [_COLUMNS.index(name) for name in core.LOG_FIELDS]
 
 
 def lockstep_problem(scenarios: Sequence[Scenario]) -> str | None:
@@ -56,10 +75,20 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         action_mode: str = "rudder",
         compile: bool = True,
         samples: bool = True,
+        row_infos: str = "all",
     ) -> None:
+        if row_infos not in ROW_INFOS:
+            raise RowInfosError(f"row_infos must be one of {ROW_INFOS}, got {row_infos!r}")
+        if row_infos == "end" and samples:
+            raise RowInfosError(
+                "row_infos='end' builds no per-step info, so no samples: pass samples=False"
+            )
         #: whether the rows' infos carry ``samples`` (False: for a policy that reads only
         #: observations, e.g. a learned agent; the rest of each info is the same)
         self.record_samples = samples
+        #: "all": each stepped row's info every step; "end": only at the row's last step
+        #: (the trajectory is kept in arrays: :meth:`trajectory`)
+        self.row_infos = row_infos
         self.scenarios = [load_scenario(s) for s in scenarios]
         self.seeds = [int(s) for s in seeds]
         if not self.scenarios or len(self.scenarios) != len(self.seeds):
@@ -74,8 +103,9 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         n = self.num_envs
         #: rows whose episode has ended (they stay done)
         self.finished = np.ones(n, dtype=bool)
-        #: the episode logs: (LOG_FIELDS, row, step) [SI], row i's first steps[i] columns
-        self._log = np.zeros((len(core.LOG_FIELDS), n, int(self._max_steps_of().max())))
+        #: the episode columns (_COLUMNS, row, step) [SI]: the reset and row i's steps[i]
+        #: control steps
+        self._columns = np.zeros((len(_COLUMNS), n, int(self._max_steps_of().max()) + 1))
         self._started = False
 
     def _max_steps_of(self) -> np.ndarray:
@@ -92,13 +122,21 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         """Start every row's episode (the seeds are the constructor's: ``seed`` must be None)."""
         if seed is not None:
             raise ValueError("the rows' seeds are given at construction; reset takes none")
+        trackers = []
         for i, (sc, s) in enumerate(zip(self.scenarios, self.seeds, strict=True)):
-            self._install(i, Trial.of(sc, s, self.action_mode, False))
+            trial = Trial.of(sc, s, self.action_mode, False)
+            self._install(i, trial)
+            trackers.append(trial.tracker)
+        k = self._k0
+        self._tracks = RouteGroups(trackers, self._state[:, k.ix], self._state[:, k.iy])
         self.finished[:] = False
         self._started = True
         self._reached_goal = np.zeros(self.num_envs, dtype=bool)
-        frames = self._frames
-        infos = [self._row_info(i, frames[i]) for i in range(self.num_envs)]
+        every = np.arange(self.num_envs)
+        self._write_columns(every, 0, self._tracks.frame.cross_track, None, None)
+        infos: list[dict[str, Any] | None] = [None] * self.num_envs
+        if self.row_infos == "all":
+            infos = [self._row_info(i) for i in range(self.num_envs)]
         return self._observation(), {"rows": infos}
 
     def step(
@@ -107,34 +145,33 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         if not self._started:
             raise RuntimeError("call reset() before step()")
         live = ~self.finished
-        a = np.zeros(self.action_space.shape)
-        a[live] = core.batch_actions(np.asarray(actions)[live], (int(live.sum()), a.shape[1]))
+        if live.all():
+            a = core.batch_actions(actions, self.action_space.shape)
+        else:
+            a = np.zeros(self.action_space.shape)
+            a[live] = core.batch_actions(np.asarray(actions)[live], (int(live.sum()), a.shape[1]))
         period = self._advance(a, live)
-        terminated, truncated = period.terminated & live, period.truncated & live
-        reasons = period.reasons()
-        k = self._k0
+        # the period's ends are the stepped rows' (goal, corridor, time limit: of the rows
+        # that advanced; a non-finite state: of a live row)
+        terminated, truncated = period.terminated, period.truncated
+        ended = terminated | truncated
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
-        x_col, y_col = self._state[:, k.ix], self._state[:, k.iy]
-        rows = np.flatnonzero(live)
-        self._log[:, rows, self._steps[rows] - 1] = (
-            self._t[rows],
-            period.frame.cross_track[rows],
-            period.heading_error[rows],
-            self._state[rows, k.idelta],
-            self._delta_c[rows],
-            period.reward[rows],
-        )
-        for i in rows.tolist():
-            frame = self._frames[i]
-            info = self._row_info(i, frame, float(x_col[i]), float(y_col[i]))
+        rows = live.nonzero()[0]
+        if rows.size:  # the live rows step together: one step count
+            step = int(self._steps[rows[0]])
+            frame = period.frame
+            self._write_columns(rows, step, frame.cross_track, period.heading_error, period.reward)
+        reasons = period.reasons() if ended.any() else None
+        for i in (rows if self.row_infos == "all" else ended.nonzero()[0]).tolist():
+            info = self._row_info(i)
             if i in period.samples:
                 info["samples"] = period.samples[i]
-            if reasons[i] is not None:
+            if ended[i]:
                 self._reached_goal[i] = bool(period.goal[i])
                 info["termination_reason"] = reasons[i]
                 info["episode_metrics"] = self.episode_metrics(i)
             infos[i] = info
-        self.finished |= terminated | truncated
+        self.finished |= ended
         return (
             self._observation(period.frame),
             period.reward,
@@ -143,15 +180,50 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
             {"rows": infos},
         )
 
-    def _row_info(
-        self, i: int, frame: Any, x: float | None = None, y: float | None = None
-    ) -> dict[str, Any]:
+    def _write_columns(
+        self,
+        rows: np.ndarray,
+        step: int,
+        cross_track: np.ndarray,
+        heading_error: np.ndarray | None,
+        reward: np.ndarray | None,
+    ) -> None:
+        """Column ``step`` (0: the reset) of the ``rows``' episode columns (_COLUMNS)."""
         k = self._k0
-        if x is None:
-            x, y = float(self._state[i, k.ix]), float(self._state[i, k.iy])
+        whole = rows.size == self.num_envs  # every row: no gathers
+
+        def take(values: np.ndarray) -> np.ndarray:
+            return values if whole else values[rows]
+
+        state = take(self._state)
+        values = [
+            take(self._t),
+            state[:, k.ix],
+            state[:, k.iy],
+            take(cross_track),
+            take(self._psi_m),
+            state[:, k.idelta],
+            take(self._delta_c),
+        ]
+        if heading_error is not None:
+            values += [take(heading_error), take(reward)]
+        self._columns[: len(values), slice(None) if whole else rows, step] = values
+
+    def trajectory(self, i: int) -> dict[str, np.ndarray]:
+        """Row i's trajectory so far: per key of ``core.TRAJECTORY_KEYS`` its values at the
+        reset and each control step (the rows' ``info`` values, bit for bit)."""
+        n = int(self._steps[i]) + 1
+        return {
+            name: self._columns[j, i, :n].copy()
+            for name, j in zip(core.TRAJECTORY_KEYS, _TRAJECTORY, strict=True)
+        }
+
+    def _row_info(self, i: int) -> dict[str, Any]:
+        k = self._k0
+        x, y = float(self._state[i, k.ix]), float(self._state[i, k.iy])
         return core.info_values(
             float(self._t[i]),
-            frame,
+            self._tracks.row_frame(i),
             float(self._psi_m[i]),
             float(self._r_m[i]),
             float(self._state[i, k.idelta]),
@@ -163,6 +235,9 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         """Row i's episode metrics so far (the single env's ``episode_metrics()``)."""
         sc = self.scenarios[i]
         steps = int(self._steps[i])
-        columns = {name: self._log[j, i, :steps].copy() for j, name in enumerate(core.LOG_FIELDS)}
+        columns = {
+            name: self._columns[j, i, 1 : steps + 1].copy()
+            for name, j in zip(core.LOG_FIELDS, _LOG, strict=True)
+        }
         log = core.episode_log(columns, sc, bool(self._reached_goal[i]))
         return compute_metrics(log, core.metric_settings(sc))

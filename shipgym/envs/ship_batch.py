@@ -167,5 +167,9 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         return Trial.of(sc, episode_seed, self.action_mode, self.context_features)
 
     def _reset_envs(self, mask: np.ndarray) -> None:
-        for i in np.flatnonzero(mask):
-            self._install(int(i), self._new_trial(int(i)))
+        k = self._k0
+        for i in np.flatnonzero(mask).tolist():
+            trial = self._new_trial(i)
+            self._install(i, trial)
+            x, y = float(self._state[i, k.ix]), float(self._state[i, k.iy])
+            self._tracks.install(i, trial.tracker, x, y)

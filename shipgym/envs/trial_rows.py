@@ -1,12 +1,13 @@
 """The row machinery of the batched trial envs: N single-env episodes as the rows of arrays.
 
-Each row runs one trial (its own :class:`~shipgym.scenarios.Scenario`, path tracker,
-parameter schedule, disturbance processes, sensors and episode generator); the plant of
-all rows is one call of the ship's compiled period function (the true parameters and
-disturbances are per-row inputs), and reward, observation and termination are the step
-core's functions (:mod:`shipgym.envs.core`) on arrays.  Row i's episode is that of a
-:class:`~shipgym.envs.path_follow.ShipPathFollowEnv` on its trial reset with its episode
-seed, bit for bit (tested).
+Each row runs one trial (its own :class:`~shipgym.scenarios.Scenario`, route, parameter
+schedule, disturbance processes, sensors and episode generator); the plant of all rows is
+one call of the ship's compiled period function (the true parameters and disturbances are
+per-row inputs), reward, observation and termination are the step core's functions
+(:mod:`shipgym.envs.core`) on arrays, and the path tracking is
+:mod:`shipgym.envs.row_tracking`'s (one tracker per row, or one per route).  Row i's
+episode is that of a :class:`~shipgym.envs.path_follow.ShipPathFollowEnv` on its trial
+reset with its episode seed, bit for bit (tested).
 
 Two envs are built on it: the training env
 :class:`~shipgym.envs.ship_batch.ShipTrialsVectorEnv` (a fresh drawn trial per reset,
@@ -19,7 +20,6 @@ variant) and every step constant but the time limit (:func:`shared_constants_pro
 from __future__ import annotations
 
 import dataclasses
-import operator
 from typing import Any
 
 import numpy as np
@@ -31,14 +31,12 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs import core
+from shipgym.envs.row_tracking import RouteGroups, RowTrackers
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY, SCALAR
 from shipgym.scenarios import Scenario
 from shipgym.scenarios.loader import nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
-
-#: a TrackFrame's fields as a tuple, in declaration order
-_FRAME_ROW = operator.attrgetter(*(f.name for f in dataclasses.fields(TrackFrame)))
 
 
 @dataclasses.dataclass
@@ -168,6 +166,10 @@ class TrialRowsVectorEnv(VectorEnv):
         self._event_start = np.full(num_envs, np.inf)  # first event time [s]
         self._event_end = np.full(num_envs, -np.inf)  # last event end [s]
         self._time_varying = np.zeros(num_envs, dtype=bool)
+        #: per row: its disturbances settle from this period start [s] (Disturbances.steady_from)
+        self._steady_from = np.full(num_envs, np.inf)
+        #: rows whose block holds their settled disturbances (no refill needed)
+        self._w_steady = np.zeros(num_envs, dtype=bool)
         self._state = np.zeros((num_envs, first.model.n_states))
         self._steps = np.zeros(num_envs, dtype=np.int64)
         self._t = np.zeros(num_envs)
@@ -177,12 +179,15 @@ class TrialRowsVectorEnv(VectorEnv):
         self._speed = np.full(num_envs, k.nominal_speed)
         self._integral = np.zeros(num_envs)
         self._context = np.zeros((num_envs, self._parts.context_row.size), dtype=np.float32)
-        self._frames: list[TrackFrame | None] = [None] * num_envs
+        self._noisy = np.zeros(num_envs, dtype=bool)  # rows whose sensors add noise
+        #: the rows' path tracking (the subclass sets it: per row, or per route at reset)
+        self._tracks: RowTrackers | RouteGroups = RowTrackers(num_envs)
         self._sample_offsets = k.fine_step * np.arange(k.substeps)
 
     # ------------------------------------------------------------------ rows
     def _install(self, i: int, tr: Trial) -> None:
-        """Start row i's episode on trial ``tr`` (a single env's reset)."""
+        """Start row i's episode on trial ``tr`` (a single env's reset; the path tracking
+        is the caller's: :class:`RowTrackers` or :class:`RouteGroups`)."""
         k = self._k0
         self._trials[i] = tr
         sc = tr.scenario
@@ -193,6 +198,8 @@ class TrialRowsVectorEnv(VectorEnv):
         self._event_end[i] = max((e.end_time() for e in events), default=-np.inf)
         self._p_dirty[i] = False
         self._time_varying[i] = tr.disturbances.time_varying
+        self._steady_from[i] = tr.disturbances.steady_from
+        self._w_steady[i] = False
         self._steps[i] = 0
         self._t[i] = 0.0
         self._delta_c[i] = 0.0
@@ -204,38 +211,45 @@ class TrialRowsVectorEnv(VectorEnv):
         tr.sensor.reset()
         psi_m, r_m = tr.sensor.measure(x[k.ipsi : k.ipsi + 1], x[k.ir : k.ir + 1], tr.rng)
         self._psi_m[i], self._r_m[i] = float(psi_m[0]), float(r_m[0])
-        self._frames[i] = tr.tracker.reset(float(x[k.ix]), float(x[k.iy]))
+        self._noisy[i] = not tr.sensor.ideal
         if self.context_features:
             self._context[i] = tr.context_row
 
     def _advance(self, a: np.ndarray, live: np.ndarray) -> Period:
         """One control period of the ``live`` rows with actions ``a`` (n_envs, n_act),
-        checked and clipped (:func:`core.batch_actions`); the other rows keep their state."""
+        checked and clipped (:func:`core.batch_actions`); the other rows keep their state.
+
+        While every row steps (and every plant state stays finite), the masked selections
+        (``np.where(live, new, old)``) are skipped: they would return ``new`` (issue 18:
+        the step's fixed cost is its ≈ 100 numpy calls)."""
         k = self._k0
-        rows = np.flatnonzero(live)
         trials: list[Trial] = self._trials  # type: ignore[assignment]
+        tracks = self._tracks
+        every = bool(live.all())
         if self.action_mode == "rudder":
             delta_c = a[:, 0] * k.rudder_limit
         else:
             delta_c = self._delta_c.copy()
-            for i in rows:
+            for i in live.nonzero()[0].tolist():
                 delta_c[i], self._integral[i] = core.guidance_command(
                     a[i, 0],
                     a[i, 1],
-                    self._frames[i],
+                    tracks.row_frame(i),
                     self._psi_m[i],
                     self._r_m[i],
                     self._integral[i],
                     trials[i],
                     SCALAR,
                 )
-        delta_c = np.where(live, delta_c, self._delta_c)
-        prev_delta_c = self._delta_c.copy()
-        t0 = self._t.copy()
+        if not every:
+            delta_c = np.where(live, delta_c, self._delta_c)
+        # the arrays below are replaced, never written in place, during a period
+        prev_delta_c = self._delta_c
+        t0 = self._t
         # true parameters of the period: only for rows whose event acts on it (or just did)
         t1 = t0 + k.control_period
-        changing = live & (self._event_end >= t0 - 1e-9) & (self._event_start <= t1 + 1e-9)
-        for i in np.flatnonzero(changing | (live & self._p_dirty)).tolist():
+        changing = (self._event_end >= t0 - 1e-9) & (self._event_start <= t1 + 1e-9)
+        for i in ((changing | self._p_dirty) & live).nonzero()[0].tolist():
             tr = trials[i]
             self._p_dirty[i] = core.refresh_parameters(
                 tr.scenario.schedule,
@@ -244,58 +258,72 @@ class TrialRowsVectorEnv(VectorEnv):
                 self._p_block[i],
                 bool(self._p_dirty[i]),
             )
-        for i in np.flatnonzero(live & self._time_varying).tolist():  # disturbances
+        # disturbances: a settled block (filled at a start ≥ steady_from) is not refilled
+        for i in (live & self._time_varying & ~self._w_steady).nonzero()[0].tolist():
             trials[i].disturbances.fill_one(self._w_block[i], float(t0[i]), trials[i].rng)
+            self._w_steady[i] = t0[i] >= self._steady_from[i]
         x_start = self._state
         traj = self._integrator.substep_states(x_start, delta_c, self._w_block, self._p_block)
-        steps = np.where(live, self._steps + 1, self._steps)
         last = traj[:, -1]
-        finite = np.all(np.isfinite(last), axis=1)
-        advance = live & finite
+        finite = np.isfinite(last).all(axis=1)
+        moved = every and bool(finite.all())  # every row advances
+        steps = self._steps + 1
+        if every:
+            self._t = steps * k.control_period
+        else:
+            steps = np.where(live, steps, self._steps)
+            self._t = np.where(live, steps * k.control_period, self._t)
+        advance = live if moved else live & finite
         self._steps = steps
-        self._t = np.where(live, steps * k.control_period, self._t)
         self._delta_c = delta_c
-        self._state = np.where(advance[:, None], last, self._state)
+        self._state = last.copy() if moved else np.where(advance[:, None], last, self._state)
         if k.substeps > 1:
             dx = last[:, k.ix] - traj[:, -2, k.ix]
             dy = last[:, k.iy] - traj[:, -2, k.iy]
-            self._speed = np.where(advance, core.speed_over_ground(dx, dy, k, ARRAY), self._speed)
+            speed = core.speed_over_ground(dx, dy, k, ARRAY)
+            self._speed = speed if moved else np.where(advance, speed, self._speed)
         psi_m0, r_m0 = self._psi_m, self._r_m
-        psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
-        r_m = np.where(advance, last[:, k.ir], self._r_m)
-        xs, ys = self._state[:, k.ix].tolist(), self._state[:, k.iy].tolist()
+        if moved:
+            psi_m, r_m = last[:, k.ipsi].copy(), last[:, k.ir].copy()
+        else:
+            psi_m = np.where(advance, last[:, k.ipsi], self._psi_m)
+            r_m = np.where(advance, last[:, k.ir], self._r_m)
         samples: dict[int, dict[str, np.ndarray]] = {}
         if self.record_samples:  # every row's at once: views into fresh (N, n_sub) arrays
             start = np.concatenate((x_start[:, None], traj[:, :-1]), axis=1)
+            # at the substep starts, before the tracker moves on
+            e_s = tracks.cross_track_of(start[:, :, k.ix], start[:, :, k.iy])
             measured_psi, measured_r = traj[:, :, k.ipsi].copy(), traj[:, :, k.ir].copy()
             psi_s = np.concatenate((psi_m0[:, None], measured_psi[:, :-1]), axis=1)
             r_s = np.concatenate((r_m0[:, None], measured_r[:, :-1]), axis=1)
             t_s = t0[:, None] + self._sample_offsets
             delta_s = start[:, :, k.idelta]
             delta_c_s = np.repeat(delta_c[:, None], k.substeps, axis=1)
-        for i in np.flatnonzero(advance).tolist():
+        for i in (advance & self._noisy).nonzero()[0].tolist():
             tr = trials[i]
-            if not tr.sensor.ideal:
-                p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
-                psi_m[i], r_m[i] = p_i[-1], r_i[-1]
-                if self.record_samples:
-                    psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
-            if self.record_samples:  # at the substep starts, before the tracker moves on
+            p_i, r_i = tr.sensor.measure(traj[i, :, k.ipsi], traj[i, :, k.ir], tr.rng)
+            psi_m[i], r_m[i] = p_i[-1], r_i[-1]
+            if self.record_samples:
+                psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
+        if self.record_samples:
+            for i in advance.nonzero()[0].tolist():
                 samples[i] = {
                     "t": t_s[i],
                     "psi": psi_s[i],
                     "r": r_s[i],
                     "delta": delta_s[i],
                     "delta_c": delta_c_s[i],
-                    "e": tr.tracker.cross_track_of(start[i, :, k.ix], start[i, :, k.iy]),
+                    "e": e_s[i],
                 }
-            self._frames[i] = tr.tracker.update(xs[i], ys[i])
+        tracks.update(self._state[:, k.ix], self._state[:, k.iy], advance)
         self._psi_m, self._r_m = psi_m, r_m
-        frame = self._stacked_frames()
+        frame = tracks.frame
         heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
         reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
         kk = self._kk  # the constants with each row's own max_steps
         reward, goal, corridor, truncated = core.terminate(reward, frame, steps, kk, ARRAY)
+        if moved:
+            return Period(frame, heading_error, reward, goal, corridor, ~live, truncated, samples)
         diverged = live & ~finite
         reward = np.where(diverged, core.diverged_reward(steps, kk), reward)
         return Period(
@@ -309,18 +337,10 @@ class TrialRowsVectorEnv(VectorEnv):
             samples=samples,
         )
 
-    def _stacked_frames(self) -> TrackFrame:
-        """The rows' frames as one TrackFrame of arrays."""
-        table = np.array([_FRAME_ROW(f) for f in self._frames], dtype=float)
-        cols = table.T
-        return TrackFrame(
-            cols[0], cols[1], cols[2], cols[3].astype(np.int64), cols[4], cols[5], cols[6] > 0.5
-        )
-
     def _observation(self, frame: TrackFrame | None = None) -> np.ndarray:
         k = self._k0
         return core.batch_observation(
-            self._stacked_frames() if frame is None else frame,
+            self._tracks.frame if frame is None else frame,
             self._psi_m,
             self._r_m,
             self._state[:, k.idelta],

@@ -3,10 +3,18 @@ the full signal."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from shipgym_baselines.decimation import DRAWN_KEYS, m4_indices, thin_trajectory
-from shipgym_baselines.runs import light_trajectory
+from shipgym_baselines.decimation import (
+    DRAWN_KEYS,
+    m4_indices,
+    pack_trajectory,
+    thin_trajectory,
+    unpack_trajectory,
+)
+from shipgym_baselines.runs import light_trajectory, read_trajectory
 
 BUCKETS = 50
 
@@ -51,6 +59,26 @@ def test_a_kept_trajectory_holds_the_drawn_arrays_only_and_short_ones_whole() ->
     trajectory = {k: np.sin(t + i) for i, k in enumerate(DRAWN_KEYS)}
     trajectory |= {"t": t, "heading": t, "rudder_command": t}
     light = light_trajectory(trajectory)
-    assert tuple(light) == DRAWN_KEYS
-    assert all(light[k].dtype == np.float32 and light[k].size == t.size for k in light)
-    np.testing.assert_array_equal(light["x"], trajectory["x"].astype(np.float32))
+    assert set(light) == {"keys", "ranges", "codes"} and light["codes"].dtype == np.uint16
+    kept = unpack_trajectory(light)
+    assert tuple(kept) == DRAWN_KEYS and all(kept[k].size == t.size for k in kept)
+    for key in DRAWN_KEYS:  # within range / 131068 of the drawn value
+        span = np.ptp(trajectory[key])
+        assert np.max(np.abs(kept[key] - trajectory[key])) <= span / 131068 * (1 + 1e-9)
+
+
+def test_a_packed_trajectory_keeps_non_finite_values_constants_and_big_steps(
+    tmp_path: Path,
+) -> None:
+    """The codes' differences wrap mod 2^16 and come back; NaN and ±inf read back as NaN
+    where they were; a constant array is its value; the file reads back as written."""
+    x = np.array([0.0, 6000.0, -3.5, np.nan, 12.25, np.inf, 6000.0])
+    packed = pack_trajectory({"t": np.arange(7.0), "x": x, "c": np.full(7, 2.5)})
+    np.savez_compressed(tmp_path / "a.npz", **packed)
+    back = read_trajectory(tmp_path / "a.npz")
+    finite = np.isfinite(x)
+    assert np.array_equal(np.isnan(back["x"]), ~finite)
+    assert np.max(np.abs(back["x"][finite] - x[finite])) <= 6003.5 / 131068 * (1 + 1e-9)
+    assert back["x"][2] == -3.5  # the range's low end exactly
+    np.testing.assert_array_equal(back["c"], np.full(7, 2.5))
+    np.testing.assert_allclose(back["t"], np.arange(7.0), rtol=0, atol=6 / 131068)

@@ -4,6 +4,7 @@ give, bit for bit, what ``run_episode`` gives one seed at a time (compute times 
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from shipgym.envs.eval_trials import lockstep_problem
@@ -12,6 +13,7 @@ from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate_batch, run_episode
 from shipgym_baselines.leaderboard import Job, trials
+from shipgym_baselines.registry import make_controller
 from shipgym_baselines.suite import load_suite
 
 from .test_evaluation import _assert_same_episodes, _one_by_one
@@ -53,6 +55,39 @@ def test_lockstep_episodes_equal_run_episode(name: str, scenario: str) -> None:
     assert lockstep_problem(per_seed) is None  # so they run as one env's rows
     batched = evaluate_batch(name, per_seed, SEEDS)
     _assert_same_episodes(batched, _one_by_one(name, per_seed, SEEDS))
+
+
+# a PCHIP route with a parameter jump (the rows' path tracking and, for a batch policy, the
+# lean rows: no per-step info, the trajectory from the env's columns)
+CURVED = "mariner_maneuverability_change_curved"
+
+
+@pytest.mark.parametrize("name", ["pid_los", "ppo", "ppo_guidance"])
+def test_lockstep_episodes_on_a_curved_route_equal_run_episode(name: str) -> None:
+    if name.startswith("ppo"):
+        pytest.importorskip("stable_baselines3")
+    per_seed = _suite_trials(name, CURVED)
+    _assert_same_episodes(evaluate_batch(name, per_seed, SEEDS), _one_by_one(name, per_seed, SEEDS))
+
+
+@pytest.mark.parametrize("scenario", [CURVED, "heldout:6"])
+def test_lean_rows_give_the_full_info_results(scenario: str) -> None:
+    """A batch policy's lean rows (row_infos="end", trajectories from the env's columns)
+    give the EpisodeResults of full-info rows: metrics, ends and trajectories bit for bit."""
+    pytest.importorskip("stable_baselines3")
+    per_seed = _suite_trials("ppo", scenario)
+    results = {}
+    for lean in (True, False):
+        policy, mode = make_controller("ppo")
+        episodes = evaluation._VectorEpisodes(per_seed, SEEDS, mode or "rudder", lean=lean)
+        assert episodes.env.row_infos == ("end" if lean else "all")
+        results[lean] = evaluation._run_lockstep(policy, episodes)
+    _assert_same_episodes(results[True], results[False])
+    for a, b in zip(results[True], results[False], strict=True):
+        assert a.metrics["termination_reason"] == b.metrics["termination_reason"]
+        for key, values in a.trajectory.items():
+            assert values.dtype == b.trajectory[key].dtype == np.float64
+            assert np.array_equal(values, b.trajectory[key]), key
 
 
 def test_each_classical_episode_is_timed_on_its_own() -> None:

@@ -334,6 +334,27 @@ def test_two_phase_defaults_switch_time_and_ramp() -> None:
     np.testing.assert_allclose(v[[0, 10, 20, 30, 39]], [0.1, 0.1, 0.15, 0.2, 0.2], atol=1e-15)
 
 
+@pytest.mark.parametrize("ramp", [0.0, 20.0])
+def test_a_settled_block_is_the_same_every_period(ramp: float) -> None:
+    """``steady_from``: a deterministic two-phase current fills the same block (bit for bit)
+    at every period start from it on, as the batched envs assume when they skip refilling;
+    a block across the switch differs.  Noise or waves never settle."""
+    current = {"kind": "two_phase", "sigma": 0.0, "switch_time": 10.0, "transition_time": ramp}
+    h, n_sub = 0.25, 8  # Ts = 2 s
+    dist = Disturbances(DisturbanceConfig.model_validate({"current": current}), NAMES, h, n_sub)
+    start = dist.steady_from
+    assert start == (10.0 - 1e-9 if ramp == 0 else 10.0 + 2 * ramp)
+    blocks = []
+    first = math.ceil(start / 2.0) * 2.0
+    for t0 in [8.0, first, first + 2.0, first + 50.0]:  # the first one: across the switch
+        block = np.zeros((1, n_sub, 3))
+        dist.fill(block, np.array([t0]), None, np.zeros(1, dtype=np.intp))
+        blocks.append(block.tobytes())
+    assert blocks[0] != blocks[1] and blocks[1] == blocks[2] == blocks[3]
+    noisy = Disturbances(DisturbanceConfig.model_validate(STOCHASTIC), NAMES, h, n_sub)
+    assert noisy.steady_from == math.inf
+
+
 # ------------------------------------------------------------------ (e) reproducibility
 
 

@@ -66,7 +66,7 @@ def run_experiment(
         case = case_name(a0, c0)
         J: dict[str, float] = {}
         for cls in CONTROLLERS:
-            runs = seeded_episodes(partial(cls, a0, c0), scenario, seeds, progress)
+            runs = seeded_episodes(partial(cls, a0, c0, preset="paper"), scenario, seeds, progress)
             examples[(case, cls.name)] = runs[0]
             values = [result.metrics["J"] for result, _ in runs]
             J[cls.name] = float(np.mean(values))

@@ -258,3 +258,20 @@ def test_fast_riccati_solution_equals_scipy_and_solves_the_care() -> None:
         residual = A.T @ P + P @ A - P @ B @ B.T @ P / w.lambda_delta + w.Rx
         assert np.abs(residual).max() <= 1e-9 * np.abs(ref).max()
         assert np.all(np.linalg.eigvalsh(P) > 0)
+
+
+@pytest.mark.parametrize("scenario", ["esso_osaka_current_shift", "blanke_current_shift"])
+def test_drift_compensation_takes_the_crab_offset_out(scenario: str) -> None:
+    """issue 21: with the course error ψ + β − ψp in its state (β measured from the
+    positions, as the PID family and L1 compensate it), the paper's LQR holds a current's
+    crab angle without the cross-track offset it needs otherwise: the second half of the
+    episode is closer to the path."""
+    from shipgym_baselines.evaluation import run_episode
+
+    late = {}
+    for compensate in (False, True):
+        result = run_episode(LQR(preset="paper", drift_compensation=compensate), scenario, 10001)
+        e = result.trajectory["cross_track_error"]
+        assert result.metrics["termination_reason"] == "goal"
+        late[compensate] = float(np.mean(np.abs(e[e.size // 2 :])))
+    assert late[True] < 0.8 * late[False]

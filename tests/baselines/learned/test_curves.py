@@ -98,5 +98,5 @@ def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
     files = plot_learning_curves(figures, {"ppo": curves, "sac": []}, vector=True)
     assert {f.name for f in files} == {f"{LEARNING_CURVES_STEM}.png", f"{LEARNING_CURVES_STEM}.svg"}
     assert plot_learning_curves(figures, {"sac": []}) == []
-    ranking_html, scenario_html = figure_sections(files)
-    assert "learning curves" in ranking_html and scenario_html == ""
+    ranking_html, scenario_html, legend_names = figure_sections(files)
+    assert "learning curves" in ranking_html and scenario_html == "" and legend_names == []

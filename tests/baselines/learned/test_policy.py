@@ -379,3 +379,25 @@ def test_an_sb3_zip_is_named_by_its_file_stem(tmp_path: Path) -> None:
     assert policy_label(tmp_path / "work" / "ppo_ship.zip") == "ppo_ship"
     assert policy_label(tmp_path / "work" / "model.zip") == "work"
     assert policy_label(tmp_path / "agent" / "seed_1" / "best_model.zip") == "agent/seed_1"
+
+
+@pytest.mark.parametrize("name", ["ppo", "ppo_guidance", "sac", "td3", "recurrent_ppo"])
+def test_the_lean_forward_is_predict_bit_for_bit(name: str) -> None:
+    """The evaluation's forward without ``predict``'s per-call overhead (issue 18: the
+    default run's CPU) gives ``predict``'s deterministic actions exactly; a recurrent
+    policy keeps ``predict``."""
+    import torch
+
+    from shipgym_baselines.learned.policy import BATCH_ROWS, LearnedPolicy, lean_forward
+
+    torch.set_num_threads(1)
+    policy = LearnedPolicy(name)
+    lean = lean_forward(policy.model.policy)
+    if name == "recurrent_ppo":
+        assert lean is None
+        return
+    rng = np.random.default_rng(7)
+    obs = rng.uniform(-1.2, 1.2, (BATCH_ROWS, *policy.model.observation_space.shape))
+    obs = obs.astype(np.float32)
+    expected, _ = policy.model.predict(obs, deterministic=True)
+    np.testing.assert_array_equal(lean(obs), expected)

@@ -184,6 +184,30 @@ def test_chosen_settings_reach_the_default_construction(
         assert (l1.settings.K1, l1.settings.K2) == (0.05, 30.0)
         assert (l1_paper.settings.K1, l1_paper.settings.K2) == (0.02, 15.0)
         assert (l1_given.settings.K1, l1_given.settings.K2) == (0.01, 30.0)
+        from shipgym_baselines.classical.lqr import (
+            LQR,
+            PAPER_LAMBDA_DELTA,
+            PAPER_LAMBDA_PSI,
+            AdaptiveLQR,
+            length_scaled_lambda_y,
+        )
+
+        weights = {"lambda_y": 0.3, "lambda_psi": 4.0, "lambda_delta": 2.0}
+        chosen.write_chosen("lqr", "nomoto2", weights, {}, tmp_path)
+        chosen._packaged.cache_clear()
+        lqr, lqr_paper, lqr_given, adaptive = (
+            LQR(),
+            LQR(preset="paper"),
+            LQR(lambda_psi=9.0),
+            AdaptiveLQR(),  # its own study's section (none): the paper's weights
+        )
+        for policy in (lqr, lqr_paper, lqr_given, adaptive):
+            policy.reset(ctx)
+        paper = (length_scaled_lambda_y(ctx.ship_length), PAPER_LAMBDA_PSI, PAPER_LAMBDA_DELTA)
+        as_tuple = lambda w: (w.lambda_y, w.lambda_psi, w.lambda_delta)  # noqa: E731
+        assert as_tuple(lqr.weights) == (0.3, 4.0, 2.0)
+        assert as_tuple(lqr_paper.weights) == paper == as_tuple(adaptive.weights)
+        assert as_tuple(lqr_given.weights) == (0.3, 9.0, 2.0)
     finally:
         chosen._packaged.cache_clear()
 
@@ -200,6 +224,16 @@ def test_bad_tuning_configs_name_the_key(tmp_path: Path) -> None:
                 "params": TINY["params"] | {"los_radius_L": {"low": 1.0, "high": 2.0}},
             },
             "tuned",
+        ),
+        (  # a learned default that would train in another env than the trials
+            {
+                "kind": "learned",
+                "per_ship": False,
+                "training": {"agent": "ppo", "n_timesteps": 256},
+                "fixed": {"env.n_envs": 64, "hyperparams.n_steps": 32},
+                "default": {"env.n_envs": 64},
+            },
+            r"default: .*\['hyperparams.n_steps'\]",
         ),
     ]:
         file = tmp_path / "bad.yaml"
@@ -249,6 +283,14 @@ def test_a_learned_study_trains_scores_and_prunes_through_the_same_command(
     assert report["validation"]["trials"] == ["validation:0"]
     assert report["best_value"] == pytest.approx(trial["value"])
     assert report["chosen"]["section"] == "all"
+    # the winner's settings as it was scored: the best trial under the fixed settings, or
+    # the default (which trains as every trial does)
+    winner = (
+        config["default"]
+        if report["chosen"]["kept_default"]
+        else {**config["fixed"], **report["best_params"]}
+    )
+    assert report["chosen"]["settings"] == winner
 
 
 def test_every_packaged_tuning_config_loads() -> None:

@@ -8,15 +8,22 @@ from typing import Any
 import numpy as np
 import pytest
 
-from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, LockstepError, lockstep_problem
+from shipgym.envs import row_tracking
+from shipgym.envs.eval_trials import (
+    EvaluationTrialsVectorEnv,
+    LockstepError,
+    RowInfosError,
+    lockstep_problem,
+)
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.scenarios import Scenario, load_scenario
 
 SEEDS = [10_000, 10_001, 10_002]
 
 
-def _variants(name: str) -> list[Scenario]:
-    """Three trials of ``name``: the start moved, the time limits apart (rows end apart)."""
+def _variants(name: str, extra: dict | None = None) -> list[Scenario]:
+    """Three trials of ``name``: the start moved, the time limits apart (rows end apart);
+    ``extra``: overrides of every trial (e.g. noisy sensors)."""
     base = load_scenario(name)
     start, limit = base.config.initial_state, base.config.time_limit
     return [
@@ -24,10 +31,22 @@ def _variants(name: str) -> list[Scenario]:
             {
                 "initial_state": {"y": start.y + 3.0 * i, "heading_deg": 4.0 * i},
                 "time_limit": limit * (1.0 - 0.2 * i),
+                **(extra or {}),
             }
         )
         for i in range(len(SEEDS))
     ]
+
+
+#: noisy heading and yaw-rate sensors with outliers and dropouts
+NOISY = {
+    "sensors": {
+        "heading_noise_deg": 0.5,
+        "yaw_rate_noise_deg_s": 0.05,
+        "outlier_probability": 0.01,
+        "dropout_probability": 0.02,
+    }
+}
 
 
 def _assert_same(a: Any, b: Any, where: str) -> None:
@@ -41,7 +60,7 @@ def _assert_same(a: Any, b: Any, where: str) -> None:
     elif isinstance(a, float) and np.isnan(a):
         assert isinstance(b, float) and np.isnan(b), where
     else:
-        assert a == b, (where, a, b)
+        assert type(a) is type(b) and a == b, (where, a, b)
 
 
 # heldout:8: nomoto2 with a parameter jump, a constant current and noisy heading sensors;
@@ -49,10 +68,61 @@ def _assert_same(a: Any, b: Any, where: str) -> None:
 @pytest.mark.parametrize("name", ["heldout:8", "heldout:6"])
 @pytest.mark.parametrize("mode", ["rudder", "guidance"])
 def test_each_row_is_the_single_env_episode_of_its_trial(name: str, mode: str) -> None:
-    trials = _variants(name)
+    _assert_rows_are_single_episodes(_variants(name), mode)
+
+
+@pytest.fixture(params=["batched", "per_row", "to_scalar"])
+def batching(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """Every route group on one batched tracker, or on one scalar tracker per row, or on a
+    batched tracker until fewer than 2 of its rows advance (then scalar trackers)."""
+    least = {"batched": 1, "per_row": 10**6, "to_scalar": 2}[request.param]
+    monkeypatch.setattr(row_tracking, "MIN_BATCHED_ROWS", {"polyline": least, "curve": least})
+    return request.param
+
+
+# a PCHIP curve with a parameter jump (Mariner), a polyline with a parameter jump (nomoto2)
+# and a curve with a current shift (Blanke), with noisy sensors; the route groups batched
+# and per row
+@pytest.mark.parametrize(
+    ("name", "mode"),
+    [
+        ("mariner_maneuverability_change_curved", "rudder"),
+        ("mariner_maneuverability_change_curved", "guidance"),
+        ("rudder_aging", "rudder"),
+        ("blanke_current_shift_curved", "rudder"),  # a current shift: settled blocks kept
+    ],
+)
+def test_rows_of_a_route_tracked_together_are_the_single_env_episodes(
+    name: str, mode: str, batching: str
+) -> None:
+    trials = _variants(name, NOISY)
+    env = _assert_rows_are_single_episodes(trials, mode, batched=batching != "per_row")
+    if batching == "to_scalar":  # the last row went on alone, on a scalar tracker
+        assert env._tracks.batched_rows == 0
+
+
+@pytest.mark.parametrize("mode", ["rudder", "guidance"])
+def test_rows_of_two_routes_are_the_single_env_episodes(mode: str, batching: str) -> None:
+    """Two route groups in one env: the curve's trials and a polyline through the same
+    waypoints (rows interleaved)."""
+    curve = _variants("rudder_aging_smooth", NOISY)
+    polyline = [t.with_overrides({"path": {"type": "waypoints"}}) for t in curve]
+    trials = [curve[0], polyline[1], curve[2]]
+    env = _assert_rows_are_single_episodes(trials, mode, batched=None, ends_apart=False)
+    assert len(env._tracks.groups) == 2
+
+
+def _assert_rows_are_single_episodes(
+    trials: list[Scenario], mode: str, batched: bool | None = None, ends_apart: bool = True
+) -> EvaluationTrialsVectorEnv:
+    """Step the trials as rows and as single envs with the same small random actions:
+    observations, rewards, ends and every info key equal, bit for bit (and the infos'
+    values of the same Python types); ``ends_apart``: the rows end at different steps."""
     env = EvaluationTrialsVectorEnv(trials, SEEDS, action_mode=mode)
     singles = [ShipPathFollowEnv(t, action_mode=mode) for t in trials]
     obs, info = env.reset()
+    if batched is not None:
+        assert env._tracks.batched_rows == (len(SEEDS) if batched else 0)
     for i, single in enumerate(singles):
         o, inf = single.reset(seed=SEEDS[i])
         np.testing.assert_array_equal(obs[i], o)
@@ -78,7 +148,8 @@ def test_each_row_is_the_single_env_episode_of_its_trial(name: str, mode: str) -
             if te or tr:
                 assert "episode_metrics" in info["rows"][i]
                 ends[i] = step
-    assert len(set(ends)) == len(SEEDS)  # the rows ended at different steps
+    assert len(set(ends)) == len(SEEDS) or not ends_apart  # the rows ended apart
+    return env
 
 
 def test_rows_of_different_ships_or_step_constants_are_refused() -> None:
@@ -115,3 +186,56 @@ def test_rows_without_samples_step_the_same() -> None:
                 continue
             assert "samples" in row_a and "samples" not in row_b
             _assert_same({k: v for k, v in row_a.items() if k != "samples"}, row_b, "info")
+
+
+def test_row_infos_end_gives_the_last_info_and_the_trajectory() -> None:
+    """``row_infos="end"``: the same observations, rewards and ends; a row's info only at
+    its last step (the full env's, bit for bit); its trajectory (the infos' values at the
+    reset and every step) from the env's columns."""
+    trials = _variants("mariner_maneuverability_change_curved", NOISY)
+    full = EvaluationTrialsVectorEnv(trials, SEEDS, samples=False)
+    lean = EvaluationTrialsVectorEnv(trials, SEEDS, samples=False, row_infos="end")
+    obs_a, info_a = full.reset()
+    obs_b, info_b = lean.reset()
+    np.testing.assert_array_equal(obs_a, obs_b)
+    assert info_b["rows"] == [None] * len(SEEDS)
+    rows = [[info] for info in info_a["rows"]]
+    rng = np.random.default_rng(5)
+    while not full.finished.all():
+        action = 0.15 * rng.standard_normal(full.action_space.shape)
+        *out_a, info_a = full.step(action)
+        *out_b, info_b = lean.step(action)
+        for a, b in zip(out_a, out_b, strict=True):
+            np.testing.assert_array_equal(a, b)
+        for i, (row_a, row_b) in enumerate(zip(info_a["rows"], info_b["rows"], strict=True)):
+            if row_a is None:
+                continue
+            rows[i].append(row_a)
+            if "termination_reason" in row_a:
+                _assert_same(row_b, row_a, f"last info of row {i}")
+            else:
+                assert row_b is None
+    assert lean.finished.all()
+    for i, infos in enumerate(rows):
+        trajectory = lean.trajectory(i)
+        expected = {
+            "t": [r["t"] for r in infos],
+            "x": [r["position"][0] for r in infos],
+            "y": [r["position"][1] for r in infos],
+            "cross_track_error": [r["cross_track_error"] for r in infos],
+            "heading": [r["heading"] for r in infos],
+            "rudder_angle": [r["rudder_angle"] for r in infos],
+            "rudder_command": [r["rudder_command"] for r in infos],
+        }
+        assert list(trajectory) == list(expected)
+        for key, values in expected.items():
+            assert trajectory[key].dtype == np.float64
+            assert trajectory[key].tobytes() == np.array(values).tobytes(), (i, key)
+
+
+def test_bad_row_infos_are_refused() -> None:
+    trials = _variants("rudder_aging")
+    with pytest.raises(RowInfosError, match="row_infos must be one of"):
+        EvaluationTrialsVectorEnv(trials, SEEDS, samples=False, row_infos="last")
+    with pytest.raises(RowInfosError, match="no samples"):
+        EvaluationTrialsVectorEnv(trials, SEEDS, row_infos="end")
