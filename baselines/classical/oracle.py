@@ -25,6 +25,19 @@ smoothed over ``switch_width_L``·L and set 2 widths inside its edge), so that a
 permanent, as in the env; a PCHIP route enters as its chords ahead of the closest point.
 The goal bonus is not in the objective (it is not in the cost either).
 
+**Tail (cost-to-go).**  To that sum the oracle adds one term, the env's |e|/L + w_ψ|ψ̃| at
+the horizon's end held for the control steps still to go after it:
+N_tail = max(0, S/(U·Ts) − N_H), S the path left to the goal from the ship's present
+point on the route [m] (the rest of the active leg and the legs after it, or the arc
+length left on a PCHIP route), U the cruise speed, N_H the horizon's steps.  Reason
+(measured, revision 1 missed the goal on 58 of 472 reference trials): the env's cost has
+no price on time, so a ship that turns the wrong way onto a leg and runs along it with
+e = 0, |ψ̃| = π pays only w_ψ·π ≈ 0.31 a step, which within one horizon is cheaper than the
+overshoot of the right turn; it never reaches the goal and pays that until the time
+limit.  Held over the rest of the route, a heading error that does not decay outweighs
+any transient, while a settled state (e, ψ̃ ≈ 0) costs next to nothing either way.  A
+one-horizon terminal weight was measured not to be enough.
+
 **Horizon rule.**  H = 2(T + (L + R0)/U) + δmax/δ̇max: two of the ship's yaw time constants T
 (its first-order Nomoto T of the nominal model, the one the classical controllers use) to
 settle a turn; twice the time to cross one ship length plus the acceptance radius R0 of a
@@ -36,11 +49,29 @@ nomoto2 10.0 s (21 steps of 0.5 s), Esso Osaka (1:100) 32 s on its curved route,
 268 s on its waypoint route, Blanke 51 s.
 
 **Decisions and grid.**  Move blocking: the first command acts for one control period Ts
-(the one applied); the horizon's rest is split into ``blocks`` equal intervals of m·Ts
-(m = ⌈(H/Ts − 1)/blocks⌉), one command each.  The stage cost is evaluated at every control
-step end, as the env does.  Prediction step h_p = Ts/n with n the smallest integer such that
-h_p·|λ_max| ≤ 2 (λ_max the fastest eigenvalue of the nominal model linearised at cruise;
-RK4 is stable to 2.79 on the negative real axis), never finer than the env's own h.
+(the one applied); the P = ⌈H/Ts − 1⌉ control periods after it are split into ``blocks``
+= B intervals, one command each, that grow geometrically (revision 3): ⌊min(r^j, T/Ts)⌋
+periods, j = 0 … B − 1, the first one period long and none longer than the ship's yaw time
+constant T (at least ⌈(P − 1)/(B − 1)⌉), r ≥ 1 chosen so that they fill P (the periods lost to the
+rounding go one each to the last intervals).  Reason: the plan is applied one period at a
+time and re-planned, so the near commands decide what the ship does (the rudder's rate
+limit and the turn's onset act within seconds), while far ahead only where the ship
+settles matters, and a command interval longer than T no longer resolves a turn.
+Catalogue grids (command intervals in periods): nomoto2 21 × 1 (P ≤ B: unchanged); the
+Mariner on ``mariner_track`` (Ts = 1 s, T = 44 s, P = 267) 1, 1, 1, 1, 1, 2, 2, 3, 4,
+5, 6, 8, 9, 13, 16, 19, 24, 29, 35, 44, 44 (revision 2: 1 then 20 × 14); Blanke (Ts =
+0.2 s, T = 2.9 s, P = 256) 1, 1, 1, 3, 13, fifteen 14, 15 (revision 2: 1 then 20 × 13); Esso
+Osaka on a waypoint route (Ts = 0.5 s, T = 7.4 s, P = 127) 1 × 6, 2, 2, 3, 3, … 14, 15,
+15, 15.  Measured (quick suite's Mariner trials and ``mariner_track``'s smoke seeds,
+scenario means): revision 2's equal intervals of 12–14 s cost 330, 193, 163 and 1180 on
+``mariner_rudder_aging``, ``_current_shift``, ``_maneuverability_change`` and
+``mariner_track``; the geometric ones 193, 108, 121 and 578, all below the tuned
+``pid_los`` (368, 193, 177, 734), at the same solve time; uncapped (the last interval 3.4 T
+on Blanke) ``blanke_rudder_aging`` cost 244 against 179 before, capped 161.  The stage
+cost is evaluated at every control step end, as the env does.  Prediction step h_p = Ts/n
+with n the smallest integer such that h_p·|λ_max| ≤ 2 (λ_max the fastest eigenvalue of the
+nominal model linearised at cruise; RK4 is stable to 2.79 on the negative real axis), never
+finer than the env's own h.
 
 **Solver.**  Generalised Gauss–Newton SQP (Messerer, Baumgärtner & Diehl 2021): the cost
 is Σ φ_i(z_i(u)) with convex outer φ (smooth |·| or square) of a smooth inner z; each
@@ -49,7 +80,23 @@ the squares and the curvature 1/√(z² + ε²) of the quadratic majoriser for t
 (iteratively reweighted least squares: φ'' itself vanishes away from 0), then a
 backtracking line search on the cost; stopped when an iteration gains less than
 ``cost_tolerance`` (relative) or moves less than ``step_tolerance``; warm-started from the
-shifted previous plan.  z and J = ∂z/∂u come from one CasADi function compiled to C
+previous plan shifted by one control period (:func:`shifted_plan`; revisions 1–2 shifted it
+by one interval but kept the first command, one period off on nomoto2's one-period
+intervals: on the agile, yaw-unstable nomoto2 after its manoeuvrability jump that start
+sent the SQP to a spin, 17 of the first 20 default ``maneuverability_change`` /
+``_long`` trials lost to the time limit, all 20 reached with the true shift).
+**Multiple starts**: the objective is not convex in the turn's direction (left and right
+round a corner, or a U-turn back onto the path, are separate basins the local SQP does
+not leave), so when the warm start's plan ends the horizon heading backwards along the
+path (|ψ̃_N| > ``reverse_heading`` = π/2) the step also solves from the cheaper (by the
+objective) of two hard-turn starts, full rudder to either side
+over the whole horizon (``turn_fraction``), and keeps the plan of lower objective.
+Measured: with the tail alone 9 of the 16 lost nomoto2 path-1 trials (nominal,
+rudder_aging, current_shift) were still lost, by turns the warm start could not undo;
+half-horizon turn starts could not reach a U-turn within nomoto2's 10 s horizon; turn
+starts at every step (not only when the plan ends backwards) lost 7 maneuverability_change
+trials (spins of the agile ship after its jump) and esso_osaka_nominal seed 10000, at
+twice the solve time.  z and J = ∂z/∂u come from one CasADi function compiled to C
 (cached, :mod:`shipgym.codegen`): the horizon is a ``mapaccum`` loop, and J is carried as
 forward sensitivities S = ∂x/∂u (S⁺ = A·S + B·e_jᵀ, A and B of one period in closed form),
 so the generated code stays small for horizons of hundreds of steps.
@@ -77,7 +124,7 @@ from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
-ORACLE_REVISION = 1
+ORACLE_REVISION = 3
 
 
 @dataclasses.dataclass(frozen=True)
@@ -86,9 +133,12 @@ class OracleSettings:
 
     horizon_factor: float = 2.0  # k in H = k(T + (L + R0)/U) + δmax/δ̇max
     blocks: int = 20  # command intervals after the first (move blocking)
+    geometric_blocks: bool = True  # intervals growing geometrically from one period (rev. 3)
     legs: int = 4  # path segments ahead in the prediction
     smooth_abs: float = 1e-3  # ε of √(z² + ε²) on e/L and ψ̃ [rad]
     switch_width_L: float = 0.1  # width of the smooth leg switch [L]
+    turn_fraction: float = 1.0  # share of the intervals at full rudder in a hard-turn start
+    reverse_heading: float = math.pi / 2  # rad: |ψ̃| at the horizon's end that calls the turns
     max_iter: int = 10  # generalised Gauss–Newton iterations per control step
     step_tolerance: float = 1e-4  # rad: stop when the accepted step is smaller
     cost_tolerance: float = 1e-3  # stop when an iteration lowers the cost by less (relative)
@@ -100,19 +150,63 @@ class OracleGrid:
     """The time grid of one ship's prediction (module doc), all in control periods Ts."""
 
     horizon_s: float  # H [s]
-    block: int  # m: control periods per interval after the first
-    blocks: int  # intervals after the first
+    lengths: tuple[int, ...]  # control periods of each command interval (the first: 1)
     substeps: int  # RK4 steps per control period (h_p = Ts / substeps)
 
     @property
     def steps(self) -> int:
         """Control steps in the horizon."""
-        return 1 + self.block * self.blocks
+        return sum(self.lengths)
 
     @property
-    def lengths(self) -> list[int]:
-        """Control periods of each command interval."""
-        return [1] + [self.block] * self.blocks
+    def blocks(self) -> int:
+        """Command intervals after the first."""
+        return len(self.lengths) - 1
+
+
+def _geometric_sum(r: float, blocks: int, cap: float) -> float:
+    return sum(min(r**j, cap) for j in range(blocks))
+
+
+def growth_ratio(periods: int, blocks: int, cap: float = math.inf) -> float:
+    """r ≥ 1 with Σ_{j<blocks} min(r^j, cap) = ``periods`` (bisection): the ratio of the
+    geometric intervals, the first one period long and none longer than ``cap`` periods,
+    that fill ``periods`` control periods with ``blocks`` intervals; 1 when ``periods`` ≤
+    ``blocks``.  Needs 1 + cap·(blocks − 1) ≥ periods (the sum's limit as r grows)."""
+    if periods <= blocks:
+        return 1.0
+    if 1.0 + cap * (blocks - 1) < periods:
+        raise ValueError(f"{blocks} intervals of at most {cap} periods cannot fill {periods}")
+    lo, hi = 1.0, 2.0
+    while _geometric_sum(hi, blocks, cap) < periods:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _geometric_sum(mid, blocks, cap) < periods else (lo, mid)
+    return hi
+
+
+def block_lengths(
+    periods: int, blocks: int, longest: float = math.inf, geometric: bool = True
+) -> tuple[int, ...]:
+    """Control periods of the command intervals of a horizon of ``periods`` + 1 steps: the
+    applied command (1), then ``blocks`` intervals (module doc, "Decisions and grid").
+    ``geometric``: the intervals ⌊min(r^j, cap)⌋, j = 0 … blocks − 1, with the cap
+    max(⌊``longest``⌋, ⌈(periods − 1)/(blocks − 1)⌉) and r from :func:`growth_ratio`, the
+    periods lost to the rounding added one each to the last intervals (one period first,
+    non-decreasing, the total exactly ``periods``); otherwise ``blocks`` equal intervals of
+    ⌈periods/blocks⌉ (revisions 1–2).  ``periods`` ≤ ``blocks``: ``blocks`` intervals of one
+    period."""
+    if periods <= blocks:
+        return (1,) * (1 + blocks)
+    if not geometric:
+        return (1,) + (math.ceil(periods / blocks),) * blocks
+    # at least the cap that one period and blocks − 1 capped intervals need to fill P
+    cap = max(float(math.floor(longest)), float(math.ceil((periods - 1) / (blocks - 1))))
+    r = growth_ratio(periods, blocks, cap)
+    lengths = [math.floor(min(r**j, cap) + 1e-9) for j in range(blocks)]
+    short = periods - sum(lengths)  # < blocks: one more period to each of the last ones
+    return (1, *(n + (j >= blocks - short) for j, n in enumerate(lengths)))
 
 
 def horizon_seconds(
@@ -158,9 +252,10 @@ def oracle_grid(context: ControllerContext, settings: OracleSettings) -> OracleG
         settings.horizon_factor,
     )
     ts = context.control_period
-    block = max(1, math.ceil((h / ts - 1.0) / settings.blocks))
+    periods = max(1, math.ceil(h / ts - 1.0 - 1e-9))  # control periods after the first
+    lengths = block_lengths(periods, settings.blocks, time_constant / ts, settings.geometric_blocks)
     substeps = prediction_substeps(model, ts, context.fine_step)
-    return OracleGrid(horizon_s=h, block=block, blocks=settings.blocks, substeps=substeps)
+    return OracleGrid(horizon_s=h, lengths=lengths, substeps=substeps)
 
 
 def _smooth_step(z: Any) -> Any:
@@ -340,10 +435,13 @@ class OracleSolver:
             ]
         )
         self.is_abs = np.concatenate([np.ones(2 * steps, bool), np.zeros(2 * n_u, bool)])
+        self._base_weight = self.weight.copy()
+        self._terminal = np.array([steps - 1, 2 * steps - 1])  # e/L and ψ̃ at the horizon's end
         self.n_z, self.n_u, self.n_p = z.shape[0], n_u, n_p
+        key = (control_period, rudder_limit, weights, length, s.switch_width_L, grid.lengths)
         tag = (
-            f"{model.name}_b{grid.blocks}x{grid.block}_s{grid.substeps}_l{n_legs}"
-            f"_{abs(hash((control_period, rudder_limit, weights, length, s))) % 10**8}"
+            f"{model.name}_b{grid.blocks}x{grid.steps}_s{grid.substeps}_l{n_legs}"
+            f"_{abs(hash(key)) % 10**8}"
         )
         value = ca.Function(f"oracle_z_{tag}", [u, p], [z])
         both = ca.Function(f"oracle_zj_{tag}", [u, p], [z_s, ca.densify(jac)])
@@ -381,9 +479,20 @@ class OracleSolver:
         self._value[1]()
         return self._outer(self._z)[0]
 
-    def solve(self, p: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, bool, int]:
-        """Plan (one command per interval, rad), success flag, iterations."""
+    def set_tail(self, steps: float) -> None:
+        """Weigh the terminal |e|/L and w_ψ|ψ̃| stage terms ``steps`` [control periods] more:
+        the tail, the stage cost at the horizon's end held for the steps still to go
+        (module doc)."""
+        self.weight = self._base_weight.copy()
+        self.weight[self._terminal] *= 1.0 + max(0.0, float(steps))
+
+    def solve(
+        self, p: np.ndarray, guess: np.ndarray, tail: float = 0.0
+    ) -> tuple[np.ndarray, bool, int]:
+        """Plan (one command per interval, rad), success flag, iterations; ``tail``: the
+        steps the terminal stage cost is held for (:meth:`set_tail`)."""
         self._p[:] = p
+        self.set_tail(tail)
 
         def direction(u: np.ndarray) -> np.ndarray | None:
             self._u[:] = u
@@ -405,6 +514,31 @@ class OracleSolver:
             s.step_tolerance,
             s.cost_tolerance,
         )
+
+    def turn_guesses(self) -> list[np.ndarray]:
+        """The two hard-turn starts: full rudder to one side over the first
+        ``turn_fraction`` of the horizon's intervals, midships after [rad]."""
+        half = np.arange(self.n_u) < max(1, round(self.settings.turn_fraction * self.n_u))
+        return [np.where(half, sign * self.rudder_limit, 0.0) for sign in (1.0, -1.0)]
+
+    def solve_multistart(
+        self, p: np.ndarray, guess: np.ndarray, tail: float = 0.0
+    ) -> tuple[np.ndarray, bool, int]:
+        """:meth:`solve` from ``guess`` (the warm start); if its plan ends the horizon
+        heading backwards along the path (|ψ̃_N| > ``reverse_heading``), also from the
+        cheaper of the two hard-turn starts (:meth:`turn_guesses`), keeping the plan of
+        lower objective."""
+        plan, ok, total = self.solve(p, guess, tail)
+        if ok:
+            self.cost(plan, p)
+            if abs(self._z[self._terminal[1]]) <= self.settings.reverse_heading:
+                return plan, ok, total
+        turn = min(self.turn_guesses(), key=lambda u: self.cost(u, p))
+        other, other_ok, iterations = self.solve(p, turn, tail)
+        total += iterations
+        if other_ok and (not ok or self.cost(other, p) < self.cost(plan, p)):
+            return other, True, total
+        return plan, ok, total
 
     def parameters(
         self,
@@ -500,6 +634,37 @@ def legs_ahead(
     return np.array(rows), context.acceptance_radius
 
 
+def remaining_path(context: ControllerContext, tracker: Any, frame: Any) -> float:
+    """The path still to go to the goal [m] from the tracker's point: the rest of the active
+    leg and the legs after it, or the arc length left on a PCHIP route."""
+    if tracker.is_curve:
+        return max(0.0, float(tracker.path.length) - float(frame.along_track))
+    wp = np.asarray(context.waypoints, dtype=float)
+    lengths = np.hypot(*np.diff(wp, axis=0).T)
+    leg = int(frame.leg)
+    return max(0.0, float(lengths[leg]) - float(frame.along_track)) + float(
+        lengths[leg + 1 :].sum()
+    )
+
+
+def tail_steps(
+    remaining_m: float, speed: float, control_period: float, horizon_steps: int
+) -> float:
+    """The control steps still to go after the horizon [-]: the time to cover the remaining
+    path [m] at cruise speed U [m/s], less the horizon's steps, at least 0."""
+    return max(0.0, remaining_m / (speed * control_period) - horizon_steps)
+
+
+def shifted_plan(plan: np.ndarray, lengths: tuple[int, ...]) -> np.ndarray:
+    """The warm start: ``plan`` [rad, one command per interval of ``lengths`` control
+    periods] one control period later, its last command held, each interval given the mean
+    of the shifted commands it covers (exact for intervals of one period)."""
+    per_step = np.repeat(plan, lengths)
+    shifted = np.append(per_step[1:], per_step[-1])
+    edges = np.cumsum((0, *lengths))
+    return np.add.reduceat(shifted, edges[:-1]) / np.asarray(lengths, dtype=float)
+
+
 @register_controller("oracle")
 class Oracle:
     """``oracle``: NMPC on the true plant through the privileged channel (module doc)."""
@@ -559,9 +724,15 @@ class Oracle:
             truth.params.to_vector(),
             truth.disturbance_forecast(mids),
         )
-        guess = np.concatenate([[self.plan[1]], self.plan[1:]])  # shifted by one period
+        guess = shifted_plan(self.plan, grid.lengths)
         start, cpu = time.perf_counter(), time.thread_time()
-        plan, ok, _ = self.solver.solve(p, guess)
+        tail = tail_steps(
+            remaining_path(ctx, self.tracker, frame),
+            ctx.nominal_speed,
+            ctx.control_period,
+            grid.steps,
+        )
+        plan, ok, _ = self.solver.solve_multistart(p, guess, tail)
         self.solve_times.append(time.perf_counter() - start)
         self.solve_cpu_times.append(time.thread_time() - cpu)  # not inflated by a busy machine
         if ok:

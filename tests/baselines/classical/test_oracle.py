@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import sys
 from pathlib import Path
@@ -19,8 +20,13 @@ from shipgym_baselines.classical.oracle import (
     Oracle,
     OracleSettings,
     OracleSolver,
+    block_lengths,
+    growth_ratio,
     horizon_seconds,
     oracle_grid,
+    remaining_path,
+    shifted_plan,
+    tail_steps,
 )
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import evaluate, run_episode
@@ -109,6 +115,130 @@ def test_the_horizon_rule_by_ship() -> None:
         ctx = ControllerContext.of(load_scenario(name), "rudder")
         grid = oracle_grid(ctx, OracleSettings())
         assert grid.steps * ctx.control_period >= grid.horizon_s - 1e-9
+
+
+# ------------------------------------------------------------------ the move blocking
+@pytest.mark.parametrize(
+    ("periods", "blocks", "longest"),
+    [
+        (267, 20, 43.8),
+        (228, 20, 43.8),
+        (256, 20, 14.3),
+        (127, 20, 14.7),
+        (64, 20, 14.7),
+        (300, 20, 2.0),  # T short against the horizon: the cap is what filling P needs
+    ],
+)
+def test_the_intervals_grow_geometrically_from_one_period_to_at_most_t(
+    periods: int, blocks: int, longest: float
+) -> None:
+    """Revision 3's rule: the applied command, then ``blocks`` intervals that start at one
+    period, never shrink, end at most one period over T/Ts (or over the cap that filling
+    the horizon needs), and sum to the horizon's periods exactly."""
+    lengths = block_lengths(periods, blocks, longest)
+    assert len(lengths) == 1 + blocks and sum(lengths) == 1 + periods
+    assert lengths[:2] == (1, 1)
+    assert all(a <= b for a, b in itertools.pairwise(lengths))
+    assert max(lengths) <= max(math.floor(longest), math.ceil((periods - 1) / (blocks - 1))) + 1
+    even = block_lengths(periods, blocks, longest, geometric=False)  # revision 2
+    assert even == (1,) + (math.ceil(periods / blocks),) * blocks
+
+
+def test_the_growth_ratio_fills_the_horizon() -> None:
+    """Uncapped, 1 + r + … + r^(B−1) = (r^B − 1)/(r − 1) = P; P ≤ B: one-period intervals;
+    a cap too low to fill P is an error."""
+    r = growth_ratio(267, 20)
+    assert (r**20 - 1.0) / (r - 1.0) == pytest.approx(267.0, rel=1e-9)
+    assert growth_ratio(20, 20) == 1.0
+    assert block_lengths(20, 20, 3.0) == (1,) * 21
+    with pytest.raises(ValueError, match="cannot fill"):
+        growth_ratio(100, 4, 10.0)
+
+
+def test_the_catalogue_grids() -> None:
+    """nomoto2 keeps one-period intervals; the Mariner's first four intervals after the
+    applied command are one period (1 s: revision 2 had 14 s) and its last is T (44 s)."""
+    nominal = oracle_grid(
+        ControllerContext.of(load_scenario("nominal"), "rudder"), OracleSettings()
+    )
+    assert nominal.lengths == (1,) * 21
+    mariner = oracle_grid(
+        ControllerContext.of(load_scenario("mariner_track"), "rudder"), OracleSettings()
+    )
+    assert mariner.lengths[:5] == (1,) * 5 and mariner.lengths[-1] == 44
+    assert mariner.steps - 1 == math.ceil(mariner.horizon_s - 1.0)
+
+
+def test_the_warm_start_is_the_plan_one_period_later() -> None:
+    """One-period intervals: the plan shifted by one, the last command held (revisions 1–2
+    kept the first command: one period off); longer intervals: the mean of the shifted
+    commands they cover."""
+    plan = np.array([0.1, 0.2, 0.3, 0.4])
+    assert shifted_plan(plan, (1, 1, 1, 1)) == pytest.approx([0.2, 0.3, 0.4, 0.4])
+    assert shifted_plan(plan, (1, 1, 2, 4)) == pytest.approx([0.2, 0.3, 0.35, 0.4])
+
+
+# ------------------------------------------------------------------ the tail and the turns
+def test_the_tail_counts_the_steps_still_to_go_after_the_horizon() -> None:
+    """N_tail = max(0, S/(U·Ts) − N_H); S the rest of the active leg and the legs after it."""
+    assert tail_steps(40.0, 0.8, 0.5, 21) == pytest.approx(100.0 - 21.0)
+    assert tail_steps(4.0, 0.8, 0.5, 21) == 0.0
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    tracker = ctx.new_tracker()
+    wp = np.asarray(ctx.waypoints, dtype=float)
+    total = float(np.hypot(*np.diff(wp, axis=0).T).sum())
+    frame = tracker.reset(float(wp[0, 0]) + 3.0, float(wp[0, 1]) + 0.5)  # 3 m along leg 0
+    assert remaining_path(ctx, tracker, frame) == pytest.approx(total - 3.0)
+
+
+def _default_trial(scenario: str, seed: int, suite: str = "default") -> Any:
+    spec = load_suite(suite)
+    (trial,) = trials(
+        Job("oracle", scenario, (seed,), None, spec.randomize.model_dump(mode="json"))
+    )
+    return trial
+
+
+@pytest.mark.parametrize(
+    ("scenario", "seed"),
+    [("nominal", 10009), ("current_shift", 10000)],
+)
+def test_the_oracle_reaches_the_goal_where_revision_1_turned_the_wrong_way(
+    scenario: str, seed: int
+) -> None:
+    """Default-suite trials that the oracle of revision 1 lost to the time limit: on
+    nominal 10009 it turned the wrong way onto the last leg, on current_shift 10000 onto
+    the second (a U-turn back was outside its local SQP's reach); competitors reach the
+    goal on both.  With the tail and the hard-turn starts the oracle reaches it too."""
+    (result,) = evaluate("oracle", _default_trial(scenario, seed), seeds=[seed])
+    assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
+    assert result.metrics["solver_failures"] == 0
+
+
+@pytest.mark.parametrize(
+    ("scenario", "seed"),
+    [("maneuverability_change", 10001), ("maneuverability_change_long", 10000)],
+)
+def test_the_oracle_does_not_spin_after_the_manoeuvrability_jump(scenario: str, seed: int) -> None:
+    """Default trials revision 2 lost to the time limit (the yaw-unstable ship spun after
+    its jump: the warm start was one period off): revision 3 reaches the goal, at a cost
+    below that of the best adaptive NMPC, ``nmpc_lambda_lssvm_svf`` (measured 31.5 vs 141,
+    19.5 vs 146)."""
+    trial = _default_trial(scenario, seed)
+    (result,) = evaluate("oracle", trial, seeds=[seed])
+    (svf,) = evaluate("nmpc_lambda_lssvm_svf", trial, seeds=[seed])
+    assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
+    assert result.metrics["cost"] < svf.metrics["cost"]
+
+
+def test_the_oracle_costs_less_than_the_tuned_pid_los_on_a_mariner_trial() -> None:
+    """quick ``mariner_rudder_aging`` seed 10000: revision 2's 20 equal intervals of 12 s
+    cost 344, near the tuned pid_los's 398; revision 3's geometric intervals 137."""
+    trial = _default_trial("mariner_rudder_aging", 10000, "quick")
+    (oracle,) = evaluate("oracle", trial, seeds=[10000])
+    (pid,) = evaluate("pid_los", trial, seeds=[10000])
+    assert oracle.metrics["termination_reason"] == "goal"
+    assert oracle.metrics["cost"] < 0.5 * pid.metrics["cost"]
 
 
 # ------------------------------------------------------------------ the privileged channel
@@ -212,11 +342,10 @@ def test_a_sample_of_the_shipped_references_recomputes_to_the_same_cost() -> Non
 
 
 def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
-    """What is achievable: on every smoke trial the oracle's cost is below that of pid_los's
-    paper design, and below the tuned pid_los's on the nomoto2 trials.  Known exception
-    (issue 17, open): on ``mariner_track`` the tuned pid_los (issue 21) costs less than this
-    revision of the oracle, whose 21 blocked intervals over a 268 s horizon are too coarse
-    for the Mariner — the test pins it so that a better oracle revision shows."""
+    """What is achievable: on every smoke trial the oracle's cost is below that of pid_los,
+    its paper design and its tuned settings (issue 21).  Revision 2 lost to the tuned
+    pid_los on ``mariner_track`` (its 20 equal intervals of 14 s were too coarse for the
+    Mariner); revision 3's geometric intervals beat it."""
     table = shipped_table()
     for scenario in load_suite("smoke").all_scenarios():
         for job, trial in _smoke_trials(scenario):
@@ -224,8 +353,7 @@ def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
             (paper,) = evaluate("pid_los", trial, seeds=list(job.seeds), preset="paper")
             assert oracle < paper.metrics["cost"], (scenario, job.seeds, oracle)
             (tuned,) = evaluate("pid_los", trial, seeds=list(job.seeds))
-            beaten = oracle >= tuned.metrics["cost"]
-            assert beaten == (trial.config.ship.model == "mariner"), (scenario, job.seeds, oracle)
+            assert oracle < tuned.metrics["cost"], (scenario, job.seeds, oracle)
 
 
 def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:
