@@ -58,7 +58,7 @@ def test_closed_loop_bias_estimate_stays_bounded_when_the_bias_exceeds_the_rudde
     data = yaml.safe_load((catalogue_dir() / "nominal.yaml").read_text())
     data["ship"]["params"]["d0"] = 20.0
     data["time_limit"] = 20.0
-    policy = L1Backstepping()
+    policy = L1Backstepping(preset="paper")
     run_episode(policy, scenario_from_dict(data), 0)
     bound = policy.model.K * policy.ctx.rudder_limit
     b_hat = np.array(policy.history["b"])
@@ -75,7 +75,7 @@ def _catalogue(name: str, **changes: object) -> dict:
 
 @pytest.mark.parametrize("policy_type", [L1Backstepping, AdaptiveBackstepping])
 def test_nomoto2_nominal_reaches_the_goal(policy_type: type) -> None:
-    res = run_episode(policy_type(), "nominal", 0)
+    res = run_episode(policy_type(preset="paper"), "nominal", 0)
     assert res.metrics["termination_reason"] == "goal"
     assert np.abs(res.trajectory["cross_track_error"]).max() < 6.0  # corridor 9.5 m
 
@@ -83,7 +83,7 @@ def test_nomoto2_nominal_reaches_the_goal(policy_type: type) -> None:
 @pytest.mark.parametrize("policy_type", [L1Backstepping, AdaptiveBackstepping])
 def test_blanke_current_shift_reaches_the_goal(policy_type: type) -> None:
     """blanke_current_shift: four legs, 0.5 m/s cross current from t = 150 s."""
-    res = run_episode(policy_type(), "blanke_current_shift", 0)
+    res = run_episode(policy_type(preset="paper"), "blanke_current_shift", 0)
     assert res.metrics["termination_reason"] == "goal"
     assert res.metrics["ace"] < 15.0  # measured 10.3 (L1), 4.2 (adaptive); L = 51.5 m
 
@@ -93,11 +93,11 @@ def test_mariner_track_stays_bounded() -> None:
     controller (filter ω = 0.09 rad/s here) limit-cycles but never drifts beyond the
     500-m start offset."""
     scenario = scenario_from_dict(_catalogue("mariner_track", time_limit=400.0))
-    adaptive = run_episode(AdaptiveBackstepping(), scenario, 0)
+    adaptive = run_episode(AdaptiveBackstepping(preset="paper"), scenario, 0)
     t = adaptive.trajectory["t"]
     settled = (t >= 280.0) & (t <= 380.0)  # end of the first leg, before the switch
     assert np.abs(adaptive.trajectory["cross_track_error"][settled]).max() < 5.0
-    l1 = run_episode(L1Backstepping(), scenario, 0)
+    l1 = run_episode(L1Backstepping(preset="paper"), scenario, 0)
     assert l1.metrics["termination_reason"] == "time_limit"
     assert np.abs(l1.trajectory["cross_track_error"]).max() < 505.0
 
@@ -107,7 +107,7 @@ def test_esso_osaka_follows_the_paper_route_in_the_two_phase_current(policy_type
     """osaka_stochastic_current (Xu et al. 2021 §5.2): the paper's ship, route and current,
     gains as printed (τ = 0.996): both reach the last waypoint with ACE < 1.5 m
     (measured 0.89 m with C(s), 0.19 m without; L = 3.25 m)."""
-    res = run_episode(policy_type(), "osaka_stochastic_current", 0)
+    res = run_episode(policy_type(preset="paper"), "osaka_stochastic_current", 0)
     assert res.metrics["termination_reason"] == "goal"
     assert res.metrics["ace"] < 1.5
 
@@ -116,7 +116,7 @@ def test_filter_removes_high_frequency_rudder_activity() -> None:
     """nomoto2 nominal: the rudder angle's power above the filter corner (ω = 1.67 rad/s
     after the similarity transfer) with C(s) is < 10 % of that without (measured 2.2 %)."""
     power = {}
-    for policy in (L1Backstepping(), AdaptiveBackstepping()):
+    for policy in (L1Backstepping(preset="paper"), AdaptiveBackstepping(preset="paper")):
         res = run_episode(policy, "nominal", 0)
         omega = policy.gains.filter_frequency
         power[policy.name] = high_frequency_power(res.trajectory["rudder_angle"], TS, omega)
@@ -131,7 +131,7 @@ def test_bad_settings_are_refused() -> None:
     with pytest.raises(ValueError, match="K1, K2"):
         L1Backstepping(K2=0.0)
     with pytest.raises(ValueError, match="rudder"):
-        L1Backstepping().reset(_context("nominal", action_mode="guidance"))
+        L1Backstepping(preset="paper").reset(_context("nominal", action_mode="guidance"))
 
 
 def test_a_step_without_samples_uses_the_period_end_points() -> None:
@@ -139,7 +139,7 @@ def test_a_step_without_samples_uses_the_period_end_points() -> None:
     measurements and the command stays finite and within ±1."""
     env = gym.make("ShipPathFollow-v0", scenario="nominal")
     obs, info = env.reset(seed=0)
-    policy = L1Backstepping()
+    policy = L1Backstepping(preset="paper")
     policy.reset(env.unwrapped.controller_context, seed=0)
     for k in range(6):
         action = policy.act(obs, info)

@@ -234,7 +234,7 @@ def test_reproduction_rows_and_J_replay(tmp_path) -> None:  # type: ignore[no-un
     data = load_scenario("mariner_track").config.model_dump()
     data["time_limit"] = 150.0
     scenario = scenario_from_dict(data)
-    result = run_episode(LQR(), scenario, 10_000)
+    result = run_episode(LQR(preset="paper"), scenario, 10_000)
     J_t = borkowski2018.cumulative_J(scenario, result.trajectory, scenario.control_period)
     assert J_t[-1] == pytest.approx(result.metrics["J"], rel=1e-9)
     assert J_t[-1] == pytest.approx(index[(case, "lqr", "J")], rel=1e-9)

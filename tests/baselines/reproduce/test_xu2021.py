@@ -60,7 +60,7 @@ def test_episode_figures_match_the_leaderboard_metrics() -> None:
     """The per-phase figures count the same steps as shipgym.metrics: over the whole
     episode, ACE, mean |ψ̃| and mean |δ| equal the leaderboard's metrics."""
     scenario = xu2021.build_scenario(120.0)
-    recorder = xu2021.Recorded(AdaptiveBackstepping(), xu2021.AB)
+    recorder = xu2021.Recorded(AdaptiveBackstepping(preset="paper"), xu2021.AB)
     result = run_episode(recorder, scenario, 10_000)
     fig = xu2021.episode_figures(scenario, result, recorder)["episode"]
     m = result.metrics
@@ -124,7 +124,7 @@ def test_adaptive_filter_placement_with_frozen_estimates_is_adaptive_backsteppin
     """filter_placement="adaptive" filters only δ − δ_nom: with the adaptation frozen at
     the nominal estimates that share is 0 and the commands equal the unfiltered law's."""
     scenario = xu2021.build_scenario(60.0)
-    frozen = {"gamma_rho": 0.0, "gamma_sigma": 0.0, "gamma_b": 0.0}
+    frozen = {"preset": "paper", "gamma_rho": 0.0, "gamma_sigma": 0.0, "gamma_b": 0.0}
     a = run_episode(L1Backstepping(filter_placement="adaptive", **frozen), scenario, 3)
     b = run_episode(AdaptiveBackstepping(**frozen), scenario, 3)
     c = run_episode(L1Backstepping(**frozen), scenario, 3)
@@ -141,7 +141,7 @@ def test_current_is_read_from_the_env_log_after_the_episode() -> None:
     switch."""
     scenario = xu2021.build_scenario(200.0)
     logs, results = [], []
-    for policy in (AdaptiveBackstepping(), xu2021.CONTROLLERS[xu2021.PID]()):
+    for policy in (AdaptiveBackstepping(preset="paper"), xu2021.CONTROLLERS[xu2021.PID]()):
         log = xu2021.DisturbanceLog()
         results.append(run_episode(policy, scenario, 7, after_episode=log.read))
         logs.append(log.episodes[0])
