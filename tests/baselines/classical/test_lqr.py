@@ -129,7 +129,7 @@ def first_leg() -> dict[str, tuple]:
     scenario = scenario_from_dict(data)
     runs = {}
     for cls in (LQR, RecordingAdaptiveLQR):
-        policy = cls()
+        policy = cls(preset="paper")  # Borkowski §5: the paper's design
         runs[cls.name] = (run_episode(policy, scenario, 10_000), policy)
     return runs
 
