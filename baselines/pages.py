@@ -587,9 +587,10 @@ _REFERENCE_SWATCH = "kref"
 _REFERENCE_CSS = f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
 
 
-def _legend_swatch(name: str, label: str) -> str:
-    """The swatch class of a legend entry: the reference's line, else the controller's."""
-    return _REFERENCE_SWATCH if label.endswith(", the reference") else _swatch_class(name)[0]
+def _legend_swatch(name: str) -> str:
+    """The swatch class of a legend entry: the oracle's reference line, else the
+    controller's."""
+    return _REFERENCE_SWATCH if name == ORACLE else _swatch_class(name)[0]
 
 
 def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
@@ -598,7 +599,7 @@ def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
     blocks = []
     for title, entries in legends:
         items = "".join(
-            f'<li><span class="{_legend_swatch(name, label)}"></span>{_e(label)}</li>'
+            f'<li><span class="{_legend_swatch(name)}"></span>{_e(label)}</li>'
             for name, label in entries
         )
         blocks.append(f"<div><b>{_e(title)}</b><ul>{items}</ul></div>")
