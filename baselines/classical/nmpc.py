@@ -56,6 +56,7 @@ from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLS
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2
 from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
+from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.classical.nmpc_ship import (
     PAPER_CONTROL_HORIZON,
     PAPER_HORIZON,
@@ -65,6 +66,7 @@ from shipgym_baselines.classical.nmpc_ship import (
 )
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.registry import register_controller
+from shipgym_baselines.tuning.chosen import tuned_settings
 
 
 @dataclasses.dataclass(frozen=True)
@@ -108,14 +110,16 @@ class NMPCSolver:
         ix, iy, ipsi = (model.state_index(k) for k in ("x", "y", "psi"))
         ir, irdot, idelta = (model.state_index(k) for k in ("r", "r_dot", "delta"))
         u = ca.SX.sym("u", s.control_horizon)
-        # parameters: x0, leg start (x_n, y_n), path angle ψp, nL, model parameters
-        p = ca.SX.sym("p", nx + 4 + npar)
+        # parameters: x0, leg start (x_n, y_n), path angle ψp, nL, model parameters, and the
+        # cost weights √Q (5), √R: solver parameters, so that one compiled function serves
+        # every weighting (a tuning study's trials) of a horizon
+        p = ca.SX.sym("p", nx + 4 + npar + N_WEIGHTS)
         x = p[:nx]
         xn, yn, psip, radius = p[nx], p[nx + 1], p[nx + 2], p[nx + 3]
         length = model.length
-        theta = p[nx + 4 :]
+        theta = p[nx + 4 : nx + 4 + npar]
+        q = [p[nx + 4 + npar + k] for k in range(N_WEIGHTS)]
         w = ca.SX.zeros(model.n_disturbances)
-        q = [math.sqrt(v) for v in s.Q]
         residuals, states = [], []
         for i in range(s.horizon):
             ui = u[min(i, s.control_horizon - 1)]  # eq. (17): held after N_c
@@ -135,20 +139,23 @@ class NMPCSolver:
                 q[3] * x[irdot],
                 q[4] * x[idelta],
             ]
-        residuals += [math.sqrt(s.R) * u[i] for i in range(s.control_horizon)]
+        residuals += [q[5] * u[i] for i in range(s.control_horizon)]
         rho = ca.vertcat(*residuals)  # cost (16) = ‖ρ‖²
         self.n_residuals = rho.shape[0]
         self.predict_function = ca.Function("predict", [u, p], [ca.horzcat(*states)])
         tag = f"{model.name}_n{s.horizon}_c{s.control_horizon}_s{s.prediction_substeps}"
-        if (s.interval, s.Q, s.R) != (1, NMPCSettings.Q, NMPCSettings.R):  # another ship's
-            tag += f"_k{s.interval}_{zlib.crc32(repr((s.Q, s.R, length)).encode()):08x}"
+        if s.interval != 1:  # another ship's (the library's name; its hash is the code's)
+            tag += f"_k{s.interval}_{zlib.crc32(repr(length).encode()):08x}"
         residual = ca.Function(f"nmpc_rho_{tag}", [u, p], [rho])
         # dense: the buffer interface writes only the structural nonzeros of an output
         jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.densify(ca.jacobian(rho, u))])
         if s.compile:
             residual, jacobian = compiled(residual), compiled(jacobian)
         self._u = np.zeros(s.control_horizon)
-        self._p = np.zeros(nx + 4 + npar)
+        self._p = np.zeros(nx + 4 + npar + N_WEIGHTS)
+        #: √Q, √R of the settings the solver was built with (what :meth:`parameters` uses
+        #: when not given others)
+        self.weights = weight_vector(s)
         self._rho = np.zeros(self.n_residuals)
         self._jac = np.zeros((s.control_horizon, self.n_residuals))  # column-major J
         self._rho_eval = self._bind(residual, [self._rho])
@@ -173,8 +180,14 @@ class NMPCSolver:
         path_angle: float,
         radius: float,
         params: np.ndarray,
+        weights: np.ndarray | None = None,
     ) -> np.ndarray:
-        return np.concatenate([x0, [leg_start[0], leg_start[1], path_angle, radius], params])
+        """The solver's parameter vector; ``weights``: :func:`weight_vector` of the
+        controller's settings (None: the solver's own)."""
+        weights = self.weights if weights is None else weights
+        return np.concatenate(
+            [x0, [leg_start[0], leg_start[1], path_angle, radius], params, weights]
+        )
 
     def cost(self, plan: np.ndarray, p: np.ndarray) -> float:
         """Cost (16) of a plan; inf when the prediction diverges (e.g. absurd parameters)."""
@@ -224,11 +237,31 @@ _SOLVERS: dict[tuple, NMPCSolver] = {}
 
 
 def get_solver(model: ShipModel, settings: NMPCSettings, ts: float, limit: float) -> NMPCSolver:
-    """Solvers are built once per process for a model class, settings and timing."""
-    key = (type(model).__name__, model.length, settings, ts, limit)  # L is in the graph
+    """Solvers are built once per process for a model class, settings and timing; settings
+    that differ only in the cost weights Q, R share one (the weights are parameters: pass
+    :func:`weight_vector` of yours to :meth:`NMPCSolver.parameters`)."""
+    structure = dataclasses.replace(settings, Q=NMPCSettings.Q, R=NMPCSettings.R)
+    key = (type(model).__name__, model.length, structure, ts, limit)  # L is in the graph
     if key not in _SOLVERS:
-        _SOLVERS[key] = NMPCSolver(model, settings, ts, limit)
+        _SOLVERS[key] = NMPCSolver(model, structure, ts, limit)
     return _SOLVERS[key]
+
+
+#: the cost weights in the solver's parameters: √Q (5) and √R
+N_WEIGHTS = 6
+
+
+def weight_vector(settings: NMPCSettings) -> np.ndarray:
+    """[√Q₁ … √Q₅, √R] of ``settings`` (read-only): the residual weights of cost (16)."""
+    if len(settings.Q) != N_WEIGHTS - 1 or not all(
+        math.isfinite(v) and v >= 0 for v in (*settings.Q, settings.R)
+    ):
+        raise ValueError(
+            f"need five finite Q ≥ 0 and a finite R ≥ 0, got Q={settings.Q}, R={settings.R}"
+        )
+    vector = np.array([math.sqrt(v) for v in (*settings.Q, settings.R)])
+    vector.flags.writeable = False
+    return vector
 
 
 @functools.lru_cache(maxsize=64)
@@ -254,8 +287,25 @@ def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) 
 class NMPC:
     """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019).
 
-    ``settings`` None: the numbers of the ship (:func:`ship_plan`; the paper's on nomoto2).
-    ``excitation_deg``: σ of eq. (45) [deg] (None: 0).
+    ``settings`` None: the numbers of the ship (:func:`ship_plan`; the paper's on nomoto2),
+    with the tuned factors below.  ``excitation_deg``: σ of eq. (45) [deg] (None: 0).
+
+    ``preset``: "tuned" (the registry's default) reads the ship's section of
+    ``configs/tuning/chosen/nmpc.yaml`` (``shipgym tune nmpc``, docs/tuning.md; the whole
+    family reads the one study of ``nmpc``, :attr:`tuning_name`) under the values given
+    here; "paper" does not (``shipgym reproduce liu2019``).  The tuned settings, each
+    None for the chosen value (else the rule's: 1, and no compensation):
+
+    * ``horizon_scale``: factor on the horizon time t_H of :func:`ship_plan`;
+    * ``cross_track_weight``, ``heading_weight``, ``rudder_weight``: factors on Q_e, Q_ψ and
+      R of cost (16) (the rule's ship-scaled weights);
+    * ``drift_compensation``: predict and penalise the course ψ + β instead of the heading,
+      with β the measured drift angle (:mod:`~shipgym_baselines.classical.drift`, as the
+      PID family, LQR and L1 compensate it): the prediction starts from ψ₀ + β, held over
+      the horizon, so that ψ̃ − ψ̃_LOS of eq. (16) is the course error (ψd = χd − β).
+
+    An explicit ``settings`` object fixes the horizon and weights (the factors then must not
+    be given).
     """
 
     name: ClassVar[str]  # set by the registration
@@ -263,10 +313,38 @@ class NMPC:
     identifier_type: ClassVar[type | None] = None
     #: options of the identifier (e.g. its front end)
     identifier_options: ClassVar[dict[str, Any]] = {}
+    #: whose chosen settings the family reads (one study, of the non-adaptive ``nmpc``)
+    tuning_name: ClassVar[str] = "nmpc"
 
     def __init__(
-        self, settings: NMPCSettings | None = None, excitation_deg: float | None = None
+        self,
+        settings: NMPCSettings | None = None,
+        excitation_deg: float | None = None,
+        preset: str = "tuned",
+        horizon_scale: float | None = None,
+        cross_track_weight: float | None = None,
+        heading_weight: float | None = None,
+        rudder_weight: float | None = None,
+        drift_compensation: bool | None = None,
     ) -> None:
+        if preset not in ("tuned", "paper"):
+            raise ValueError(f"preset must be 'tuned' or 'paper', got {preset!r}")
+        factors = {
+            "horizon_scale": horizon_scale,
+            "cross_track_weight": cross_track_weight,
+            "heading_weight": heading_weight,
+            "rudder_weight": rudder_weight,
+        }
+        for key, value in factors.items():
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{key} must be finite and > 0, got {value!r}")
+        #: the settings given here (over the chosen ones at reset)
+        self.explicit: dict[str, Any] = {k: float(v) for k, v in factors.items() if v is not None}
+        if settings is not None and self.explicit:
+            raise ValueError(f"give settings or the factors {sorted(self.explicit)}, not both")
+        if drift_compensation is not None:
+            self.explicit["drift_compensation"] = bool(drift_compensation)
+        self.preset = preset
         self._given_settings = settings
         self.settings = settings if settings is not None else NMPCSettings()
         # eq. (45) excitation (σ not given by the paper; 0 by default: see the README)
@@ -288,15 +366,29 @@ class NMPC:
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
         self.ctx = context
-        self.ship_plan = plan = ship_plan(context)
+        chosen = tuned_settings(self.tuning_name, context.ship) if self.preset == "tuned" else {}
+        given = {**chosen, **self.explicit}
+        if self._given_settings is not None:  # the settings object fixes horizon and weights
+            given = {k: v for k, v in given.items() if k == "drift_compensation"}
+        self.tuned = given
+        self.ship_plan = plan = ship_plan(context, float(given.get("horizon_scale", 1.0)))
         if self._given_settings is None:
+            q = plan.Q
             self.settings = NMPCSettings(
                 horizon=plan.horizon,
                 control_horizon=plan.control_horizon,
-                Q=plan.Q,
+                Q=(
+                    q[0] * float(given.get("cross_track_weight", 1.0)),
+                    q[1] * float(given.get("heading_weight", 1.0)),
+                    *q[2:],
+                ),
+                R=NMPCSettings.R * float(given.get("rudder_weight", 1.0)),
                 prediction_substeps=plan.substeps,
                 interval=plan.interval,
             )
+        self.drift_compensation = bool(given.get("drift_compensation", False))
+        self._last: dict[str, Any] | None = None
+        self.weights = weight_vector(self.settings)
         # nomoto2 predicts with its own model; another ship with its Nomoto model (module doc)
         self.model = context.nominal_model if not plan.reduce else Nomoto2(plan.nominal)
         self.solver = get_solver(
@@ -386,11 +478,17 @@ class NMPC:
         )
         radius = self.ctx.guidance.los_radius_L * self.ctx.ship_length  # nL; |e| + L applied inside
         x0 = self._state(info)
+        if self.drift_compensation:  # predict the course ψ + β (class doc)
+            _, drift = course_and_drift(
+                info, self._last, self.ctx.control_period, self.ctx.nominal_speed
+            )
+            self._last = {"position": (float(x), float(y)), "psi": float(info["heading"])}
+            x0[self._index[2]] += drift
         guess = self._warm_start()
         start, start_cpu = time.perf_counter(), time.thread_time()
         plan, ok, _ = self.solver.solve(
             self.solver.parameters(
-                x0, leg_start, frame.path_angle, radius, self._vector(self.params)
+                x0, leg_start, frame.path_angle, radius, self._vector(self.params), self.weights
             ),
             guess,
         )
@@ -403,7 +501,12 @@ class NMPC:
             self.model_fallbacks += 1
             plan, ok, _ = self.solver.solve(
                 self.solver.parameters(
-                    x0, leg_start, frame.path_angle, radius, self._vector(self._good_params)
+                    x0,
+                    leg_start,
+                    frame.path_angle,
+                    radius,
+                    self._vector(self._good_params),
+                    self.weights,
                 ),
                 guess,
             )

@@ -228,8 +228,11 @@ class ShipNMPCPlan:
         }
 
 
-def ship_plan(context: ControllerContext) -> ShipNMPCPlan:
-    """The family's numbers for the context's ship (module doc, rule by rule)."""
+def ship_plan(context: ControllerContext, horizon_scale: float = 1.0) -> ShipNMPCPlan:
+    """The family's numbers for the context's ship (module doc, rule by rule);
+    ``horizon_scale``: a factor on the horizon time t_H (1: the rule; a tuned setting)."""
+    if not (math.isfinite(horizon_scale) and horizon_scale > 0):
+        raise ValueError(f"horizon_scale must be finite and > 0, got {horizon_scale!r}")
     nominal = nominal_prediction_params(context)
     closed_form = isinstance(context.nominal_params, Nomoto2Params)
     p = paper_ship()
@@ -241,7 +244,9 @@ def ship_plan(context: ControllerContext) -> ShipNMPCPlan:
             nominal, context.control_period, context.fine_step, context.guidance.los_radius_L
         )
     )
-    horizon_time = max((s.los_radius_L + 1.0) * s.length_time, SETTLING_TIME_CONSTANTS * s.T)
+    horizon_time = horizon_scale * max(
+        (s.los_radius_L + 1.0) * s.length_time, SETTLING_TIME_CONSTANTS * s.T
+    )
     interval = max(1, _ceil(horizon_time / (PAPER_HORIZON * s.Ts)))
     horizon = _ceil(horizon_time / (interval * s.Ts))
     substeps = _ceil(interval * s.Ts / (STEP_PER_FAST_TIME_CONSTANT * s.fast))

@@ -61,7 +61,7 @@ def straight_leg(offset: float = 1.0) -> object:
 
 def test_nmpc_with_true_model_converges_on_a_straight_leg() -> None:
     """From 1 m off the leg, |e| < 0.05 m from t = 10 s on, and |δc| ≤ 30° at every step."""
-    policy = NMPC()
+    policy = NMPC(preset="paper")
     result = run_episode(policy, straight_leg(), seed=0)
     tr = result.trajectory
     after = tr["t"] >= 10.0
@@ -151,11 +151,11 @@ def test_identifier_tracks_what_the_data_can_identify() -> None:
     """After the d0 jump the steady-state rudder −d0/K is identified; d0 itself needs
     persistent excitation (eq. (45)): without it K and d0 drift together on straight legs."""
     true_ratio = 4.0 / 0.506  # deg: −d0/K after the change
-    plain = NMPCLambdaLSSVM()  # σ = 0
+    plain = NMPCLambdaLSSVM(preset="paper")  # σ = 0
     run_episode(plain, "current_shift_long", seed=0)
     ratio = -plain.identifier.params.d0 / plain.identifier.params.K / DEG
     assert ratio == pytest.approx(true_ratio, rel=0.25)
-    excited = NMPCLambdaLSSVM(excitation_deg=2.0)
+    excited = NMPCLambdaLSSVM(excitation_deg=2.0, preset="paper")
     run_episode(excited, "current_shift_long", seed=0)
     assert excited.identifier.params.d0 == pytest.approx(-4.0 * DEG, rel=0.05)
     assert excited.identifier.params.K == pytest.approx(0.506, rel=0.05)

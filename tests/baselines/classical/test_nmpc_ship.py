@@ -45,7 +45,7 @@ def test_nomoto2_keeps_the_paper_numbers_whatever_its_parameters(scenario: str) 
     assert plan.lambda_c == (1e-5, 1e-2) and plan.svf_bandwidth == 3.0
     assert plan.excitation_hold == 1 and not plan.reduce
     ctx = context(scenario)
-    policy = NMPC()
+    policy = NMPC(preset="paper")
     policy.reset(ctx, seed=0)
     assert policy.settings == NMPCSettings()
     assert policy.params is ctx.nominal_params and policy.model is ctx.nominal_model
