@@ -70,13 +70,14 @@ def test_finding7_shipped_agents_act_as_through_the_pickle_loader() -> None:
 
     torch.set_num_threads(1)
     golden = np.load(GOLDEN, allow_pickle=False)
-    observations = golden["observations"]
-    keys = [k for k in golden.files if k != "observations"]
+    keys = [k for k in golden.files if "__seed_" in k]
     assert len(keys) == 15  # 5 agents × 3 training seeds
     for key in keys:
         name, seed = key.split("__seed_")
         policy = LearnedPolicy(name, training_seed=int(seed))
         assert not pickle_trusted()
+        # an agent trained with the context features reads them after the observation
+        observations = golden["observations_context" if policy.context_features else "observations"]
         actions = np.array([policy.act(obs, {}) for obs in observations])
         np.testing.assert_array_equal(actions, golden[key], err_msg=key)
 
@@ -95,7 +96,7 @@ def test_finding7_a_pickle_payload_in_a_zip_is_not_executed(tmp_path: Path) -> N
     hostile = _rewrite(_shipped_zip(), tmp_path / "agent" / "model.zip", plant)
     policy = LearnedPolicy(hostile)
     golden = np.load(GOLDEN, allow_pickle=False)
-    obs = golden["observations"][0]
+    obs = golden["observations_context" if policy.context_features else "observations"][0]
     np.testing.assert_array_equal(policy.act(obs, {}), golden["ppo__seed_0"][0])
     assert not target.exists()
 
