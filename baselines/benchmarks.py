@@ -413,11 +413,12 @@ def bench_training(
     env: same config, env steps and machine, measured in the same run, one torch thread.
     ``scenario``: one fixed scenario instead of the distribution.
 
-    ``wide_envs``: also the batched path with that many envs (``batched_wide``; n_steps
-    scaled so that a rollout has the config's n_steps·n_envs env steps: the same
-    gradient updates per env step), since the batched envs' per-call cost is spread over
-    more envs.  The first rollout of each run (process start-up, torch warm-up, compile) is
-    excluded.
+    ``wide_envs``: also the batched path and DummyVecEnv with that many envs
+    (``batched_wide``, ``dummy_wide``; n_steps scaled so that a rollout has the config's
+    n_steps·n_envs env steps: the same gradient updates per env step), since the batched
+    envs' per-call cost is spread over more envs; 64 × 32 is the tuned agents' rollout
+    (docs/tuning.md).  ``batched_wide_over_dummy_wide`` compares equal widths.  The first
+    rollout of each run (process start-up, torch warm-up, compile) is excluded.
     Besides the wall-clock rate, ``…_cpu_s`` is this process's CPU time of the timed part
     (subprocess workers not counted), for loaded machines.
     """
@@ -443,8 +444,10 @@ def bench_training(
         "torch_threads": torch.get_num_threads(),
     }
     runs = [(kind, kind, n_envs) for kind in kinds]
-    if wide_envs and "batched" in kinds:
-        runs.append(("batched_wide", "batched", wide_envs))
+    if wide_envs:  # the same comparison at the tuned agents' width (64 envs × 32 steps)
+        runs += [
+            (f"{kind}_wide", kind, wide_envs) for kind in ("batched", "dummy") if kind in kinds
+        ]
         figures["wide_envs"] = wide_envs
     rollout = int(config.hyperparams.get("n_steps", 2048)) * n_envs
     for label, kind, count in runs:
@@ -470,13 +473,18 @@ def bench_training(
         figures[f"ppo_{label}_cpu_s"] = statistics.median(cpu)
         figures[f"ppo_{label}_env_steps_per_cpu_s"] = timesteps / statistics.median(cpu)
     if "batched" in kinds and "dummy" in kinds:
-        for label in ("batched", "batched_wide"):
-            if f"ppo_{label}_cpu_s" in figures:
-                figures[f"{label}_over_dummy"] = (
-                    figures[f"ppo_{label}_env_steps_per_s"] / figures["ppo_dummy_env_steps_per_s"]
+        for label, dummy in (
+            ("batched", "dummy"),
+            ("batched_wide", "dummy"),
+            ("batched_wide", "dummy_wide"),
+        ):
+            if f"ppo_{label}_cpu_s" in figures and f"ppo_{dummy}_cpu_s" in figures:
+                figures[f"{label}_over_{dummy}"] = (
+                    figures[f"ppo_{label}_env_steps_per_s"]
+                    / figures[f"ppo_{dummy}_env_steps_per_s"]
                 )
-                figures[f"{label}_over_dummy_cpu"] = (
-                    figures["ppo_dummy_cpu_s"] / figures[f"ppo_{label}_cpu_s"]
+                figures[f"{label}_over_{dummy}_cpu"] = (
+                    figures[f"ppo_{dummy}_cpu_s"] / figures[f"ppo_{label}_cpu_s"]
                 )
         figures["batched_over_dummy_target"] = BATCHED_OVER_DUMMY_TARGET
     if "batched" in kinds and "subproc" in kinds:
