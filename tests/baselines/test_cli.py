@@ -285,3 +285,19 @@ def test_no_help_text_points_to_the_unshipped_spec(capsys) -> None:
     texts += [p.format_help() for p in sub.choices.values()]
     assert len(texts) == len(SUBCOMMANDS) + 1  # the top level and each subcommand
     assert not [t for t in texts if "SPEC" in t]
+
+
+def test_bench_training_compares_equal_widths() -> None:
+    """Each path's rate and CPU, and the ratios at the config's width and at the wide one
+    (tiny runs: the figures' shape, not their speed)."""
+    from shipgym_baselines.benchmarks import bench_training
+
+    figures = bench_training(n_envs=4, timesteps=64, kinds=("batched", "dummy"), wide_envs=8)
+    for label in ("batched", "dummy", "batched_wide", "dummy_wide"):
+        assert figures[f"ppo_{label}_env_steps_per_s"] > 0 and figures[f"ppo_{label}_cpu_s"] > 0
+    for ratio in ("batched_over_dummy", "batched_wide_over_dummy", "batched_wide_over_dummy_wide"):
+        assert figures[ratio] == pytest.approx(
+            figures[f"ppo_{ratio.split('_over_')[0]}_env_steps_per_s"]
+            / figures[f"ppo_{ratio.split('_over_')[1]}_env_steps_per_s"]
+        )
+    assert figures["wide_envs"] == 8 and figures["n_envs"] == 4
