@@ -65,7 +65,16 @@ TRAINING_OUTPUTS = (
 TUNED_FROM_FILE = "tuned_from.json"
 
 
-def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall_offset: float):
+def _callbacks(
+    config: AgentConfig,
+    out: Path,
+    n_envs: int,
+    progress: bool,
+    wall_offset: float,
+    resumed_at: int | None = None,
+):
+    """Progress, checkpoints and the periodic validation; ``resumed_at``: the env steps of
+    the checkpoint a resumed run starts from (None: a fresh run)."""
     from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 
     class _Progress(BaseCallback):
@@ -120,9 +129,9 @@ def _callbacks(config: AgentConfig, out: Path, n_envs: int, progress: bool, wall
         save_vecnormalize=True,
     )
     if config.eval.select_on == "relative_cost":
-        evaluation = _relative_cost_callback(config, out, n_envs, wall_offset > 0)
+        evaluation = _relative_cost_callback(config, out, n_envs, resumed_at)
     else:
-        evaluation = _return_callback(config, out, n_envs, wall_offset > 0)
+        evaluation = _return_callback(config, out, n_envs, resumed_at)
     callbacks = CallbackList([progress_cb, checkpoint, evaluation])
     return callbacks, progress_cb, evaluation.curves
 
@@ -154,7 +163,15 @@ class _Curves:
         return True
 
 
-def _return_callback(config: AgentConfig, out: Path, n_envs: int, resuming: bool):
+def _kept_history(steps: list[int], resumed_at: int) -> int:
+    """How many of a run's evaluations to keep when it resumes from the checkpoint at
+    ``resumed_at`` env steps: those up to it.  Evaluations after the checkpoint belong to
+    the interrupted stretch of training, which the resumed run trains again (its curve then
+    stays strictly increasing); the best model file keeps the best value ever evaluated."""
+    return sum(1 for step in steps if step <= resumed_at)
+
+
+def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: int | None):
     """SB3's EvalCallback on the validation env (best model by mean return), writing the
     learning curve and applying the plateau rule after each evaluation."""
     from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
@@ -188,18 +205,19 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resuming: bool
     )
     evaluation.curves = curves
     previous = out / "eval" / "evaluations.npz"
-    if resuming and previous.is_file():  # resuming: keep the history and the best
+    if resumed_at is not None and previous.is_file():  # keep the history and the best
         import numpy as np
 
         data = np.load(previous)
-        evaluation.evaluations_timesteps = data["timesteps"].tolist()
-        evaluation.evaluations_results = data["results"].tolist()
-        evaluation.evaluations_length = data["ep_lengths"].tolist()
+        keep = _kept_history(data["timesteps"].tolist(), resumed_at)
+        evaluation.evaluations_timesteps = data["timesteps"].tolist()[:keep]
+        evaluation.evaluations_results = data["results"].tolist()[:keep]
+        evaluation.evaluations_length = data["ep_lengths"].tolist()[:keep]
         evaluation.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
     return evaluation
 
 
-def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resuming: bool):
+def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: int | None):
     """Every ``eval.freq`` env steps: the agent on the fixed validation trials, scored by
     the geometric-mean cost ratio to the reference (:mod:`shipgym_baselines.learned.
     selection`); the best (lowest) model saved as ``best_model.zip``."""
@@ -225,11 +243,12 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumin
             self.returns: list[list[float]] = []
             self.selection: list[float] = []
             self.best = float("inf")
-            if resuming and history.is_file():
+            if resumed_at is not None and history.is_file():
                 data = json.loads(history.read_text())
-                self.steps, self.returns = data["env_steps"], data["returns"]
-                self.selection = data["selection"]
-                self.best = min(self.selection, default=float("inf"))
+                keep = _kept_history(data["env_steps"], resumed_at)
+                self.steps, self.returns = data["env_steps"][:keep], data["returns"][:keep]
+                self.selection = data["selection"][:keep]
+                self.best = min(data["selection"], default=float("inf"))  # best_model.zip's
             self.curves = curves
 
         def _on_step(self) -> bool:
@@ -402,7 +421,12 @@ def train(
         # exp(−Ts/τ); SB3's time-limit bootstrap keeps the scalar hyperparams γ
         model.rollout_buffer.gamma = np.asarray(gamma)
     callbacks, progress_cb, curves = _callbacks(
-        config, out, config.env.n_envs, progress, wall_offset
+        config,
+        out,
+        config.env.n_envs,
+        progress,
+        wall_offset,
+        resumed_at=previous[1] if previous is not None else None,
     )
     remaining = config.n_timesteps - model.num_timesteps
     if remaining > 0:
@@ -478,12 +502,14 @@ def save_obs_statistics(venv: Any, out: Path) -> Path | None:
 
 def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
     """The meta of the run in ``out`` if it is finished (its ``model.zip`` saved and its
-    ``meta.json`` counting at least ``n_timesteps`` env steps), else None."""
+    ``meta.json`` counting at least ``n_timesteps`` env steps, or saying the plateau rule
+    stopped it), else None."""
     meta_file = Path(out) / "meta.json"
     if not (meta_file.is_file() and (Path(out) / "model.zip").is_file()):
         return None
     meta = json.loads(meta_file.read_text())
-    return meta if int(meta.get("env_steps", 0)) >= n_timesteps else None
+    done = int(meta.get("env_steps", 0)) >= n_timesteps
+    return meta if done or meta.get("stopped_on_plateau_at") is not None else None
 
 
 def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:

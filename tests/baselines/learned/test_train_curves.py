@@ -108,3 +108,57 @@ def test_a_per_ship_normalised_run_resumes_from_its_checkpoint(tmp_path: Path) -
     )
     assert meta["env_steps"] == 512
     assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
+
+
+def _relative(**changes: object) -> AgentConfig:
+    return _tiny(
+        eval={
+            "distribution": "validation",
+            "freq": 128,
+            "n_episodes": 1,
+            "select_on": "relative_cost",
+        },
+        **changes,
+    )
+
+
+def test_a_run_stopped_on_its_plateau_is_finished_for_resume(tmp_path: Path) -> None:
+    """``--resume`` on a run the plateau rule stopped returns it as it is (the final
+    pipeline then only exports it): no evaluation is added, nothing is retrained."""
+    config = _relative(
+        n_timesteps=2048,
+        plateau={"min_gain": 10.0, "window": 0.25, "min_evaluations": 2, "metric": "selection"},
+    )
+    out = tmp_path / "run"
+    first = train(config, out_dir=out, progress=False, tensorboard=False)
+    assert first["stopped_on_plateau_at"] == 256
+    model_bytes = (out / "model.zip").read_bytes()
+    again = train(config, out_dir=out, resume=True, progress=False, tensorboard=False)
+    assert again == first
+    assert load_curve(out)["env_steps"] == [128, 256]
+    assert (out / "model.zip").read_bytes() == model_bytes
+
+
+def test_a_run_killed_after_an_evaluation_past_its_checkpoint_resumes(tmp_path: Path) -> None:
+    """Evaluations after the newest checkpoint belong to the stretch a resumed run trains
+    again: the history keeps those up to the checkpoint, so the curve stays strictly
+    increasing (before: the evaluation at 384 was repeated and the curve refused)."""
+    out = tmp_path / "run"
+    train(
+        _relative(n_timesteps=384, checkpoint_freq=256),
+        out_dir=out,
+        progress=False,
+        tensorboard=False,
+    )
+    assert load_curve(out)["env_steps"] == [128, 256, 384]
+    for name in ("model.zip", "meta.json"):  # killed before the end: unfinished
+        (out / name).unlink()
+    meta = train(
+        _relative(n_timesteps=512, checkpoint_freq=256),
+        out_dir=out,
+        resume=True,
+        progress=False,
+        tensorboard=False,
+    )
+    assert meta["env_steps"] == 512
+    assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
