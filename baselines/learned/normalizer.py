@@ -23,10 +23,12 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from shipgym.config import validate_model
-from shipgym.envs.core import OBS_NAMES
+from shipgym.envs.core import observation_names
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.trust import pickle_trusted, refuse_unpickling
 
+#: the lengths an observation can have: without and with the controller-context features
+OBSERVATION_SIZES = (len(observation_names(False)), len(observation_names(True)))
 #: the data file of the statistics, and the pickle SB3 writes (read only when trusted)
 NORMALIZER_FILE = "vecnormalize.json"
 PICKLED_NORMALIZER_FILE = "vecnormalize.pkl"
@@ -34,14 +36,15 @@ PICKLED_NORMALIZER_FILE = "vecnormalize.pkl"
 
 class ObsNormalizer(BaseModel):
     """Observation statistics of a ``VecNormalize``: ``mean`` and ``var`` per observation
-    entry (in the observation's scaled units), ``epsilon`` (> 0) added to ``var``,
-    ``clip_obs`` (> 0) the bound of a normalised entry; ``norm_obs`` False: unchanged."""
+    entry (in the observation's scaled units; the env's observation, or with the
+    controller-context features after it), ``epsilon`` (> 0) added to ``var``, ``clip_obs``
+    (> 0) the bound of a normalised entry; ``norm_obs`` False: unchanged."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     norm_obs: bool
-    mean: list[float] = Field(min_length=len(OBS_NAMES), max_length=len(OBS_NAMES))
-    var: list[float] = Field(min_length=len(OBS_NAMES), max_length=len(OBS_NAMES))
+    mean: list[float]
+    var: list[float]
     epsilon: float = Field(gt=0)
     clip_obs: float = Field(gt=0)
 
@@ -51,6 +54,16 @@ class ObsNormalizer(BaseModel):
         values = value if isinstance(value, list) else [value]
         if not all(math.isfinite(v) for v in values):
             raise ValueError("every number must be finite")
+        return value
+
+    @field_validator("mean", "var")
+    @classmethod
+    def _length(cls, value: list[float]) -> list[float]:
+        if len(value) not in OBSERVATION_SIZES:
+            raise ValueError(
+                f"{len(value)} entries: the observation has {OBSERVATION_SIZES[0]}, "
+                f"or {OBSERVATION_SIZES[1]} with the context features"
+            )
         return value
 
     @field_validator("var")

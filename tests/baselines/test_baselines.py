@@ -111,7 +111,9 @@ def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -
     for png in out.glob("*.png"):
         assert f"<code>{png.name}</code>" in html, png.name
     embedded = re.findall("data:image/(?:png|webp);base64,", html)  # lossless, the PNG's pixels
-    assert len(embedded) == len(list(out.glob("*.png"))) == 7
+    # the ranking, scenario and held-out figures, and the shipped ppo's learning curves
+    assert len(embedded) == len(list(out.glob("*.png"))) == 8
+    assert (out / "learning_curves.png").is_file()
     assert "data:image/svg" not in html
     assert all(row["controller"] in html for row in rows)
 

@@ -150,8 +150,13 @@ def test_finding7_a_pickled_vecnormalize_is_refused_unless_trusted(tmp_path: Pat
     with pytest.raises(UnsafeFileError, match=r"vecnormalize\.pkl: .*--trust-pickle"):
         LearnedPolicy(folder)
     assert not target.exists()
-    # a genuine one, converted to data, normalises exactly as SB3's VecNormalize
-    venv = VecNormalize(DummyVecEnv([lambda: gym.make("ShipPathFollow-v0")]), norm_obs=True)
+    # a genuine one, converted to data, normalises exactly as SB3's VecNormalize (of the
+    # observation the shipped model reads: with the context features if it was so trained)
+    wide = LearnedPolicy(_shipped_zip().parent).context_features
+    venv = VecNormalize(
+        DummyVecEnv([lambda: gym.make("ShipPathFollow-v0", context_features=wide)]),
+        norm_obs=True,
+    )
     venv.reset()
     for _ in range(30):
         venv.step(np.array([[0.5]], dtype=np.float32))
@@ -164,7 +169,7 @@ def test_finding7_a_pickled_vecnormalize_is_refused_unless_trusted(tmp_path: Pat
     data = LearnedPolicy(folder)  # the JSON beside it: no unpickling
     assert isinstance(data.obs_normalizer, ObsNormalizer)
     assert read_normalizer(folder / NORMALIZER_FILE) == trusted.obs_normalizer
-    golden = np.load(GOLDEN, allow_pickle=False)["observations"]
+    golden = np.load(GOLDEN, allow_pickle=False)["observations_context" if wide else "observations"]
     np.testing.assert_array_equal(
         data.obs_normalizer.normalize_obs(golden), venv.normalize_obs(golden)
     )
@@ -216,3 +221,17 @@ def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
     export_policy(run, dest)
     assert sorted(p.name for p in dest.iterdir()) == ["meta.json", "model.zip", NORMALIZER_FILE]
     assert LearnedPolicy(dest).obs_normalizer == ObsNormalizer.of(venv)
+
+
+@pytest.mark.parametrize("size, ok", [(9, True), (16, True), (10, False), (0, False)])
+def test_observation_statistics_have_an_observation_s_length(size: int, ok: bool) -> None:
+    """9 entries (the env's observation) or 9 + the context features; other lengths are
+    refused naming both."""
+    from pydantic import ValidationError
+
+    fields = {"norm_obs": True, "mean": [0.0] * size, "var": [1.0] * size}
+    if ok:
+        assert len(ObsNormalizer(**fields, epsilon=1e-8, clip_obs=10.0).mean) == size
+    else:
+        with pytest.raises(ValidationError, match="the observation has 9, or 16 with the context"):
+            ObsNormalizer(**fields, epsilon=1e-8, clip_obs=10.0)

@@ -70,6 +70,9 @@ def test_chosen_settings_and_the_final_block_reach_the_agent_config(tmp_path: Pa
     assert agent.plateau is not None and agent.plateau.metric == "selection"
     assert tuned_from["chosen"] == str(file) and tuned_from["settings"] == CHOSEN
     assert tuned_from["report"] == STUDY["report"] and tuned_from["final"]["seeds"] == [0, 1, 2]
+    # the packaged file is recorded by its repository path, not this machine's
+    _, packaged = tuned_agent(load_agent_config("ppo"))
+    assert packaged["chosen"] == "configs/tuning/chosen/ppo.yaml"
 
 
 @pytest.mark.parametrize(
