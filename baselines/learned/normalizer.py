@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from shipgym.config import validate_model
 from shipgym.envs.core import observation_names
@@ -72,6 +72,12 @@ class ObsNormalizer(BaseModel):
         if any(v < 0 for v in value):
             raise ValueError("a variance is ≥ 0")
         return value
+
+    @model_validator(mode="after")
+    def _same_length(self) -> ObsNormalizer:
+        if len(self.mean) != len(self.var):
+            raise ValueError(f"mean has {len(self.mean)} entries, var {len(self.var)}")
+        return self
 
     @classmethod
     def of(cls, vecnormalize: Any) -> ObsNormalizer:

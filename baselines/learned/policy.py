@@ -546,6 +546,12 @@ class LearnedPolicy:
         self.obs_normalizer: ObsNormalizer | None = (
             load_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
         )
+        width = len(observation_names(self.context_features))
+        if self.obs_normalizer is not None and len(self.obs_normalizer.mean) != width:
+            raise ControllerError(
+                f"{files.vecnormalize}: statistics of {len(self.obs_normalizer.mean)} "
+                f"observation entries, the model reads {width}"
+            )
         self.recurrent = self.algo in RECURRENT
         #: the deterministic action without ``predict``'s per-call checks and distribution
         #: object (None: ``predict``, e.g. a recurrent or another policy class)

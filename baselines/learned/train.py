@@ -165,10 +165,33 @@ class _Curves:
 
 def _kept_history(steps: list[int], resumed_at: int) -> int:
     """How many of a run's evaluations to keep when it resumes from the checkpoint at
-    ``resumed_at`` env steps: those up to it.  Evaluations after the checkpoint belong to
-    the interrupted stretch of training, which the resumed run trains again (its curve then
-    stays strictly increasing); the best model file keeps the best value ever evaluated."""
-    return sum(1 for step in steps if step <= resumed_at)
+    ``resumed_at`` env steps: the strictly increasing first ones up to it.  Evaluations
+    after the checkpoint belong to the interrupted stretch of training, which the resumed
+    run trains again (its curve then stays strictly increasing); the best model file keeps
+    the best value ever evaluated (:data:`BEST_FILE`)."""
+    kept = 0
+    for step in steps:
+        if step > resumed_at or (kept and step <= steps[kept - 1]):
+            break
+        kept += 1
+    return kept
+
+
+#: the value of ``best_model.zip`` (the best ever evaluated, which a resumed run's history
+#: may no longer hold) and the env step it was evaluated at
+BEST_FILE = "best.json"
+
+
+def _write_best(out: Path, value: float, step: int) -> None:
+    (out / "eval").mkdir(parents=True, exist_ok=True)
+    (out / "eval" / BEST_FILE).write_text(json.dumps({"value": value, "env_steps": step}))
+
+
+def _read_best(out: Path, history_best: float) -> float:
+    """The value of the saved best model: from :data:`BEST_FILE`, else (a run from before
+    the file) the best of the history on disk."""
+    file = out / "eval" / BEST_FILE
+    return float(json.loads(file.read_text())["value"]) if file.is_file() else history_best
 
 
 def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: int | None):
@@ -186,6 +209,11 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
                 parent.evaluations_timesteps, parent.evaluations_results, None
             )
 
+    class _NewBest(BaseCallback):  # best_model.zip was just saved: record its value
+        def _on_step(self) -> bool:
+            _write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
+            return True
+
     eval_env = make_eval_env(
         config.eval,
         config.env.action_mode,
@@ -196,6 +224,7 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
     evaluation = EvalCallback(
         eval_env,
         callback_after_eval=_AfterEval(),
+        callback_on_new_best=_NewBest(),
         best_model_save_path=str(out),
         log_path=str(out / "eval"),
         eval_freq=max(config.eval.freq // n_envs, 1),
@@ -213,7 +242,8 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
         evaluation.evaluations_timesteps = data["timesteps"].tolist()[:keep]
         evaluation.evaluations_results = data["results"].tolist()[:keep]
         evaluation.evaluations_length = data["ep_lengths"].tolist()[:keep]
-        evaluation.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
+        history_best = float(np.max(np.mean(data["results"], axis=1)))
+        evaluation.best_mean_reward = _read_best(out, history_best)
     return evaluation
 
 
@@ -248,7 +278,7 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
                 keep = _kept_history(data["env_steps"], resumed_at)
                 self.steps, self.returns = data["env_steps"][:keep], data["returns"][:keep]
                 self.selection = data["selection"][:keep]
-                self.best = min(data["selection"], default=float("inf"))  # best_model.zip's
+                self.best = _read_best(out, min(data["selection"], default=float("inf")))
             self.curves = curves
 
         def _on_step(self) -> bool:
@@ -285,6 +315,7 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             if found["selection"] < self.best:
                 self.best = found["selection"]
                 self.model.save(str(out / "best_model.zip"))
+                _write_best(out, self.best, int(self.num_timesteps))
             return curves.after_evaluation(self.steps, self.returns, self.selection)
 
     return _RelativeCostEval()
@@ -334,6 +365,11 @@ def train(
         config = config.model_copy(update=updates)
     out = Path(out_dir or f"results/agents/{config.name}")
     if resume and (finished := finished_run(out, config.n_timesteps)) is not None:
+        if int(finished.get("env_steps", 0)) < config.n_timesteps:
+            sys.stderr.write(
+                f"{out}: stopped by its plateau rule at {finished['stopped_on_plateau_at']} env "
+                "steps, so finished: nothing trained (--force trains it afresh)\n"
+            )
         return finished
     if not resume:
         check_agent_folder(out, config.name, force)

@@ -119,6 +119,27 @@ def test_the_family_reads_the_one_nmpc_study_and_paper_reads_none(monkeypatch) -
     assert len(asked) == 1
 
 
+def test_the_controller_s_weights_reach_the_shared_solver() -> None:
+    """Two controllers sharing one compiled solver plan with their own weights: a 100×
+    rudder weight gives a smaller first command from the same state (5 cm right of the
+    first leg, (1, 1) → (15, 1), on its heading)."""
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    info = {
+        "t": 0.0,
+        "heading": 0.0,
+        "yaw_rate": 0.0,
+        "rudder_angle": 0.0,
+        "position": (2.0, 0.95),
+    }
+    plain, heavy = NMPC(preset="paper"), NMPC(preset="paper", rudder_weight=100.0)
+    plain.reset(ctx, seed=0)
+    heavy.reset(ctx, seed=0)
+    assert plain.solver is heavy.solver
+    obs = np.zeros(9, dtype=np.float32)
+    gentle, firm = float(heavy.act(obs, info)[0]), float(plain.act(obs, info)[0])
+    assert 0 < gentle < 0.5 * firm
+
+
 def test_drift_compensation_predicts_the_course(monkeypatch) -> None:
     """With compensation the solver's initial heading is ψ + β, β the measured drift angle
     over the last period (classical.drift); without it, ψ."""
@@ -132,6 +153,7 @@ def test_drift_compensation_predicts_the_course(monkeypatch) -> None:
 
         def spy(x0, *args):
             seen.append(float(x0[2]))
+            assert args[-1] is policy.weights  # the controller's weights reach the solver
             return original(x0, *args)
 
         monkeypatch.setattr(policy.solver, "parameters", spy)

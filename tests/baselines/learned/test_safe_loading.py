@@ -202,7 +202,8 @@ def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
 
     from shipgym_baselines.learned.train import export_policy, save_obs_statistics
 
-    env = DummyVecEnv([lambda: gym.make("ShipPathFollow-v0")])
+    wide = LearnedPolicy(_shipped_zip().parent).context_features  # the observation it reads
+    env = DummyVecEnv([lambda: gym.make("ShipPathFollow-v0", context_features=wide)])
     assert save_obs_statistics(VecNormalize(env, norm_obs=False), tmp_path) is None
     venv = VecNormalize(env, norm_obs=True)
     venv.reset()
@@ -221,6 +222,26 @@ def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
     export_policy(run, dest)
     assert sorted(p.name for p in dest.iterdir()) == ["meta.json", "model.zip", NORMALIZER_FILE]
     assert LearnedPolicy(dest).obs_normalizer == ObsNormalizer.of(venv)
+
+
+def test_statistics_of_another_width_than_the_model_s_are_refused(tmp_path: Path) -> None:
+    """A normaliser whose mean and var lengths differ, or whose width is not what the model
+    reads (the shipped PPO reads the context features when so trained), is a clear error."""
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match="mean has 9 entries, var 16"):
+        ObsNormalizer(norm_obs=True, mean=[0.0] * 9, var=[1.0] * 16, epsilon=1e-8, clip_obs=10.0)
+    folder = tmp_path / "agent"
+    folder.mkdir()
+    shutil.copyfile(_shipped_zip(), folder / "model.zip")
+    wide = LearnedPolicy(folder).context_features
+    other = 9 if wide else 16
+    stats = ObsNormalizer(
+        norm_obs=True, mean=[0.0] * other, var=[1.0] * other, epsilon=1e-8, clip_obs=10.0
+    )
+    (folder / NORMALIZER_FILE).write_text(stats.model_dump_json())
+    with pytest.raises(Exception, match=f"statistics of {other} observation entries"):
+        LearnedPolicy(folder)
 
 
 @pytest.mark.parametrize("size, ok", [(9, True), (16, True), (10, False), (0, False)])
