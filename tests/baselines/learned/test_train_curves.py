@@ -107,7 +107,12 @@ def test_a_per_ship_normalised_run_resumes_from_its_checkpoint(tmp_path: Path) -
         _tiny(n_timesteps=512, env=env), out_dir=out, resume=True, progress=False, tensorboard=False
     )
     assert meta["env_steps"] == 512
-    assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
+    second = load_curve(out)
+    assert second["env_steps"] == [128, 256, 384, 512]
+    # best_model.zip's value: the best ever evaluated, the dropped evaluation at 384 too,
+    # kept on disk for a further resume (the history no longer holds it)
+    best = json.loads((out / "eval" / "best.json").read_text())["value"]
+    assert best == min(first["selection"] + second["selection"][3:])
 
 
 def _relative(**changes: object) -> AgentConfig:
@@ -150,7 +155,8 @@ def test_a_run_killed_after_an_evaluation_past_its_checkpoint_resumes(tmp_path: 
         progress=False,
         tensorboard=False,
     )
-    assert load_curve(out)["env_steps"] == [128, 256, 384]
+    first = load_curve(out)
+    assert first["env_steps"] == [128, 256, 384]
     for name in ("model.zip", "meta.json"):  # killed before the end: unfinished
         (out / name).unlink()
     meta = train(
@@ -161,4 +167,9 @@ def test_a_run_killed_after_an_evaluation_past_its_checkpoint_resumes(tmp_path: 
         tensorboard=False,
     )
     assert meta["env_steps"] == 512
-    assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
+    second = load_curve(out)
+    assert second["env_steps"] == [128, 256, 384, 512]
+    # best_model.zip's value: the best ever evaluated, the dropped evaluation at 384 too,
+    # kept on disk for a further resume (the history no longer holds it)
+    best = json.loads((out / "eval" / "best.json").read_text())["value"]
+    assert best == min(first["selection"] + second["selection"][3:])
