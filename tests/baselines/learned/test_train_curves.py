@@ -107,12 +107,7 @@ def test_a_per_ship_normalised_run_resumes_from_its_checkpoint(tmp_path: Path) -
         _tiny(n_timesteps=512, env=env), out_dir=out, resume=True, progress=False, tensorboard=False
     )
     assert meta["env_steps"] == 512
-    second = load_curve(out)
-    assert second["env_steps"] == [128, 256, 384, 512]
-    # best_model.zip's value: the best ever evaluated, the dropped evaluation at 384 too,
-    # kept on disk for a further resume (the history no longer holds it)
-    best = json.loads((out / "eval" / "best.json").read_text())["value"]
-    assert best == min(first["selection"] + second["selection"][3:])
+    assert load_curve(out)["env_steps"] == [128, 256, 384, 512]
 
 
 def _relative(**changes: object) -> AgentConfig:
