@@ -104,7 +104,7 @@ def test_solver_failure_falls_back_to_the_shifted_plan() -> None:
         if policy.last_t >= 2.0:
             shifted.append(np.array_equal(policy.plan, np.append(before[1:], before[-1])))
 
-    policy, commands = _run_steps(BrokenSensor(), 12, check)
+    policy, commands = _run_steps(BrokenSensor(preset="paper"), 12, check)  # 1-period intervals
     assert policy.failures == 12 - 4 and all(shifted) and len(shifted) == 8
     assert all(math.isfinite(c) and abs(c) <= 1.0 for c in commands)
     assert policy.episode_stats()["solver_failures"] == 8.0
