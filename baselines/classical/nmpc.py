@@ -290,10 +290,11 @@ class NMPC:
     ``settings`` None: the numbers of the ship (:func:`ship_plan`; the paper's on nomoto2),
     with the tuned factors below.  ``excitation_deg``: σ of eq. (45) [deg] (None: 0).
 
-    ``preset``: "tuned" (the registry's default) reads the ship's section of
-    ``configs/tuning/chosen/nmpc.yaml`` (``shipgym tune nmpc``, docs/tuning.md; the whole
-    family reads the one study of ``nmpc``, :attr:`tuning_name`) under the values given
-    here; "paper" does not (``shipgym reproduce liu2019``).  The tuned settings, each
+    ``preset``: "tuned" (the registry's default) reads the ship's section of the member's
+    own chosen settings (``configs/tuning/chosen/<name>.yaml``, ``shipgym tune <name>``,
+    docs/tuning.md), else of ``nmpc``'s (:attr:`tuning_name`: the members without a study of
+    their own share the non-adaptive controller's), under the values given here; "paper"
+    reads none (``shipgym reproduce liu2019``).  The tuned settings, each
     None for the chosen value (else the rule's: 1, and no compensation):
 
     * ``horizon_scale``: factor on the horizon time t_H of :func:`ship_plan`;
@@ -313,7 +314,7 @@ class NMPC:
     identifier_type: ClassVar[type | None] = None
     #: options of the identifier (e.g. its front end)
     identifier_options: ClassVar[dict[str, Any]] = {}
-    #: whose chosen settings the family reads (one study, of the non-adaptive ``nmpc``)
+    #: whose chosen settings a member without a study of its own reads
     tuning_name: ClassVar[str] = "nmpc"
 
     def __init__(
@@ -366,7 +367,10 @@ class NMPC:
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         check_action_mode(self, context)
         self.ctx = context
-        chosen = tuned_settings(self.tuning_name, context.ship) if self.preset == "tuned" else {}
+        chosen: dict[str, Any] = {}
+        if self.preset == "tuned":  # the member's own study if it has one, else nmpc's
+            own = tuned_settings(type(self).name, context.ship)
+            chosen = own or tuned_settings(self.tuning_name, context.ship)
         given = {**chosen, **self.explicit}
         if self._given_settings is not None:  # the settings object fixes horizon and weights
             given = {k: v for k, v in given.items() if k == "drift_compensation"}

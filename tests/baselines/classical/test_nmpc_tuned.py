@@ -89,8 +89,8 @@ def test_horizon_scale_stretches_the_horizon_time_by_the_rule() -> None:
 
 
 def test_the_family_reads_the_one_nmpc_study_and_paper_reads_none(monkeypatch) -> None:
-    """Every member reads ``nmpc``'s chosen section of its ship; explicit values win; the
-    paper preset reads nothing (what ``shipgym reproduce liu2019`` runs)."""
+    """A member without a study of its own reads ``nmpc``'s chosen section of its ship;
+    explicit values win; the paper preset reads nothing (``shipgym reproduce liu2019``)."""
     asked: list[tuple[str, str]] = []
     chosen = {
         "horizon_scale": 2.0,
@@ -102,13 +102,13 @@ def test_the_family_reads_the_one_nmpc_study_and_paper_reads_none(monkeypatch) -
 
     def fake(controller: str, ship: str) -> dict:
         asked.append((controller, ship))
-        return dict(chosen)
+        return dict(chosen) if controller == "nmpc" else {}
 
     monkeypatch.setattr(nmpc_module, "tuned_settings", fake)
     ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
     policy = NMPCLambdaLSSVMSVF(heading_weight=3.0)
     policy.reset(ctx, seed=0)
-    assert asked == [("nmpc", "nomoto2")]
+    assert asked == [("nmpc_lambda_lssvm_svf", "nomoto2"), ("nmpc", "nomoto2")]
     s = policy.settings
     assert s.Q == (4.0 * PAPER_Q[0], 3.0 * PAPER_Q[1], *PAPER_Q[2:])
     assert s.R == pytest.approx(0.1) and (s.interval, s.horizon) == (2, 10)
@@ -116,7 +116,13 @@ def test_the_family_reads_the_one_nmpc_study_and_paper_reads_none(monkeypatch) -
     paper = NMPC(preset="paper")
     paper.reset(ctx, seed=0)
     assert paper.settings == NMPCSettings() and not paper.drift_compensation
-    assert len(asked) == 1
+    assert len(asked) == 2
+    # a member with its own section reads that one only
+    own = {"horizon_scale": 1.0, "rudder_weight": 2.0}
+    monkeypatch.setattr(nmpc_module, "tuned_settings", lambda c, ship: dict(own))
+    member = NMPCLambdaLSSVMSVF()
+    member.reset(ctx, seed=0)
+    assert member.settings.R == pytest.approx(0.02) and member.settings.Q == PAPER_Q
 
 
 def test_the_controller_s_weights_reach_the_shared_solver() -> None:
