@@ -20,7 +20,7 @@ def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
 
 
 def test_packaged_suites_load() -> None:
-    assert list_suites() == list_names("suites") == ["default", "quick", "smoke"]
+    assert list_suites() == list_names("suites") == ["default", "paper_settings", "quick", "smoke"]
     smoke = load_suite("smoke")
     assert smoke == SuiteConfig(
         name="smoke",
@@ -125,7 +125,7 @@ def test_unknown_scenario_names_suite_key_and_valid_names(tmp_path: Path) -> Non
 
 
 def test_unknown_suite_lists_the_suites() -> None:
-    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, quick, smoke"):
+    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, paper_settings, quick, smoke"):
         load_suite("nope")
 
 
