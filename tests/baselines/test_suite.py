@@ -125,7 +125,8 @@ def test_unknown_scenario_names_suite_key_and_valid_names(tmp_path: Path) -> Non
 
 
 def test_unknown_suite_lists_the_suites() -> None:
-    with pytest.raises(ConfigError, match=r"unknown suite 'nope'.*valid: default, paper_settings, quick, smoke"):
+    listed = r"unknown suite 'nope'.*valid: default, paper_settings, quick, smoke"
+    with pytest.raises(ConfigError, match=listed):
         load_suite("nope")
 
 
