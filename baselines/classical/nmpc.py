@@ -374,7 +374,6 @@ class NMPC:
         given = {**chosen, **self.explicit}
         if self._given_settings is not None:  # the settings object fixes horizon and weights
             given = {k: v for k, v in given.items() if k == "drift_compensation"}
-        self.tuned = given
         self.ship_plan = plan = ship_plan(context, float(given.get("horizon_scale", 1.0)))
         if self._given_settings is None:
             q = plan.Q
