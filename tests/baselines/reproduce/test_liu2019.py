@@ -10,7 +10,9 @@ from shipgym_baselines.reproduce.liu2019 import markdown, run_experiment
 from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED
 
 #: the paper-literal ACE [m] (si reading, 1 seed) as recorded before the SVF front end:
-#: the extension must not move them by one bit
+#: the extension must not move them.  Bit for bit on the recording machine; to
+#: ``LITERAL_REL`` elsewhere, since the LS-SVM solves go through BLAS kernels that the CPU
+#: picks (an AMD EPYC gave 1.6417532889 for 1.6417532888, tests/golden/README.md)
 LITERAL_ACE = {
     ("rudder_aging", "nmpc_lambda_lssvm"): 1.5424723526143127,
     ("rudder_aging", "nmpc_wlssvm"): 1.5748427594629526,
@@ -22,6 +24,7 @@ LITERAL_ACE = {
     ("maneuverability_change", "nmpc_wlssvm"): 3.4623110423764354,
     ("maneuverability_change", "nmpc"): 3.2307120415366892,
 }
+LITERAL_REL = 1e-6
 SVF = ("nmpc_lambda_lssvm_svf", "nmpc_wlssvm_svf")
 
 
@@ -36,7 +39,8 @@ def test_paper_literal_rows_stay_what_they_are(rows) -> None:
     for r in literal:
         assert set(r) == {"case", "controller", "metric", "ours", "paper", "unit_reading", "seeds"}
         if r["metric"] == "ace":
-            assert r["ours"] == LITERAL_ACE[(r["case"], r["controller"])]
+            want = LITERAL_ACE[(r["case"], r["controller"])]
+            assert r["ours"] == pytest.approx(want, rel=LITERAL_REL, abs=0), r
     t_c = {(r["case"], r["controller"]): r["ours"] for r in literal if r["metric"] == "t_c"}
     assert t_c.pop(("current_shift", "nmpc_wlssvm")) == 55.0
     assert all(v == math.inf for v in t_c.values())
