@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 
@@ -146,31 +147,39 @@ def test_run_replays_the_leaderboards_trial(
 
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
-#: the golden's floats agree to this across machines (tests/golden/README.md)
-GOLDEN_REL = 1e-5
+#: the floats of rows computed through BLAS or torch agree to this across machines
+#: (tests/golden/README.md); every other row is compared exactly
+GOLDEN_REL = 1e-4
+
+
+def _through_blas_or_torch(row: dict) -> bool:
+    """A learned agent (torch) or an LS-SVM identifier (BLAS solves): the CPU's kernels
+    round these differently from machine to machine."""
+    return row.get("kind") == "learned" or "lssvm" in row["controller"]
 
 
 def assert_equals_golden(rows: list[dict], golden: Path) -> None:
     """Every number equal to the recorded golden (tests/golden/README.md), wall-clock
-    controller timings aside: a restructure must not move them."""
+    controller timings aside, the floats of BLAS / torch rows to ``GOLDEN_REL``: a
+    restructure must not move them."""
     want = json.loads(golden.read_text())
     assert len(rows) == len(want)
     for got, ref in zip(rows, want, strict=True):
         keys = {k for k in ref if not k.startswith("compute_ms")}
         assert {k for k in got if not k.startswith("compute_ms")} == keys
+        loose = _through_blas_or_torch(ref)
         for key in keys:
-            # floats to GOLDEN_REL: the BLAS and torch kernels a CPU dispatches to round
-            # differently (tests/golden/README.md); everything else exactly
             where = (ref["scenario"], ref["controller"], key, got[key], ref[key])
-            assert _close(got[key], ref[key]), where
+            assert _close(got[key], ref[key]) if loose else got[key] == ref[key], where
 
 
 def _close(got: object, ref: object) -> bool:
-    """Equal, floats to ``GOLDEN_REL`` relative (lists element by element)."""
+    """Equal, floats to ``GOLDEN_REL`` relative (lists element by element; an infinite or
+    NaN float only equals itself)."""
     if isinstance(ref, list):
         return isinstance(got, list) and len(got) == len(ref) and all(map(_close, got, ref))
     if isinstance(ref, float) and isinstance(got, float):
-        return got == ref or abs(got - ref) <= GOLDEN_REL * max(abs(got), abs(ref))
+        return got == ref or math.isclose(got, ref, rel_tol=GOLDEN_REL, abs_tol=0.0)
     return got == ref
 
 

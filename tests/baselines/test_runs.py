@@ -343,6 +343,10 @@ def test_sigint_stops_the_workers_without_tracebacks(tmp_path: Path) -> None:
         stdout=subprocess.DEVNULL,
         text=True,
         start_new_session=True,
+        # a terminal's foreground job: SIGINT at its default even when pytest runs as a
+        # background job of a non-interactive shell, which ignores SIGINT for its children
+        # (an ignored SIGINT is inherited, and the run then rightly finishes)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 120
     while not ((out / "run.json").is_file() and read_episodes(out)):  # an episode ended

@@ -12,7 +12,7 @@ from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED
 #: the paper-literal ACE [m] (si reading, 1 seed) as recorded before the SVF front end:
 #: the extension must not move them.  Bit for bit on the recording machine; to
 #: ``LITERAL_REL`` elsewhere, since the LS-SVM solves go through BLAS kernels that the CPU
-#: picks (an AMD EPYC gave 1.6417532889 for 1.6417532888, tests/golden/README.md)
+#: picks (an AMD EPYC gave 1.6417532889 for 1.6417532888; tests/golden/README.md, the end)
 LITERAL_ACE = {
     ("rudder_aging", "nmpc_lambda_lssvm"): 1.5424723526143127,
     ("rudder_aging", "nmpc_wlssvm"): 1.5748427594629526,
