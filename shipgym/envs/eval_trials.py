@@ -98,8 +98,7 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         problem = lockstep_problem(self.scenarios)
         if problem is not None:
             raise LockstepError(f"these trials cannot run in one env: {problem}")
-        # one thread: the least CPU (the leaderboard's workers already fill the cores)
-        super().__init__(len(self.seeds), self.scenarios[0], action_mode, compile, False, 1)
+        super().__init__(len(self.seeds), self.scenarios[0], action_mode, compile, False)
         n = self.num_envs
         #: rows whose episode has ended (they stay done)
         self.finished = np.ones(n, dtype=bool)

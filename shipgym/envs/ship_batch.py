@@ -95,10 +95,7 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         self.ship_index = ship_index_of(dist, ship)
         self.ship = dist.config.ships[self.ship_index].model
         self._first = build_scenario(self._draw(train_rng(0), "first"))
-        # one thread for the plant: a training process runs one torch thread, and training
-        # jobs run side by side on the cores; a second thread then waits for a core
-        # (≈ 2.5 ms per call instead of 0.05–0.12 ms, docs/training.md "Throughput")
-        super().__init__(num_envs, self._first, action_mode, compile, context_features, threads=1)
+        super().__init__(num_envs, self._first, action_mode, compile, context_features)
         self.episode_metrics = False  # a training env: no per-episode metrics
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
         #: the config of each env's current trial (names ``<distribution>:train-<seed>``)
