@@ -399,6 +399,35 @@ def bench_nmpc(
 BATCHED_OVER_DUMMY_TARGET = 2.0
 
 
+def _env_clock(venv: Any) -> Any:
+    """``venv`` wrapped so that the CPU time [s] of this process spent inside its ``reset``
+    and ``step`` is added up in the wrapper's ``cpu_s`` (the env's share of a training;
+    the rest is the agent's: forward passes, returns and gradient updates)."""
+    from stable_baselines3.common.vec_env import VecEnvWrapper
+
+    class EnvClock(VecEnvWrapper):
+        cpu_s = 0.0
+
+        def reset(self) -> Any:
+            start = time.process_time()
+            obs = self.venv.reset()
+            self.cpu_s += time.process_time() - start
+            return obs
+
+        def step_async(self, actions: np.ndarray) -> None:
+            start = time.process_time()
+            self.venv.step_async(actions)
+            self.cpu_s += time.process_time() - start
+
+        def step_wait(self) -> Any:
+            start = time.process_time()
+            out = self.venv.step_wait()
+            self.cpu_s += time.process_time() - start
+            return out
+
+    return EnvClock(venv)
+
+
 def bench_training(
     n_envs: int | None = None,
     timesteps: int = 16_384,
@@ -421,7 +450,12 @@ def bench_training(
     (docs/tuning.md).  ``batched_wide_over_dummy_wide`` compares equal widths.  The first
     rollout of each run (process start-up, torch warm-up, compile) is excluded.
     Besides the wall-clock rate, ``…_cpu_s`` is this process's CPU time of the timed part
-    (subprocess workers not counted), for loaded machines.
+    (subprocess workers not counted), for loaded machines, split into the env's
+    (``…_env_cpu_s``: inside the VecEnv's reset and step) and the agent's
+    (``…_agent_cpu_s``: forward passes, returns, gradient updates); not for SubprocVecEnv.
+    ``…_cpu_bound`` is Amdahl's bound on a ratio: the DummyVecEnv run's CPU over the
+    batched run's agent CPU alone (the ratio if the batched env cost nothing);
+    ``…_env_cpu`` is the ratio of the two env shares alone.
     """
     import torch
     from stable_baselines3 import PPO
@@ -455,24 +489,28 @@ def bench_training(
         env_config = config.env.model_copy(update={"vec_env": kind, "n_envs": count, **source})
         hyper = build_hyperparams(config, 1)
         hyper["n_steps"] = max(rollout // count, 1)
-        rates, cpu = [], []
+        rates, cpu, env_cpu = [], [], []
         for rep in range(repeats):
-            venv = VecNormalize(
-                make_training_env(env_config, seed=rep),
-                norm_obs=False,
-                norm_reward=config.env.normalize_reward,
-            )
+            clock = _env_clock(make_training_env(env_config, seed=rep))
+            venv = VecNormalize(clock, norm_obs=False, norm_reward=config.env.normalize_reward)
             model = PPO(config.policy, venv, seed=rep, device="cpu", **hyper)
             warm = model.n_steps * count
             model.learn(warm)
             done, start, start_cpu = model.num_timesteps, time.perf_counter(), time.process_time()
+            env_cpu0 = clock.cpu_s
             model.learn(timesteps, reset_num_timesteps=False)
             rates.append((model.num_timesteps - done) / (time.perf_counter() - start))
             cpu.append(time.process_time() - start_cpu)
+            env_cpu.append(clock.cpu_s - env_cpu0)
             venv.close()
         figures[f"ppo_{label}_env_steps_per_s"] = statistics.median(rates)
         figures[f"ppo_{label}_cpu_s"] = statistics.median(cpu)
         figures[f"ppo_{label}_env_steps_per_cpu_s"] = timesteps / statistics.median(cpu)
+        if kind != "subproc":  # its env runs in the workers, whose CPU is not counted
+            figures[f"ppo_{label}_env_cpu_s"] = statistics.median(env_cpu)
+            figures[f"ppo_{label}_agent_cpu_s"] = statistics.median(
+                [c - e for c, e in zip(cpu, env_cpu, strict=True)]
+            )
     if "batched" in kinds and "dummy" in kinds:
         for label, dummy in (
             ("batched", "dummy"),
@@ -486,6 +524,13 @@ def bench_training(
                 )
                 figures[f"{label}_over_{dummy}_cpu"] = (
                     figures[f"ppo_{dummy}_cpu_s"] / figures[f"ppo_{label}_cpu_s"]
+                )
+                # Amdahl's bound: the CPU ratio if the batched env cost nothing at all
+                figures[f"{label}_over_{dummy}_cpu_bound"] = (
+                    figures[f"ppo_{dummy}_cpu_s"] / figures[f"ppo_{label}_agent_cpu_s"]
+                )
+                figures[f"{label}_over_{dummy}_env_cpu"] = (
+                    figures[f"ppo_{dummy}_env_cpu_s"] / figures[f"ppo_{label}_env_cpu_s"]
                 )
         figures["batched_over_dummy_target"] = BATCHED_OVER_DUMMY_TARGET
     if "batched" in kinds and "subproc" in kinds:

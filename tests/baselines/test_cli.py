@@ -301,3 +301,12 @@ def test_bench_training_compares_equal_widths() -> None:
             / figures[f"ppo_{ratio.split('_over_')[1]}_env_steps_per_s"]
         )
     assert figures["wide_envs"] == 8 and figures["n_envs"] == 4
+    for label in ("batched", "dummy", "batched_wide", "dummy_wide"):  # env + agent = the whole
+        env, agent = figures[f"ppo_{label}_env_cpu_s"], figures[f"ppo_{label}_agent_cpu_s"]
+        assert env > 0 and agent > 0
+        assert env + agent == pytest.approx(figures[f"ppo_{label}_cpu_s"])
+    bound = figures["ppo_dummy_wide_cpu_s"] / figures["ppo_batched_wide_agent_cpu_s"]
+    assert figures["batched_wide_over_dummy_wide_cpu_bound"] == pytest.approx(bound)
+    assert figures["batched_wide_over_dummy_wide_cpu_bound"] > figures[
+        "batched_wide_over_dummy_wide_cpu"
+    ]  # the batched env's own CPU is not zero
