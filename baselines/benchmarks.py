@@ -452,7 +452,9 @@ def bench_training(
     Besides the wall-clock rate, ``…_cpu_s`` is this process's CPU time of the timed part
     (subprocess workers not counted), for loaded machines, split into the env's
     (``…_env_cpu_s``: inside the VecEnv's reset and step) and the agent's
-    (``…_agent_cpu_s``: forward passes, returns, gradient updates); not for SubprocVecEnv.
+    (``…_agent_cpu_s``, the median whole less the median env: forward passes, returns,
+    gradient updates, and VecNormalize's reward scaling, which wraps the env's clock); not
+    for SubprocVecEnv.
     ``…_cpu_bound`` is Amdahl's bound on a ratio: the DummyVecEnv run's CPU over the
     batched run's agent CPU alone (the ratio if the batched env cost nothing);
     ``…_env_cpu`` is the ratio of the two env shares alone.
@@ -508,8 +510,10 @@ def bench_training(
         figures[f"ppo_{label}_env_steps_per_cpu_s"] = timesteps / statistics.median(cpu)
         if kind != "subproc":  # its env runs in the workers, whose CPU is not counted
             figures[f"ppo_{label}_env_cpu_s"] = statistics.median(env_cpu)
-            figures[f"ppo_{label}_agent_cpu_s"] = statistics.median(
-                [c - e for c, e in zip(cpu, env_cpu, strict=True)]
+            # the whole's median less the env's: env + agent = the whole over repeats too
+            # (non-negative: each repeat's env CPU is part of its whole)
+            figures[f"ppo_{label}_agent_cpu_s"] = statistics.median(cpu) - statistics.median(
+                env_cpu
             )
     if "batched" in kinds and "dummy" in kinds:
         for label, dummy in (

@@ -311,3 +311,52 @@ def test_bench_training_compares_equal_widths() -> None:
         figures["batched_wide_over_dummy_wide_cpu_bound"]
         > figures["batched_wide_over_dummy_wide_cpu"]
     )  # the batched env's own CPU is not zero
+
+
+def test_env_clock_counts_the_env_cpu_and_nothing_else() -> None:
+    """The bench's env clock adds up the CPU spent inside the wrapped VecEnv's reset and
+    step (a stub env burning known CPU), not the caller's CPU between the calls."""
+    import time
+
+    import gymnasium as gym
+    import numpy as np
+    from stable_baselines3.common.vec_env import VecEnv
+
+    from shipgym_baselines.benchmarks import _env_clock
+
+    def burn(seconds: float) -> None:
+        end = time.process_time() + seconds
+        while time.process_time() < end:
+            pass
+
+    class Burner(VecEnv):
+        def __init__(self) -> None:
+            box = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+            super().__init__(1, box, box)
+
+        def reset(self):  # type: ignore[override]
+            burn(0.02)
+            return np.zeros((1, 1), np.float32)
+
+        def step_async(self, actions):  # type: ignore[override]
+            burn(0.01)
+
+        def step_wait(self):  # type: ignore[override]
+            burn(0.03)
+            return np.zeros((1, 1), np.float32), np.zeros(1), np.zeros(1, bool), [{}]
+
+        def get_attr(self, name, indices=None):  # type: ignore[override]
+            return [None]  # render_mode, which VecEnv.__init__ asks for
+
+        def close(self) -> None: ...
+        def set_attr(self, name, value, indices=None): ...  # type: ignore[override]
+        def env_method(self, name, *args, indices=None, **kwargs): ...  # type: ignore[override]
+        def env_is_wrapped(self, wrapper_class, indices=None): ...  # type: ignore[override]
+
+    clock = _env_clock(Burner())
+    clock.reset()
+    for _ in range(3):
+        burn(0.05)  # the agent's CPU, outside the env
+        clock.step(np.zeros((1, 1), np.float32))
+    expected = 0.02 + 3 * (0.01 + 0.03)  # 0.14 s inside the env, 0.15 s outside
+    assert expected <= clock.cpu_s < expected + 0.03
