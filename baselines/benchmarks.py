@@ -408,22 +408,21 @@ def _env_clock(venv: Any) -> Any:
     class EnvClock(VecEnvWrapper):
         cpu_s = 0.0
 
-        def reset(self) -> Any:
+        def _timed(self, call: Any, *args: Any) -> Any:
             start = time.process_time()
-            obs = self.venv.reset()
-            self.cpu_s += time.process_time() - start
-            return obs
+            try:
+                return call(*args)
+            finally:
+                self.cpu_s += time.process_time() - start
+
+        def reset(self) -> Any:
+            return self._timed(self.venv.reset)
 
         def step_async(self, actions: np.ndarray) -> None:
-            start = time.process_time()
-            self.venv.step_async(actions)
-            self.cpu_s += time.process_time() - start
+            self._timed(self.venv.step_async, actions)
 
         def step_wait(self) -> Any:
-            start = time.process_time()
-            out = self.venv.step_wait()
-            self.cpu_s += time.process_time() - start
-            return out
+            return self._timed(self.venv.step_wait)
 
     return EnvClock(venv)
 
