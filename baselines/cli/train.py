@@ -129,6 +129,9 @@ def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
 
 def run(args: argparse.Namespace) -> int:
     """Train every job, print one line per run (or the meta(s) with ``--json``)."""
+    from shipgym_baselines.extras import require
+
+    require("stable_baselines3", "rl", "shipgym train")
     from shipgym_baselines.learned.train import train_sweep
 
     metas = train_sweep(training_jobs(args), backend=args.backend, workers=args.workers)

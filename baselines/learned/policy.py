@@ -421,9 +421,10 @@ def load_model(path: Path, algo: str, action_mode: str, context_features: bool =
     try:
         algorithm = getattr(importlib.import_module(module), name)
     except ImportError as exc:
-        package = module.replace("_", "-")
+        from shipgym_baselines.extras import install_hint
+
         raise ControllerError(
-            f"{path}: a {name} model needs {package} (pip install {package}): {exc}"
+            f"{path}: a {name} model needs {module} ({exc}): {install_hint('rl')}"
         ) from exc
     try:
         return load_data_only(path, algorithm, action_mode, context_features)

@@ -10,7 +10,13 @@ every ship, e.g. a learned agent's hyperparameters)::
       mariner: {study: "pid_los:mariner", best_value: 1.83, default_value: 7.2, ...}
 
 :func:`tuned_settings` is what a controller's default construction (``preset="tuned"``)
-reads at reset; :func:`write_chosen` is what ``shipgym tune`` writes when a study ends.
+reads at reset; :func:`write_chosen` is what ``shipgym tune`` writes when a study ends (into
+the study's own folder unless it is promoted: :mod:`~shipgym_baselines.tuning.promotion`).
+
+Each study summary records the validation objective of the settings it chose and, under
+``validation``, the trials it was scored on with their cost ratios and the env and oracle
+revisions: a later study compares its winner with these settings on the same trials
+(paired) before it may replace them.
 """
 
 from __future__ import annotations
@@ -51,6 +57,18 @@ def read_chosen(controller: str, folder: str | os.PathLike | None = None) -> dic
 @functools.cache
 def _packaged(controller: str) -> dict[str, Any]:
     return read_chosen(controller)
+
+
+def section_record(
+    controller: str, section: str, folder: str | os.PathLike | None = None
+) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    """The settings of ``section`` and the summary of the study that chose them, or None
+    when the file has no such section."""
+    data = read_chosen(controller, folder)
+    ships = data.get("ships") or {}
+    if section not in ships:
+        return None
+    return dict(ships[section] or {}), dict((data.get("studies") or {}).get(section) or {})
 
 
 def tuned_settings(controller: str, ship: str) -> dict[str, Any]:

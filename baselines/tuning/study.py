@@ -15,7 +15,10 @@ design, ``preset: paper``; for a learned agent its agent config unchanged) and k
 ratios in the study, so the report can compare best and default on the same trials.  When the study
 ends, its ``tuning_report.json`` is (re)written and the chosen settings — the best trial's,
 or none (the default kept) when the best is not below the default — go into
-``configs/tuning/chosen/<controller>.yaml`` (:mod:`~shipgym_baselines.tuning.chosen`).
+``<out>/chosen/<controller>.yaml`` (:mod:`~shipgym_baselines.tuning.chosen`): the packaged
+``configs/tuning/chosen`` only with ``promote`` (or another folder with ``chosen_dir``).
+Settings already in the target section are replaced only when the winner is not worse on
+the same validation trials, or with ``force`` (:mod:`~shipgym_baselines.tuning.promotion`).
 
 ``backend="ray"`` runs the trials as Ray tasks, ``workers`` at a time, each loading the
 study from the shared storage.
@@ -33,6 +36,7 @@ from typing import Any
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.tuning import chosen as chosen_settings
+from shipgym_baselines.tuning import promotion
 from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
 from shipgym_baselines.tuning.report import best_vs_default, trial_rows
 from shipgym_baselines.tuning.space import TuningConfig, load_tuning
@@ -40,6 +44,8 @@ from shipgym_baselines.tuning.validation import ValidationTrial, oracle_costs, v
 
 REPORT_FILE = "tuning_report.json"
 STORAGE_FILE = "study.db"
+#: the folder under ``--out`` that a study's chosen settings go to unless promoted
+CHOSEN_FOLDER = "chosen"
 BACKENDS = ("local", "ray")
 #: Optuna's states of a finished trial
 FINISHED = ("COMPLETE", "PRUNED", "FAIL")
@@ -49,7 +55,8 @@ Progress = Callable[[str], object]
 
 @dataclasses.dataclass
 class StudyPlan:
-    """What one study runs: config, ship (None: every ship), folder, storage, name."""
+    """What one study runs: config, ship (None: every ship), folder, storage, name, and
+    the folder its chosen settings go to (None: not written, as in a Ray task)."""
 
     tuning: str  # the config's name or path (what a Ray worker reloads)
     config: TuningConfig
@@ -70,12 +77,22 @@ def plan_studies(
     out: str | os.PathLike | None = None,
     storage: str | None = None,
     chosen_dir: str | os.PathLike | None = None,
+    promote: bool = False,
 ) -> list[StudyPlan]:
     """The studies ``shipgym tune`` runs: one per ship for a per-ship config (only ``ship``
-    when given), else one."""
+    when given), else one.  Their chosen settings go to ``<out>/chosen``, the packaged
+    folder with ``promote``, or ``chosen_dir``."""
     config = load_tuning(tuning)
     base = Path(out) if out is not None else Path("results") / "tuning" / config.name
-    chosen = Path(chosen_dir) if chosen_dir is not None else None
+    if promote and chosen_dir is not None:
+        raise RunError(
+            "--promote writes the packaged chosen settings and --chosen-dir another folder: "
+            "give one of them"
+        )
+    if promote:
+        chosen = chosen_settings.chosen_dir()
+    else:
+        chosen = Path(chosen_dir) if chosen_dir is not None else base / CHOSEN_FOLDER
     if not config.per_ship:
         if ship is not None:
             raise RunError(f"--ship: {config.name} is one setting for every ship (per_ship false)")
@@ -108,7 +125,7 @@ def _plan(
     ship: str | None,
     folder: Path,
     storage: str | None,
-    chosen: Path | None,
+    chosen: Path,
 ) -> StudyPlan:
     url = storage or f"sqlite:///{(folder / STORAGE_FILE).absolute()}"
     name = f"{config.name}:{ship}" if ship else config.name
@@ -240,9 +257,11 @@ def run_study(
     backend: str = "local",
     workers: int = 1,
     progress: Progress | None = None,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Run (or continue) one study to ``n_trials`` finished trials (default: the config's
-    budget), then write its report and chosen settings; returns the report."""
+    budget), then write its report and chosen settings (``force``: even over better
+    settings; module doc); returns the report."""
     if backend not in BACKENDS:
         raise RunError(f"--backend {backend!r}: valid: {', '.join(BACKENDS)}")
     total = int(n_trials if n_trials is not None else plan.config.budget)
@@ -267,7 +286,7 @@ def run_study(
                 callbacks=[_progress_callback(plan, progress)],
             )
     study = open_study(plan, resume=True, create=False)
-    return write_report(plan, study, scorer.trials, scorer.oracle)
+    return write_report(plan, study, scorer, force, progress)
 
 
 def _progress_callback(plan: StudyPlan, progress: Progress | None) -> Callable[..., None]:
@@ -288,11 +307,16 @@ def say(progress: Progress | None, text: str) -> None:
 
 
 def write_report(
-    plan: StudyPlan, study: Any, trials: list[ValidationTrial], oracle: list[float]
+    plan: StudyPlan,
+    study: Any,
+    scorer: Scorer,
+    force: bool = False,
+    progress: Progress | None = None,
 ) -> dict[str, Any]:
     """Write ``tuning_report.json`` and the chosen settings (module doc); returns the
     report."""
     config = plan.config
+    trials, oracle = scorer.trials, scorer.oracle
     default = list(study.user_attrs["default_ratios"])
     complete = [t for t in study.trials if t.state.name == "COMPLETE"]
     best = min(complete, key=lambda t: t.value) if complete else None
@@ -343,28 +367,110 @@ def write_report(
         # controller's construction without chosen settings)
         winner = {**config.fixed, **best.params} if improved else dict(config.default)
         settings = {k: v for k, v in winner.items() if k != "preset"}
+        ratios = list(best.user_attrs["ratios"]) if improved else default
         summary = {
             "study": plan.study_name,
             "report": str(plan.folder / REPORT_FILE),
             "best_value": best.value,
             "default_value": report["default_value"],
             "trials": len(study.trials),
+            "value": geometric_mean(ratios),
+            "validation": promotion.validation_record(trials, ratios),
         }
-        file, replaced = chosen_settings.write_chosen(
-            config.controller, plan.section, settings, summary, plan.chosen_dir
-        )
         report["chosen"] = {
-            "file": str(file),
             "section": plan.section,
             "settings": settings,
             "kept_default": not improved,
-            "replaced": replaced,
+            **write_chosen(plan, scorer, settings, ratios, summary, force, progress),
         }
     plan.folder.mkdir(parents=True, exist_ok=True)
     staged = plan.folder / f"{REPORT_FILE}.{os.getpid()}.tmp"
     staged.write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
     os.replace(staged, plan.folder / REPORT_FILE)
     return report
+
+
+def write_chosen(
+    plan: StudyPlan,
+    scorer: Scorer,
+    settings: dict[str, Any],
+    ratios: list[float],
+    summary: dict[str, Any],
+    force: bool,
+    progress: Progress | None,
+) -> dict[str, Any]:
+    """Write the winner's ``settings`` into the plan's chosen folder unless the section
+    there holds settings that are better on the same trials (``force``: write anyway);
+    returns the report's ``chosen`` block: ``file``, ``written``, ``replaced``,
+    ``incumbent`` (the paired comparison, None for a new section) and ``refused``."""
+    if plan.chosen_dir is None:
+        return {"file": None, "written": False, "replaced": None, "incumbent": None}
+    controller = plan.config.controller
+    file = chosen_settings.chosen_file(controller, plan.chosen_dir)
+    where = f"{file} [{plan.section}]"
+    held = chosen_settings.section_record(controller, plan.section, plan.chosen_dir)
+    incumbent = None
+    if held is not None:
+        incumbent = _incumbent(plan, scorer, held, progress)
+        incumbent["comparison"] = promotion.compare(ratios, incumbent.pop("ratios"))
+        if not promotion.not_worse(incumbent["comparison"]) and not force:
+            c = incumbent["comparison"]
+            refused = (
+                f"{plan.study_name}: kept {where}: its settings score {c['incumbent_value']:.4g} "
+                f"on the same {c['trials']} validation trials, this study's winner "
+                f"{c['new_value']:.4g} (lower is better); --force replaces them"
+            )
+            say(progress, refused)
+            return {
+                "file": str(file),
+                "written": False,
+                "replaced": None,
+                "incumbent": incumbent,
+                "refused": refused,
+            }
+    written, replaced = chosen_settings.write_chosen(
+        controller, plan.section, settings, summary, plan.chosen_dir
+    )
+    if incumbent is None:
+        say(progress, f"{plan.study_name}: chosen settings written to {where} (a new section)")
+    else:
+        c = incumbent["comparison"]
+        say(
+            progress,
+            f"{plan.study_name}: replaced {where}: {replaced} (objective "
+            f"{c['incumbent_value']:.4g}) by {settings} ({c['new_value']:.4g}, the same "
+            f"{c['trials']} validation trials)",
+        )
+    return {
+        "file": str(written),
+        "written": True,
+        "replaced": replaced,
+        "incumbent": incumbent,
+        "refused": None,
+    }
+
+
+def _incumbent(
+    plan: StudyPlan,
+    scorer: Scorer,
+    held: tuple[dict[str, Any], dict[str, Any]],
+    progress: Progress | None,
+) -> dict[str, Any]:
+    """The settings a chosen section holds, with their ratios on the study's trials:
+    recorded, or scored now (:mod:`~shipgym_baselines.tuning.promotion`)."""
+    settings, summary = held
+    ratios = promotion.recorded_ratios(summary, scorer.trials)
+    source = "recorded"
+    if ratios is None:
+        say(
+            progress,
+            f"{plan.study_name}: scoring the settings already chosen for {plan.section} on the "
+            f"same {len(scorer.trials)} validation trials (no record on these trials)",
+        )
+        scorer.run_name = "incumbent"
+        ratios = scorer.score(promotion.incumbent_settings(plan.config, settings))
+        source = "scored"
+    return {"settings": settings, "source": source, "study": summary.get("study"), "ratios": ratios}
 
 
 def _jsonable(value: Any) -> Any:

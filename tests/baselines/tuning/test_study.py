@@ -348,3 +348,134 @@ def test_bad_tune_input_is_one_line_naming_it(
     code = main([*argv, "--out", str(tmp_path / "out"), "--chosen-dir", str(tmp_path)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and match in err[0], err
+
+
+def _digests(folder: Path) -> dict[str, str]:
+    import hashlib
+
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in folder.glob("*.yaml")}
+
+
+def test_a_short_study_leaves_the_packaged_settings_byte_identical(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without --promote a study writes its chosen settings into OUT/chosen only."""
+    packaged = _digests(chosen.chosen_dir())
+    out = tmp_path / "out"
+    assert main(["tune", str(tiny), "--out", str(out), "--trials", "1"]) == 0
+    assert _digests(chosen.chosen_dir()) == packaged
+    written = chosen.read_chosen("pid_los", out / "chosen")
+    assert written["studies"]["nomoto2"]["study"] == "pid_los_tiny:nomoto2"
+    record = written["studies"]["nomoto2"]["validation"]
+    assert record["trials"] == ["validation:0"] and len(record["ratios"]) == 1
+    assert f"{out / 'chosen' / 'pid_los.yaml'} [nomoto2]" in capsys.readouterr().err
+
+
+def test_promote_targets_the_packaged_folder_and_excludes_chosen_dir(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "out", promote=True)
+    assert plan.chosen_dir == chosen.chosen_dir()
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "out")
+    assert plan.chosen_dir == tmp_path / "out" / "chosen"
+    with pytest.raises(RunError, match="--promote"):
+        plan_studies(str(tiny), out=tmp_path / "out", chosen_dir=tmp_path, promote=True)
+    argv = ["tune", str(tiny), "--promote", "--chosen-dir", str(tmp_path)]
+    with pytest.raises(SystemExit) as exit_:  # argparse: mutually exclusive
+        main(argv)
+    assert exit_.value.code == 2 and "--chosen-dir" in capsys.readouterr().err
+
+
+def _incumbent_file(folder: Path, ratios: list[float] | None, settings: dict[str, Any]) -> None:
+    """A chosen file whose nomoto2 section holds ``settings``, recorded on the tiny study's
+    trial with ``ratios`` (None: no record)."""
+    from shipgym_baselines.tuning.promotion import revisions
+
+    summary: dict[str, Any] = {"study": "earlier"}
+    if ratios is not None:
+        summary["validation"] = {
+            "trials": ["validation:0"],
+            "seeds": [10000],
+            "ratios": ratios,
+            **revisions(),
+        }
+    chosen.write_chosen("pid_los", "nomoto2", settings, summary, folder)
+
+
+def test_better_recorded_settings_are_kept_unless_force(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Settings recorded at a ratio no study can reach (0.5: half the oracle's cost) on the
+    same trial are kept, the file byte-identical and exit 1; --force replaces them and says
+    what it replaced."""
+    folder = tmp_path / "chosen"
+    incumbent = {"tuning": "pole_placement", "natural_frequency_T": 3.0}
+    _incumbent_file(folder, [0.5], incumbent)
+    before = _digests(folder)
+    argv = ["tune", str(tiny), "--out", str(tmp_path / "a"), "--chosen-dir", str(folder)]
+    assert main([*argv, "--trials", "1", "--json"]) == 1
+    captured = capsys.readouterr()
+    (report,) = json.loads(captured.out)
+    assert _digests(folder) == before
+    block = report["chosen"]
+    assert block["written"] is False and "--force" in block["refused"]
+    assert block["incumbent"]["source"] == "recorded"
+    assert block["incumbent"]["comparison"]["incumbent_value"] == pytest.approx(0.5)
+    assert block["incumbent"]["comparison"]["new_value"] > 0.5
+    assert "not written" in captured.err and "0.5" in captured.err
+    argv[3] = str(tmp_path / "b")
+    assert main([*argv, "--trials", "1", "--force"]) == 0
+    err = capsys.readouterr().err
+    assert "replaced" in err and "natural_frequency_T': 3.0" in err
+    assert chosen.read_chosen("pid_los", folder)["studies"]["nomoto2"]["study"] != "earlier"
+
+
+def test_unrecorded_settings_are_scored_on_the_same_trials(tiny: Path, tmp_path: Path) -> None:
+    """Settings without a record on the study's trials are scored there before the
+    comparison: the incumbent's objective is the controller's ratio with those settings over
+    the paper preset, through the same evaluation loop."""
+    folder = tmp_path / "chosen"
+    incumbent = {"tuning": "pole_placement", "natural_frequency_T": 0.9, "los_radius_L": 5.0}
+    _incumbent_file(folder, None, incumbent)
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "out", chosen_dir=folder)
+    report = run_study(plan, n_trials=1)
+    block = report["chosen"]["incumbent"]
+    assert block["source"] == "scored" and block["settings"] == incumbent
+    trials = validation_trials("validation", "nomoto2", 1)
+    ratios = controller_ratios(
+        "pid_los", {"preset": "paper", **incumbent}, trials, report["validation"]["oracle_costs"]
+    )
+    assert block["comparison"]["incumbent_value"] == pytest.approx(ratios[0], rel=1e-12)
+    expect_written = report["chosen"]["incumbent"]["comparison"]["new_value"] <= ratios[0]
+    assert report["chosen"]["written"] is expect_written
+
+
+def test_the_packaged_records_reproduce_their_ratios() -> None:
+    """A packaged chosen section's recorded validation ratios are what its settings score
+    now (pid_los on nomoto2; the denominators from its report's oracle costs)."""
+    from shipgym_baselines.tuning.promotion import incumbent_settings, recorded_ratios
+
+    settings, summary = chosen.section_record("pid_los", "nomoto2")
+    config = load_tuning("pid_los")
+    v = config.validation
+    trials = validation_trials(v.distribution, "nomoto2", v.per_ship, config.ships)
+    recorded = recorded_ratios(summary, trials)
+    assert recorded is not None and geometric_mean(recorded) == pytest.approx(summary["value"])
+    report = json.loads((Path(__file__).parents[3] / summary["report"]).read_text())
+    oracle = report["validation"]["oracle_costs"]
+    now = controller_ratios("pid_los", incumbent_settings(config, settings), trials, oracle)
+    assert now == pytest.approx(recorded, rel=1e-9)
+
+
+def test_a_missing_extra_is_one_line_naming_the_install(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "optuna" else real(name, *a)
+    )
+    assert main(["tune", "pid_los", "--out", str(tmp_path / "out")]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert 'pip install -e ".[tune]"' in line and "optuna" in line
