@@ -17,10 +17,20 @@ from typing import Any
 
 from sphinx.application import Sphinx
 
-from shipgym_docs import api, cli, controllers, docstrings, envs, scenarios, ships, tutorials
+from shipgym_docs import (
+    api,
+    cli,
+    controllers,
+    docstrings,
+    envs,
+    measurements,
+    scenarios,
+    ships,
+    tutorials,
+)
 
 GENERATED = "_generated"
-GENERATORS = (envs, scenarios, controllers, ships, cli, tutorials, api)
+GENERATORS = (envs, scenarios, controllers, ships, cli, measurements, tutorials, api)
 
 
 def generate(app: Sphinx) -> None:
