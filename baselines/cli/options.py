@@ -27,7 +27,9 @@ def add_vector_option(parser: argparse.ArgumentParser) -> None:
 
 def add_progress_option(parser: argparse.ArgumentParser, help: str | None = None) -> None:
     """``--no-progress``: no progress bar on stderr."""
-    parser.add_argument("--no-progress", action="store_true", help=help)
+    parser.add_argument(
+        "--no-progress", action="store_true", help=help or "no progress bar on stderr"
+    )
 
 
 def add_trust_pickle_option(parser: argparse.ArgumentParser) -> None:
@@ -43,7 +45,12 @@ def add_trust_pickle_option(parser: argparse.ArgumentParser) -> None:
 
 def add_backend_option(parser: argparse.ArgumentParser) -> None:
     """``--backend``: a local process pool or a Ray cluster."""
-    parser.add_argument("--backend", choices=BACKENDS, default="local")
+    parser.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="local",
+        help="where the jobs run: local processes or a Ray cluster",
+    )
 
 
 def add_out_options(

@@ -3,10 +3,10 @@
 At ``builder-inited`` the generators write MyST pages into ``<srcdir>/_generated/`` (ignored by
 git): one page per registered env id (:mod:`.envs`, from the env class's docstring), the
 scenario catalogue with route figures (:mod:`.scenarios`), one page per registered controller
-(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the API reference
-(:mod:`.api`) and the notebooks as
-tutorials (:mod:`.tutorials`).  A page is rewritten only when its text changes, so that an
-incremental build rereads only what moved.
+(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the command-line
+reference (:mod:`.cli`), the recorded measurements (:mod:`.measurements`), the API reference
+(:mod:`.api`) and the notebooks as tutorials (:mod:`.tutorials`).  A page is rewritten only
+when its text changes, so that an incremental build rereads only what moved.
 """
 
 from __future__ import annotations
@@ -17,10 +17,20 @@ from typing import Any
 
 from sphinx.application import Sphinx
 
-from shipgym_docs import api, controllers, docstrings, envs, scenarios, ships, tutorials
+from shipgym_docs import (
+    api,
+    cli,
+    controllers,
+    docstrings,
+    envs,
+    measurements,
+    scenarios,
+    ships,
+    tutorials,
+)
 
 GENERATED = "_generated"
-GENERATORS = (envs, scenarios, controllers, ships, tutorials, api)
+GENERATORS = (envs, scenarios, controllers, ships, cli, measurements, tutorials, api)
 
 
 def generate(app: Sphinx) -> None:

@@ -1,19 +1,29 @@
 """One page per controller: the registry's built-ins and the shipped learned agents.
 
 From the registration (:data:`shipgym_baselines.registry.CONTROLLERS`): kind, the action mode
-(what it drives), the ships it applies to, its settings (the factory's keyword arguments with
-their defaults) and its docstring; a learned agent's page comes from its ``meta.json``.
+(what it drives), the ships it applies to, its settings (the factory's keyword arguments, what
+is used when one is not given: the paper's design, and the value the shipped chosen settings
+give on each ship, ``configs/tuning/chosen/<name>.yaml``, with each study's validation
+objective) and its docstring; a learned agent's page comes from its ``meta.json`` and its
+chosen settings.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import json
 from pathlib import Path
+from typing import Any
 
 from shipgym.models import MODELS
+from shipgym.scenarios.schema import GuidanceConfig
+from shipgym_baselines.classical import lqr, nmpc, pid
+from shipgym_baselines.classical.adaptive.settings import L1BacksteppingSettings
+from shipgym_baselines.classical.l1_backstepping import L1Backstepping
 from shipgym_baselines.learned.policy import POLICY_DIR, shipped_policies
 from shipgym_baselines.registry import CONTROLLERS, ControllerRecord
+from shipgym_baselines.tuning.chosen import ALL_SHIPS, read_chosen
 from shipgym_docs.pages import cell, rst_block, table, write_text
 
 #: module -> the source paper(s) of its controllers (keys of docs/references.bib)
@@ -43,21 +53,156 @@ READS = {
 }
 
 
-def settings(record: ControllerRecord) -> list[tuple[str, str]]:
-    """The factory's keyword arguments and their defaults."""
+def _code(value: object) -> str:
+    return f"`{value!r}`"
+
+
+def paper_values(factory: Any) -> dict[str, str]:
+    """Keyword -> what the controller uses when it is neither given nor chosen (the paper's
+    design, read from the controller's module), for the keywords whose signature default is
+    None or that the factory takes through ``**kwargs``."""
+    if not isinstance(factory, type):
+        return {}
+    if issubclass(factory, pid._GuidedPID):
+        values = {k: _code(v) for k, v in pid.SETTINGS.items() if v is not None}
+        values["preset"] = _code(factory.default_preset)
+        values["tuning"] = _code(factory.default_tuning)
+        values["natural_frequency_T"] = "none: `natural_frequency` [rad/s] is used"
+        for key in pid.GUIDANCE_SETTINGS:
+            default = GuidanceConfig.model_fields[key].default
+            values[key] = f"the scenario's `guidance:` (default {_code(default)})"
+        return values
+    if issubclass(factory, lqr.LQR):
+        return {
+            "a0": "the paper's on mariner, else 1/T of the nominal Nomoto model",
+            "c0": "the paper's on mariner, else K/T of the nominal Nomoto model",
+            "lambda_y": f"{lqr.PAPER_LAMBDA_Y:g}·({lqr.PAPER_SHIP_LENGTH:g} m / L)² [1/m²]",
+            "lambda_psi": _code(lqr.PAPER_LAMBDA_PSI),
+            "lambda_delta": _code(lqr.PAPER_LAMBDA_DELTA),
+            "drift_compensation": _code(False),
+        }
+    if issubclass(factory, nmpc.NMPC):
+        values = {k: f"{_code(1.0)} (the ship's plan)" for k in _NMPC_FACTORS}
+        values["settings"] = "the ship's plan (`ship_plan`; the paper's on nomoto2)"
+        values["excitation_deg"] = _code(0.0)
+        values["drift_compensation"] = _code(False)
+        return values
+    if issubclass(factory, L1Backstepping):
+        values = {f.name: _code(f.default) for f in dataclasses.fields(L1BacksteppingSettings)}
+        values["settings"] = "`L1BacksteppingSettings()` (the paper's)"
+        return values
+    return {}
+
+
+#: the NMPC family's tuned factors (on the ship plan's horizon and weights)
+_NMPC_FACTORS = ("horizon_scale", "cross_track_weight", "heading_weight", "rudder_weight")
+
+
+def chosen_document(record: ControllerRecord) -> tuple[str, dict[str, Any]]:
+    """(whose file, document) of the chosen settings ``record`` reads: its own, else (the
+    NMPC members without a study) those of its ``tuning_name``."""
+    own = read_chosen(record.name)
+    fallback = getattr(record.factory, "tuning_name", None)
+    if not own.get("ships") and fallback and fallback != record.name:
+        return fallback, read_chosen(fallback)
+    return record.name, own
+
+
+def chosen_for(document: dict[str, Any], ship: str) -> dict[str, Any]:
+    """The settings ``ship`` gets from ``document``: its section, else the ``all`` one."""
+    ships = document.get("ships") or {}
+    return dict(ships.get(ship, ships.get(ALL_SHIPS)) or {})
+
+
+def _value(value: object) -> str:
+    """A chosen value: a float to 6 significant digits, anything else as Python writes it."""
+    if isinstance(value, float):
+        return f"`{value:.6g}`"
+    return _code(value)
+
+
+def settings(record: ControllerRecord) -> list[tuple[str, ...]]:
+    """Per keyword of the factory (and per chosen keyword it takes through ``**kwargs``):
+    its default (a None default: what is used, :func:`paper_values`) and each ship's chosen
+    value (``—``: none; the default is used)."""
     factory = record.factory
     target = factory.__init__ if isinstance(factory, type) else factory
     try:
         signature = inspect.signature(target)
     except (TypeError, ValueError):
         return []
+    paper = paper_values(factory)
+    _, document = chosen_document(record)
+    ships = list(MODELS)
+    chosen = {ship: chosen_for(document, ship) for ship in ships}
+    keywords = [
+        name
+        for name, parameter in signature.parameters.items()
+        if name != "self"
+        and parameter.kind not in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
+    ]
+    for ship in ships:
+        keywords += [k for k in chosen[ship] if k not in keywords]
     rows = []
-    for name, parameter in signature.parameters.items():
-        if name == "self" or parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD):
-            continue
-        default = "required" if parameter.default is parameter.empty else repr(parameter.default)
-        rows.append((f"`{name}`", f"`{default}`"))
+    for name in keywords:
+        parameter = signature.parameters.get(name)
+        if parameter is not None and parameter.default is parameter.empty:
+            default = "required"
+        elif parameter is not None and parameter.default is not None:
+            default = _code(parameter.default)
+        else:
+            default = paper.get(name, "`None` (the description says what is used)")
+        values = [_value(chosen[s][name]) if name in chosen[s] else "—" for s in ships]
+        rows.append((f"`{name}`", default, *(values if document.get("ships") else ())))
     return rows
+
+
+def studies(name: str, owner: str, document: dict[str, Any], learned: bool = False) -> str:
+    """The provenance of the chosen settings ``name`` reads (``owner``'s ``document``): per
+    ship its study, trials and validation objective (the tuned settings' and the paper
+    default's), or a sentence that there are none."""
+    if not document.get("ships"):
+        return (
+            "No chosen settings (`configs/tuning/chosen/"
+            f"{name}.yaml` does not exist): every ship gets the defaults.\n"
+        )
+    rows = []
+    for section, study in (document.get("studies") or {}).items():
+        rows.append(
+            (
+                f"`{section}`",
+                f"`{study.get('study', '')}`",
+                study.get("trials", "—"),
+                _objective(study.get("best_value")),
+                _objective(study.get("default_value")),
+                f"`{study['report']}`" if study.get("report") else "—",
+            )
+        )
+    whose = (
+        f"its own, `configs/tuning/chosen/{owner}.yaml`"
+        if owner == name
+        else f"`{owner}`'s, `configs/tuning/chosen/{owner}.yaml` (it has no study of its own)"
+    )
+    reader = (
+        "`shipgym train --settings tuned` reads"
+        if learned
+        else 'the default construction (`preset="tuned"`) reads'
+    )
+    default = "the study's `default:` settings" if learned else "the paper's design"
+    return (
+        f"The chosen settings {reader} are {whose}, written by `shipgym tune` "
+        "([Tuning](../../tuning.md)).  The validation objective is the geometric mean over "
+        "the study's validation trials of the cost ratio C / C_oracle (lower is better): "
+        f"with the chosen settings and with {default} (default).\n\n"
+        + table(
+            ["ship", "study", "trials", "objective: chosen", "objective: default", "report"],
+            rows,
+        )
+    )
+
+
+def _objective(value: object) -> str:
+    return f"{float(value):.3f}" if isinstance(value, int | float) else "—"
 
 
 def _ships(record: ControllerRecord) -> str:
@@ -82,13 +227,31 @@ def page(record: ControllerRecord) -> str:
         f"# {record.name}\n",
         table(["", ""], rows),
         "\n## Settings\n",
-        (table(["keyword", "default"], settings(record)) if settings(record) else "No settings.\n"),
+        _settings_section(record),
         "\nA suite passes them in its long form: "
         f"`{{controller: {record.name}, name: DISPLAY_NAME, settings: {{keyword: value}}}}`.\n",
         "\n## Description\n",
         rst_block(inspect.getdoc(factory) or ""),
     ]
     return "\n".join(parts)
+
+
+def _settings_section(record: ControllerRecord) -> str:
+    rows = settings(record)
+    if not rows:
+        return "No settings.\n"
+    owner, document = chosen_document(record)
+    if not document.get("ships"):
+        return table(["keyword", "default"], rows) + "\n" + studies(record.name, owner, document)
+    header = ["keyword", "default", *(f"chosen: {ship}" for ship in MODELS)]
+    return (
+        "The default is what is used when the keyword is not given and no chosen setting "
+        "applies; a `chosen: SHIP` column is the shipped tuned value on that ship (`—`: none, "
+        "the default is used).  A keyword given explicitly wins over both.\n\n"
+        + table(header, rows)
+        + "\n"
+        + studies(record.name, owner, document)
+    )
 
 
 def learned_page(name: str) -> str:
@@ -108,6 +271,17 @@ def learned_page(name: str) -> str:
         ("config", f"`configs/agents/{name}.yaml`"),
     ]
     hyper = config.get("hyperparams", {})
+    document = read_chosen(name)
+    chosen = chosen_for(document, ALL_SHIPS)
+    tuned = (
+        [
+            "\n## Chosen settings\n",
+            table(["setting", "chosen"], [(f"`{k}`", _value(v)) for k, v in chosen.items()]),
+            "\n" + studies(name, name, document, learned=True),
+        ]
+        if chosen
+        else []
+    )
     return "\n".join(
         [
             f"# {name}\n",
@@ -117,6 +291,7 @@ def learned_page(name: str) -> str:
             table(["name", "value"], [(f"`{k}`", cell(v)) for k, v in hyper.items()]),
             "\n## Policy\n",
             f"`{config.get('policy')}`, `policy_kwargs` = `{config.get('policy_kwargs')}`\n",
+            *tuned,
         ]
     )
 
