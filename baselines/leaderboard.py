@@ -77,6 +77,7 @@ from shipgym_baselines.runs import (
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 from shipgym_baselines.suite import load_suite
+from shipgym_baselines.verdict import folder_verdict, plain_name, verdict
 
 #: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
 COLUMNS = (
@@ -589,7 +590,10 @@ def write_results(
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
         files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
-    pages.write_html(out, rows, board, scores, files, subtitle=subtitle(suite, results))
+    lead = verdict(board, ranked, plain_name)
+    pages.write_html(
+        out, rows, board, scores, files, subtitle=subtitle(suite, results), verdict=lead
+    )
     return rows
 
 
@@ -792,7 +796,8 @@ def ranking_markdown(
     """The head of ``leaderboard.md``: the score in two sentences, the ranking per split
     (and its partial tables), the resolution and the controller × scenario table of cost
     ratios; ``episodes``: the ranked ones (to name the scenarios without the oracle's)."""
-    lines = ["# Leaderboard", "", "## Ranking", ""]
+    lead = verdict(board, episodes)
+    lines = ["# Leaderboard", "", *([lead, ""] if lead else []), "## Ranking", ""]
     if not board:
         return "\n".join([*lines, NO_RANKING, ""])
     lines += [SCORE_EXPLAINED, ""]
@@ -852,8 +857,13 @@ def terminal_summary(folder: str | os.PathLike) -> str:
     ``leaderboard.html``."""
     from shipgym_baselines.pages import PAGE_FILE
 
+    lead = folder_verdict(folder)
     board = json.loads((Path(folder) / AGGREGATE_FILE).read_text())
-    lines = ["## Ranking (cost over the oracle's; lower is better)", ""]
+    lines = [
+        *([lead, ""] if lead else []),
+        "## Ranking (cost over the oracle's; lower is better)",
+        "",
+    ]
     lines += ranking_tables(board) + resolution_lines(board) if board else [NO_RANKING, ""]
     return "\n".join([*lines, f"leaderboard: {Path(folder) / PAGE_FILE}"])
 

@@ -1,5 +1,6 @@
 """``leaderboard.html``: the leaderboard as one self-contained page (issue 13).
 
+It opens with the run's verdict in two sentences (:mod:`shipgym_baselines.verdict`).
 No network: the style sheet and the script are inline and every figure is embedded as a
 data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
 
@@ -22,7 +23,8 @@ click's order) or ``#sort=<column>:asc`` / ``:desc``, where a column is ``contro
 ``kind``, ``iqm:<split>`` or a scenario's name.  Every text from the data (controller
 names are user input: plug-ins) is HTML-escaped.
 
-:func:`write_html` ``(out_dir, rows, aggregate, scores, figures, title=…, subtitle=None)``
+:func:`write_html` ``(out_dir, rows, aggregate, scores, figures, title=…, subtitle=None,
+verdict=None)``
 writes the page and returns its path.
 """
 
@@ -649,14 +651,17 @@ def page(
     figures: Iterable[str | Path] = (),
     title: str = "shipgym leaderboard",
     subtitle: str | None = None,
+    verdict: str | None = None,
 ) -> str:
-    """The page's HTML (module doc)."""
+    """The page's HTML (module doc); ``verdict``: the run's two sentences
+    (:mod:`shipgym_baselines.verdict`), the page's first paragraph."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
         figures, (r["scenario"] for r in rows)
     )
     names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
     names += [c["controller"] for s in scores for c in s["controllers"]]
     sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
+    sub += f'<p id="verdict">{_e(verdict)}</p>' if verdict else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
@@ -696,15 +701,18 @@ def write_html(
     figures: Iterable[str | Path] = (),
     title: str = "shipgym leaderboard",
     subtitle: str | None = None,
+    verdict: str | None = None,
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
     :func:`shipgym_baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
     :mod:`shipgym_baselines.figures`; ``subtitle``: a line under the title (e.g. the suite
-    and seeds).
+    and seeds); ``verdict``: the paragraph the page opens with.
     Returns the page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
-    write_bytes(path, page(rows, aggregate, scores, figures, title, subtitle).encode("utf-8"))
+    write_bytes(
+        path, page(rows, aggregate, scores, figures, title, subtitle, verdict).encode("utf-8")
+    )
     return path

@@ -119,6 +119,33 @@ def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -
     assert all(row["controller"] in html for row in rows)
 
 
+def test_the_smoke_leaderboard_opens_with_its_verdict(smoke: tuple[Path, list[dict]]) -> None:
+    """leaderboard.md, the terminal summary and the page open with the run's two sentences:
+    the catalogue leader of aggregate.json with its IQM, the learned agent's rank."""
+    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.verdict import folder_verdict, plain_name
+
+    out, _ = smoke
+    board = [
+        r for r in json.loads((out / "aggregate.json").read_text()) if r["split"] == "catalogue"
+    ]
+    lead = folder_verdict(out)
+    assert lead is not None
+    first, second = lead.split(". The ")
+    assert first.startswith(
+        f"`{board[0]['controller']}` leads the 2 catalogue scenarios with a cost-ratio IQM of "
+        f"{board[0]['cost_ratio_iqm']:.3f}"
+    )
+    rank = 1 + [r["controller"] for r in board].index("ppo")
+    assert f"the best learned agent, `ppo`, ranks {rank}" in first and "failure rate" in second
+    assert (out / "leaderboard.md").read_text().startswith(f"# Leaderboard\n\n{lead}\n\n")
+    assert terminal_summary(out).startswith(f"{lead}\n\n## Ranking")
+    html = (out / "leaderboard.html").read_text()
+    plain = folder_verdict(out, plain_name)
+    assert plain is not None and plain.replace("'", "&#x27;") in html
+    assert html.index('id="verdict"') < html.index('id="ranking"')
+
+
 def test_run_replays_the_leaderboards_trial(
     smoke: tuple[Path, list[dict]], tmp_path: Path, capsys
 ) -> None:

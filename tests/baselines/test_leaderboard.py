@@ -184,7 +184,8 @@ def test_the_same_episodes_give_the_same_aggregate_json_bit_for_bit(
 
 def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
     text = (ranked / "leaderboard.md").read_text()
-    assert text.startswith("# Leaderboard\n\n## Ranking\n\nAn episode's cost is the sum")
+    assert text.startswith("# Leaderboard\n\n`pid_los` is the only ranked controller")  # verdict
+    assert "\n\n## Ranking\n\nAn episode's cost is the sum" in text
     ranking, rest = text.split("## Cost ratio per scenario", 1)
     assert "### Catalogue scenarios (2, the same for every controller)" in ranking
     assert "| rank | controller | kind | training seeds | scenarios | cost ratio IQM" in ranking
@@ -196,6 +197,32 @@ def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
     assert "| pid_los | 1.250 [1.250, 1.250] | 1.250 [1.250, 1.250] |" in scores
     assert "| oracle (cost) |" in scores
     assert "| rudder_aging | zero_rudder | reference | 3 |" in rows
+
+
+def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
+    randomised: Path, ranked: Path
+) -> None:
+    """The run's two sentences (shipgym_baselines.verdict) first; a report folder (no
+    episodes of its own) prints those its leaderboard.md opens with; no ranking: none."""
+    from shipgym_baselines.leaderboard import terminal_summary
+
+    verdict = (
+        "`pid_los` is the only ranked controller on the 2 catalogue scenarios, with a "
+        "cost-ratio IQM of 1.250 [1.250, 1.250] (1 = the oracle's cost, lower is better); no "
+        "learned agent is ranked. The failure rate (episodes ending outside the corridor or "
+        "non-finite) of `pid_los` is 0 %: none of its episodes failed."
+    )
+    assert (ranked / "leaderboard.md").read_text().startswith(f"# Leaderboard\n\n{verdict}\n\n")
+    assert terminal_summary(ranked).startswith(f"{verdict}\n\n## Ranking")
+    html = (ranked / "leaderboard.html").read_text()
+    plain = verdict.replace("`", "").replace("'", "&#x27;")
+    assert f'<p id="verdict">{plain}</p><h2 id="ranking">' in html
+    assert html.index('id="verdict"') < html.index("<table")
+    assert (
+        "leads" not in terminal_summary(randomised)
+        and 'id="verdict"' not in (randomised / "leaderboard.html").read_text()
+    )
+    assert "only ranked" not in (randomised / "leaderboard.md").read_text()
 
 
 def test_trials_are_reproducible_per_seed_and_differ_across_seeds(
