@@ -139,7 +139,11 @@ class ReferenceTable:
         file.parent.mkdir(parents=True, exist_ok=True)
         data = {**oracle_header(), "entries": dict(sorted(self.entries.items()))}
         staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
-        with open(staged, "wb") as raw, gzip.GzipFile(fileobj=raw, mode="wb", mtime=0) as f:
+        # no file name or time in the gzip header: the same entries give the same bytes
+        with (
+            open(staged, "wb") as raw,
+            gzip.GzipFile(filename="", fileobj=raw, mode="wb", mtime=0) as f,
+        ):
             f.write(json.dumps(data, allow_nan=False).encode())
         os.replace(staged, file)
         return file
@@ -262,14 +266,16 @@ def lookup(
 
 # --- announcing a computation ----------------------------------------------------------------
 
-#: an oracle episode's CPU seconds per control step, by ship: the validation split's 32
-#: episodes (``shipgym references --validation --workers 1``, a cold compilation cache: the
-#: C compilation of each trial's solver included), total CPU over total steps per ship
+#: the oracle's CPU seconds per control step of a trial at its full length (time limit over
+#: control period), by ship: the validation split's 8 episodes per ship (``shipgym references
+#: --validation --workers 1``, a cold compilation cache), the oracle's CPU and its C
+#: compilations' (each trial's solver is compiled anew) over the full-length steps; episodes
+#: that reach the goal early cost less
 ORACLE_CPU_S_PER_STEP: dict[str, float] = {
-    "nomoto2": 0.0066,
-    "esso_osaka": 0.028,
-    "mariner": 0.005,
-    "blanke": 0.007,
+    "nomoto2": 0.0026,  # 3.9 CPU s (2.6 of it gcc) for 1512 steps
+    "esso_osaka": 0.0133,  # 135.0 CPU s (84.3 gcc) for 10136 steps
+    "mariner": 0.0023,  # 48.3 CPU s (10.2 gcc) for 20683 steps
+    "blanke": 0.0039,  # 87.1 CPU s (12.8 gcc) for 22595 steps
 }
 
 

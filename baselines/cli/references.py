@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
     from shipgym_baselines.privileged import ORACLE
-    from shipgym_baselines.references import ReferenceTable
+    from shipgym_baselines.references import ReferenceTable, announce
     from shipgym_baselines.suite import load_suite
 
     table = ReferenceTable.load(args.table)
@@ -78,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
             elif (v.name, v.seed) not in trial_of:
                 trial_of[(v.name, v.seed)] = v.scenario
                 jobs.append(job)
+    announce(list(trial_of.values()), f"written to {table.path} after each")
     start = time.perf_counter()
     done = 0
     with closing(iter_results(jobs, "local", args.workers or os.cpu_count() or 1)) as results:
