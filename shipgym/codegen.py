@@ -5,8 +5,9 @@ compiled by a C compiler runs 5–8× faster.  :func:`compiled` generates the C 
 it, compiles it with ``gcc -O1`` into :func:`cache_dir` unless a library with that hash is
 already there, and loads it with ``casadi.external``.  A compilation that is needed is
 announced first, in one line on stderr (what, an estimate of its seconds from the size of
-the C code, where it is cached).  Without a compiler, or if anything fails, it returns the
-original function (same results, slower) and says why once through ``warnings``.
+the C code: :func:`compile_seconds`, where it is cached).  Without a compiler, or if
+anything fails, it returns the original function (same results, slower) and says why once
+through ``warnings``.
 
 The per-user cache folder (:func:`user_cache_dir`) is ``$SHIPGYM_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``; compiled libraries sit at its top
@@ -29,10 +30,13 @@ import casadi as ca
 
 #: the environment variable naming the per-user cache folder
 CACHE_DIR_ENV = "SHIPGYM_CACHE_DIR"
-#: gcc -O1's speed on CasADi's generated C [bytes of source per second]: 100–190 kB/s
-#: measured on the project's 2-core machine (the plants and the oracle's solvers); the slow
-#: end, so an announced estimate is rather long than short
+#: gcc -O1's speed on CasADi's generated C up to :data:`COMPILE_LINEAR_BYTES` of source
+#: [bytes/s]: 100–270 kB/s measured on the project's 2-core machine (the plants and the
+#: oracle's and NMPC's solvers); the slow end, so an estimate is rather long than short
 COMPILE_BYTES_PER_S = 100e3
+#: beyond this size [bytes] a file compiles more slowly, in proportion to its size (the
+#: NMPC's 2.5 MB Jacobian of nomoto2's paper settings: 47 s, 52 kB/s)
+COMPILE_LINEAR_BYTES = 1.2e6
 
 
 def user_cache_dir() -> Path:
@@ -50,6 +54,11 @@ def cache_dir() -> Path:
     if os.environ.get("SHIPGYM_CACHE"):
         return Path(os.environ["SHIPGYM_CACHE"])
     return user_cache_dir()
+
+
+def compile_seconds(size: int) -> float:
+    """The estimated seconds to compile ``size`` bytes of C (one file)."""
+    return size / COMPILE_BYTES_PER_S * max(1.0, size / COMPILE_LINEAR_BYTES)
 
 
 def compile_message(what: str, seconds: float, folder: Path) -> str:
@@ -95,9 +104,9 @@ def compiled_all(
             else:
                 todo.append((i, source, target))
         if todo:
-            size = sum(source.stat().st_size for _, source, _ in todo)
+            seconds = sum(compile_seconds(source.stat().st_size) for _, source, _ in todo)
             name = what or ", ".join(functions[i].name() for i, _, _ in todo)
-            sys.stderr.write(compile_message(name, size / COMPILE_BYTES_PER_S, cache_dir()) + "\n")
+            sys.stderr.write(compile_message(name, seconds, cache_dir()) + "\n")
             sys.stderr.flush()
         for i, source, target in todo:
             out[i] = _build(functions[i], compiler, flags, source, target)

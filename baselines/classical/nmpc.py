@@ -151,7 +151,8 @@ class NMPCSolver:
         jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.densify(ca.jacobian(rho, u))])
         if s.compile:
             residual, jacobian = compiled_all(
-                [residual, jacobian], what=f"the NMPC's {model.name} solver"
+                [residual, jacobian],
+                what=f"the NMPC's solver ({s.horizon} intervals of {s.interval} periods)",
             )
         self._u = np.zeros(s.control_horizon)
         self._p = np.zeros(nx + 4 + npar + N_WEIGHTS)
