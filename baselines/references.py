@@ -41,14 +41,13 @@ import hashlib
 import json
 import math
 import os
-import sys
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from shipgym.codegen import user_cache_dir
+from shipgym.codegen import notice, user_cache_dir
 from shipgym.envs.core import ENV_REVISION
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
@@ -305,8 +304,7 @@ def announce(trials: Sequence[Scenario], where: str) -> None:
     if not trials:
         return
     n = len(trials)
-    sys.stderr.write(
+    notice(
         f"shipgym: computing {n} oracle reference{'s' if n != 1 else ''} "
-        f"(≈ {duration(estimate_cpu_s(trials))} CPU; {where})\n"
+        f"(≈ {duration(estimate_cpu_s(trials))} CPU; {where})"
     )
-    sys.stderr.flush()

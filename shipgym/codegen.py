@@ -56,6 +56,14 @@ def cache_dir() -> Path:
     return user_cache_dir()
 
 
+def notice(line: str) -> None:
+    """Write ``line`` on stderr, on a line of its own: on a terminal the line a progress
+    bar is drawing is cleared first (the bar draws itself again below)."""
+    clear = "\r\x1b[K" if sys.stderr.isatty() else ""
+    sys.stderr.write(f"{clear}{line}\n")
+    sys.stderr.flush()
+
+
 def compile_seconds(size: int) -> float:
     """The estimated seconds to compile ``size`` bytes of C (one file)."""
     return size / COMPILE_BYTES_PER_S * max(1.0, size / COMPILE_LINEAR_BYTES)
@@ -106,8 +114,7 @@ def compiled_all(
         if todo:
             seconds = sum(compile_seconds(source.stat().st_size) for _, source, _ in todo)
             name = what or ", ".join(functions[i].name() for i, _, _ in todo)
-            sys.stderr.write(compile_message(name, seconds, cache_dir()) + "\n")
-            sys.stderr.flush()
+            notice(compile_message(name, seconds, cache_dir()))
         for i, source, target in todo:
             out[i] = _build(functions[i], compiler, flags, source, target)
     return [f for f in out if f is not None]
