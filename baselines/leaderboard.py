@@ -226,7 +226,8 @@ def announce_references(jobs: Iterable[Job]) -> None:
     """One line on stderr before the oracle's episodes of ``jobs`` that are computed, not
     read (a trial neither table holds; every trial with ``--recompute-references``): how
     many, the estimated CPU time."""
-    cache, pending, where = ReferenceCache(), [], f"once: cached in {ReferenceCache().path}"
+    cache, pending = ReferenceCache(), []
+    where = f"once: cached in {cache.path}"
     for job in jobs:
         if not grants_truth(job.controller):
             continue
