@@ -64,7 +64,7 @@ from shipgym_baselines.ranking import (
     row_intervals,
 )
 from shipgym_baselines.ranking import scenario_scores as score_table
-from shipgym_baselines.references import result_from_entry, shipped_table
+from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
 from shipgym_baselines.runs import (
     BACKENDS,
@@ -209,16 +209,36 @@ def run_batch(job: Job) -> list[EpisodeResult]:
 
 def reference_work(job: Job) -> list[EpisodeResult]:
     """The oracle's episodes of ``job``: each trial's entry of the shipped reference table
-    (:mod:`shipgym_baselines.references`), the oracle run for a trial the table lacks."""
-    table = shipped_table()
-    out = []
+    or of the per-user cache (:mod:`shipgym_baselines.references`), the oracle run for a
+    trial both lack (and stored in the cache)."""
+    cache, out = ReferenceCache(), []
     for seed, trial in zip(job.seeds, trials(job), strict=True):
-        entry = table.lookup(trial, seed)
+        entry = lookup(trial, seed, cache)
         if entry is not None:
             out.append(result_from_entry(entry, job.scenario, seed))
         else:
-            out += _named(evaluation.evaluate(job.controller, trial, [seed]), job)
+            (result,) = _named(evaluation.evaluate(job.controller, trial, [seed]), job)
+            cache.store(trial, result)
+            out.append(result)
     return out
+
+
+def announce_references(jobs: Iterable[Job]) -> None:
+    """One line on stderr before the oracle's episodes of ``jobs`` that are computed, not
+    read (a trial neither table holds; every trial with ``--recompute-references``): how
+    many, the estimated CPU time."""
+    cache, pending = ReferenceCache(), []
+    where = f"once: cached in {cache.path}"
+    for job in jobs:
+        if not grants_truth(job.controller):
+            continue
+        for seed, trial in zip(job.seeds, trials(job), strict=True):
+            if job.references == "recompute":
+                pending.append(trial)
+                where = "--recompute-references: every trial, the cache neither read nor written"
+            elif lookup(trial, seed, cache) is None:
+                pending.append(trial)
+    announce(pending, where)
 
 
 def work(job: Job) -> list[EpisodeResult]:
@@ -439,6 +459,7 @@ def run_leaderboard(
     )
     with log.recording():  # holds out_dir's lock to the end
         todo = longest_first(missing(jobs, log.done), scenarios)
+        announce_references(todo)
         rows = row_keys(jobs)
         bar = tqdm(
             total=n_episodes,

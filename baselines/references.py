@@ -18,24 +18,39 @@ The leaderboard reads an entry for each oracle episode and runs the oracle only 
 missing from the table (``--recompute-references``: for every trial); ``shipgym references``
 fills the table (resumable: it writes after every episode).  A table of another env revision
 or other oracle settings is ignored as a whole (every trial is then computed).
+
+A trial the shipped table lacks (an own scenario, a suite's extra seeds) is computed once per
+user: :class:`ReferenceCache` keeps its entry in a table of the same format at
+:func:`user_cache_path`, ``references/oracle.json.gz`` in the per-user cache folder
+(:func:`shipgym.codegen.user_cache_dir`: ``$SHIPGYM_CACHE_DIR``, else
+``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``).  Lookups go shipped table → user
+cache → compute and store.  Several processes may store at once: each store re-reads the
+file, merges and replaces it atomically under an exclusive lock (``fcntl.lockf`` on a
+``.lock`` file beside it).  Before computing, :func:`announce` says how many and an estimate
+of their CPU time (:data:`ORACLE_CPU_S_PER_STEP`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import fcntl
 import functools
 import gzip
 import hashlib
 import json
+import math
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from shipgym.codegen import notice, user_cache_dir
 from shipgym.envs.core import ENV_REVISION
 from shipgym.scenarios import Scenario
+from shipgym_baselines.errors import RunError
 from shipgym_baselines.runs import _number, _plain
 
 if TYPE_CHECKING:
@@ -115,11 +130,7 @@ class ReferenceTable:
 
     def add(self, scenario: Scenario, result: EpisodeResult) -> None:
         """Record the oracle's episode ``result`` of ``scenario`` (a trial)."""
-        self.entries[entry_key(scenario, result.seed)] = {
-            "scenario": result.scenario,
-            "metrics": _plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
-            "trace": thin_trace(result.trajectory),
-        }
+        self.entries[entry_key(scenario, result.seed)] = table_entry(result)
 
     def save(self, path: str | os.PathLike | None = None) -> Path:
         """Write the table atomically (sorted keys: the same entries give the same bytes)."""
@@ -127,10 +138,23 @@ class ReferenceTable:
         file.parent.mkdir(parents=True, exist_ok=True)
         data = {**oracle_header(), "entries": dict(sorted(self.entries.items()))}
         staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
-        with open(staged, "wb") as raw, gzip.GzipFile(fileobj=raw, mode="wb", mtime=0) as f:
+        # no file name or time in the gzip header: the same entries give the same bytes
+        with (
+            open(staged, "wb") as raw,
+            gzip.GzipFile(filename="", fileobj=raw, mode="wb", mtime=0) as f,
+        ):
             f.write(json.dumps(data, allow_nan=False).encode())
         os.replace(staged, file)
         return file
+
+
+def table_entry(result: EpisodeResult) -> dict[str, Any]:
+    """The table's entry of the oracle's episode ``result``."""
+    return {
+        "scenario": result.scenario,
+        "metrics": _plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
+        "trace": thin_trace(result.trajectory),
+    }
 
 
 @functools.lru_cache(maxsize=1)
@@ -160,3 +184,127 @@ def missing_trials(
 ) -> list[tuple[Scenario, int]]:
     """The (trial, seed) pairs the table does not hold."""
     return [(sc, seed) for sc, seed in trials if table.lookup(sc, seed) is None]
+
+
+# --- the per-user cache ----------------------------------------------------------------------
+
+
+def user_cache_path() -> Path:
+    """The per-user cache of computed references (module doc)."""
+    return user_cache_dir() / "references" / TABLE_FILE
+
+
+@contextlib.contextmanager
+def _locked(file: Path) -> Iterator[None]:
+    """Hold the exclusive lock of ``file`` (on ``<file>.lock``; waits for another holder)."""
+    file.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(file.with_name(file.name + ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.lockf(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+class ReferenceCache:
+    """The per-user cache (module doc): a :class:`ReferenceTable` file, re-read when another
+    process replaced it, stored to under a lock.  ``path``: its file (default:
+    :func:`user_cache_path`)."""
+
+    def __init__(self, path: str | os.PathLike | None = None) -> None:
+        self.path = Path(path) if path is not None else user_cache_path()
+        self._table = ReferenceTable({}, self.path)
+        self._stamp: tuple[int, int, int] | None = None
+
+    def _load(self) -> ReferenceTable:
+        """The table as on disk now (read again only when the file changed)."""
+        try:
+            stat = self.path.stat()
+        except FileNotFoundError:
+            self._table, self._stamp = ReferenceTable({}, self.path), None
+            return self._table
+        stamp = (stat.st_ino, stat.st_mtime_ns, stat.st_size)
+        if stamp != self._stamp:
+            try:
+                self._table = ReferenceTable.load(self.path)
+            except (OSError, EOFError, ValueError) as exc:
+                raise RunError(
+                    f"the reference cache {self.path} is unreadable ({exc}): delete it "
+                    "(it holds only computed references, computed again when needed)"
+                ) from None
+            self._stamp = stamp
+        return self._table
+
+    def lookup(self, scenario: Scenario, seed: int) -> dict[str, Any] | None:
+        return self._load().lookup(scenario, seed)
+
+    def store(self, scenario: Scenario, result: EpisodeResult) -> dict[str, Any]:
+        """Add the oracle's episode ``result`` of ``scenario``: re-read, merge and replace
+        the file under its lock (entries stored meanwhile by other processes are kept; a
+        file of another revision is replaced).  Returns the entry."""
+        entry = table_entry(result)
+        with _locked(self.path):
+            self._stamp = None  # read what is on disk now
+            table = self._load()
+            table.entries[entry_key(scenario, result.seed)] = entry
+            table.save(self.path)
+            stat = self.path.stat()
+            self._stamp = (stat.st_ino, stat.st_mtime_ns, stat.st_size)
+        return entry
+
+
+def lookup(
+    scenario: Scenario, seed: int, cache: ReferenceCache | None = None
+) -> dict[str, Any] | None:
+    """The trial's entry: the shipped table's, else the user cache's (None: neither)."""
+    entry = shipped_table().lookup(scenario, seed)
+    if entry is None and cache is not None:
+        entry = cache.lookup(scenario, seed)
+    return entry
+
+
+# --- announcing a computation ----------------------------------------------------------------
+
+#: the oracle's CPU seconds per control step of a trial at its full length (time limit over
+#: control period), by ship: the validation split's 8 episodes per ship (``shipgym references
+#: --validation --workers 1``, a cold compilation cache), the oracle's CPU and its C
+#: compilations' (each trial's solver is compiled anew) over the full-length steps; episodes
+#: that reach the goal early cost less
+ORACLE_CPU_S_PER_STEP: dict[str, float] = {
+    "nomoto2": 0.0026,  # 3.9 CPU s (2.6 of it gcc) for 1512 steps
+    "esso_osaka": 0.0133,  # 135.0 CPU s (84.3 gcc) for 10136 steps
+    "mariner": 0.0023,  # 48.3 CPU s (10.2 gcc) for 20683 steps
+    "blanke": 0.0039,  # 87.1 CPU s (12.8 gcc) for 22595 steps
+}
+
+
+def estimate_cpu_s(trials: Iterable[Scenario]) -> float:
+    """The oracle's estimated CPU seconds on ``trials`` (each at its full length; a ship
+    not measured at the slowest ship's rate)."""
+    slowest = max(ORACLE_CPU_S_PER_STEP.values())
+    total = 0.0
+    for trial in trials:
+        steps = math.ceil(trial.config.time_limit / trial.control_period)
+        total += steps * ORACLE_CPU_S_PER_STEP.get(trial.model.name, slowest)
+    return total
+
+
+def duration(seconds: float) -> str:
+    """``seconds`` for a person: "40 s", "3 min", "1.5 h"."""
+    if seconds < 90:
+        return f"{max(seconds, 1):.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def announce(trials: Sequence[Scenario], where: str) -> None:
+    """One line on stderr before the oracle runs on ``trials``: how many, the estimated CPU
+    time, ``where`` the results go."""
+    if not trials:
+        return
+    n = len(trials)
+    notice(
+        f"shipgym: computing {n} oracle reference{'s' if n != 1 else ''} "
+        f"(≈ {duration(estimate_cpu_s(trials))} CPU; {where})"
+    )

@@ -2,10 +2,16 @@
 
 CasADi's virtual machine evaluates an SX graph at a few ns per instruction; the same graph
 compiled by a C compiler runs 5–8× faster.  :func:`compiled` generates the C code, hashes
-it, compiles it with ``gcc -O1`` into ``$SHIPGYM_CACHE`` (default ``~/.cache/shipgym``)
-unless a library with that hash is already there, and loads it with ``casadi.external``.
-Without a compiler, or if anything fails, it returns the original function (same results,
-slower) and says why once through ``warnings``.
+it, compiles it with ``gcc -O1`` into :func:`cache_dir` unless a library with that hash is
+already there, and loads it with ``casadi.external``.  A compilation that is needed is
+announced first, in one line on stderr (what, an estimate of its seconds from the size of
+the C code: :func:`compile_seconds`, where it is cached).  Without a compiler, or if
+anything fails, it returns the original function (same results, slower) and says why once
+through ``warnings``.
+
+The per-user cache folder (:func:`user_cache_dir`) is ``$SHIPGYM_CACHE_DIR`` if set, else
+``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``; compiled libraries sit at its top
+(``$SHIPGYM_CACHE``, if set, names their folder alone).  Deleting the folder clears it.
 """
 
 from __future__ import annotations
@@ -14,45 +20,134 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import casadi as ca
 
+#: the environment variable naming the per-user cache folder
+CACHE_DIR_ENV = "SHIPGYM_CACHE_DIR"
+#: gcc -O1's speed on CasADi's generated C up to :data:`COMPILE_LINEAR_BYTES` of source
+#: [bytes/s]: 100–270 kB/s measured on the project's 2-core machine (the plants and the
+#: oracle's and NMPC's solvers); the slow end, so an estimate is rather long than short
+COMPILE_BYTES_PER_S = 100e3
+#: beyond this size [bytes] a file compiles more slowly, in proportion to its size (the
+#: NMPC's 2.5 MB Jacobian of nomoto2's paper settings: 47 s, 52 kB/s)
+COMPILE_LINEAR_BYTES = 1.2e6
+
+
+def user_cache_dir() -> Path:
+    """The per-user cache folder: ``$SHIPGYM_CACHE_DIR``, else ``$XDG_CACHE_HOME/shipgym``,
+    else ``~/.cache/shipgym``."""
+    if os.environ.get(CACHE_DIR_ENV):
+        return Path(os.environ[CACHE_DIR_ENV])
+    if os.environ.get("XDG_CACHE_HOME"):
+        return Path(os.environ["XDG_CACHE_HOME"]) / "shipgym"
+    return Path.home() / ".cache" / "shipgym"
+
 
 def cache_dir() -> Path:
-    return Path(os.environ.get("SHIPGYM_CACHE", Path.home() / ".cache" / "shipgym"))
+    """The compiled libraries' folder: ``$SHIPGYM_CACHE`` if set, else :func:`user_cache_dir`."""
+    if os.environ.get("SHIPGYM_CACHE"):
+        return Path(os.environ["SHIPGYM_CACHE"])
+    return user_cache_dir()
 
 
-def compiled(function: ca.Function, flags: tuple[str, ...] = ("-O1",)) -> ca.Function:
-    """``function`` compiled to a cached shared library, or itself if that is impossible."""
+def notice(line: str) -> None:
+    """Write ``line`` on stderr, on a line of its own: on a terminal the line a progress
+    bar is drawing is cleared first (the bar draws itself again below)."""
+    clear = "\r\x1b[K" if sys.stderr.isatty() else ""
+    sys.stderr.write(f"{clear}{line}\n")
+    sys.stderr.flush()
+
+
+def compile_seconds(size: int) -> float:
+    """The estimated seconds to compile ``size`` bytes of C (one file)."""
+    return size / COMPILE_BYTES_PER_S * max(1.0, size / COMPILE_LINEAR_BYTES)
+
+
+def compile_message(what: str, seconds: float, folder: Path) -> str:
+    """The line announcing a compilation of ``what`` estimated at ``seconds`` [s]."""
+    return (
+        f"shipgym: compiling {what} to C (one-off, ≈ {max(seconds, 1):.0f} s; cached in {folder})"
+    )
+
+
+def compiled(
+    function: ca.Function, flags: tuple[str, ...] = ("-O1",), what: str | None = None
+) -> ca.Function:
+    """``function`` compiled to a cached shared library, or itself if that is impossible;
+    ``what``: its name in the announcement (default: the function's)."""
+    return compiled_all([function], flags, what)[0]
+
+
+def compiled_all(
+    functions: Sequence[ca.Function], flags: tuple[str, ...] = ("-O1",), what: str | None = None
+) -> list[ca.Function]:
+    """Each of ``functions`` as :func:`compiled` makes it; the compilations that are needed
+    announced together in one line."""
     compiler = shutil.which("gcc") or shutil.which("cc")
     if compiler is None or os.environ.get("SHIPGYM_NO_COMPILE"):
-        return function
+        return list(functions)
+    out: list[ca.Function | None] = [None] * len(functions)
+    with tempfile.TemporaryDirectory() as tmp:
+        todo = []  # (index, source, target) of the libraries not cached yet
+        for i, function in enumerate(functions):
+            try:
+                folder = Path(tmp) / str(i)
+                folder.mkdir()
+                generator = ca.CodeGenerator(f"{function.name()}.c", {"with_header": False})
+                generator.add(function)
+                source = Path(generator.generate(str(folder) + os.sep))
+                key = hashlib.sha256(source.read_bytes() + " ".join(flags).encode())
+                target = cache_dir() / f"{function.name()}_{key.hexdigest()[:20]}.so"
+            except (OSError, RuntimeError) as exc:
+                out[i] = _fallback(function, exc)
+                continue
+            if target.exists():
+                out[i] = _load(function, target)
+            else:
+                todo.append((i, source, target))
+        if todo:
+            seconds = sum(compile_seconds(source.stat().st_size) for _, source, _ in todo)
+            name = what or ", ".join(functions[i].name() for i, _, _ in todo)
+            notice(compile_message(name, seconds, cache_dir()))
+        for i, source, target in todo:
+            out[i] = _build(functions[i], compiler, flags, source, target)
+    return [f for f in out if f is not None]
+
+
+def _build(
+    function: ca.Function, compiler: str, flags: tuple[str, ...], source: Path, target: Path
+) -> ca.Function:
+    """``function`` compiled from ``source`` into ``target`` and loaded (or itself)."""
     try:
-        with tempfile.TemporaryDirectory() as tmp:
-            generator = ca.CodeGenerator(f"{function.name()}.c", {"with_header": False})
-            generator.add(function)
-            source = Path(generator.generate(tmp + os.sep))
-            code = source.read_bytes()
-            key = hashlib.sha256(code + " ".join(flags).encode()).hexdigest()[:20]
-            target = cache_dir() / f"{function.name()}_{key}.so"
-            if not target.exists():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                partial = Path(tmp) / "lib.so"
-                subprocess.run(
-                    [compiler, "-shared", "-fPIC", *flags, str(source), "-o", str(partial)],
-                    check=True,
-                    capture_output=True,
-                )
-                # atomic publish: concurrent processes may compile the same library
-                staged = target.with_suffix(f".{os.getpid()}.tmp")
-                shutil.copy(partial, staged)
-                os.replace(staged, target)
-        return ca.external(function.name(), str(target))
-    except (OSError, subprocess.CalledProcessError, RuntimeError) as exc:
-        warnings.warn(
-            f"could not compile {function.name()} ({exc}); using CasADi's VM", stacklevel=2
+        target.parent.mkdir(parents=True, exist_ok=True)
+        partial = source.with_name("lib.so")
+        subprocess.run(
+            [compiler, "-shared", "-fPIC", *flags, str(source), "-o", str(partial)],
+            check=True,
+            capture_output=True,
         )
-        return function
+        # atomic publish: concurrent processes may compile the same library
+        staged = target.with_suffix(f".{os.getpid()}.tmp")
+        shutil.copy(partial, staged)
+        os.replace(staged, target)
+    except (OSError, subprocess.CalledProcessError, RuntimeError) as exc:
+        return _fallback(function, exc)
+    return _load(function, target)
+
+
+def _load(function: ca.Function, target: Path) -> ca.Function:
+    try:
+        return ca.external(function.name(), str(target))
+    except RuntimeError as exc:
+        return _fallback(function, exc)
+
+
+def _fallback(function: ca.Function, exc: Exception) -> ca.Function:
+    warnings.warn(f"could not compile {function.name()} ({exc}); using CasADi's VM", stacklevel=4)
+    return function

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from shipgym import codegen
+
 #: folders of the working directory that commands write into by default (``results/…``)
 DEFAULT_OUTPUTS = ("results",)
 
@@ -34,3 +36,14 @@ def leaves_no_trace(request: pytest.FixtureRequest) -> Iterator[None]:
     yield
     new = sorted(working_directory_listing(root) - before)
     assert not new, f"{request.node.nodeid} wrote into the working directory {root}: {new}"
+
+
+@pytest.fixture(autouse=True)
+def user_cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The per-user cache (``$SHIPGYM_CACHE_DIR``) in a fresh temporary folder, so that no
+    test reads or writes the real one; compiled C libraries stay in the machine's cache
+    (``$SHIPGYM_CACHE`` pinned to it), so that tests do not compile again."""
+    monkeypatch.setenv("SHIPGYM_CACHE", str(codegen.cache_dir()))
+    folder = tmp_path_factory.mktemp("user_cache")
+    monkeypatch.setenv(codegen.CACHE_DIR_ENV, str(folder))
+    return folder

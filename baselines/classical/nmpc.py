@@ -50,7 +50,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from shipgym.codegen import compiled
+from shipgym.codegen import compiled_all
 from shipgym.envs.context import ControllerContext
 from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
 from shipgym.models.base import ShipModel
@@ -150,7 +150,10 @@ class NMPCSolver:
         # dense: the buffer interface writes only the structural nonzeros of an output
         jacobian = ca.Function(f"nmpc_jac_{tag}", [u, p], [rho, ca.densify(ca.jacobian(rho, u))])
         if s.compile:
-            residual, jacobian = compiled(residual), compiled(jacobian)
+            residual, jacobian = compiled_all(
+                [residual, jacobian],
+                what=f"the NMPC's solver ({s.horizon} intervals of {s.interval} periods)",
+            )
         self._u = np.zeros(s.control_horizon)
         self._p = np.zeros(nx + 4 + npar + N_WEIGHTS)
         #: √Q, √R of the settings the solver was built with (what :meth:`parameters` uses

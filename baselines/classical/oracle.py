@@ -113,7 +113,7 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from shipgym.codegen import compiled
+from shipgym.codegen import compiled_all
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
 from shipgym.identification import first_order_nomoto
@@ -446,7 +446,7 @@ class OracleSolver:
         value = ca.Function(f"oracle_z_{tag}", [u, p], [z])
         both = ca.Function(f"oracle_zj_{tag}", [u, p], [z_s, ca.densify(jac)])
         if s.compile:
-            value, both = compiled(value), compiled(both)
+            value, both = compiled_all([value, both], what=f"the oracle's {model.name} solver")
         self._u = np.zeros(n_u)
         self._p = np.zeros(n_p)
         self._z = np.zeros(self.n_z)

@@ -157,9 +157,7 @@ class Scorer:
         self.run_name: str | None = None  # a learned trial's run folder name
         self.trials = plan_trials(plan)
         plan.folder.mkdir(parents=True, exist_ok=True)
-        self.oracle = oracle_costs(
-            self.trials, plan.folder.parent if plan.ship else plan.folder, progress
-        )
+        self.oracle = oracle_costs(self.trials, progress=progress)  # the per-user cache
 
     def score(
         self, settings: dict[str, Any], report: Callable[[float, int], None] | None = None

@@ -8,11 +8,13 @@ that is not the training ranges in the test seed space (so never the held-out sp
 a catalogue scenario).
 
 The denominator of the cost ratio is the ``oracle``'s cost on the same trial
-(:mod:`shipgym_baselines.references`): read from the shipped table if it holds the trial,
-else run once with the privileged oracle (the built-in channel,
-:mod:`shipgym_baselines.privileged`; the tuned controller never sees the truth) and cached in
-the study folder, ``oracle.json.gz``, whose header carries the env and oracle revisions and
-settings (a cache of another revision is ignored as a whole).
+(:mod:`shipgym_baselines.references`): read from the shipped table (which holds every trial
+of the ``validation`` split: ``shipgym references --validation``), else from the per-user
+cache of computed references (:func:`~shipgym_baselines.references.user_cache_path`), else
+run once with the privileged oracle (the built-in channel,
+:mod:`shipgym_baselines.privileged`; the tuned controller never sees the truth) and stored
+in that cache, which every later study reads.  Its header carries the env and oracle
+revisions and settings (a cache of another revision is ignored as a whole).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from shipgym.scenarios.sampling import load_distribution
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 
-#: the oracle cache's file name in a study folder
+#: the oracle cache's file name in its folder
 ORACLE_CACHE = "oracle.json.gz"
 
 
@@ -85,29 +87,27 @@ def validation_trials(
 
 def oracle_costs(
     trials: Sequence[ValidationTrial],
-    cache_dir: str | os.PathLike,
+    cache_dir: str | os.PathLike | None = None,
     progress: Callable[[str], object] | None = None,
 ) -> list[float]:
-    """The oracle's cost on each trial (module doc: shipped table, else the study folder's
-    cache, else run now and cached)."""
+    """The oracle's cost on each trial (module doc: shipped table, else the cache, else run
+    now and cached).  ``cache_dir``: the folder of the cache's :data:`ORACLE_CACHE` (default:
+    the per-user cache's)."""
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.privileged import ORACLE
-    from shipgym_baselines.references import ReferenceTable, shipped_table
+    from shipgym_baselines.references import ReferenceCache, announce, lookup
 
-    shipped = shipped_table()
-    cache = ReferenceTable.load(Path(cache_dir) / ORACLE_CACHE)
+    cache = ReferenceCache(None if cache_dir is None else Path(cache_dir) / ORACLE_CACHE)
+    entries = [lookup(trial.scenario, trial.seed, cache) for trial in trials]
+    pending = [trial for trial, entry in zip(trials, entries, strict=True) if entry is None]
+    announce([trial.scenario for trial in pending], f"once: cached in {cache.path}")
     costs = []
-    for trial in trials:
-        entry = shipped.lookup(trial.scenario, trial.seed) or cache.lookup(
-            trial.scenario, trial.seed
-        )
+    for trial, entry in zip(trials, entries, strict=True):
         if entry is None:
             if progress is not None:
                 progress(f"oracle reference for {trial.name} (seed {trial.seed}): computing")
             (result,) = evaluate(ORACLE, trial.scenario, [trial.seed])
-            cache.add(trial.scenario, result)
-            cache.save()
-            entry = cache.lookup(trial.scenario, trial.seed)
+            entry = cache.store(trial.scenario, result)
         costs.append(_cost(entry["metrics"].get("cost")))
     return costs
 

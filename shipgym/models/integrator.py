@@ -45,7 +45,7 @@ def _period_function(
         states.append(x)
     function = ca.Function(f"{model.name}_period_{n_sub}", [x0, u, w, p], [ca.horzcat(*states)])
     if compile:
-        function = compiled(function)
+        function = compiled(function, what=f"the {model.name} plant")
     if batch > 1:  # the same function per ship: results bit-identical to the single call
         function = function.map(batch, "thread", threads) if threads > 1 else function.map(batch)
     _FUNCTIONS[key] = function

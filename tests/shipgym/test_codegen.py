@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import casadi as ca
@@ -110,3 +111,74 @@ def test_a_failed_compilation_warns_and_returns_the_function(
     with pytest.warns(UserWarning, match="using CasADi's VM"):
         assert codegen.compiled(function) is function
     assert not list(cache.glob("*.so"))
+
+
+def test_the_user_cache_folder_follows_the_environment(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """$SHIPGYM_CACHE_DIR, else $XDG_CACHE_HOME/shipgym, else ~/.cache/shipgym; compiled
+    libraries go there unless $SHIPGYM_CACHE names their own folder."""
+    monkeypatch.setenv("SHIPGYM_CACHE_DIR", str(tmp_path / "mine"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    monkeypatch.delenv("SHIPGYM_CACHE")
+    assert codegen.user_cache_dir() == codegen.cache_dir() == tmp_path / "mine"
+    monkeypatch.delenv("SHIPGYM_CACHE_DIR")
+    assert codegen.user_cache_dir() == tmp_path / "xdg" / "shipgym"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert codegen.user_cache_dir() == tmp_path / "home" / ".cache" / "shipgym"
+    monkeypatch.setenv("SHIPGYM_CACHE", str(tmp_path / "libs"))
+    assert codegen.cache_dir() == tmp_path / "libs"
+    assert codegen.user_cache_dir() == tmp_path / "home" / ".cache" / "shipgym"
+
+
+@needs_compiler
+def test_a_compilation_is_announced_in_one_line_on_stderr(
+    cache: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A needed compilation prints one line on stderr (what, ≈ seconds, where cached);
+    nothing on stdout; a cached library prints nothing."""
+    codegen.compiled(_step(), what="the nomoto2 step")
+    out, err = capfd.readouterr()
+    assert out == ""
+    assert err == (
+        f"shipgym: compiling the nomoto2 step to C (one-off, ≈ 1 s; cached in {cache})\n"
+    )
+    codegen.compiled(_step(), what="the nomoto2 step")
+    assert capfd.readouterr() == ("", "")
+
+
+@needs_compiler
+def test_functions_compiled_together_are_announced_together(
+    cache: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """``compiled_all``: one line for all the compilations it needs, its estimate from the
+    size of their C code (:data:`~shipgym.codegen.COMPILE_BYTES_PER_S`)."""
+    step = _step()
+    x, u = ca.SX.sym("x", 4), ca.SX.sym("u", 1)
+    other = ca.Function("nomoto2_twice", [x, u], [2 * x + u])
+    fast = codegen.compiled_all([step, other], what="two functions")
+    assert all(f is not g for f, g in zip(fast, [step, other], strict=True))
+    (line,) = capfd.readouterr().err.splitlines()
+    assert line.startswith("shipgym: compiling two functions to C (one-off, ≈ ")
+    assert len(list(cache.glob("*.so"))) == 2
+
+
+def test_the_estimate_grows_with_the_code_size() -> None:
+    """Linear at the measured speed up to 1.2 MB of C, in proportion to the size beyond
+    (the NMPC's 2.5 MB Jacobian took 47 s)."""
+    assert codegen.compile_seconds(170_000) == pytest.approx(1.7)
+    assert codegen.compile_seconds(1_200_000) == pytest.approx(12)
+    assert codegen.compile_seconds(2_460_065) == pytest.approx(50.4, abs=0.1)
+    line = codegen.compile_message("the mariner plant", 26.2, Path("/c"))
+    assert line == "shipgym: compiling the mariner plant to C (one-off, ≈ 26 s; cached in /c)"
+
+
+def test_a_notice_clears_a_progress_bar_on_a_terminal(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a terminal the line under way (a progress bar) is cleared first; in a file not."""
+    codegen.notice("shipgym: a")
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    codegen.notice("shipgym: b")
+    assert capsys.readouterr().err == "shipgym: a\n\r\x1b[Kshipgym: b\n"

@@ -394,10 +394,14 @@ def test_shipgym_references_fills_a_table_and_resumes(
     table = tmp_path / "refs.json.gz"
     args = ["references", "--suite", str(suite), "--table", str(table), "--workers", "1", "--json"]
     assert main(args) == 0
-    first = json.loads(capsys.readouterr().out)
+    out, err = capsys.readouterr()
+    first = json.loads(out)
     assert (first["computed"], first["held"]) == (1, 0)
+    assert "shipgym: computing 1 oracle reference (≈ " in err
+    assert f" CPU; written to {table} after each)\n" in err
     assert main(args) == 0
-    again = json.loads(capsys.readouterr().out)
-    assert (again["computed"], again["held"]) == (0, 1)
+    out, err = capsys.readouterr()
+    again = json.loads(out)
+    assert (again["computed"], again["held"]) == (0, 1) and "computing" not in err
     (entry,) = ReferenceTable.load(table).entries.values()
     assert entry["metrics"]["termination_reason"] == "goal" and entry["metrics"]["cost"] > 0

@@ -134,7 +134,7 @@ def test_a_study_reports_resumes_and_refuses_to_overwrite(tiny: Path, tmp_path: 
         assert written["ships"]["nomoto2"]["los_radius_L"] == resumed["best_params"]["los_radius_L"]
     # the best value is the objective of its settings, re-scored through the evaluation loop
     trials = validation_trials("validation", "nomoto2", 1)
-    oracle = oracle_costs(trials, out)
+    oracle = oracle_costs(trials)  # the per-user cache (shipped: the validation split)
     settings = {**TINY["fixed"], **resumed["best_params"]}
     ratios = controller_ratios("pid_los", settings, trials, oracle)
     assert geometric_mean(ratios) == pytest.approx(resumed["best_value"], rel=1e-12)
