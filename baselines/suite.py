@@ -292,7 +292,7 @@ def _scenario_problems(entries: Any, anchor: Path | None) -> list[Problem]:
     indices = list(good)
     named = name_scenarios([good[i] for i in indices], load_scenario)
     problems += [Problem(f"scenarios.{indices[j]}", text) for j, text in named.problems]
-    return problems
+    return sorted(problems, key=lambda p: int(p.key.split(".")[1]))  # in the file's order
 
 
 def _controller_problems(entries: Any, anchor: Path | None) -> list[Problem]:
