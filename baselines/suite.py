@@ -107,10 +107,14 @@ def _scenario_entry(entry: str, file: ConfigFile, index: int) -> str:
 
 def load_suite(name_or_path: str | os.PathLike) -> SuiteConfig:
     """A suite by name (``configs/suites/<name>.yaml``) or YAML path; errors name the file
-    and the key."""
+    and the key (a scenario file's ``name:`` that cannot be its table name too:
+    :func:`name_scenarios`)."""
     file = resolve("suites", name_or_path, error=ConfigError)
     suite = load_yaml_model(file, SuiteConfig, ConfigError)
     scenarios = [_scenario_entry(s, file, i) for i, s in enumerate(suite.scenarios)]
+    problems = name_scenarios(scenarios, load_scenario).problems  # before any episode
+    if problems:
+        raise ConfigError("\n".join(f"{file}: key 'scenarios.{i}': {t}" for i, t in problems))
     controllers = [_controller_entry(c, file) for c in suite.controllers]
     return suite.model_copy(update={"scenarios": scenarios, "controllers": controllers})
 

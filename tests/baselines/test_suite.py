@@ -71,7 +71,9 @@ def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
 def test_relative_scenario_paths_are_read_against_the_suite_folder(
     tmp_path: Path, monkeypatch
 ) -> None:
-    scenario = write(tmp_path, "name: mine\n", "suites/scenarios/mine.yaml")
+    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    text = nominal.replace("name: nominal", "name: mine")
+    scenario = write(tmp_path, text, "suites/scenarios/mine.yaml")
     suite = write(
         tmp_path,
         "name: s\nscenarios: [nominal, scenarios/mine.yaml, heldout:2]\ncontrollers: [pid_los]\n",
