@@ -669,7 +669,11 @@ def plot_scenarios(
 
 
 # ----------------------------------------------------------------------------- ranking
-SPLIT_TITLES = {"catalogue": "catalogue scenarios", "heldout": "held-out scenarios"}
+SPLIT_TITLES = {
+    "catalogue": "catalogue scenarios",
+    "heldout": "held-out scenarios",
+    "yours": "your scenarios",
+}
 _RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"
 #: the intervals drawn per controller: key, panel title, axis label, reference lines
 _INTERVAL_PANELS = (

@@ -30,7 +30,7 @@ import math
 import os
 import sys
 from collections import defaultdict
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from contextlib import closing
 from pathlib import Path
@@ -76,7 +76,7 @@ from shipgym_baselines.runs import (
 )
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.style import FIGURE_DPI, controller_style
-from shipgym_baselines.suite import load_suite
+from shipgym_baselines.suite import load_suite, scenario_names
 from shipgym_baselines.verdict import folder_verdict, plain_name, verdict
 
 #: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
@@ -115,9 +115,23 @@ def check_controllers(names: list[str]) -> list[str]:
     return labels
 
 
-def scenario_split(scenario: str) -> str:
-    """``heldout`` for named held-out test scenarios (``heldout:3``), else ``catalogue``."""
-    return "heldout" if scenario.startswith("heldout:") else "catalogue"
+#: the split of the scenarios a suite gives as YAML files (run.json's ``scenario_files``)
+YOURS = "yours"
+#: the ranking tables' headings, by split
+SPLIT_TITLES = {
+    "catalogue": "Catalogue scenarios",
+    "heldout": "Held-out scenarios",
+    YOURS: "Your scenarios",
+}
+
+
+def scenario_split(scenario: str, own: Collection[str] = ()) -> str:
+    """``heldout`` for named held-out test scenarios (``heldout:3``), :data:`YOURS` for the
+    suite's own scenarios (``own``: their table names; a YAML path, as older records name
+    them), else ``catalogue``."""
+    if scenario.startswith("heldout:"):
+        return "heldout"
+    return YOURS if scenario in own or is_path(scenario) else "catalogue"
 
 
 # --- jobs ------------------------------------------------------------------------------------
@@ -125,7 +139,8 @@ def scenario_split(scenario: str) -> str:
 
 class Job(NamedTuple):
     """One unit of work: a controller (trained with ``training_seed``; None: not trained)
-    on the trials of scenario ``scenario`` (a name as the suite gives it) that ``seeds``
+    on the trials of scenario ``scenario`` (its table name, :func:`suite_scenarios`; or a
+    catalogue name, held-out name or YAML path loaded as such) that ``seeds``
     draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
     ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
     as recorded whatever its file says now; None: resolved from ``scenario`` here."""
@@ -155,6 +170,16 @@ def suite_scenario(name: str) -> Scenario:
     return _cached_scenario(name, stamp)
 
 
+def suite_scenarios(entries: Iterable[str]) -> dict[str, Scenario]:
+    """A suite's scenarios (as :func:`~shipgym_baselines.suite.load_suite` gives them) by
+    table name: a catalogue or held-out name as given, a YAML file's under its ``name:``
+    (:func:`~shipgym_baselines.suite.scenario_names`: a name that clashes is refused, naming
+    both files)."""
+    entries = list(entries)
+    names = scenario_names(entries, suite_scenario).names
+    return {names[entry]: suite_scenario(entry) for entry in entries}
+
+
 @functools.lru_cache(maxsize=128)
 def _recorded_scenario(settings: str) -> Scenario:
     return load_scenario(json.loads(settings))
@@ -177,8 +202,8 @@ def trials(job: Job) -> list[Scenario]:
 
 
 def _named(results: list[EpisodeResult], job: Job) -> list[EpisodeResult]:
-    """``results`` under the table name and the suite's scenario name (a YAML path stays a
-    path), with the job's training seed."""
+    """``results`` under the table name and the job's scenario name, with the job's
+    training seed."""
     label = controller_label(job.controller)
     for result in results:
         result.controller = label
@@ -314,7 +339,8 @@ def suite_record(
 ) -> dict[str, Any]:
     """The resolved suite as ``run.json`` keeps it: evaluation seeds, the trial
     randomisation, controllers (table name, how the suite names it, kind, training seeds),
-    each scenario's settings and the pairs that do not apply."""
+    each scenario's settings (by table name), the pairs that do not apply and, when the
+    suite has its own scenarios, ``scenario_files`` (table name → the YAML file read)."""
     ships = {s: sc.model.name for s, sc in scenarios.items()}
     controllers = []
     for c in names:
@@ -327,6 +353,8 @@ def suite_record(
                 "training_seeds": list(seeds_of[label]),
             }
         )
+    files = scenario_names(spec.all_scenarios(), suite_scenario).files
+    own = {"scenario_files": {n: f for n, f in files.items() if n in scenarios}}
     return {
         "name": spec.name,
         "seeds": seed_list,
@@ -339,6 +367,7 @@ def suite_record(
             for c in controllers
             if not applies_to(c["name"], ships[s])
         ],
+        **(own if own["scenario_files"] else {}),  # absent without: older records resume
     }
 
 
@@ -440,7 +469,7 @@ def run_leaderboard(
     labels = check_controllers(names)
     seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
-    scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
+    scenarios = suite_scenarios(spec.all_scenarios())
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
     references = "recompute" if recompute_references else "table"
@@ -557,7 +586,7 @@ def write_results(
     out = Path(out)
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     episodes = episode_rows(results)
-    splits = {s: scenario_split(s) for s in suite["scenarios"]}
+    splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
     ranked = rankable(episodes)
     drawn = figures.episodes_to_draw(results)
     shown = sorted({scenario for scenario, _ in drawn})
@@ -601,6 +630,7 @@ def write_results(
             list(kinds),
             kinds=kinds,
             not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
+            splits=splits,
         )
         scores = score_table(ranked, splits, kinds)
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
@@ -670,6 +700,7 @@ def aggregate_results(
     controllers: list[str],
     kinds: Mapping[str, str] | None = None,
     not_applicable: set[tuple[str, str]] | None = None,
+    splits: Mapping[str, str] | None = None,
 ) -> list[dict[str, Any]]:
     """One row per (scenario, controller) over its episodes (training seeds × evaluation
     seeds): means, ``*_std`` and 95 % ``*_ci95`` intervals ``[low, high]`` (bootstrap,
@@ -680,7 +711,7 @@ def aggregate_results(
     ``episodes``: their product.  ``kinds``: controller kinds (default: the registry's);
     ``not_applicable``: the (scenario, controller) pairs that do not apply (None: every pair
     without episodes); a pair without episodes that is not listed has no row (a partial or
-    merged record)."""
+    merged record); ``splits``: scenario → split (default: :func:`scenario_split`)."""
     groups: dict[tuple[str, str], list[EpisodeResult]] = defaultdict(list)
     for r in results:
         groups[(r.scenario, r.controller)].append(r)
@@ -693,7 +724,7 @@ def aggregate_results(
                 continue  # not run (yet): no row
             head = {
                 "scenario": scenario,
-                "split": scenario_split(scenario),
+                "split": (splits or {}).get(scenario) or scenario_split(scenario),
                 "controller": controller,
                 "kind": group[0].kind
                 if group
@@ -768,7 +799,7 @@ def _table_title(split: str, rows: Sequence[Mapping[str, Any]]) -> str:
     """A ranking table's heading: the split, and its scenarios (every controller's in a
     main table; a partial table's controllers have their own)."""
     base = split.removesuffix(PARTIAL)
-    name = "Catalogue scenarios" if base == "catalogue" else "Held-out scenarios"
+    name = SPLIT_TITLES.get(base, base)
     if is_partial(split):
         return (
             f"{name}: controllers that do not apply to every scenario (each ranked on the "

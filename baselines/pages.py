@@ -62,7 +62,11 @@ from shipgym_baselines.style import controller_style
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
 SORT_DIGITS = 7
-SPLIT_TITLES = {"catalogue": "Catalogue scenarios", "heldout": "Held-out scenarios"}
+SPLIT_TITLES = {
+    "catalogue": "Catalogue scenarios",
+    "heldout": "Held-out scenarios",
+    "yours": "Your scenarios",
+}
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
     "ace": "ACE [m]",

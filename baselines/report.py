@@ -84,6 +84,8 @@ def merge_runs(
                     f"scenario {name!r} has other settings in {folder} than in "
                     f"{first_with[name]}: {'; '.join(changed[:3])}"
                 )
+        for name, file in run_suite.get("scenario_files", {}).items():
+            suite.setdefault("scenario_files", {}).setdefault(name, file)  # the first run's
         known = {c["name"] for c in suite["controllers"]}
         suite["controllers"] += [c for c in run_suite["controllers"] if c["name"] not in known]
         suite["does_not_apply"] += [

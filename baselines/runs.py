@@ -3,7 +3,8 @@
 ::
 
     run.json         command (argv), suite (resolved: seeds, randomize, controllers with
-                     their training seeds, each scenario's settings), versions, git commit,
+                     their training seeds, each scenario's settings by table name, the
+                     files of the suite's own scenarios), versions, git commit,
                      start/end time (ISO 8601 UTC), status ("running" → "complete" |
                      "interrupted" | "failed"), jobs (the episodes the run holds when
                      complete), episodes, wall_s and cpu_s (wall-clock and CPU seconds

@@ -3,14 +3,29 @@ leaderboard run (SPEC §9), validated when the file is read."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Discriminator, Field, Tag, model_validator
+import yaml
+from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
-from shipgym.config import ConfigFile, StrictModel, is_path, list_names, load_yaml_model, resolve
+from shipgym.config import (
+    ConfigFile,
+    StrictModel,
+    is_path,
+    list_names,
+    load_yaml_model,
+    read_config_text,
+    read_yaml,
+    resolve,
+)
+from shipgym.errors import ShipgymError
 from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_SEEDS
+from shipgym.scenarios import Scenario, list_scenarios, load_scenario
+from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
 from shipgym.scenarios.trials import TrialRandomization
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec, anchored
@@ -53,13 +68,18 @@ class SuiteConfig(StrictModel):
     seeds: int = Field(5, ge=1, le=MAX_SEEDS)
     randomize: TrialRandomization | None = None
 
-    @model_validator(mode="after")
-    def _scenarios_given_once(self) -> SuiteConfig:
-        if not self.scenarios and not self.heldout_scenarios:
-            raise ValueError("a suite needs 'scenarios' or 'heldout_scenarios'")
-        repeated = sorted({s for s in self.scenarios if self.scenarios.count(s) > 1})
+    @field_validator("scenarios")
+    @classmethod
+    def _scenarios_given_once(cls, scenarios: list[str]) -> list[str]:
+        repeated = sorted({s for s in scenarios if scenarios.count(s) > 1})
         if repeated:
             raise ValueError(f"scenarios listed more than once: {repeated}")
+        return scenarios
+
+    @model_validator(mode="after")
+    def _some_scenarios(self) -> SuiteConfig:
+        if not self.scenarios and not self.heldout_scenarios:
+            raise ValueError("a suite needs 'scenarios' or 'heldout_scenarios'")
         return self
 
     def all_scenarios(self) -> list[str]:
@@ -87,10 +107,14 @@ def _scenario_entry(entry: str, file: ConfigFile, index: int) -> str:
 
 def load_suite(name_or_path: str | os.PathLike) -> SuiteConfig:
     """A suite by name (``configs/suites/<name>.yaml``) or YAML path; errors name the file
-    and the key."""
+    and the key (a scenario file's ``name:`` that cannot be its table name too:
+    :func:`name_scenarios`)."""
     file = resolve("suites", name_or_path, error=ConfigError)
     suite = load_yaml_model(file, SuiteConfig, ConfigError)
     scenarios = [_scenario_entry(s, file, i) for i, s in enumerate(suite.scenarios)]
+    problems = name_scenarios(scenarios, load_scenario).problems  # before any episode
+    if problems:
+        raise ConfigError("\n".join(f"{file}: key 'scenarios.{i}': {t}" for i, t in problems))
     controllers = [_controller_entry(c, file) for c in suite.controllers]
     return suite.model_copy(update={"scenarios": scenarios, "controllers": controllers})
 
@@ -103,3 +127,208 @@ def _controller_entry(entry: ControllerSpec, file: ConfigFile) -> ControllerSpec
     if isinstance(entry, str):
         return anchored(entry, folder)
     return entry.model_copy(update={"controller": anchored(entry.controller, folder)})
+
+
+# --- how a suite's scenarios are named in the tables -----------------------------------------
+
+
+@dataclasses.dataclass(frozen=True)
+class ScenarioNames:
+    """How a suite's scenario entries are named in its tables.
+
+    ``names``: entry (as :func:`load_suite` gives it) → table name: a catalogue or held-out
+    name as written, a YAML file's ``name:``; ``files``: table name → YAML file of the
+    suite's own scenarios (a file that is a catalogue scenario, content for content, is
+    named and grouped as that one); ``problems``: (entry index, message) of the names that
+    cannot be table names (a clash with a catalogue scenario or another entry).
+    """
+
+    names: dict[str, str]
+    files: dict[str, str]
+    problems: list[tuple[int, str]]
+
+
+def name_scenarios(entries: Sequence[str], load: Callable[[str], Scenario]) -> ScenarioNames:
+    """The table names of a suite's scenario ``entries`` (:class:`ScenarioNames`); ``load``
+    loads a YAML entry (the leaderboard's cached loader)."""
+    catalogue = set(list_scenarios())
+    names: dict[str, str] = {}
+    files: dict[str, str] = {}
+    problems: list[tuple[int, str]] = []
+    taken: dict[str, str] = {}  # table name -> the entry that took it
+    for index, entry in enumerate(entries):
+        name = entry
+        if is_path(entry):
+            name = load(entry).name
+            problem = _file_name_problem(entry, name, load, catalogue)
+            if problem is not None:
+                problems.append((index, problem))
+                continue
+            if name not in catalogue:
+                files[name] = entry
+        if name in taken:
+            first = taken[name]
+            what = "scenario files" if is_path(first) and is_path(entry) else "scenarios"
+            problems.append(
+                (
+                    index,
+                    f"{what} {first} and {entry} are both named {name!r}: each scenario of a "
+                    "suite needs its own name (a file's `name:` key)",
+                )
+            )
+            continue
+        taken[name] = entry
+        names[entry] = name
+    return ScenarioNames(names, files, problems)
+
+
+def _file_name_problem(
+    entry: str, name: str, load: Callable[[str], Scenario], catalogue: set[str]
+) -> str | None:
+    """Why a scenario file's ``name:`` cannot name its table rows, or None."""
+    if is_path(name) or ":" in name or not name.strip():
+        return (
+            f"scenario file {entry} is named {name!r}: a table name has no '/' or ':' and "
+            "does not end in .yaml (give the file another `name:`)"
+        )
+    if name in catalogue and load(name).config != load(entry).config:
+        return (
+            f"scenario file {entry} is named {name!r}, as the catalogue's scenario "
+            f"configs/scenarios/{name}.yaml, but its settings differ: give the file its own "
+            "`name:`"
+        )
+    return None
+
+
+def scenario_names(entries: Sequence[str], load: Callable[[str], Scenario]) -> ScenarioNames:
+    """:func:`name_scenarios`, a :class:`ConfigError` listing every problem when there is any."""
+    found = name_scenarios(entries, load)
+    if found.problems:
+        raise ConfigError("\n".join(f"key 'scenarios.{i}': {text}" for i, text in found.problems))
+    return found
+
+
+# --- checking a suite file (``shipgym scenarios --validate``) --------------------------------
+
+#: top-level keys that make a YAML file a suite (a scenario file has none of them)
+SUITE_KEYS = ("controllers", "scenarios", "heldout_scenarios")
+
+
+def is_suite_file(name_or_path: str | os.PathLike) -> bool:
+    """Whether ``name_or_path`` is a suite: a packaged suite's name (that is no catalogue
+    scenario's), or a YAML file whose top level has one of :data:`SUITE_KEYS`."""
+    text = os.fspath(name_or_path)
+    if not is_path(text):
+        return text not in list_scenarios() and text in list_suites()
+    try:
+        data = read_yaml(Path(text).expanduser())
+    except ShipgymError:
+        return False  # unreadable: the scenario check names why
+    return isinstance(data, Mapping) and any(key in data for key in SUITE_KEYS)
+
+
+def check_suite_file(name_or_path: str | os.PathLike) -> list[Problem]:
+    """Every problem of a suite file, each with its key and line (empty: valid).
+
+    The schema's problems (types, ranges, unknown keys), then each scenario (a catalogue
+    name, a held-out test scenario, a YAML file checked as ``shipgym scenarios --validate``
+    checks it, its table name) and each controller (resolvable, its settings accepted by
+    its factory, one table name each), whatever the schema found elsewhere."""
+    try:
+        file = resolve("suites", name_or_path, error=ConfigError)
+        text = read_config_text(file, ConfigError)
+    except ConfigError as exc:
+        return [Problem("", str(exc))]
+    try:
+        root = yaml.compose(text)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]
+    except yaml.YAMLError as exc:
+        return [Problem("", f"malformed YAML: {exc}")]
+    data = yaml.safe_load(text)
+    if not isinstance(data, Mapping):
+        return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
+    problems: list[Problem] = []
+    try:
+        SuiteConfig.model_validate(data)
+    except ValidationError as exc:
+        for item in exc.errors():
+            parts = [str(p) for p in item["loc"] if p not in ("short form", "long form")]
+            problems.append(Problem(".".join(parts), item["msg"]))
+    anchor = file if isinstance(file, Path) else None
+    problems += _scenario_problems(data.get("scenarios"), anchor)
+    problems += _controller_problems(data.get("controllers"), anchor)
+    return [dataclasses.replace(p, line=yaml_line(root, p.key)) for p in problems]
+
+
+def _scenario_problems(entries: Any, anchor: Path | None) -> list[Problem]:
+    """The problems of a suite's ``scenarios`` list (entries that are not strings are the
+    schema's)."""
+    if not isinstance(entries, list):
+        return []
+    problems: list[Problem] = []
+    good: dict[int, str] = {}  # index -> the entry as the leaderboard loads it
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, str):
+            continue
+        key = f"scenarios.{i}"
+        if ":" in entry and not is_path(entry):
+            try:
+                load_scenario(entry)
+            except ShipgymError as exc:
+                problems.append(Problem(key, str(exc)))
+            else:
+                good[i] = entry
+            continue
+        try:
+            found = resolve("scenarios", entry, relative_to=anchor, error=ConfigError)
+        except ConfigError as exc:
+            problems.append(Problem(key, str(exc)))
+            continue
+        if not is_path(entry):
+            good[i] = entry
+            continue
+        inner = check_scenario_file(found)
+        problems += [Problem(key, p.text(str(found))) for p in inner]
+        if not inner:
+            good[i] = str(found)
+    indices = list(good)
+    named = name_scenarios([good[i] for i in indices], load_scenario)
+    problems += [Problem(f"scenarios.{indices[j]}", text) for j, text in named.problems]
+    return sorted(problems, key=lambda p: int(p.key.split(".")[1]))  # in the file's order
+
+
+def _controller_problems(entries: Any, anchor: Path | None) -> list[Problem]:
+    """The problems of a suite's ``controllers`` list: each resolved as a run resolves it
+    (entries of the wrong shape are the schema's), then their table names."""
+    from shipgym_baselines.registry import controller_label
+
+    if not isinstance(entries, list):
+        return []
+    labels: dict[str, int] = {}
+    problems: list[Problem] = []
+    for i, raw in enumerate(entries):
+        try:
+            entry: ControllerSpec = (
+                raw if isinstance(raw, str) else ControllerEntry.model_validate(raw)
+            )
+        except ValidationError:
+            continue  # the schema names it
+        if anchor is not None:
+            entry = _controller_entry(entry, anchor)
+        try:
+            label = controller_label(entry)
+        except ShipgymError as exc:
+            problems.append(Problem(f"controllers.{i}", str(exc)))
+            continue
+        if label in labels:
+            problems.append(
+                Problem(
+                    f"controllers.{i}",
+                    f"table name {label!r} is also controllers.{labels[label]}'s: give each "
+                    "its own name (the long form {controller: ..., name: ...})",
+                )
+            )
+        labels.setdefault(label, i)
+    return problems

@@ -17,6 +17,28 @@ from shipgym.models.base import ShipModel
 from shipgym.models.integrator import PeriodIntegrator
 
 DEG = math.pi / 180.0
+#: metres per second in a knot (1852 m per hour)
+KNOT = 1852.0 / 3600.0
+
+#: the unit of each figure :func:`zigzag` and :func:`turning_circle` return (``"1"``: a
+#: fraction, here of the approach speed U0)
+FIGURE_UNITS: dict[str, str] = {
+    "time_to_first_switch": "s",
+    "overshoot_1": "deg",
+    "time_overshoot_1": "s",
+    "overshoot_2": "deg",
+    "time_overshoot_2": "s",
+    "period": "s",
+    "t_90": "s",
+    "advance": "m",
+    "transfer": "m",
+    "t_180": "s",
+    "tactical_diameter": "m",
+    "steady_turn_rate": "deg/s",
+    "steady_speed": "m/s",
+    "steady_diameter": "m",
+    "speed_loss": "1",
+}
 
 
 class ManoeuvreError(ShipgymError, ValueError):
@@ -248,7 +270,8 @@ def plot_manoeuvre(
     axes[0].set_aspect("equal", adjustable="datalim")
     axes[1].plot(log.t, np.degrees(log.psi), label="ψ [deg]")
     axes[1].plot(log.t, np.degrees(log.delta), label="δ [deg]")
-    axes[1].set(xlabel="t [s]", title=", ".join(f"{k} {v:.4g}" for k, v in figures.items())[:90])
+    title = ", ".join(f"{k} {v:.4g} {FIGURE_UNITS.get(k, '')}".rstrip() for k, v in figures.items())
+    axes[1].set(xlabel="t [s]", title=title[:90])
     axes[1].legend()
     fig.tight_layout()
     fig.savefig(path, dpi=90)

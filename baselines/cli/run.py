@@ -37,7 +37,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "run", help="one episode of a controller on a scenario: its metrics and a track plot"
     )
     p.add_argument(
-        "scenario", help="catalogue name, held-out test scenario (heldout:3) or scenario YAML"
+        "scenario",
+        help="catalogue name, held-out test scenario (heldout:3), scenario YAML, or the name: "
+        "of a scenario file that --suite lists",
     )
     p.add_argument(
         "controller", help="controller name, shipped policy name or trained agent folder / zip"
@@ -100,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.suite import load_suite
 
     suite = load_suite(args.suite)
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(_suite_file(args.scenario, suite))
     video = None if args.video is None else check_video_file(args.video)
     (label,) = check_controllers([args.controller])
     ship = scenario.model.name
@@ -115,12 +117,14 @@ def run(args: argparse.Namespace) -> int:
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
     result = evaluate(args.controller, trial, [args.seed])[0]
-    result.controller, result.scenario = label, args.scenario  # as the leaderboard names them
+    # as the leaderboard names them: a scenario file under its name:
+    table_name = scenario.name if is_path(args.scenario) else args.scenario
+    result.controller, result.scenario = label, table_name
     row = result.row()
     out.mkdir(parents=True, exist_ok=True)
     (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
     randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
-    plot_results([result], out, {args.scenario: scenario}, randomize)
+    plot_results([result], out, {table_name: scenario}, randomize)
     plots = sorted(p.name for p in out.glob("*.png"))
     if video is not None:
         _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}")
@@ -131,6 +135,19 @@ def run(args: argparse.Namespace) -> int:
         f"seed {args.seed})\n"
     )
     return 0
+
+
+def _suite_file(scenario: str, suite: Any) -> str:
+    """``scenario``, or the YAML file of the suite's own scenario of that name (a name that
+    is neither a catalogue scenario, a held-out one nor a path)."""
+    from shipgym.config import is_path
+    from shipgym.scenarios import list_scenarios, load_scenario
+    from shipgym_baselines.suite import name_scenarios
+
+    if is_path(scenario) or ":" in scenario or scenario in list_scenarios():
+        return scenario
+    files = [s for s in suite.all_scenarios() if is_path(s)]
+    return name_scenarios(files, load_scenario).files.get(scenario, scenario)
 
 
 def _write_video(file: Path, result: Any, trial: Any, title: str) -> None:

@@ -1,9 +1,13 @@
-"""``shipgym scenarios``: list the scenario catalogue, or check scenario files.
+"""``shipgym scenarios``: list the scenario catalogue, or check scenario and suite files.
 
 ``--validate FILE…`` loads and checks each file and names every problem it finds (key and
 YAML line): one ``ok FILE`` line per good file, one ``FILE:LINE: key 'K': message`` line per
-problem of a bad one; exit code 2 when any file is bad.  With ``--json``: a list of
-``{"file", "ok", "problems"}`` (``problems``: the lines without the file name).
+problem of a bad one; exit code 2 when any file is bad.  A file whose top level has
+``controllers``, ``scenarios`` or ``heldout_scenarios`` (or a packaged suite's name) is
+checked as a suite (:func:`shipgym_baselines.suite.check_suite_file`: its schema, every
+scenario it lists, every controller), any other as a scenario.  With ``--json``: a list of
+``{"file", "kind", "ok", "problems"}`` (``kind``: ``scenario`` or ``suite``; ``problems``:
+the lines without the file name).
 """
 
 from __future__ import annotations
@@ -18,13 +22,16 @@ EXIT_BAD_FILE = 2
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("scenarios", help="list the scenario catalogue, or check scenario files")
+    p = sub.add_parser(
+        "scenarios", help="list the scenario catalogue, or check scenario and suite files"
+    )
     p.add_argument(
         "--validate",
         nargs="+",
         metavar="FILE",
         default=None,
-        help="load and check these scenario YAML files, naming every problem (exit 2 if any)",
+        help="load and check these scenario or suite YAML files, naming every problem "
+        "(exit 2 if any)",
     )
     add_json_option(p, "print the names (with --validate: one result per file) as JSON")
     p.set_defaults(func=run)
@@ -48,12 +55,21 @@ def run(args: argparse.Namespace) -> int:
 def validate(args: argparse.Namespace) -> int:
     """Check every ``--validate`` file; 0 when all are good, else :data:`EXIT_BAD_FILE`."""
     from shipgym.scenarios.loader import check_scenario_file
+    from shipgym_baselines.suite import check_suite_file, is_suite_file
 
     results = []
     lines = []
     for file in args.validate:
-        problems = check_scenario_file(file)
-        results.append({"file": file, "ok": not problems, "problems": [p.text() for p in problems]})
+        suite = is_suite_file(file)
+        problems = check_suite_file(file) if suite else check_scenario_file(file)
+        results.append(
+            {
+                "file": file,
+                "kind": "suite" if suite else "scenario",
+                "ok": not problems,
+                "problems": [p.text() for p in problems],
+            }
+        )
         if not problems:
             lines.append(f"ok {file}")
         lines += [p.text(file) for p in problems]

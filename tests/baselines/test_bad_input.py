@@ -108,6 +108,72 @@ def test_scenarios_validate_json(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert main(["scenarios", "--validate", "nominal", "--json"]) == 0
 
 
+def test_scenarios_validate_reports_two_problems_of_a_scenario_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = scenario_file(tmp_path, heading=".nan", direction=".inf")
+    assert main(["scenarios", "--validate", bad]) == 2
+    assert capsys.readouterr().out.splitlines() == [
+        f"{bad}:3: key 'initial_state.heading_deg': Input should be a finite number",
+        f"{bad}:5: key 'disturbances.current.constant.direction_deg': Input should be a "
+        "finite number",
+    ]
+
+
+def bad_suite(tmp_path: Path) -> str:
+    """A suite with a bad controller, a bad scenario name and a scenario file with two
+    problems (the schema itself passes)."""
+    scenario_file(tmp_path, heading=".nan", params="K: -1")
+    file = tmp_path / "suite.yaml"
+    file.write_text(
+        "name: mine\n"
+        "scenarios:\n  - nominal\n  - no_such_scenario\n  - scenario.yaml\n"
+        "controllers:\n  - pid_los\n  - no_such_controller\n"
+        "seeds: 2\n"
+    )
+    return str(file)
+
+
+def test_scenarios_validate_checks_a_suite_and_reports_every_problem(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    suite = bad_suite(tmp_path)
+    assert main(["scenarios", "--validate", suite, "smoke"]) == 2
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    scenario = tmp_path / "scenario.yaml"
+    assert lines[0].startswith(f"{suite}:4: key 'scenarios.1': unknown scenario 'no_such_scenario'")
+    assert lines[1].startswith(f"{suite}:5: key 'scenarios.2': {scenario}:2: key 'ship.params':")
+    assert lines[2].startswith(
+        f"{suite}:5: key 'scenarios.2': {scenario}:3: key 'initial_state.heading_deg':"
+    )
+    assert lines[3].startswith(
+        f"{suite}:8: key 'controllers.1': unknown controller 'no_such_controller'"
+    )
+    assert lines[4:] == ["ok smoke"]
+    assert captured.err == "shipgym scenarios: 1 of 2 files have problems\n"
+
+
+def test_scenarios_validate_json_says_which_kind_of_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    smoke = Path(__file__).resolve().parents[2] / "configs/suites/smoke.yaml"
+    copy = tmp_path / "smoke_copy.yaml"
+    copy.write_text(smoke.read_text())
+    assert main(["scenarios", "--validate", str(copy), "nominal", "--json"]) == 0
+    results = json.loads(capsys.readouterr().out)
+    assert [(r["kind"], r["ok"], r["problems"]) for r in results] == [
+        ("suite", True, []),
+        ("scenario", True, []),
+    ]
+    assert main(["scenarios", "--validate", bad_suite(tmp_path), "--json"]) == 2
+    (result,) = json.loads(capsys.readouterr().out)
+    assert result["kind"] == "suite" and not result["ok"] and len(result["problems"]) == 4
+    assert result["problems"][0].startswith("line 4: key 'scenarios.1': unknown scenario")
+
+
 def test_a_manoeuvre_rudder_beyond_the_limit_is_an_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -360,3 +360,43 @@ def test_env_clock_counts_the_env_cpu_and_nothing_else() -> None:
         clock.step(np.zeros((1, 1), np.float32))
     expected = 0.02 + 3 * (0.01 + 0.03)  # 0.14 s inside the env, 0.15 s outside
     assert expected <= clock.cpu_s < expected + 0.03
+
+
+#: a number in the manoeuvre's text output (not a digit inside a name: t_90, U0, 20_20)
+NUMBER = r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[+-]?\d+)?"
+#: what must follow it: one of the units the output uses
+UNIT = r"\s*(?:m/s|deg/s|deg|kn|m|L|s|%)(?![\w/])"
+
+
+@pytest.mark.parametrize(
+    ("ship", "kind", "options"),
+    [("mariner", "turning", []), ("nomoto2", "zigzag", ["--rudder", "10"])],
+)
+def test_every_number_of_the_manoeuvre_output_has_its_unit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], ship: str, kind: str, options: list[str]
+) -> None:
+    """Each figure and criterion line names a unit after every number (a distance in m and
+    in ship lengths L); ``--json`` keeps the figures' names and adds their units."""
+    import re
+
+    out = ["--out", str(tmp_path)]
+    assert main(["manoeuvre", ship, kind, *options, *out]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[-1] == f"plot: {tmp_path / f'{ship}_{kind}.png'}"
+    for line in lines[:-1]:
+        numbers = re.findall(NUMBER, line)
+        assert numbers and len(re.findall(NUMBER + UNIT, line)) == len(numbers), line
+    figures = {line.split()[0]: line for line in lines[1:-1]}
+    if kind == "turning":
+        assert re.fullmatch(r"advance +[\d.]+ m = [\d.]+ L", figures["advance"])
+        assert re.search(r"ship length L = 172 m, approach speed U0 = 7.857 m/s", lines[0])
+    else:
+        assert re.fullmatch(r"overshoot_1 +[\d.]+ deg", figures["overshoot_1"])
+    assert main(["manoeuvre", ship, kind, *options, *out, "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    named = {k for k in document if k not in ("units", "imo_criteria")}
+    assert set(document["units"]) == named and named
+    if kind == "turning":
+        assert document["units"]["advance"] == "m" and document["advance"] > 600.0
+    else:
+        assert document["units"]["overshoot_1"] == "deg"

@@ -50,8 +50,9 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
     leaderboard writes every table and figure (it used to die after all episodes); in
     leaderboard.md a ``|`` in a name stays inside its cell, in leaderboard.csv a name that
     starts with ``=`` is no formula."""
-    scenario = tmp_path / r"$\undefinedmacro{y}$.yaml"
-    scenario.write_text((ROOT / "configs/scenarios/nominal.yaml").read_text())
+    scenario = tmp_path / "named.yaml"  # the tables name it by its name:
+    nominal = (ROOT / "configs/scenarios/nominal.yaml").read_text()
+    scenario.write_text(nominal.replace("name: nominal", r"name: '$\undefinedmacro{y}$'"))
     suite = tmp_path / "names.yaml"
     controllers = [
         "pid_los",
@@ -79,11 +80,11 @@ def test_finding5_a_mathtext_name_is_drawn_as_typed_and_tables_escape_names(
     }
     figures = sorted(p.name for p in out.glob("*.png"))
     assert figures == [
-        "profile_catalogue.png",
-        "ranking_catalogue.png",
+        "profile_yours.png",
+        "ranking_yours.png",
         "scenario___undefinedmacro_y__.png",
     ]
-    svg = (out / "ranking_catalogue.svg").read_text()
+    svg = (out / "ranking_yours.svg").read_text()
     assert MATHTEXT in svg  # drawn as typed (SVG text keeps the characters)
     markdown = (out / "leaderboard.md").read_text()
     assert markdown.count(r"=HYPERLINK(1)\|x") == 3  # ranking, scores, rows

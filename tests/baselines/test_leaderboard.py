@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from shipgym_baselines.errors import RunError
+from shipgym_baselines.errors import ConfigError, RunError
 from shipgym_baselines.leaderboard import (
     COLUMNS,
     Job,
@@ -376,7 +376,8 @@ def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, worker
     once the first episode is recorded: every episode still runs the scenario as run.json
     recorded it at the start, in the parent and in the pool's workers."""
     case = tmp_path / "case.yaml"
-    original = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    original = nominal.replace("name: nominal", "name: case")
     case.write_text(original)
     suite = write_suite(tmp_path, scenarios=[str(case)], seeds=4)
 
@@ -390,7 +391,8 @@ def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, worker
     run_leaderboard(suite, out_dir=out, workers=workers, show_progress=False, on_episode=edit_once)
     assert "time_limit: 20.0" in case.read_text()
     record = read_run(out)
-    settings = record["suite"]["scenarios"][str(case)]
+    assert record["suite"]["scenario_files"] == {"case": str(case)}
+    settings = record["suite"]["scenarios"]["case"]
     assert settings["time_limit"] == 90.0 and settings["initial_state"]["heading_deg"] == 0.0
     assert record["status"] == "complete"
     for controller in ("pid_los", "zero_rudder"):
@@ -427,3 +429,132 @@ def test_quick_suite_finishes(tmp_path: Path) -> None:
         "ppo",
     }
     assert read_run(tmp_path)["status"] == "complete"
+
+
+# --- the suite's own scenarios ---------------------------------------------------------------
+
+NOMINAL = Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml"
+
+
+def own_scenario(folder: Path, file: str, name: str, time_limit: float = 40.0) -> Path:
+    """The catalogue's ``nominal`` as a file of its own: ``name``, a shorter time limit."""
+    text = NOMINAL.read_text().replace("name: nominal", f"name: {name}")
+    path = folder / file
+    path.write_text(text.replace("time_limit: 90.0", f"time_limit: {time_limit}"))
+    return path
+
+
+@pytest.fixture(scope="module")
+def own_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, str]:
+    """pid_los and zero_rudder on ``rudder_aging`` and a scenario file named ``my_turn``:
+    (the run's folder, the scenario file, the suite file)."""
+    root = tmp_path_factory.mktemp("own")
+    file = own_scenario(root, "turn_v2.yaml", "my_turn")
+    suite = write_suite(root, scenarios=["rudder_aging", "turn_v2.yaml"], seeds=2)
+    run(suite, root / "out")
+    return root / "out", file, suite
+
+
+def test_a_scenario_file_is_named_by_its_name_in_the_record_and_rows(
+    own_run: tuple[Path, Path, str],
+) -> None:
+    out, file, _ = own_run
+    suite = read_run(out)["suite"]
+    assert list(suite["scenarios"]) == ["rudder_aging", "my_turn"]
+    assert suite["scenario_files"] == {"my_turn": str(file)}  # where its content came from
+    assert suite["scenarios"]["my_turn"]["time_limit"] == 40.0
+    assert {e["scenario"] for e in read_episodes(out)} == {"rudder_aging", "my_turn"}
+    rows = json.loads((out / "leaderboard.json").read_text())
+    assert {(r["scenario"], r["split"]) for r in rows} == {
+        ("rudder_aging", "catalogue"),
+        ("my_turn", "yours"),
+    }
+    assert "| my_turn | pid_los |" in (out / "leaderboard.md").read_text()
+    assert str(file) not in (out / "leaderboard.md").read_text()
+    assert (out / "scenario_my_turn.png").is_file()
+
+
+def test_your_scenarios_are_ranked_in_a_group_of_their_own(
+    own_run: tuple[Path, Path, str], tmp_path: Path
+) -> None:
+    out, _, _ = own_run
+    ranked = with_stand_in_oracle(out, tmp_path)  # the report keeps the files' names
+    board = json.loads((ranked / "aggregate.json").read_text())
+    assert [(r["split"], r["controller"], r["scenarios"]) for r in board] == [
+        ("catalogue", "pid_los", ["rudder_aging"]),
+        ("yours", "pid_los", ["my_turn"]),
+    ]
+    scores = json.loads((ranked / "scenario_scores.json").read_text())
+    assert {(s["scenario"], s["split"]) for s in scores} == {
+        ("rudder_aging", "catalogue"),
+        ("my_turn", "yours"),
+    }
+    text = (ranked / "leaderboard.md").read_text()
+    assert "### Catalogue scenarios (1, the same for every controller)" in text
+    assert "### Your scenarios (1, the same for every controller)" in text
+    assert "| controller | rudder_aging | my_turn |" in text
+    assert (ranked / "ranking_yours.png").is_file()
+    assert "Your scenarios" in (ranked / "leaderboard.html").read_text()
+
+
+def test_a_run_with_your_scenario_resumes_and_replays(
+    own_run: tuple[Path, Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--resume`` finds the same suite (names and the file's content); ``shipgym run
+    NAME --suite SUITE`` replays the leaderboard's episode of the file named NAME."""
+    from shipgym_baselines.cli import main
+
+    out, _, suite = own_run
+    before = read_episodes(out)
+    run(suite, out, resume=True)  # nothing missing: nothing runs, nothing refused
+    assert read_episodes(out) == before
+    replay = tmp_path / "replay"
+    args = ["run", "my_turn", "pid_los", "--suite", suite, "--seed", "10001", "--out", str(replay)]
+    assert main([*args, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (recorded,) = [
+        e
+        for e in before
+        if (e["scenario"], e["controller"], e["seed"]) == ("my_turn", "pid_los", 10001)
+    ]
+    assert doc["scenario"] == "my_turn"
+    assert (doc["ace"], doc["cost"], doc["steps"]) == (
+        recorded["ace"],
+        recorded["cost"],
+        recorded["steps"],
+    )
+
+
+def test_a_scenario_file_named_as_another_is_refused_naming_both(tmp_path: Path) -> None:
+    first = own_scenario(tmp_path, "a.yaml", "my_turn")
+    second = own_scenario(tmp_path, "b.yaml", "my_turn", time_limit=30.0)
+    suite = write_suite(tmp_path, scenarios=["nominal", "a.yaml", "b.yaml"])
+    with pytest.raises(ConfigError) as info:
+        run(suite, tmp_path / "out")
+    message = str(info.value)
+    assert f"scenario files {first} and {second} are both named 'my_turn'" in message
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_scenario_file_named_as_a_catalogue_scenario_is_refused(tmp_path: Path) -> None:
+    file = own_scenario(tmp_path, "mine.yaml", "rudder_aging")
+    suite = write_suite(tmp_path, scenarios=["mine.yaml"])
+    with pytest.raises(ConfigError) as info:
+        run(suite, tmp_path / "out")
+    assert (
+        f"scenario file {file} is named 'rudder_aging', as the catalogue's scenario "
+        "configs/scenarios/rudder_aging.yaml, but its settings differ"
+    ) in str(info.value)
+
+
+def test_a_copy_of_a_catalogue_scenario_is_that_scenario(tmp_path: Path) -> None:
+    from shipgym_baselines.leaderboard import suite_record, suite_scenarios
+    from shipgym_baselines.suite import load_suite
+
+    copy = tmp_path / "copy.yaml"
+    copy.write_text(NOMINAL.read_text())
+    spec = load_suite(write_suite(tmp_path, scenarios=["copy.yaml", "rudder_aging"]))
+    scenarios = suite_scenarios(spec.all_scenarios())
+    assert list(scenarios) == ["nominal", "rudder_aging"]
+    record = suite_record(spec, ["pid_los"], scenarios, [10_000], {"pid_los": [None]})
+    assert "scenario_files" not in record  # grouped with the catalogue

@@ -300,16 +300,17 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
 
 
 def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
-    """A scenario given by its YAML path is plotted as ``scenario_<stem>.png`` inside --out,
-    never beside the scenario file."""
+    """A scenario given by its YAML path is plotted as ``scenario_<name>.png`` (its
+    ``name:``) inside --out, never beside the scenario file."""
     cases = tmp_path / "cases"
     cases.mkdir()
-    (cases / "my_case.yaml").write_text((ROOT / "configs/scenarios/nominal.yaml").read_text())
-    suite = write_suite(tmp_path, scenarios=["cases/my_case.yaml"], controllers=["pid_los"])
+    nominal = (ROOT / "configs/scenarios/nominal.yaml").read_text()
+    (cases / "case_v1.yaml").write_text(nominal.replace("name: nominal", "name: my_case"))
+    suite = write_suite(tmp_path, scenarios=["cases/case_v1.yaml"], controllers=["pid_los"])
     out = tmp_path / "out"
     run_leaderboard(suite, seeds=1, out_dir=out, workers=1, show_progress=False)
     assert (out / "scenario_my_case.png").is_file()
-    assert sorted(p.name for p in cases.iterdir()) == ["my_case.yaml"]
+    assert sorted(p.name for p in cases.iterdir()) == ["case_v1.yaml"]
 
 
 def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> None:

@@ -71,7 +71,9 @@ def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
 def test_relative_scenario_paths_are_read_against_the_suite_folder(
     tmp_path: Path, monkeypatch
 ) -> None:
-    scenario = write(tmp_path, "name: mine\n", "suites/scenarios/mine.yaml")
+    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    text = nominal.replace("name: nominal", "name: mine")
+    scenario = write(tmp_path, text, "suites/scenarios/mine.yaml")
     suite = write(
         tmp_path,
         "name: s\nscenarios: [nominal, scenarios/mine.yaml, heldout:2]\ncontrollers: [pid_los]\n",
@@ -143,3 +145,52 @@ def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
     file = write(tmp_path, "name: s\nscenarios: [nominal, nominal]\ncontrollers: [pid_los]\n")
     with pytest.raises(ConfigError, match="more than once"):
         load_suite(file)
+
+
+# --- check_suite_file (shipgym scenarios --validate) -----------------------------------------
+
+NOMINAL = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+
+
+def test_a_suite_check_lists_schema_and_later_problems_together(tmp_path: Path) -> None:
+    from shipgym_baselines.suite import check_suite_file
+
+    scenario = write(tmp_path, NOMINAL.replace("name: nominal", "name: my_turn"), "mine.yaml")
+    write(tmp_path, NOMINAL.replace("name: nominal", "name: my_turn"), "twin.yaml")
+    file = write(
+        tmp_path,
+        "name: s\n"
+        "scenarios: [nominal, mine.yaml, twin.yaml, heldout:99999]\n"
+        "controllers:\n"
+        "  - pid_los\n"
+        "  - {controller: pid_los, name: pid_los}\n"
+        "  - {controller: pid_los, name: stiff, settings: {no_such_setting: 1}}\n"
+        "seeds: 0\n",
+    )
+    found = [(p.line, p.key, p.message) for p in check_suite_file(file)]
+    assert [(line, key) for line, key, _ in found] == [
+        (7, "seeds"),
+        (2, "scenarios.2"),
+        (2, "scenarios.3"),
+        (5, "controllers.1"),
+        (6, "controllers.2"),
+    ]
+    assert "greater than or equal to 1" in found[0][2]
+    assert found[1][2].startswith(
+        f"scenario files {scenario} and {tmp_path / 'twin.yaml'} are both named 'my_turn'"
+    )
+    assert "heldout: index 99999 out of range" in found[2][2]
+    assert "table name 'pid_los' is also controllers.0's" in found[3][2]
+    assert "no_such_setting" in found[4][2]
+
+
+def test_a_good_suite_has_no_problems(tmp_path: Path) -> None:
+    from shipgym_baselines.suite import check_suite_file, is_suite_file
+
+    for name in list_suites():
+        assert is_suite_file(name) and check_suite_file(name) == [], name
+    write(tmp_path, NOMINAL.replace("name: nominal", "name: mine"), "scenarios/mine.yaml")
+    file = write(tmp_path, "name: s\nscenarios: [scenarios/mine.yaml]\ncontrollers: [pid_los]\n")
+    assert is_suite_file(str(file)) and check_suite_file(str(file)) == []
+    assert not is_suite_file(str(tmp_path / "scenarios/mine.yaml"))
+    assert not is_suite_file("nominal")
