@@ -12,18 +12,41 @@ per-episode setup.  The oracle's jobs read its reference table and cost next to 
 
 from __future__ import annotations
 
+import functools
+import json
 import os
 import time
 from collections import defaultdict
-from collections.abc import Iterable, Mapping
-from typing import Any
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from shipgym.config import is_path
+from shipgym.scenarios import Scenario
 from shipgym_baselines import evaluation
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.plugins import ControllerSpec
+
+if TYPE_CHECKING:
+    from shipgym_baselines.leaderboard import Job
 
 
 def _entry() -> dict[str, float]:
-    return {"episodes": 0, "steps": 0, "cpu_s": 0.0, "act_cpu_s": 0.0, "suite_cpu_s": 0.0}
+    return {
+        "episodes": 0,
+        "steps": 0,
+        "limit_steps": 0.0,
+        "cpu_s": 0.0,
+        "act_cpu_s": 0.0,
+        "suite_cpu_s": 0.0,
+    }
+
+
+def limit_steps(scenario: Scenario) -> float:
+    """Control steps of ``scenario``'s time limit (an episode's most steps)."""
+    return scenario.config.time_limit / scenario.control_period
 
 
 def _finish(entry: dict[str, float]) -> dict[str, float]:
@@ -62,7 +85,6 @@ def profile_suite(
     from tqdm import tqdm
 
     from shipgym_baselines.errors import check_seeds
-    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import (
         check_controllers,
         plan_jobs,
@@ -98,6 +120,7 @@ def profile_suite(
         from_table = grants_truth(job.controller)
         cell = cells[(controller_label(job.controller), job.scenario)]
         cell["episodes"] += len(results)
+        cell["limit_steps"] += len(results) * limit_steps(loaded[job.scenario])
         cell["cpu_s"] += cpu
         for r in results:
             steps = max(len(r.trajectory.get("t", ())) - 1, 0)
@@ -141,3 +164,180 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
     """The entries, most CPU first, with their per-step figures."""
     ordered = sorted(entries.items(), key=lambda item: -item[1]["cpu_s"])
     return {name: _finish(entry) for name, entry in ordered}
+
+
+# --- recorded costs: the leaderboard's first estimate ----------------------------------------
+
+#: the recorded costs (:func:`record_costs`), shipped beside the oracle's reference table
+COSTS_FILE = Path(__file__).parent / "reference_data" / "leaderboard_costs.json"
+#: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
+LEARNED_SEEDS = 10
+#: the kinds whose fallback a controller without a recorded cost takes
+FALLBACK_KINDS = ("classical", "learned")
+
+
+def _per_step(entry: Mapping[str, float]) -> float:
+    """CPU seconds per control step of the time limit of an entry of :func:`profile_suite`."""
+    return entry["cpu_s"] / max(entry["limit_steps"], 1.0)
+
+
+def record_costs(suite: str = "default", show_progress: bool = False) -> dict[str, Any]:
+    """Measure the costs :func:`estimate_cpu_s` reads (written to :data:`COSTS_FILE` by
+    ``python -m shipgym_baselines.run_costs``): per controller and ship, CPU seconds per
+    control step of the scenario's time limit, from :func:`profile_suite` on ``suite``
+    (classical controllers and references with 1 evaluation seed, learned agents with
+    :data:`LEARNED_SEEDS` in one batch, their first training seed); the oracle computed
+    (not read from its table) on the suite's first scenario of each ship, 1 seed; and per
+    kind and ship the median over the kind's controllers (the fallback of a plug-in)."""
+    import platform
+    import subprocess
+
+    from shipgym_baselines.leaderboard import Job, run_job, suite_scenario
+    from shipgym_baselines.registry import controller_kind, controller_label
+    from shipgym_baselines.suite import load_suite
+
+    spec = load_suite(suite)
+    labels = [controller_label(c) for c in spec.controllers]
+    learned = [
+        c
+        for c, lb in zip(spec.controllers, labels, strict=True)
+        if controller_kind(lb) == "learned"
+    ]
+    others = [c for c in spec.controllers if c not in learned]
+    start = time.process_time()
+    profiles = [
+        profile_suite(suite, seeds=1, controllers=others, show_progress=show_progress),
+        profile_suite(suite, seeds=LEARNED_SEEDS, controllers=learned, show_progress=show_progress),
+    ]
+    per_step: dict[str, dict[str, float]] = {}
+    for profile in profiles:
+        for label, ships in profile["per_controller_ship"].items():
+            per_step[label] = {ship: _per_step(entry) for ship, entry in ships.items()}
+    first: dict[str, str] = {}
+    for name in spec.all_scenarios():
+        first.setdefault(suite_scenario(name).model.name, name)
+    oracle_computed = {}
+    for ship, name in sorted(first.items()):
+        job = Job("oracle", name, (EVAL_SEED_OFFSET,), None, _randomize(spec))
+        clock = time.process_time()
+        run_job(tuple(job))  # the oracle run, not read from its table
+        oracle_computed[ship] = (time.process_time() - clock) / limit_steps(suite_scenario(name))
+    kinds = {label: controller_kind(label) for label in per_step}
+    fallback = {
+        kind: {
+            ship: float(
+                np.median(
+                    [
+                        per_step[c][ship]
+                        for c in per_step
+                        if kinds[c] == kind and ship in per_step[c]
+                    ]
+                )
+            )
+            for ship in sorted(first)
+        }
+        for kind in FALLBACK_KINDS
+    }
+    commit = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"],
+        capture_output=True,
+        text=True,
+        cwd=Path(__file__).parent,
+        check=False,
+    ).stdout.strip()
+    return {
+        "about": "CPU seconds per control step of a scenario's time limit (time_limit / "
+        "control_period), per controller and ship, as the leaderboard runs its jobs; "
+        "shipgym_baselines.run_costs.estimate_cpu_s reads it",
+        "measured": {
+            "suite": spec.name,
+            "commit": commit,
+            "machine": platform.processor() or platform.machine(),
+            "cpu_s": time.process_time() - start,
+            "load_average": [p["load_average"] for p in profiles],
+            "command": "python -m shipgym_baselines.run_costs",
+        },
+        "cpu_s_per_limit_step": dict(sorted(per_step.items())),
+        "oracle_computed": oracle_computed,
+        "fallback": fallback,
+    }
+
+
+@functools.lru_cache(maxsize=1)
+def recorded_costs() -> dict[str, Any]:
+    """The shipped recorded costs (:data:`COSTS_FILE`, :func:`record_costs`), read once."""
+    return json.loads(COSTS_FILE.read_text())
+
+
+def _median(values: Iterable[float]) -> float:
+    return float(np.median(list(values)))
+
+
+def step_cost(
+    job: Job, ship: str, costs: Mapping[str, Any] | None = None, from_table: bool = True
+) -> float:
+    """The recorded CPU seconds per control step of the time limit of ``job``'s controller
+    on ``ship``: its own (by spec), the oracle's computed cost when it does not read its
+    table (``from_table`` False, or the job recomputes), else its kind's median (a plug-in,
+    a trained agent: :data:`FALLBACK_KINDS`; a ship not recorded: the median over ships)."""
+    from shipgym_baselines.privileged import grants_truth
+    from shipgym_baselines.registry import controller_kind, controller_label
+
+    costs = costs if costs is not None else recorded_costs()
+    spec = job.controller if isinstance(job.controller, str) else job.controller.controller
+    if grants_truth(job.controller) and (job.references == "recompute" or not from_table):
+        per_ship = costs["oracle_computed"]
+    elif spec in costs["cpu_s_per_limit_step"]:
+        per_ship = costs["cpu_s_per_limit_step"][spec]
+    else:
+        kind = controller_kind(controller_label(job.controller))
+        per_ship = costs["fallback"][kind if kind in FALLBACK_KINDS else "classical"]
+    return per_ship[ship] if ship in per_ship else _median(per_ship.values())
+
+
+def estimate_cpu_s(
+    jobs: Iterable[Job], scenarios: Mapping[str, Scenario], costs: Mapping[str, Any] | None = None
+) -> float:
+    """CPU seconds the leaderboard's ``jobs`` take by the recorded costs: per job, its
+    controller's :func:`step_cost` on the scenario's ship × the scenario's time limit in
+    control steps × its seeds.  The oracle reads its table on a named scenario, and is
+    computed on a scenario file (the shipped table holds catalogue and held-out trials)."""
+    total = 0.0
+    for job in jobs:
+        scenario = scenarios[job.scenario]
+        per_step = step_cost(job, scenario.model.name, costs, from_table=not is_path(job.scenario))
+        total += per_step * limit_steps(scenario) * len(job.seeds)
+    return total
+
+
+def duration(seconds: float) -> str:
+    """``seconds`` for a person: "40 s", "9 min", "2.5 h"."""
+    if seconds < 90:
+        return f"{max(seconds, 1):.0f} s"
+    if seconds < 90 * 60:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def eta_line(
+    jobs: Sequence[Job], scenarios: Mapping[str, Scenario], workers: int, episodes: int
+) -> str:
+    """The leaderboard's first line: the episodes to run (of ``episodes`` in the run), the
+    workers and the wall time by :func:`estimate_cpu_s` over the workers (the run is
+    CPU-bound; its jobs are spread longest first)."""
+    todo = sum(len(job.seeds) for job in jobs)
+    count = f"{todo:,} episodes" if todo == episodes else f"{todo:,} of {episodes:,} episodes"
+    wall = estimate_cpu_s(jobs, scenarios) / max(min(workers, len(jobs)), 1)
+    plural = "" if workers == 1 else "s"
+    return (
+        f"leaderboard: {count} on {workers} worker{plural}, about {duration(wall)} (recorded costs)"
+    )
+
+
+def _randomize(spec: Any) -> dict[str, Any] | None:
+    return None if spec.randomize is None else spec.randomize.model_dump(mode="json")
+
+
+if __name__ == "__main__":
+    COSTS_FILE.write_text(json.dumps(record_costs(show_progress=True), indent=1) + "\n")
+    print(f"wrote {COSTS_FILE}")
