@@ -172,6 +172,8 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
 COSTS_FILE = Path(__file__).parent / "reference_data" / "leaderboard_costs.json"
 #: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
 LEARNED_SEEDS = 10
+#: evaluation seeds of the other controllers' measured jobs (in lockstep, as a run's)
+OTHER_SEEDS = 3
 #: the kinds whose fallback a controller without a recorded cost takes
 FALLBACK_KINDS = ("classical", "learned")
 
@@ -181,37 +183,50 @@ def _per_step(entry: Mapping[str, float]) -> float:
     return entry["cpu_s"] / max(entry["limit_steps"], 1.0)
 
 
-def record_costs(suite: str = "default", show_progress: bool = False) -> dict[str, Any]:
+def record_costs(
+    suite: str = "quick", show_progress: bool = False, cache: Path | None = None
+) -> dict[str, Any]:
     """Measure the costs :func:`estimate_cpu_s` reads (written to :data:`COSTS_FILE` by
     ``python -m shipgym_baselines.run_costs``): per controller and ship, CPU seconds per
     control step of the scenario's time limit, from :func:`profile_suite` on ``suite``
-    (classical controllers and references with 1 evaluation seed, learned agents with
-    :data:`LEARNED_SEEDS` in one batch, their first training seed); the oracle computed
+    (classical controllers and references with :data:`OTHER_SEEDS` evaluation seeds, learned
+    agents with :data:`LEARNED_SEEDS`, each job's seeds in lockstep as a run's; a learned
+    agent's first training seed); the oracle computed
     (not read from its table) on the suite's first scenario of each ship, 1 seed; and per
-    kind and ship the median over the kind's controllers (the fallback of a plug-in)."""
+    kind and ship the median over the kind's controllers (the fallback of a plug-in).
+    ``cache``: a folder keeping each profile once measured (a second call reads it)."""
     import platform
-    import subprocess
 
-    from shipgym_baselines.leaderboard import Job, run_job, suite_scenario
+    from shipgym_baselines.leaderboard import Job, suite_scenario, work
     from shipgym_baselines.registry import controller_kind, controller_label
+    from shipgym_baselines.runs import git_commit
     from shipgym_baselines.suite import load_suite
 
     spec = load_suite(suite)
     labels = [controller_label(c) for c in spec.controllers]
+    kinds = dict(zip(labels, map(controller_kind, labels), strict=True))
     learned = [
-        c
-        for c, lb in zip(spec.controllers, labels, strict=True)
-        if controller_kind(lb) == "learned"
+        c for c, label in zip(spec.controllers, labels, strict=True) if kinds[label] == "learned"
     ]
     others = [c for c in spec.controllers if c not in learned]
     start = time.process_time()
+
+    def profile(part: str, controllers: list[ControllerSpec], seeds: int) -> dict[str, Any]:
+        file = None if cache is None else cache / f"{spec.name}_{part}.json"
+        if file is not None and file.is_file():
+            return json.loads(file.read_text())
+        found = profile_suite(suite, seeds, controllers, show_progress=show_progress)
+        if file is not None:
+            file.write_text(json.dumps(found))
+        return found
+
     profiles = [
-        profile_suite(suite, seeds=1, controllers=others, show_progress=show_progress),
-        profile_suite(suite, seeds=LEARNED_SEEDS, controllers=learned, show_progress=show_progress),
+        profile("others", others, OTHER_SEEDS),
+        profile("learned", learned, LEARNED_SEEDS),
     ]
     per_step: dict[str, dict[str, float]] = {}
-    for profile in profiles:
-        for label, ships in profile["per_controller_ship"].items():
+    for found in profiles:
+        for label, ships in found["per_controller_ship"].items():
             per_step[label] = {ship: _per_step(entry) for ship, entry in ships.items()}
     first: dict[str, str] = {}
     for name in spec.all_scenarios():
@@ -220,41 +235,28 @@ def record_costs(suite: str = "default", show_progress: bool = False) -> dict[st
     for ship, name in sorted(first.items()):
         job = Job("oracle", name, (EVAL_SEED_OFFSET,), None, _randomize(spec))
         clock = time.process_time()
-        run_job(tuple(job))  # the oracle run, not read from its table
+        work(job._replace(references="recompute"))  # the oracle run, not read from its table
         oracle_computed[ship] = (time.process_time() - clock) / limit_steps(suite_scenario(name))
-    kinds = {label: controller_kind(label) for label in per_step}
     fallback = {
         kind: {
-            ship: float(
-                np.median(
-                    [
-                        per_step[c][ship]
-                        for c in per_step
-                        if kinds[c] == kind and ship in per_step[c]
-                    ]
-                )
+            ship: _median(
+                steps[ship] for c, steps in per_step.items() if kinds[c] == kind and ship in steps
             )
             for ship in sorted(first)
         }
         for kind in FALLBACK_KINDS
     }
-    commit = subprocess.run(
-        ["git", "rev-parse", "--short", "HEAD"],
-        capture_output=True,
-        text=True,
-        cwd=Path(__file__).parent,
-        check=False,
-    ).stdout.strip()
     return {
         "about": "CPU seconds per control step of a scenario's time limit (time_limit / "
         "control_period), per controller and ship, as the leaderboard runs its jobs; "
         "shipgym_baselines.run_costs.estimate_cpu_s reads it",
         "measured": {
             "suite": spec.name,
-            "commit": commit,
+            "commit": git_commit(),
             "machine": platform.processor() or platform.machine(),
             "cpu_s": time.process_time() - start,
-            "load_average": [p["load_average"] for p in profiles],
+            "profiles_cpu_s": [found["cpu_s"] for found in profiles],
+            "load_average": [found["load_average"] for found in profiles],
             "command": "python -m shipgym_baselines.run_costs",
         },
         "cpu_s_per_limit_step": dict(sorted(per_step.items())),
@@ -339,5 +341,9 @@ def _randomize(spec: Any) -> dict[str, Any] | None:
 
 
 if __name__ == "__main__":
-    COSTS_FILE.write_text(json.dumps(record_costs(show_progress=True), indent=1) + "\n")
+    import sys
+
+    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else None  # the profiles' cache
+    costs = record_costs(show_progress=True, cache=folder)
+    COSTS_FILE.write_text(json.dumps(costs, indent=1) + "\n")
     print(f"wrote {COSTS_FILE}")

@@ -160,8 +160,9 @@ def test_evaluate_runs_merge_into_one_ranking_reading_the_references_once(
         folders.append(tmp_path / policy.rpartition(":")[2].lower())
         _run(["evaluate", policy, "--suite", one_scenario, "--out", str(folders[-1])], capsys)
     note = (folders[1] / "leaderboard.md").read_text()
-    # pid_los is one of the suite's: the comparison is the suite's own run
-    assert f"`shipgym leaderboard --suite {one_scenario}`" in note
+    # pid_los is the suite's one competitor: nothing of the suite is left out
+    assert "References added for the cost ratio: `oracle`, `zero_rudder`, `random`" in note
+    assert "Ranked against" not in note
     write_report(folders, tmp_path / "both")
     board = json.loads((tmp_path / "both" / "aggregate.json").read_text())
     assert sorted(r["controller"] for r in board) == ["pid_los", "steer"]
