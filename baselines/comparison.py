@@ -2,8 +2,9 @@
 
 The ranking divides each episode's cost by the ``oracle``'s on the same trial
 (:mod:`shipgym_baselines.ranking`), so a run without the oracle has no ranking.
-``shipgym leaderboard`` and ``shipgym evaluate`` add the references :data:`REFERENCES` to
-the controllers they run, unless ``--no-references``:
+``shipgym evaluate`` and ``shipgym leaderboard --controllers`` add the references
+:data:`REFERENCES` to the controllers given, unless ``--no-references`` (a suite's own
+controllers run as the suite lists them):
 
 * ``oracle``: the denominator of the cost ratio, read from its shipped reference table
   (:mod:`shipgym_baselines.references`: no episode to run on the packaged suites);

@@ -76,11 +76,13 @@ from shipgym_baselines.registry import applies_to, controller_kind, controller_l
 from shipgym_baselines.run_costs import eta_line
 from shipgym_baselines.runs import (
     BACKENDS,
+    RUN_FILE,
     RunLog,
     check_out_dir,
     check_out_usable,
     episode_result,
     read_episodes,
+    read_run,
 )
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.style import FIGURE_DPI, controller_style
@@ -416,10 +418,12 @@ def run_leaderboard(
     the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  ``add_references``: run the
     references (:data:`shipgym_baselines.comparison.REFERENCES`) too, those not among the
-    controllers already (``run.json`` records which).  ``out_dir``: default
-    ``results/<suite>`` (:func:`~shipgym_baselines.comparison.suite_folder`).  Before the
-    first episode, one line on stderr: the episodes, workers and the time estimated from the
-    recorded costs (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
+    controllers already (``run.json`` records which; a resumed run that did not add them
+    does not).  ``out_dir``: default
+    ``results/<suite>`` (:func:`~shipgym_baselines.comparison.suite_folder`).
+    ``show_progress``: a progress bar on stderr, after one line before the first episode: the
+    episodes, workers and the time estimated from the recorded costs
+    (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
     if out_dir is None:
@@ -433,6 +437,8 @@ def run_leaderboard(
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
     added: list[str] = []
+    if resume and RECORD_KEY not in read_run(out_dir)["suite"]:
+        add_references = False  # resumed as it was started: without the references
     if add_references:
         names, added = with_references(names)
     labels = check_controllers(names)
@@ -461,7 +467,8 @@ def run_leaderboard(
     with log.recording():  # holds out_dir's lock to the end
         todo = longest_first(missing(jobs, log.done), scenarios)
         rows = row_keys(jobs)
-        sys.stderr.write(eta_line(todo, scenarios, workers, n_episodes) + "\n")
+        if show_progress:  # the bar's first line, before any job ends
+            sys.stderr.write(eta_line(todo, scenarios, workers, n_episodes) + "\n")
         bar = tqdm(
             total=n_episodes,
             initial=n_episodes - sum(len(job.seeds) for job in todo),
@@ -902,8 +909,6 @@ def _why_none(folder: str | os.PathLike) -> str:
 def _note_lines(folder: str | os.PathLike) -> list[str]:
     """What a run folder's ranking is against (its ``run.json``), as lines; none for a
     report's folder or a run that added no reference."""
-    from shipgym_baselines.runs import RUN_FILE, read_run
-
     if not (Path(folder) / RUN_FILE).is_file():
         return []
     note = comparison_note(read_run(folder).get("suite", {}), folder)

@@ -4,8 +4,9 @@ Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
 :mod:`shipgym_baselines.runs`); a folder that is not empty is refused before any work unless
 ``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for ``leaderboard``,
 ``results/evaluate/<suite>/<policy>`` for ``evaluate`` (one folder per suite and policy, outside
-the leaderboard's).  Both run the references too (:mod:`shipgym_baselines.comparison`), unless
-``--no-references``.
+the leaderboard's).  The controllers given (``evaluate``'s policy, ``--controllers``) run
+with the references (:mod:`shipgym_baselines.comparison`), unless ``--no-references``; a
+suite's own controllers run as the suite lists them.
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ def add_references_option(parser: argparse.ArgumentParser) -> None:
         "--no-references",
         action="store_true",
         help=f"do not add the references ({', '.join(REFERENCES)}: the oracle read from its "
-        "shipped table) to the controllers; without the oracle there is no ranking",
+        "shipped table) to the controllers given (evaluate's policy, --controllers); without "
+        "the oracle there is no ranking",
     )
 
 
@@ -41,7 +43,8 @@ def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
     add_run_options(
         p,
         out=None,
-        progress_help="no progress bar on stderr",
+        progress_help="no progress bar on stderr, nor its first line (the time estimated "
+        "from the recorded costs)",
         out_help=f"output directory (default {RESULTS_ROOT}/<suite>: the suite's name or its "
         "file's stem; refused if not empty: see --resume, --force)",
     )
@@ -88,6 +91,8 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
     add_run_options(
         p,
         out=None,
+        progress_help="no progress bar on stderr, nor its first line (the time estimated "
+        "from the recorded costs)",
         out_help=f"output directory (default {EVALUATE_ROOT}/<suite>/<policy>; refused if not "
         "empty: see --resume, --force)",
     )
@@ -170,6 +175,7 @@ def run(args: argparse.Namespace) -> int:
     check_out_usable(out, resume=args.resume, force=args.force)
     spec = load_suite(args.suite)
     controllers = [policy] if policy is not None else getattr(args, "controllers", None)
+    explicit = controllers is not None  # the references join controllers given, not a suite's
     if policy is None and args.name:
         controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
@@ -188,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
         vector_figures=args.vector_figures,
-        add_references=not args.no_references,
+        add_references=explicit and not args.no_references,
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

@@ -75,14 +75,15 @@ def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[str, str]
 
 @pytest.fixture(scope="module")
 def evaluated(steer: str, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str, str]:
-    """``shipgym evaluate steer.py:Steer --suite smoke``: (its folder, stdout, stderr)."""
+    """``shipgym evaluate steer.py:Steer --suite smoke``: (its folder, stdout, stderr), with
+    the progress bar."""
     out = tmp_path_factory.mktemp("evaluated") / "steer"
     with pytest.MonkeyPatch.context() as mp:
         stdout, stderr = io.StringIO(), io.StringIO()
         mp.setattr(sys, "stdout", stdout)
         mp.setattr(sys, "stderr", stderr)
         argv = ["evaluate", steer, "--suite", "smoke", "--out", str(out)]
-        assert main([*argv, "--no-progress", "--workers", "1"]) == 0
+        assert main([*argv, "--workers", "1"]) == 0  # with its progress bar
     return out, stdout.getvalue(), stderr.getvalue()
 
 
@@ -209,3 +210,18 @@ def test_the_note_says_what_the_run_is_ranked_against() -> None:
 def test_each_suite_has_its_own_default_folder() -> None:
     assert suite_folder("quick") == Path("results/quick")
     assert suite_folder("suites/my_suite.yaml") == Path("results/my_suite")
+
+
+def test_a_run_started_without_the_references_resumes_without_them(
+    one_scenario: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run of an earlier version (or ``--no-references``) is finished as it was started."""
+    from shipgym_baselines.leaderboard import run_leaderboard
+
+    out, given = tmp_path / "before", ["pid_los", "zero_rudder", "oracle"]
+    run_leaderboard(one_scenario, 1, out, workers=1, show_progress=False, controllers=given)
+    before = read_run(out)["suite"]
+    argv = ["leaderboard", "--suite", one_scenario, "--seeds", "1", "--out", str(out)]
+    _run([*argv, "--controllers", *given, "--resume"], capsys)
+    assert read_run(out)["suite"] == before and "references" not in before
+    assert {e["controller"] for e in read_episodes(out)} == set(given)  # no random
