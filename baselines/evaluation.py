@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol, runtime_checkable
@@ -464,17 +465,45 @@ def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:
     )
 
 
+def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) -> list[Any]:
+    """The trial of ``scenario`` (a name, YAML path, :class:`~shipgym.scenarios.Scenario`
+    or settings dict) that each seed draws with ``suite``'s ``randomize`` ranges: the
+    leaderboard's own drawing (:func:`shipgym_baselines.leaderboard.trials`), so seed
+    10000 + i is the leaderboard's trial i of the scenario."""
+    from shipgym_baselines.leaderboard import Job, trials
+    from shipgym_baselines.suite import load_suite
+
+    spec = load_suite(suite)
+    randomize = None if spec.randomize is None else spec.randomize.model_dump(mode="json")
+    if isinstance(scenario, str | os.PathLike):
+        name, settings = str(scenario), None
+    else:
+        loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        name, settings = loaded.name, loaded.config.model_dump(mode="json")
+    seeds = tuple(int(seed) for seed in seeds)
+    return trials(Job("zero_rudder", name, seeds, None, randomize, settings))  # any controller
+
+
 def evaluate(
-    controller: ControllerSpec | Policy, scenario: Any, seeds: list[int], **settings: Any
+    controller: ControllerSpec | Policy,
+    scenario: Any,
+    seeds: list[int],
+    *,
+    suite: str | os.PathLike | None = None,
+    **settings: Any,
 ) -> list[EpisodeResult]:
     """Evaluate a controller on a scenario over seeds.
 
     ``controller``: a name, spec or long form :func:`~shipgym_baselines.registry.make_controller`
     knows (made afresh per seed with ``settings``) or a Policy instance (``settings`` may
-    give its ``action_mode``; default: the policy's own).
+    give its ``action_mode``; default: the policy's own).  ``suite``: a suite name or file;
+    each seed then runs its trial of the scenario as that suite's leaderboard draws it
+    (:func:`suite_trials`: start, jump time and current from the seed; seed 10000 + i is
+    the leaderboard's i-th); None: every seed runs the scenario as written.
     """
+    trials = [scenario] * len(seeds) if suite is None else suite_trials(scenario, seeds, suite)
     results = []
-    for seed in seeds:
+    for seed, trial in zip(seeds, trials, strict=True):
         privileged = False
         if isinstance(controller, str | ControllerEntry):
             policy, mode = make_controller(controller, **settings)
@@ -482,5 +511,5 @@ def evaluate(
             privileged = plain and grants_truth(controller)
         else:
             policy, mode = controller, settings.get("action_mode")
-        results.append(run_episode(policy, scenario, seed, mode, privileged=privileged))
+        results.append(run_episode(policy, trial, seed, mode, privileged=privileged))
     return results

@@ -45,6 +45,13 @@ from shipgym.metrics import aggregate
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines import evaluation
+from shipgym_baselines.comparison import (
+    RECORD_KEY,
+    comparison_note,
+    references_record,
+    suite_folder,
+    with_references,
+)
 from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
@@ -54,25 +61,28 @@ from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
     BASELINE,
-    NO_RANKING,
     ORACLE,
     PARTIAL,
     SCORE_EXPLAINED,
     aggregate_ranking,
     is_partial,
+    no_ranking,
     resolution_lines,
     row_intervals,
 )
 from shipgym_baselines.ranking import scenario_scores as score_table
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
+from shipgym_baselines.run_costs import eta_line
 from shipgym_baselines.runs import (
     BACKENDS,
+    RUN_FILE,
     RunLog,
     check_out_dir,
     check_out_usable,
     episode_result,
     read_episodes,
+    read_run,
 )
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.style import FIGURE_DPI, controller_style
@@ -433,7 +443,7 @@ def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
 def run_leaderboard(
     suite: str = "default",
     seeds: int | None = None,
-    out_dir: str | os.PathLike = "results/leaderboard",
+    out_dir: str | os.PathLike | None = None,
     backend: str = "local",
     workers: int | None = None,
     controllers: Iterable[ControllerSpec] | None = None,
@@ -444,6 +454,7 @@ def run_leaderboard(
     on_episode: Callable[[EpisodeResult], None] | None = None,
     recompute_references: bool = False,
     vector_figures: bool = False,
+    add_references: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -455,9 +466,18 @@ def run_leaderboard(
     recorded; ``recompute_references``: run the ``oracle`` on every trial instead of reading
     its shipped reference table (:mod:`shipgym_baselines.references`); ``vector_figures``:
     the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
-    (default: the cores), clamped to the jobs; below 1 refused.  Ctrl-C raises
+    (default: the cores), clamped to the jobs; below 1 refused.  ``add_references``: run the
+    references (:data:`shipgym_baselines.comparison.REFERENCES`) too, those not among the
+    controllers already (``run.json`` records which; a resumed run that did not add them
+    does not).  ``out_dir``: default
+    ``results/<suite>`` (:func:`~shipgym_baselines.comparison.suite_folder`).
+    ``show_progress``: a progress bar on stderr, after one line before the first episode: the
+    episodes, workers and the time estimated from the recorded costs
+    (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
     """
+    if out_dir is None:
+        out_dir = suite_folder(suite)
     check_out_usable(out_dir, resume=resume, force=force)  # before any work
     if backend not in BACKENDS:
         raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
@@ -466,11 +486,19 @@ def run_leaderboard(
     n_seeds = int(seeds if seeds is not None else spec.seeds)
     check_seeds(n_seeds, "--seeds")
     names = list(controllers) if controllers else list(spec.controllers)
+    added: list[str] = []
+    if resume and RECORD_KEY not in read_run(out_dir)["suite"]:
+        add_references = False  # resumed as it was started: without the references
+    if add_references:
+        names, added = with_references(names)
     labels = check_controllers(names)
     seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
     seed_list = [EVAL_SEED_OFFSET + i for i in range(n_seeds)]
     scenarios = suite_scenarios(spec.all_scenarios())
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
+    if add_references:
+        given = list(controllers) if controllers else None
+        record[RECORD_KEY] = references_record(suite, spec.controllers, given, added)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
     references = "recompute" if recompute_references else "table"
     jobs = plan_jobs(
@@ -490,6 +518,8 @@ def run_leaderboard(
         todo = longest_first(missing(jobs, log.done), scenarios)
         announce_references(todo)
         rows = row_keys(jobs)
+        if show_progress:  # the bar's first line, before any job ends
+            sys.stderr.write(eta_line(todo, scenarios, workers, n_episodes) + "\n")
         bar = tqdm(
             total=n_episodes,
             initial=n_episodes - sum(len(job.seeds) for job in todo),
@@ -636,7 +666,9 @@ def write_results(
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
         (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
-        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked)
+        head = ranking_markdown(
+            board, scores, list(suite["scenarios"]), left_out, ranked, comparison_note(suite, out)
+        )
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
@@ -844,21 +876,30 @@ def ranking_markdown(
     scenarios: list[str],
     left_out: Sequence[str] = (),
     episodes: Sequence[Mapping[str, Any]] = (),
+    note: str = "",
 ) -> str:
     """The head of ``leaderboard.md``: the score in two sentences, the ranking per split
     (and its partial tables), the resolution and the controller × scenario table of cost
-    ratios; ``episodes``: the ranked ones (to name the scenarios without the oracle's)."""
+    ratios; ``episodes``: the ranked ones (to name the scenarios without the oracle's);
+    ``note``: what the run is ranked against
+    (:func:`~shipgym_baselines.comparison.comparison_note`), under the score's sentences."""
     lead = verdict(board, episodes)
     lines = ["# Leaderboard", "", *([lead, ""] if lead else []), "## Ranking", ""]
     if not board:
-        return "\n".join([*lines, NO_RANKING, ""])
+        return "\n".join([*lines, no_ranking(scores), ""])
     lines += [SCORE_EXPLAINED, ""]
+    if note:
+        lines += [note, ""]
     if left_out:
         lines += [f"Left out (episodes missing): {', '.join(left_out)}.", ""]
     with_oracle = {e["scenario"] for e in episodes if e["controller"] == ORACLE}
     unranked = sorted({e["scenario"] for e in episodes} - with_oracle)
     if unranked:
-        lines += [f"Not ranked (no episodes of {ORACLE}): {', '.join(unranked)}.", ""]
+        lines += [
+            f"Not ranked (no episodes of {ORACLE}; a run with the references has them): "
+            f"{', '.join(unranked)}.",
+            "",
+        ]
     lines += ranking_tables(board) + resolution_lines(board)
     lines += scores_markdown(board, scores, scenarios)
     return "\n".join(lines)
@@ -916,8 +957,24 @@ def terminal_summary(folder: str | os.PathLike) -> str:
         "## Ranking (cost over the oracle's; lower is better)",
         "",
     ]
-    lines += ranking_tables(board) + resolution_lines(board) if board else [NO_RANKING, ""]
+    lines += ranking_tables(board) + resolution_lines(board) if board else [_why_none(folder), ""]
+    lines += _note_lines(folder) if board else []
     return "\n".join([*lines, f"leaderboard: {Path(folder) / PAGE_FILE}"])
+
+
+def _why_none(folder: str | os.PathLike) -> str:
+    """Why the run folder has no ranking (:func:`~shipgym_baselines.ranking.no_ranking`)."""
+    file = Path(folder) / SCENARIO_SCORES_FILE
+    return no_ranking(json.loads(file.read_text()) if file.is_file() else [])
+
+
+def _note_lines(folder: str | os.PathLike) -> list[str]:
+    """What a run folder's ranking is against (its ``run.json``), as lines; none for a
+    report's folder or a run that added no reference."""
+    if not (Path(folder) / RUN_FILE).is_file():
+        return []
+    note = comparison_note(read_run(folder).get("suite", {}), folder)
+    return [note, ""] if note else []
 
 
 def _fmt(value: Any, std: Any = None) -> str:

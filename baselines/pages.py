@@ -49,11 +49,11 @@ from shipgym_baselines.figures import (
     figure_stem,
 )
 from shipgym_baselines.ranking import (
-    NO_RANKING,
     ORACLE,
     PARTIAL,
     SCORE_EXPLAINED,
     is_partial,
+    no_ranking,
     resolution_lines,
 )
 from shipgym_baselines.runs import write_bytes
@@ -675,7 +675,7 @@ def page(
         f"<h1>{_e(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
-        f"{ranking_tables(aggregate) if aggregate else _no_ranking()}"
+        f"{ranking_tables(aggregate) if aggregate else _no_ranking(scores)}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
         "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
         "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
@@ -693,8 +693,8 @@ def page(
     )
 
 
-def _no_ranking() -> str:
-    return f'<p class="note">{_e(NO_RANKING.replace("`", ""))}</p>'
+def _no_ranking(scores: Sequence[Mapping[str, Any]]) -> str:
+    return f'<p class="note">{_e(no_ranking(scores).replace("`", ""))}</p>'
 
 
 def write_html(

@@ -90,11 +90,27 @@ SCORE_EXPLAINED = (
     "stratified-bootstrap interval (rliable; Agarwal et al. 2021), ranked by IQM, lowest "
     "first."
 )
-#: what leaderboard.md and the terminal say without the oracle's episodes
+#: what leaderboard.md, the page and the terminal say without the oracle's episodes
 NO_RANKING = (
     f"No ranking: the cost ratio needs the episodes of the reference `{ORACLE}` on the same "
-    "scenarios and trials, and this record has none."
+    "scenarios and trials, and this record has none. To get one, run with the references "
+    f"(without `--no-references`, or with `{ORACLE}` among `--controllers` or the suite's "
+    "controllers): its episodes are read from the shipped reference table."
 )
+#: what they say when the oracle ran but every controller is a reference
+NOTHING_TO_RANK = (
+    f"Nothing to rank: every controller of this record is a reference (`{ORACLE}` and the "
+    "controllers of kind `reference`, shown on every scenario but never ranked). Add a "
+    f"controller to rank, e.g. `shipgym leaderboard --controllers {BASELINE} MINE` or "
+    "`shipgym evaluate MINE` (the references are added)."
+)
+
+
+def no_ranking(scores: Sequence[Mapping[str, Any]]) -> str:
+    """Why a record has no ranking: :data:`NOTHING_TO_RANK` when it has the oracle's episodes
+    (``scores``: :func:`scenario_scores`, one entry per scenario with them), else
+    :data:`NO_RANKING`."""
+    return NOTHING_TO_RANK if scores else NO_RANKING
 
 
 @contextlib.contextmanager

@@ -5,7 +5,9 @@ Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.
 different
 policies on the same suite give the leaderboard of those policies).  Runs that give the same
 scenario name different settings, draw their trials differently (``randomize``), or hold the
-same (scenario, controller, seed, training_seed) episode, are refused.  The output folder
+same (scenario, controller, seed, training_seed) episode, are refused; a reference's episode
+(``oracle``, ``zero_rudder``, ``random``: every run adds them) held by several runs with the
+same cost is read once.  The output folder
 gets the leaderboard's tables, ranking (``aggregate.json``) and figures, and ``report.json``
 (which runs, when, with what).
 """
@@ -13,7 +15,7 @@ gets the leaderboard's tables, ranking (``aggregate.json``) and figures, and ``r
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -60,6 +62,7 @@ def merge_runs(
     }
     first_with: dict[str, str] = {}
     episode_in: dict[Key, str] = {}
+    cost_of: dict[Key, Any] = {}
     results = []
     sources = []
     for folder in map(str, folders):
@@ -94,8 +97,11 @@ def merge_runs(
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         suite["name"] = suite["name"] or run_suite.get("name")
         episodes = read_episodes(folder, suite=run_suite)
+        kinds = {c["name"]: c["kind"] for c in run_suite["controllers"]}
         for episode in episodes:
             key = episode_key(episode)
+            if key in episode_in and _same_reference(episode, kinds, cost_of[key]):
+                continue  # the references every run adds: the same trial, the same episode
             if key in episode_in:
                 raise RunError(
                     f"episode (scenario, controller, seed, training_seed) {key} is in "
@@ -103,6 +109,7 @@ def merge_runs(
                     f"in {folder}: report one of them"
                 )
             episode_in[key] = folder
+            cost_of[key] = episode.get("cost")
             results.append(episode_result(episode, folder))
         sources.append(
             {
@@ -116,6 +123,12 @@ def merge_runs(
             }
         )
     return suite, results, sources
+
+
+def _same_reference(episode: Mapping[str, Any], kinds: Mapping[str, str], cost: Any) -> bool:
+    """Whether ``episode`` is a reference's (kind ``reference``: ``evaluate`` and
+    ``leaderboard`` add them to every run) with the cost ``cost`` of the one already read."""
+    return kinds.get(episode["controller"]) == "reference" and episode.get("cost") == cost
 
 
 def write_report(

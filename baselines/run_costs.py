@@ -12,18 +12,41 @@ per-episode setup.  The oracle's jobs read its reference table and cost next to 
 
 from __future__ import annotations
 
+import functools
+import json
 import os
 import time
 from collections import defaultdict
-from collections.abc import Iterable, Mapping
-from typing import Any
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from shipgym.config import is_path
+from shipgym.scenarios import Scenario
 from shipgym_baselines import evaluation
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.plugins import ControllerSpec
+
+if TYPE_CHECKING:
+    from shipgym_baselines.leaderboard import Job
 
 
 def _entry() -> dict[str, float]:
-    return {"episodes": 0, "steps": 0, "cpu_s": 0.0, "act_cpu_s": 0.0, "suite_cpu_s": 0.0}
+    return {
+        "episodes": 0,
+        "steps": 0,
+        "limit_steps": 0.0,
+        "cpu_s": 0.0,
+        "act_cpu_s": 0.0,
+        "suite_cpu_s": 0.0,
+    }
+
+
+def limit_steps(scenario: Scenario) -> float:
+    """Control steps of ``scenario``'s time limit (an episode's most steps)."""
+    return scenario.config.time_limit / scenario.control_period
 
 
 def _finish(entry: dict[str, float]) -> dict[str, float]:
@@ -62,7 +85,6 @@ def profile_suite(
     from tqdm import tqdm
 
     from shipgym_baselines.errors import check_seeds
-    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import (
         check_controllers,
         plan_jobs,
@@ -98,6 +120,7 @@ def profile_suite(
         from_table = grants_truth(job.controller)
         cell = cells[(controller_label(job.controller), job.scenario)]
         cell["episodes"] += len(results)
+        cell["limit_steps"] += len(results) * limit_steps(loaded[job.scenario])
         cell["cpu_s"] += cpu
         for r in results:
             steps = max(len(r.trajectory.get("t", ())) - 1, 0)
@@ -141,3 +164,192 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
     """The entries, most CPU first, with their per-step figures."""
     ordered = sorted(entries.items(), key=lambda item: -item[1]["cpu_s"])
     return {name: _finish(entry) for name, entry in ordered}
+
+
+# --- recorded costs: the leaderboard's first estimate ----------------------------------------
+
+#: the recorded costs (:func:`record_costs`), shipped beside the oracle's reference table
+COSTS_FILE = Path(__file__).parent / "reference_data" / "leaderboard_costs.json"
+#: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
+LEARNED_SEEDS = 10
+#: evaluation seeds of the other controllers' measured jobs (in lockstep, as a run's)
+OTHER_SEEDS = 3
+#: the kinds whose fallback a controller without a recorded cost takes
+FALLBACK_KINDS = ("classical", "learned")
+#: CPU seconds of the tables, ranking and figures per scenario of a run, after its episodes
+#: (measured: 4.3 s for the smoke suite's 3 scenarios, ``write_results`` in one process; the
+#: default run's 47 scenarios took 47 s wall on 2 workers, ≈ 2 s each)
+TABLES_CPU_S_PER_SCENARIO = 1.5
+
+
+def _per_step(entry: Mapping[str, float]) -> float:
+    """CPU seconds per control step of the time limit of an entry of :func:`profile_suite`."""
+    return entry["cpu_s"] / max(entry["limit_steps"], 1.0)
+
+
+def record_costs(
+    suite: str = "quick", show_progress: bool = False, cache: Path | None = None
+) -> dict[str, Any]:
+    """Measure the costs :func:`estimate_cpu_s` reads (written to :data:`COSTS_FILE` by
+    ``python -m shipgym_baselines.run_costs``): per controller and ship, CPU seconds per
+    control step of the scenario's time limit, from :func:`profile_suite` on ``suite``
+    (classical controllers and references with :data:`OTHER_SEEDS` evaluation seeds, learned
+    agents with :data:`LEARNED_SEEDS`, each job's seeds in lockstep as a run's; a learned
+    agent's first training seed); the oracle computed
+    (not read from its table) on the suite's first scenario of each ship, 1 seed; and per
+    kind and ship the median over the kind's controllers (the fallback of a plug-in).
+    ``cache``: a folder keeping each profile once measured (a second call reads it)."""
+    import platform
+
+    from shipgym_baselines.leaderboard import Job, suite_scenario, work
+    from shipgym_baselines.registry import controller_kind, controller_label
+    from shipgym_baselines.runs import git_commit
+    from shipgym_baselines.suite import load_suite
+
+    spec = load_suite(suite)
+    labels = [controller_label(c) for c in spec.controllers]
+    kinds = dict(zip(labels, map(controller_kind, labels), strict=True))
+    learned = [
+        c for c, label in zip(spec.controllers, labels, strict=True) if kinds[label] == "learned"
+    ]
+    others = [c for c in spec.controllers if c not in learned]
+    start = time.process_time()
+
+    def profile(part: str, controllers: list[ControllerSpec], seeds: int) -> dict[str, Any]:
+        file = None if cache is None else cache / f"{spec.name}_{part}.json"
+        if file is not None and file.is_file():
+            return json.loads(file.read_text())
+        found = profile_suite(suite, seeds, controllers, show_progress=show_progress)
+        if file is not None:
+            file.write_text(json.dumps(found))
+        return found
+
+    profiles = [
+        profile("others", others, OTHER_SEEDS),
+        profile("learned", learned, LEARNED_SEEDS),
+    ]
+    per_step: dict[str, dict[str, float]] = {}
+    for found in profiles:
+        for label, ships in found["per_controller_ship"].items():
+            per_step[label] = {ship: _per_step(entry) for ship, entry in ships.items()}
+    first: dict[str, str] = {}
+    for name in spec.all_scenarios():
+        first.setdefault(suite_scenario(name).model.name, name)
+    oracle_computed = {}
+    for ship, name in sorted(first.items()):
+        job = Job("oracle", name, (EVAL_SEED_OFFSET,), None, _randomize(spec))
+        clock = time.process_time()
+        work(job._replace(references="recompute"))  # the oracle run, not read from its table
+        oracle_computed[ship] = (time.process_time() - clock) / limit_steps(suite_scenario(name))
+    fallback = {
+        kind: {
+            ship: _median(
+                steps[ship] for c, steps in per_step.items() if kinds[c] == kind and ship in steps
+            )
+            for ship in sorted(first)
+        }
+        for kind in FALLBACK_KINDS
+    }
+    return {
+        "about": "CPU seconds per control step of a scenario's time limit (time_limit / "
+        "control_period), per controller and ship, as the leaderboard runs its jobs; "
+        "shipgym_baselines.run_costs.estimate_cpu_s reads it",
+        "measured": {
+            "suite": spec.name,
+            "commit": git_commit(),
+            "machine": platform.processor() or platform.machine(),
+            "cpu_s": time.process_time() - start,
+            "profiles_cpu_s": [found["cpu_s"] for found in profiles],
+            "load_average": [found["load_average"] for found in profiles],
+            "command": "python -m shipgym_baselines.run_costs",
+        },
+        "cpu_s_per_limit_step": dict(sorted(per_step.items())),
+        "oracle_computed": oracle_computed,
+        "fallback": fallback,
+    }
+
+
+@functools.lru_cache(maxsize=1)
+def recorded_costs() -> dict[str, Any]:
+    """The shipped recorded costs (:data:`COSTS_FILE`, :func:`record_costs`), read once."""
+    return json.loads(COSTS_FILE.read_text())
+
+
+def _median(values: Iterable[float]) -> float:
+    return float(np.median(list(values)))
+
+
+def step_cost(
+    job: Job, ship: str, costs: Mapping[str, Any] | None = None, from_table: bool = True
+) -> float:
+    """The recorded CPU seconds per control step of the time limit of ``job``'s controller
+    on ``ship``: its own (by spec), the oracle's computed cost when it does not read its
+    table (``from_table`` False, or the job recomputes), else its kind's median (a plug-in,
+    a trained agent: :data:`FALLBACK_KINDS`; a ship not recorded: the median over ships)."""
+    from shipgym_baselines.privileged import grants_truth
+    from shipgym_baselines.registry import controller_kind, controller_label
+
+    costs = costs if costs is not None else recorded_costs()
+    spec = job.controller if isinstance(job.controller, str) else job.controller.controller
+    if grants_truth(job.controller) and (job.references == "recompute" or not from_table):
+        per_ship = costs["oracle_computed"]
+    elif spec in costs["cpu_s_per_limit_step"]:
+        per_ship = costs["cpu_s_per_limit_step"][spec]
+    else:
+        kind = controller_kind(controller_label(job.controller))
+        per_ship = costs["fallback"][kind if kind in FALLBACK_KINDS else "classical"]
+    return per_ship[ship] if ship in per_ship else _median(per_ship.values())
+
+
+def estimate_cpu_s(
+    jobs: Iterable[Job], scenarios: Mapping[str, Scenario], costs: Mapping[str, Any] | None = None
+) -> float:
+    """CPU seconds the leaderboard's ``jobs`` take by the recorded costs: per job, its
+    controller's :func:`step_cost` on the scenario's ship × the scenario's time limit in
+    control steps × its seeds.  The oracle reads its table on a named scenario, and is
+    computed on a scenario file (the shipped table holds catalogue and held-out trials)."""
+    total = 0.0
+    for job in jobs:
+        scenario = scenarios[job.scenario]
+        per_step = step_cost(job, scenario.model.name, costs, from_table=not is_path(job.scenario))
+        total += per_step * limit_steps(scenario) * len(job.seeds)
+    return total
+
+
+def duration(seconds: float) -> str:
+    """``seconds`` for a person: "40 s", "9 min", "2.5 h"."""
+    if seconds < 90:
+        return f"{max(seconds, 1):.0f} s"
+    if seconds < 90 * 60:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def eta_line(
+    jobs: Sequence[Job], scenarios: Mapping[str, Scenario], workers: int, episodes: int
+) -> str:
+    """The leaderboard's first line: the episodes to run (of ``episodes`` in the run), the
+    workers and the wall time: :func:`estimate_cpu_s` and the tables' time
+    (:data:`TABLES_CPU_S_PER_SCENARIO` × ``scenarios``) over the workers (the run is
+    CPU-bound; its jobs are spread longest first)."""
+    todo = sum(len(job.seeds) for job in jobs)
+    count = f"{todo:,} episodes" if todo == episodes else f"{todo:,} of {episodes:,} episodes"
+    cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
+    wall = cpu / max(min(workers, len(jobs)), 1)
+    plural = "" if workers == 1 else "s"
+    return (
+        f"leaderboard: {count} on {workers} worker{plural}, about {duration(wall)} (recorded costs)"
+    )
+
+
+def _randomize(spec: Any) -> dict[str, Any] | None:
+    return None if spec.randomize is None else spec.randomize.model_dump(mode="json")
+
+
+if __name__ == "__main__":
+    import sys
+
+    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else None  # the profiles' cache
+    costs = record_costs(show_progress=True, cache=folder)
+    COSTS_FILE.write_text(json.dumps(costs, indent=1) + "\n")
+    print(f"wrote {COSTS_FILE}")

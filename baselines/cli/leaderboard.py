@@ -2,7 +2,11 @@
 
 Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
 :mod:`shipgym_baselines.runs`); a folder that is not empty is refused before any work unless
-``--resume`` or ``--force``.
+``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for ``leaderboard``,
+``results/evaluate/<suite>/<policy>`` for ``evaluate`` (one folder per suite and policy, outside
+the leaderboard's).  The controllers given (``evaluate``'s policy, ``--controllers``) run
+with the references (:mod:`shipgym_baselines.comparison`), unless ``--no-references``; a
+suite's own controllers run as the suite lists them.
 """
 
 from __future__ import annotations
@@ -12,11 +16,23 @@ import sys
 from pathlib import Path
 
 from shipgym_baselines.cli.options import add_run_options, command_line, emit
+from shipgym_baselines.comparison import REFERENCES, RESULTS_ROOT, suite_folder
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 
-#: ``evaluate`` writes to ``EVALUATE_ROOT/<policy>`` unless given ``--out``
-EVALUATE_ROOT = Path("results/evaluate")
+#: ``evaluate`` writes to ``EVALUATE_ROOT/<suite>/<policy>`` unless given ``--out``
+EVALUATE_ROOT = RESULTS_ROOT / "evaluate"
+
+
+def add_references_option(parser: argparse.ArgumentParser) -> None:
+    """``--no-references``: run only the controllers named, not the references too."""
+    parser.add_argument(
+        "--no-references",
+        action="store_true",
+        help=f"do not add the references ({', '.join(REFERENCES)}: the oracle read from its "
+        "shipped table) to the controllers given (evaluate's policy, --controllers); without "
+        "the oracle there is no ranking",
+    )
 
 
 def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
@@ -24,7 +40,14 @@ def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
         "leaderboard",
         help="run every controller on a suite (docs: 'The leaderboard and its statistics')",
     )
-    add_run_options(p, out="results/leaderboard", progress_help="no progress bar on stderr")
+    add_run_options(
+        p,
+        out=None,
+        progress_help="no progress bar on stderr, nor its first line (the time estimated "
+        "from the recorded costs)",
+        out_help=f"output directory (default {RESULTS_ROOT}/<suite>: the suite's name or its "
+        "file's stem; refused if not empty: see --resume, --force)",
+    )
     p.add_argument(
         "--controllers",
         nargs="+",
@@ -46,6 +69,7 @@ def add_leaderboard_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="run the oracle on every trial instead of reading its shipped reference table",
     )
+    add_references_option(p)
     p.set_defaults(func=run)
 
 
@@ -67,18 +91,23 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
     add_run_options(
         p,
         out=None,
-        out_help=f"output directory (default {EVALUATE_ROOT}/<policy>; refused if not empty: "
-        "see --resume, --force)",
+        progress_help="no progress bar on stderr, nor its first line (the time estimated "
+        "from the recorded costs)",
+        out_help=f"output directory (default {EVALUATE_ROOT}/<suite>/<policy>; refused if not "
+        "empty: see --resume, --force)",
     )
+    add_references_option(p)
     p.set_defaults(func=run)
 
 
-def evaluate_folder(policy: ControllerSpec) -> Path:
-    """``evaluate``'s default folder for ``policy``: one per table name."""
+def evaluate_folder(policy: ControllerSpec, suite: str | Path = "default") -> Path:
+    """``evaluate``'s default folder for ``policy`` on ``suite``: one per suite (its name
+    or file stem) and table name."""
     from shipgym_baselines.registry import controller_label
 
     label = controller_label(policy)
-    return EVALUATE_ROOT / "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
+    name = "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
+    return EVALUATE_ROOT / suite_folder(suite).name / name
 
 
 def named(controller: ControllerSpec, name: str | None) -> ControllerSpec:
@@ -133,13 +162,20 @@ def run(args: argparse.Namespace) -> int:
     if policy is not None:
         policy = named(policy, args.name)
     out, note = args.out, ""
-    if out is None:
-        out = evaluate_folder(policy)
-        note = f" (evaluate's folder for {args.policy!r}; give --out for another)"
+    if out is None and policy is not None:
+        out = evaluate_folder(policy, args.suite)
+        note = (
+            f" (evaluate's folder for {args.policy!r} on --suite {args.suite}; give --out for "
+            "another)"
+        )
+    elif out is None:
+        out = suite_folder(args.suite)
+        note = f" (the leaderboard's folder for --suite {args.suite}; give --out for another)"
     # before any work: an unusable --out, then a bad suite, then --out in use or not empty
     check_out_usable(out, resume=args.resume, force=args.force)
     spec = load_suite(args.suite)
     controllers = [policy] if policy is not None else getattr(args, "controllers", None)
+    explicit = controllers is not None  # the references join controllers given, not a suite's
     if policy is None and args.name:
         controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
@@ -158,6 +194,7 @@ def run(args: argparse.Namespace) -> int:
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
         vector_figures=args.vector_figures,
+        add_references=explicit and not args.no_references,
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

@@ -261,18 +261,21 @@ def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
 def test_finding11_a_bad_suite_is_named_before_the_state_of_out(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Run where the main job ran before (``results/leaderboard`` holds a run): a
-    misspelt --suite is reported as such, not as "--out is not empty"."""
+    """Run where a run of the smoke suite was made before (``results/smoke`` holds it): a
+    misspelt --suite is reported as such, not as "--out is not empty"; each suite has its
+    own default folder."""
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "results" / "leaderboard").mkdir(parents=True)
-    (tmp_path / "results" / "leaderboard" / "run.json").write_text("{}")
+    (tmp_path / "results" / "smoke").mkdir(parents=True)
+    (tmp_path / "results" / "smoke" / "run.json").write_text("{}")
     for command in (["leaderboard"], ["evaluate", "pid_los"]):
-        out = [] if command[0] == "leaderboard" else ["--out", "results/leaderboard"]
+        out = ["--out", "results/smoke"]
         assert main([*command, "--suite", "smok", *out, "--no-progress"]) == 2
         message = _error_line(capsys, command[0])
         assert "smok" in message and "valid: default" in message and "not empty" not in message
     assert main(["leaderboard", "--suite", "smoke", "--no-progress"]) == 2  # then the folder
-    assert "--out results/leaderboard is not empty" in _error_line(capsys, "leaderboard")
+    message = _error_line(capsys, "leaderboard")
+    assert "--out results/smoke is not empty" in message
+    assert "(the leaderboard's folder for --suite smoke; give --out for another)" in message
 
 
 def test_no_help_text_points_to_the_unshipped_spec(capsys) -> None:

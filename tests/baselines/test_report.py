@@ -18,15 +18,16 @@ from tests.baselines.test_runs import untimed, write_suite
 @pytest.fixture(scope="module")
 def evaluated(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """``evaluate pid_los`` and ``evaluate zero_rudder`` in their own folders, and the
-    leaderboard of both, on the tiny suite."""
+    leaderboard of both, on the tiny suite (the references not added: test_comparison)."""
     root = tmp_path_factory.mktemp("runs")
     suite = write_suite(root)
     folders = {name: root / name for name in ("pid_los", "zero_rudder", "both")}
+    quiet = ["--workers", "1", "--no-progress", "--json", "--no-references"]
     for policy in ("pid_los", "zero_rudder"):
         args = ["evaluate", policy, "--suite", suite, "--out", str(folders[policy])]
-        assert main([*args, "--workers", "1", "--no-progress", "--json"]) == 0
-    args = ["leaderboard", "--suite", suite, "--out", str(folders["both"]), "--workers", "1"]
-    assert main([*args, "--no-progress", "--json"]) == 0
+        assert main([*args, *quiet]) == 0
+    args = ["leaderboard", "--suite", suite, "--out", str(folders["both"])]
+    assert main([*args, *quiet]) == 0
     return folders
 
 
@@ -91,11 +92,12 @@ def test_evaluate_writes_a_folder_per_policy(tmp_path: Path, monkeypatch, capsys
     suite = write_suite(tmp_path, scenarios=["nominal"], seeds=1)
     for policy in ("pid_los", "zero_rudder"):
         assert main(["evaluate", policy, "--suite", suite, "--no-progress", "--json"]) == 0
-        assert read_run(tmp_path / "results" / "evaluate" / policy)["status"] == "complete"
+        folder = tmp_path / "results" / "evaluate" / "tiny" / policy  # the suite file's stem
+        assert read_run(folder)["status"] == "complete"
     capsys.readouterr()
     assert main(["evaluate", "pid_los", "--suite", suite, "--no-progress"]) == 2
     err = capsys.readouterr().err
-    assert "results/evaluate/pid_los is not empty" in err and "evaluate's folder" in err
+    assert "results/evaluate/tiny/pid_los is not empty" in err and "evaluate's folder" in err
 
 
 def test_report_writes_results_report_by_default_and_never_over_it(
@@ -119,7 +121,7 @@ def test_a_renamed_run_merges_with_the_one_of_its_own_name(
     again = tmp_path / "again"
     args = ["leaderboard", "--suite", suite, "--out", str(again), "--workers", "1"]
     args += ["--controllers", "pid_los", "--name", "pid_los=pid_again", "--no-progress"]
-    assert main([*args, "--json"]) == 0
+    assert main([*args, "--json", "--no-references"]) == 0
     assert {r["controller"] for r in json.loads(capsys.readouterr().out)} == {"pid_again"}
     assert read_run(again)["suite"]["controllers"][0]["controller"] == {
         "controller": "pid_los",
@@ -138,7 +140,7 @@ def test_a_renamed_run_merges_with_the_one_of_its_own_name(
 
 def test_evaluate_name_and_its_errors(evaluated: dict[str, Path], tmp_path: Path, capsys) -> None:
     suite = str(evaluated["pid_los"].parent / "tiny.yaml")
-    out = ["--suite", suite, "--workers", "1", "--no-progress", "--json"]
+    out = ["--suite", suite, "--workers", "1", "--no-progress", "--json", "--no-references"]
     assert main(["evaluate", "zero_rudder", "--name", "still", "--out", str(tmp_path), *out]) == 0
     assert {r["controller"] for r in json.loads(capsys.readouterr().out)} == {"still"}
     bad = ["leaderboard", "--controllers", "pid_los", "--out", str(tmp_path / "x"), *out]

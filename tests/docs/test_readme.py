@@ -5,6 +5,10 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
 
 REPO = Path(__file__).resolve().parents[2]
 README = (REPO / "README.md").read_text(encoding="utf-8")
@@ -32,3 +36,47 @@ def test_the_readme_mentions_the_notebooks_and_the_docs_build() -> None:
     for notebook in (REPO / "notebooks").glob("*.ipynb"):
         assert f"notebooks/{notebook.name}" in README
     assert "python -m sphinx -W -b html docs docs/_build/html" in README
+
+
+def test_the_evaluate_example_gives_the_leaderboards_episodes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The README's ``evaluate(..., suite="default")`` prints what the default leaderboard
+    records for those seeds: the leaderboard, run on a suite of that one scenario and
+    controller with the default suite's trial ranges, gives the same episodes."""
+    from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+    from shipgym_baselines.leaderboard import run_leaderboard
+    from shipgym_baselines.runs import read_episodes
+    from shipgym_baselines.suite import load_suite
+
+    blocks = re.findall(r"```python\n(.*?)```", README, flags=re.S)
+    (block,) = [b for b in blocks if "suite=" in b and "evaluate(" in b]
+    call = re.search(r'evaluate\("(\w+)", "(\w+)", seeds=\[([\d, ]+)\], suite="(\w+)"\)', block)
+    assert call, block
+    controller, scenario, suite = call[1], call[2], call[4]
+    seeds = [int(s) for s in call[3].split(",")]
+    assert seeds == [EVAL_SEED_OFFSET + i for i in range(len(seeds))]  # the first trials
+    spec = load_suite(suite)
+    assert scenario in spec.scenarios and controller in spec.controllers
+    one = {
+        "name": "one",
+        "scenarios": [scenario],
+        "controllers": [controller],
+        "seeds": len(seeds),
+        "randomize": spec.randomize.model_dump(mode="json"),
+    }
+    (tmp_path / "one.yaml").write_text(yaml.safe_dump(one))
+    run_leaderboard(
+        str(tmp_path / "one.yaml"), out_dir=tmp_path / "run", workers=1, show_progress=False
+    )
+    recorded = {int(e["seed"]): e for e in read_episodes(tmp_path / "run")}
+    namespace: dict[str, Any] = {"__name__": "readme"}
+    capsys.readouterr()
+    exec(compile(block, "README.md: the evaluate block", "exec"), namespace)
+    printed = capsys.readouterr().out.strip()
+    for seed, result in zip(seeds, namespace["results"], strict=True):
+        assert result.metrics["ace"] == recorded[seed]["ace"]  # the same episode, bit for bit
+        assert result.metrics["cost"] == recorded[seed]["cost"]
+    expected = str([round(recorded[s]["ace"], 3) for s in seeds])
+    assert printed == expected
+    assert f"# {expected}" in block  # the numbers the README shows
