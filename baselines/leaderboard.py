@@ -666,16 +666,22 @@ def write_results(
         (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
         (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
-        head = ranking_markdown(
-            board, scores, list(suite["scenarios"]), left_out, ranked, comparison_note(suite, out)
-        )
+        note = comparison_note(suite, out)
+        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked, note)
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
         files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
     lead = verdict(board, ranked, plain_name)
     pages.write_html(
-        out, rows, board, scores, files, subtitle=subtitle(suite, results), verdict=lead
+        out,
+        rows,
+        board,
+        scores,
+        files,
+        subtitle=subtitle(suite, results),
+        verdict=lead,
+        note=note if board else "",
     )
     return rows
 

@@ -656,9 +656,11 @@ def page(
     title: str = "shipgym leaderboard",
     subtitle: str | None = None,
     verdict: str | None = None,
+    note: str = "",
 ) -> str:
     """The page's HTML (module doc); ``verdict``: the run's two sentences
-    (:mod:`shipgym_baselines.verdict`), the page's first paragraph."""
+    (:mod:`shipgym_baselines.verdict`), the page's first paragraph; ``note``: what the run
+    is ranked against (:func:`~shipgym_baselines.comparison.comparison_note`), under it."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
         figures, (r["scenario"] for r in rows)
     )
@@ -666,6 +668,7 @@ def page(
     names += [c["controller"] for s in scores for c in s["controllers"]]
     sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
     sub += f'<p id="verdict">{_e(verdict)}</p>' if verdict else ""
+    sub += f'<p class="note" id="ranked-against">{_e(note.replace("`", ""))}</p>' if note else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
@@ -706,17 +709,19 @@ def write_html(
     title: str = "shipgym leaderboard",
     subtitle: str | None = None,
     verdict: str | None = None,
+    note: str = "",
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
     :func:`shipgym_baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
     :mod:`shipgym_baselines.figures`; ``subtitle``: a line under the title (e.g. the suite
-    and seeds); ``verdict``: the paragraph the page opens with.
-    Returns the page's path."""
+    and seeds); ``verdict``: the paragraph the page opens with; ``note``: what the run is
+    ranked against.  Returns the page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
     write_bytes(
-        path, page(rows, aggregate, scores, figures, title, subtitle, verdict).encode("utf-8")
+        path,
+        page(rows, aggregate, scores, figures, title, subtitle, verdict, note).encode("utf-8"),
     )
     return path

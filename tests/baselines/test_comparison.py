@@ -108,6 +108,9 @@ def test_a_plugin_evaluated_on_smoke_gets_a_cost_ratio_and_a_rank(
             "shipgym leaderboard --suite smoke --controllers nmpc_lambda_lssvm pid_los ppo" in text
         )
         assert f"shipgym report results/smoke {out}" in text
+    page = (out / "leaderboard.html").read_text()
+    assert 'id="ranked-against"' in page
+    assert "Ranked against the references only (oracle, zero_rudder, random)" in page
     episodes = read_episodes(out)
     assert {e["controller"] for e in episodes} == {"steer", *REFERENCES}
 
