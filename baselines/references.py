@@ -47,8 +47,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from shipgym.codegen import notice, user_cache_dir
+from shipgym.codegen import user_cache_dir
 from shipgym.envs.core import ENV_REVISION
+from shipgym.notices import duration, notice
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.runs import _number, _plain
@@ -287,15 +288,6 @@ def estimate_cpu_s(trials: Iterable[Scenario]) -> float:
         steps = math.ceil(trial.config.time_limit / trial.control_period)
         total += steps * ORACLE_CPU_S_PER_STEP.get(trial.model.name, slowest)
     return total
-
-
-def duration(seconds: float) -> str:
-    """``seconds`` for a person: "40 s", "3 min", "1.5 h"."""
-    if seconds < 90:
-        return f"{max(seconds, 1):.0f} s"
-    if seconds < 5400:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
 
 
 def announce(trials: Sequence[Scenario], where: str) -> None:

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from shipgym.config import is_path
+from shipgym.notices import duration
 from shipgym.scenarios import Scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
@@ -314,15 +315,6 @@ def estimate_cpu_s(
         per_step = step_cost(job, scenario.model.name, costs, from_table=not is_path(job.scenario))
         total += per_step * limit_steps(scenario) * len(job.seeds)
     return total
-
-
-def duration(seconds: float) -> str:
-    """``seconds`` for a person: "40 s", "9 min", "2.5 h"."""
-    if seconds < 90:
-        return f"{max(seconds, 1):.0f} s"
-    if seconds < 90 * 60:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
 
 
 def eta_line(

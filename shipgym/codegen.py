@@ -20,13 +20,14 @@ import hashlib
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
 import casadi as ca
+
+from shipgym.notices import duration, notice
 
 #: the environment variable naming the per-user cache folder
 CACHE_DIR_ENV = "SHIPGYM_CACHE_DIR"
@@ -56,14 +57,6 @@ def cache_dir() -> Path:
     return user_cache_dir()
 
 
-def notice(line: str) -> None:
-    """Write ``line`` on stderr, on a line of its own: on a terminal the line a progress
-    bar is drawing is cleared first (the bar draws itself again below)."""
-    clear = "\r\x1b[K" if sys.stderr.isatty() else ""
-    sys.stderr.write(f"{clear}{line}\n")
-    sys.stderr.flush()
-
-
 def compile_seconds(size: int) -> float:
     """The estimated seconds to compile ``size`` bytes of C (one file)."""
     return size / COMPILE_BYTES_PER_S * max(1.0, size / COMPILE_LINEAR_BYTES)
@@ -71,9 +64,7 @@ def compile_seconds(size: int) -> float:
 
 def compile_message(what: str, seconds: float, folder: Path) -> str:
     """The line announcing a compilation of ``what`` estimated at ``seconds`` [s]."""
-    return (
-        f"shipgym: compiling {what} to C (one-off, ≈ {max(seconds, 1):.0f} s; cached in {folder})"
-    )
+    return f"shipgym: compiling {what} to C (one-off, ≈ {duration(seconds)}; cached in {folder})"
 
 
 def compiled(

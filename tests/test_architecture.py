@@ -23,9 +23,10 @@ PACKAGES = {"shipgym": "shipgym", "shipgym_baselines": "baselines"}
 #: lower layer.
 LAYERS: dict[str, int] = {
     # 0 — foundations: the error base, config files, scalar/array operation sets, angle
-    #     arithmetic, path geometry
+    #     arithmetic, path geometry, the terminal's notice lines
     "shipgym.errors": 0,
     "shipgym.limits": 0,
+    "shipgym.notices": 0,
     "shipgym.config": 0,
     "shipgym.numerics": 0,
     "shipgym.angles": 0,

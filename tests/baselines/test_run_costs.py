@@ -18,7 +18,6 @@ from shipgym_baselines.leaderboard import (
 from shipgym_baselines.registry import training_seeds
 from shipgym_baselines.run_costs import (
     TABLES_CPU_S_PER_SCENARIO,
-    duration,
     estimate_cpu_s,
     eta_line,
     limit_steps,
@@ -124,14 +123,3 @@ def test_a_controller_without_recorded_costs_takes_its_kinds(tmp_path: Path) -> 
     assert set(costs["fallback"]) == {"classical", "learned"}
     for per_ship in costs["cpu_s_per_limit_step"].values():
         assert all(value > 0 for value in per_ship.values())
-
-
-def test_durations_read_as_a_person_says_them() -> None:
-    assert [duration(s) for s in (0.2, 40, 95, 540, 5400, 9000)] == [
-        "1 s",
-        "40 s",
-        "2 min",
-        "9 min",
-        "1.5 h",
-        "2.5 h",
-    ]

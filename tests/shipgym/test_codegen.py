@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import casadi as ca
@@ -172,13 +171,3 @@ def test_the_estimate_grows_with_the_code_size() -> None:
     assert codegen.compile_seconds(2_460_065) == pytest.approx(50.4, abs=0.1)
     line = codegen.compile_message("the mariner plant", 26.2, Path("/c"))
     assert line == "shipgym: compiling the mariner plant to C (one-off, ≈ 26 s; cached in /c)"
-
-
-def test_a_notice_clears_a_progress_bar_on_a_terminal(
-    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """On a terminal the line under way (a progress bar) is cleared first; in a file not."""
-    codegen.notice("shipgym: a")
-    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
-    codegen.notice("shipgym: b")
-    assert capsys.readouterr().err == "shipgym: a\n\r\x1b[Kshipgym: b\n"
