@@ -2,9 +2,9 @@
 
 The ranking divides each episode's cost by the ``oracle``'s on the same trial
 (:mod:`shipgym_baselines.ranking`), so a run without the oracle has no ranking.
-``shipgym evaluate`` and ``shipgym leaderboard --controllers`` add the references
-:data:`REFERENCES` to the controllers given, unless ``--no-references`` (a suite's own
-controllers run as the suite lists them):
+Every run adds the references :data:`REFERENCES` its controllers lack (the packaged suites
+list them all; a suite of your own may not, ``evaluate`` and ``--controllers`` do not),
+unless ``--no-references``:
 
 * ``oracle``: the denominator of the cost ratio, read from its shipped reference table
   (:mod:`shipgym_baselines.references`: no episode to run on the packaged suites);
@@ -131,8 +131,8 @@ def comparison_note(suite: Mapping[str, Any], folder: str | Path | None = None) 
         f"{head}, not against the suite's other controllers ({len(not_run)}); to compare "
         f"with them, add them: `{shlex.join(run)}`"
     )
-    if folder is not None:
-        suite_run = str(suite_folder(record["suite"]))
+    suite_run = str(suite_folder(record["suite"]))
+    if folder is not None and Path(str(folder)).resolve() != Path(suite_run).resolve():
         merged = f"{suite_run}_with_{Path(str(folder)).name}"
         report = ["shipgym", "report", suite_run, _shown(folder), "--out", merged]
         text += f", or merge this run with one of the suite: `{shlex.join(report)}`"

@@ -2,11 +2,12 @@
 
 Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
 :mod:`shipgym_baselines.runs`); a folder that is not empty is refused before any work unless
-``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for ``leaderboard``,
-``results/evaluate/<suite>/<policy>`` for ``evaluate`` (one folder per suite and policy, outside
-the leaderboard's).  The controllers given (``evaluate``'s policy, ``--controllers``) run
-with the references (:mod:`shipgym_baselines.comparison`), unless ``--no-references``; a
-suite's own controllers run as the suite lists them.
+``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for a suite's own
+controllers, ``results/evaluate/<suite>/<controllers>`` for the controllers given
+(``evaluate``'s policy, ``--controllers``: one folder per suite and set of controllers, outside
+the suite's).  Every run adds the references the controllers lack
+(:mod:`shipgym_baselines.comparison`; the packaged suites list them all), unless
+``--no-references``.
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ def add_references_option(parser: argparse.ArgumentParser) -> None:
         "--no-references",
         action="store_true",
         help=f"do not add the references ({', '.join(REFERENCES)}: the oracle read from its "
-        "shipped table) to the controllers given (evaluate's policy, --controllers); without "
-        "the oracle there is no ranking",
+        "shipped table) that the run's controllers lack; without the oracle there is no "
+        "ranking",
     )
 
 
@@ -100,13 +101,25 @@ def add_evaluate_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def evaluate_folder(policy: ControllerSpec, suite: str | Path = "default") -> Path:
-    """``evaluate``'s default folder for ``policy`` on ``suite``: one per suite (its name
-    or file stem) and table name."""
+#: the longest folder name of :func:`evaluate_folder` before it is shortened with a hash
+FOLDER_NAME_MAX = 80
+
+
+def evaluate_folder(
+    policy: ControllerSpec | list[ControllerSpec], suite: str | Path = "default"
+) -> Path:
+    """The default folder of a run of chosen controllers (``evaluate``'s ``policy``, or the
+    list ``--controllers`` gives) on ``suite``: one per suite (its name or file stem) and set
+    of table names (joined by ``+``; a long one cut and ended by a hash of the whole)."""
+    import hashlib
+
     from shipgym_baselines.registry import controller_label
 
-    label = controller_label(policy)
-    name = "".join(c if c.isalnum() or c in "-_./" else "_" for c in label)
+    labels = [controller_label(c) for c in (policy if isinstance(policy, list) else [policy])]
+    name = "".join(c if c.isalnum() or c in "-_.+" else "_" for c in "+".join(labels))
+    if len(name) > FOLDER_NAME_MAX:
+        digest = hashlib.sha256(name.encode()).hexdigest()[:8]
+        name = f"{name[: FOLDER_NAME_MAX - 9]}-{digest}"
     return EVALUATE_ROOT / suite_folder(suite).name / name
 
 
@@ -161,21 +174,18 @@ def run(args: argparse.Namespace) -> int:
     policy = getattr(args, "policy", None)
     if policy is not None:
         policy = named(policy, args.name)
+    controllers = [policy] if policy is not None else getattr(args, "controllers", None)
     out, note = args.out, ""
-    if out is None and policy is not None:
-        out = evaluate_folder(policy, args.suite)
-        note = (
-            f" (evaluate's folder for {args.policy!r} on --suite {args.suite}; give --out for "
-            "another)"
-        )
+    if out is None and controllers is not None:
+        out = evaluate_folder(controllers, args.suite)
+        whose = f"evaluate's folder for {args.policy!r}" if policy else "--controllers' folder"
+        note = f" ({whose} on --suite {args.suite}; give --out for another)"
     elif out is None:
         out = suite_folder(args.suite)
         note = f" (the leaderboard's folder for --suite {args.suite}; give --out for another)"
     # before any work: an unusable --out, then a bad suite, then --out in use or not empty
     check_out_usable(out, resume=args.resume, force=args.force)
     spec = load_suite(args.suite)
-    controllers = [policy] if policy is not None else getattr(args, "controllers", None)
-    explicit = controllers is not None  # the references join controllers given, not a suite's
     if policy is None and args.name:
         controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
@@ -194,7 +204,7 @@ def run(args: argparse.Namespace) -> int:
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
         vector_figures=args.vector_figures,
-        add_references=explicit and not args.no_references,
+        add_references=not args.no_references,
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

@@ -228,3 +228,42 @@ def test_a_run_started_without_the_references_resumes_without_them(
     _run([*argv, "--controllers", *given, "--resume"], capsys)
     assert read_run(out)["suite"] == before and "references" not in before
     assert {e["controller"] for e in read_episodes(out)} == set(given)  # no random
+
+
+def test_a_suite_of_your_own_without_the_oracle_gets_it_and_a_ranking(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A suite file that lists no reference: the run adds them (the oracle from its table) and
+    ranks the suite's controller, saying so; --no-references runs the suite as listed."""
+    smoke = load_suite("smoke")
+    file = tmp_path / "mine.yaml"
+    suite = {
+        "name": "mine",
+        "scenarios": ["rudder_aging"],
+        "controllers": ["pid_los"],
+        "seeds": 1,
+        "randomize": smoke.randomize.model_dump(mode="json"),
+    }
+    file.write_text(yaml.safe_dump(suite))
+    out, _ = _run(["leaderboard", "--suite", str(file), "--out", str(tmp_path / "a")], capsys)
+    assert "| 1 | pid_los | classical |" in out
+    assert "References added for the cost ratio: `oracle`, `zero_rudder`, `random`" in out
+    assert read_run(tmp_path / "a")["suite"]["references"]["added"] == list(REFERENCES)
+    argv = ["leaderboard", "--suite", str(file), "--out", str(tmp_path / "b")]
+    out, _ = _run([*argv, "--no-references"], capsys)
+    assert "No ranking" in out
+    assert {e["controller"] for e in read_episodes(tmp_path / "b")} == {"pid_los"}
+
+
+def test_chosen_controllers_get_a_folder_of_their_own() -> None:
+    """--controllers never writes into the suite's folder: one folder per set of controllers."""
+    from shipgym_baselines.cli.leaderboard import FOLDER_NAME_MAX, evaluate_folder
+
+    assert evaluate_folder(["pid_los", "lqr"], "smoke") == Path(
+        "results/evaluate/smoke/pid_los+lqr"
+    )
+    assert evaluate_folder("pid_los", "suites/my.yaml") == Path("results/evaluate/my/pid_los")
+    many = ["pid_los", "pid_vf", "pid_tvvf", "pid_lookahead_los", "lqr", "adaptive_lqr"]
+    many += ["l1_backstepping", "adaptive_backstepping", "nmpc", "nmpc_lambda_lssvm"]
+    name = evaluate_folder(many, "quick").name
+    assert len(name) == FOLDER_NAME_MAX and name != evaluate_folder(many[:-1], "quick").name
