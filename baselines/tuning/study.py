@@ -415,10 +415,10 @@ def write_chosen(
             c = incumbent["comparison"]
             refused = (
                 f"{plan.study_name}: kept {where}: its settings score {c['incumbent_value']:.4g} "
-                f"on the same {c['trials']} validation trials, this study's winner "
-                f"{c['new_value']:.4g} (lower is better); --force replaces them"
+                f"on the same {c['trials']} validation trials, this study's choice "
+                f"({_choice(summary)}) {c['new_value']:.4g} (lower is better); --force "
+                "replaces them"
             )
-            say(progress, refused)
             return {
                 "file": str(file),
                 "written": False,
@@ -430,14 +430,18 @@ def write_chosen(
         controller, plan.section, settings, summary, plan.chosen_dir
     )
     if incumbent is None:
-        say(progress, f"{plan.study_name}: chosen settings written to {where} (a new section)")
+        say(
+            progress,
+            f"{plan.study_name}: chose {_choice(summary)}, objective {summary['value']:.4g}: "
+            f"written to {where} (a new section)",
+        )
     else:
         c = incumbent["comparison"]
         say(
             progress,
-            f"{plan.study_name}: replaced {where}: {replaced} (objective "
-            f"{c['incumbent_value']:.4g}) by {settings} ({c['new_value']:.4g}, the same "
-            f"{c['trials']} validation trials)",
+            f"{plan.study_name}: chose {_choice(summary)}: replaced {where}: {replaced} "
+            f"(objective {c['incumbent_value']:.4g}) by {settings} ({c['new_value']:.4g}, the "
+            f"same {c['trials']} validation trials)",
         )
     return {
         "file": str(written),
@@ -446,6 +450,18 @@ def write_chosen(
         "incumbent": incumbent,
         "refused": None,
     }
+
+
+def _choice(summary: dict[str, Any]) -> str:
+    """What a study chose, in words: its best trial's settings, or the default ones when no
+    trial beat them (with both objectives)."""
+    best, default = summary["best_value"], summary["default_value"]
+    if best >= default:
+        return (
+            f"the default settings (no trial beat them: best trial {best:.4g}, default "
+            f"{default:.4g})"
+        )
+    return f"the best trial's settings (best {best:.4g}, default {default:.4g})"
 
 
 def _incumbent(

@@ -368,7 +368,12 @@ def test_a_short_study_leaves_the_packaged_settings_byte_identical(
     assert written["studies"]["nomoto2"]["study"] == "pid_los_tiny:nomoto2"
     record = written["studies"]["nomoto2"]["validation"]
     assert record["trials"] == ["validation:0"] and len(record["ratios"]) == 1
-    assert f"{out / 'chosen' / 'pid_los.yaml'} [nomoto2]" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"{out / 'chosen' / 'pid_los.yaml'} [nomoto2]" in err
+    summary = written["studies"]["nomoto2"]
+    kept = summary["best_value"] >= summary["default_value"]
+    said = "chose the default settings (no trial beat them" if kept else "chose the best trial's"
+    assert said in err
 
 
 def test_promote_targets_the_packaged_folder_and_excludes_chosen_dir(
@@ -423,6 +428,7 @@ def test_better_recorded_settings_are_kept_unless_force(
     assert block["incumbent"]["comparison"]["incumbent_value"] == pytest.approx(0.5)
     assert block["incumbent"]["comparison"]["new_value"] > 0.5
     assert "not written" in captured.err and "0.5" in captured.err
+    assert captured.err.count("kept ") == 1  # said once, at the end
     argv[3] = str(tmp_path / "b")
     assert main([*argv, "--trials", "1", "--force"]) == 0
     err = capsys.readouterr().err
