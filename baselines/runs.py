@@ -336,7 +336,30 @@ def differences(old: Any, new: Any, where: str = "") -> list[str]:
         return found
     if old == new:
         return []
+    if isinstance(old, list) and isinstance(new, list):
+        return _list_differences(old, new, where or "value")
     return [f"{where or 'value'}: {_short(old)} in the run, {_short(new)} now"]
+
+
+def _item(value: Any) -> str:
+    """A list item as a person names it: a mapping by its ``name``, else its JSON."""
+    if isinstance(value, dict) and isinstance(value.get("name"), str):
+        return value["name"]
+    return _short(value, 30)
+
+
+def _list_differences(old: list, new: list, where: str) -> list[str]:
+    """How two lists differ: the items only in one (by name), else item by item."""
+    a, b = [_item(v) for v in old], [_item(v) for v in new]
+    if a != b:
+        gone, added = [x for x in a if x not in b], [x for x in b if x not in a]
+        parts = [f"{', '.join(gone)} only in the run"] if gone else []
+        parts += [f"{', '.join(added)} only now"] if added else []
+        return [f"{where}: {'; '.join(parts) or 'the same items in another order'}"]
+    found = []
+    for name, x, y in zip(a, old, new, strict=True):
+        found += differences(x, y, f"{where}[{name}]")
+    return found
 
 
 def _short(value: Any, limit: int = 60) -> str:

@@ -246,10 +246,20 @@ def test_an_interrupted_run_resumes_to_the_clean_table(tmp_path: Path, clean_run
 
 
 def test_resume_with_a_changed_suite_is_refused(tmp_path: Path, clean_run: Path) -> None:
-    with pytest.raises(RunError, match=r"suite differs.*seeds: \[10000, 10001\] in the run"):
+    with pytest.raises(RunError, match=r"suite differs.*seeds: 10001 only in the run"):
         run_leaderboard(
             write_suite(tmp_path), seeds=1, out_dir=clean_run, show_progress=False, resume=True
         )
+    # a list of controllers is told by their names, never cut short
+    with pytest.raises(RunError, match=r"controllers: .* only in the run; random only now") as e:
+        run_leaderboard(
+            write_suite(tmp_path),
+            out_dir=clean_run,
+            show_progress=False,
+            resume=True,
+            controllers=["random"],
+        )
+    assert "…" not in str(e.value)
     changed = write_suite(tmp_path, scenarios=["nominal", "current_shift"])
     with pytest.raises(RunError, match=r"scenarios\.rudder_aging only in the run"):
         run_leaderboard(changed, out_dir=clean_run, show_progress=False, resume=True)
