@@ -42,6 +42,7 @@ from tqdm import tqdm
 from shipgym.config import is_path
 from shipgym.limits import worker_count
 from shipgym.metrics import aggregate
+from shipgym.notices import notice
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines import evaluation
@@ -73,7 +74,7 @@ from shipgym_baselines.ranking import (
 from shipgym_baselines.ranking import scenario_scores as score_table
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from shipgym_baselines.run_costs import eta_line
+from shipgym_baselines.run_costs import eta_line, tables_line
 from shipgym_baselines.runs import (
     BACKENDS,
     RUN_FILE,
@@ -544,7 +545,9 @@ def run_leaderboard(
             keep_drawn(log, rows, row)
         with log.manifest.claiming():  # the tables and figures: listed for --force
             results = load_results(log.folder)
-            return write_results(log.folder, log.record["suite"], results, workers, vector_figures)
+            return write_results(
+                log.folder, log.record["suite"], results, workers, vector_figures, show_progress
+            )
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
@@ -593,9 +596,11 @@ def write_results(
     results: list[EpisodeResult],
     workers: int | None = None,
     vector_figures: bool = False,
+    announce: bool = True,
 ) -> list[dict[str, Any]]:
     """Tables, ranking and figures into ``out`` from episode results and a suite as
-    ``run.json`` keeps it (:func:`suite_record`); returns the rows.
+    ``run.json`` keeps it (:func:`suite_record`); returns the rows.  ``announce``: say so
+    first in one line on stderr, with the time it takes (:func:`tables_line`).
 
     ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
     controller × scenario cost ratios, then the rows), ``generalisation.json``,
@@ -618,6 +623,8 @@ def write_results(
     episodes = episode_rows(results)
     splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
     ranked = rankable(episodes)
+    if announce:
+        notice(tables_line(len(splits), workers or os.cpu_count() or 1))
     drawn = figures.episodes_to_draw(results)
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:

@@ -317,6 +317,21 @@ def estimate_cpu_s(
     return total
 
 
+#: what the estimate of :func:`eta_line` leaves out
+COMPILATIONS = "one-off C compilations on a new machine come on top, each announced"
+
+
+def tables_line(scenarios: int, workers: int) -> str:
+    """The line before a run's tables, ranking and figures are written: how many scenarios
+    and about how long (:data:`TABLES_CPU_S_PER_SCENARIO` each, over the ``workers``)."""
+    wall = TABLES_CPU_S_PER_SCENARIO * scenarios / max(1, min(workers, scenarios))
+    plural = "s" if scenarios != 1 else ""
+    return (
+        f"shipgym: writing the tables, ranking and figures of {scenarios} scenario{plural} "
+        f"(about {duration(wall)})"
+    )
+
+
 def eta_line(
     jobs: Sequence[Job], scenarios: Mapping[str, Scenario], workers: int, episodes: int
 ) -> str:
@@ -330,7 +345,8 @@ def eta_line(
     wall = cpu / max(min(workers, len(jobs)), 1)
     plural = "" if workers == 1 else "s"
     return (
-        f"leaderboard: {count} on {workers} worker{plural}, about {duration(wall)} (recorded costs)"
+        f"leaderboard: {count} on {workers} worker{plural}, about {duration(wall)} (recorded "
+        f"costs; {COMPILATIONS})"
     )
 
 

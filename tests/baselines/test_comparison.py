@@ -22,7 +22,6 @@ from shipgym_baselines.comparison import (
     with_references,
 )
 from shipgym_baselines.ranking import NO_RANKING, NOTHING_TO_RANK
-from shipgym_baselines.report import write_report
 from shipgym_baselines.runs import read_episodes, read_run
 from shipgym_baselines.suite import load_suite
 
@@ -122,7 +121,11 @@ def test_the_leaderboard_announces_its_time_before_the_first_episode(
     first = stderr.splitlines()[0]
     # smoke: 3 scenarios × 2 seeds × 4 controllers (the oracle's read from its table)
     assert first.startswith("leaderboard: 24 episodes on 1 worker, about ")
-    assert first.endswith(" (recorded costs)")
+    assert first.endswith(
+        " (recorded costs; one-off C compilations on a new machine come on top, each announced)"
+    )
+    # after the episodes, the tables' wait is announced too
+    assert "shipgym: writing the tables, ranking and figures of 3 scenarios (about " in stderr
 
 
 def test_no_references_gives_no_ranking_and_says_how_to_get_one(
@@ -167,7 +170,10 @@ def test_evaluate_runs_merge_into_one_ranking_reading_the_references_once(
     # pid_los is the suite's one competitor: nothing of the suite is left out
     assert "References added for the cost ratio: `oracle`, `zero_rudder`, `random`" in note
     assert "Ranked against" not in note
-    write_report(folders, tmp_path / "both")
+    assert main(["report", *map(str, folders), "--out", str(tmp_path / "both")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith("shipgym: reading 2 run folders\n")
+    assert "shipgym: writing the tables, ranking and figures of 1 scenario (about " in err
     board = json.loads((tmp_path / "both" / "aggregate.json").read_text())
     assert sorted(r["controller"] for r in board) == ["pid_los", "steer"]
     assert "Ranked against" not in (tmp_path / "both" / "leaderboard.md").read_text()
