@@ -731,7 +731,9 @@ def _plot_intervals(
     plt = pyplot()
     rows = sorted(rows, key=lambda r: (-r["cost_ratio_iqm"], r["controller"]))  # best on top
     common = max(len(r["scenarios"]) for r in rows)
-    keys = [panel[0] for panel in _INTERVAL_PANELS]
+    # no P(ratio < pid_los's) panel where no row compares with pid_los (not ranked here)
+    panels = [p for p in _INTERVAL_PANELS if any(r.get(p[0]) is not None for r in rows)]
+    keys = [panel[0] for panel in panels]
     names = [r["controller"] for r in rows]
     point = {r["controller"]: np.array([_value(r, k) for k in keys]) for r in rows}
     interval = {r["controller"]: np.array([_interval(r, k) for k in keys]).T for r in rows}
@@ -739,14 +741,14 @@ def _plot_intervals(
         fig, axes = plot_utils.plot_interval_estimates(
             point,
             interval,
-            metric_names=[panel[1] for panel in _INTERVAL_PANELS],
+            metric_names=[panel[1] for panel in panels],
             algorithms=names,
             colors={n: controller_style(n).color for n in names},
             subfigure_width=3.4,
             row_height=0.3,
             xlabel="",
         )
-    for ax, (key, _, label, refs) in zip(axes, _INTERVAL_PANELS, strict=True):
+    for ax, (key, _, label, refs) in zip(axes, panels, strict=True):
         if key.startswith("cost_ratio"):
             _log_ratio_axis(ax, [v for r in rows for v in (*_interval(r, key), _value(r, key))])
         ax.set_xlabel(label, fontsize=9)

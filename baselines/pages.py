@@ -49,6 +49,7 @@ from shipgym_baselines.figures import (
     figure_stem,
 )
 from shipgym_baselines.ranking import (
+    BASELINE,
     ORACLE,
     PARTIAL,
     SCORE_EXPLAINED,
@@ -58,6 +59,9 @@ from shipgym_baselines.ranking import (
 )
 from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import controller_style
+
+#: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)
+PROB = f"prob_improvement_over_{BASELINE}"
 
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
@@ -369,7 +373,9 @@ def unpacked_body(table: str) -> str:
 # ----------------------------------------------------------------------------- sections
 def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
-    cost ratio's IQM, lowest first); a split's partial table is titled as such."""
+    cost ratio's IQM, lowest first); a split's partial table is titled as such.  A table
+    whose rows have no probability of improvement (``pid_los`` not ranked there) has no
+    such column; a row without one (``pid_los`` itself) shows "–"."""
     columns = [
             ("controller", "controller", "text"),
             ("rank", "rank", "number"),
@@ -400,8 +406,8 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
                     _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95")),
                     _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95")),
                     _cell(
-                        r.get("prob_improvement_over_pid_los"),
-                        r.get("prob_improvement_over_pid_los_ci95"),
+                        r.get(PROB),
+                        r.get(f"{PROB}_ci95"),
                     ),
                     _cell(r.get("failure_rate"), r.get("failure_rate_ci95")),
                 ]
@@ -410,7 +416,12 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
         title = SPLIT_TITLES.get(base, base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        table = _table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
+        mine = columns
+        if all(r.get(PROB) is None for r in rows):  # pid_los not ranked here: no comparison
+            skip = [c[0] for c in columns].index("prob")
+            mine = columns[:skip] + columns[skip + 1 :]
+            body = [cells[:skip] + cells[skip + 1 :] for cells in body]
+        table = _table(f"ranking-{split}", mine, body, compact=True, cls="ranking")
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
     notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes

@@ -18,7 +18,8 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   of the split that have the oracle's episodes: the interquartile mean (IQM) and the
   geometric mean of the cost ratios, the probability of improvement over ``pid_los``
   P(ratio < pid_los's ratio on a scenario) + ½ P(equal) (rliable's probability of
-  improvement of the negated ratios: lower cost is the improvement) and the failure rate,
+  improvement of the negated ratios: lower cost is the improvement; None for ``pid_los``
+  itself and where ``pid_los`` lacks a scenario of the row) and the failure rate,
   each with a 95 % stratified-bootstrap interval (runs = training seeds × evaluation seeds,
   tasks = scenarios; :func:`aggregate_ranking`), ranked by the IQM, ascending.  References
   (kind ``reference``: ``oracle``, ``zero_rudder``, ``random``) are not ranked.  Every
@@ -343,7 +344,8 @@ def ranking_row(
     seed: int = 0,
 ) -> dict[str, Any]:
     """One ``aggregate.json`` object (:data:`AGGREGATE_FIELDS`): ``controller`` over
-    ``tasks``; the probability of improvement is None where ``pid_los`` lacks a task."""
+    ``tasks``; the probability of improvement is None for ``pid_los`` itself (no comparison
+    with itself) and where ``pid_los`` lacks a task (not ranked in this run, or not there)."""
     ratios = run_matrix(scored, controller, tasks)
     point, interval = interval_estimate(ratios, _ratio_estimates, reps, seed)
     fail_point, fail_interval = interval_estimate(
@@ -351,7 +353,7 @@ def ranking_row(
     )
     prob: float | None = None
     prob_ci: list[float] | None = None
-    if set(tasks) <= set(_tasks(scored, BASELINE, set(tasks))):
+    if controller != BASELINE and set(tasks) <= set(_tasks(scored, BASELINE, set(tasks))):
         pair = [ratios, run_matrix(scored, BASELINE, tasks)]
         p_point, p_interval = interval_estimate(pair, probability_of_lower_ratio, reps, seed)
         prob, prob_ci = float(p_point[0]), _pairs(p_interval, 0)

@@ -15,6 +15,7 @@ from pydantic import Discriminator, Field, Tag, ValidationError, field_validator
 from shipgym.config import (
     ConfigFile,
     StrictModel,
+    error_message,
     is_path,
     list_names,
     load_yaml_model,
@@ -255,7 +256,7 @@ def check_suite_file(name_or_path: str | os.PathLike) -> list[Problem]:
     except ValidationError as exc:
         for item in exc.errors():
             parts = [str(p) for p in item["loc"] if p not in ("short form", "long form")]
-            problems.append(Problem(".".join(parts), item["msg"]))
+            problems.append(Problem(".".join(parts), error_message(item, SuiteConfig)))
     anchor = file if isinstance(file, Path) else None
     problems += _scenario_problems(data.get("scenarios"), anchor)
     problems += _controller_problems(data.get("controllers"), anchor)

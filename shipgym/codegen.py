@@ -7,7 +7,10 @@ already there, and loads it with ``casadi.external``.  A compilation that is nee
 announced first, in one line on stderr (what, an estimate of its seconds from the size of
 the C code: :func:`compile_seconds`, where it is cached).  Without a compiler, or if
 anything fails, it returns the original function (same results, slower) and says why once
-through ``warnings``.
+through ``warnings``.  Compiling a library is exclusive across processes: a process holds
+an ``fcntl`` lock on ``<library>.lock`` beside it while it compiles, and a process that
+waited for the lock loads the library the other one published instead of compiling it (so
+only the process that compiles announces it).  The lock files stay in the cache folder.
 
 The per-user cache folder (:func:`user_cache_dir`) is ``$SHIPGYM_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``; compiled libraries sit at its top
@@ -16,13 +19,14 @@ The per-user cache folder (:func:`user_cache_dir`) is ``$SHIPGYM_CACHE_DIR`` if 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
 import subprocess
 import tempfile
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import casadi as ca
@@ -102,13 +106,58 @@ def compiled_all(
                 out[i] = _load(function, target)
             else:
                 todo.append((i, source, target))
-        if todo:
-            seconds = sum(compile_seconds(source.stat().st_size) for _, source, _ in todo)
-            name = what or ", ".join(functions[i].name() for i, _, _ in todo)
-            notice(compile_message(name, seconds, cache_dir()))
-        for i, source, target in todo:
-            out[i] = _build(functions[i], compiler, flags, source, target)
+        with _locked(sorted({target for _, _, target in todo})):
+            # another process may have published a library while this one waited for it
+            todo = _published(functions, todo, out)
+            if todo:
+                seconds = sum(compile_seconds(source.stat().st_size) for _, source, _ in todo)
+                name = what or ", ".join(functions[i].name() for i, _, _ in todo)
+                notice(compile_message(name, seconds, cache_dir()))
+            for i, source, target in todo:
+                out[i] = (
+                    _load(functions[i], target)
+                    if target.exists()  # the same library twice in ``functions``
+                    else _build(functions[i], compiler, flags, source, target)
+                )
     return [f for f in out if f is not None]
+
+
+def _published(
+    functions: Sequence[ca.Function],
+    todo: list[tuple[int, Path, Path]],
+    out: list[ca.Function | None],
+) -> list[tuple[int, Path, Path]]:
+    """The entries of ``todo`` whose library is still missing; the others loaded into
+    ``out``."""
+    missing = []
+    for i, source, target in todo:
+        if target.exists():
+            out[i] = _load(functions[i], target)
+        else:
+            missing.append((i, source, target))
+    return missing
+
+
+@contextlib.contextmanager
+def _locked(targets: Sequence[Path]) -> Iterator[None]:
+    """Exclusive ``fcntl`` locks on ``<target>.lock`` for each of ``targets`` inside, taken
+    in the given (sorted) order so that two processes cannot wait for each other; without
+    ``fcntl`` (Windows) or a writable folder, no lock (a concurrent compilation then only
+    repeats work: the library is published atomically)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on POSIX
+        yield
+        return
+    with contextlib.ExitStack() as stack:
+        for target in targets:
+            try:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                handle = stack.enter_context(open(f"{target}.lock", "a"))
+                fcntl.flock(handle.fileno(), fcntl.LOCK_EX)
+            except OSError:
+                continue
+        yield
 
 
 def _build(

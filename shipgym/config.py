@@ -18,12 +18,14 @@ and the bad key.
 
 from __future__ import annotations
 
+import difflib
 import os
+import types
 from collections.abc import Iterable, Mapping
 from importlib.resources import files
 from importlib.resources.abc import Traversable
 from pathlib import Path
-from typing import Any, Self, TypeVar
+from typing import Annotated, Any, Self, TypeVar, Union, get_args, get_origin
 
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
@@ -156,13 +158,65 @@ def resolve(
 # --------------------------------------------------------------------- the loader
 
 
-def format_validation_error(err: ValidationError, origin: str) -> str:
-    """One line per problem, naming the file (``origin``) and the key."""
+def format_validation_error(
+    err: ValidationError, origin: str, model: type[BaseModel] | None = None
+) -> str:
+    """One line per problem, naming the file (``origin``) and the key; an unknown key of
+    ``model`` with the close field names (:func:`error_message`)."""
     lines = []
     for item in err.errors():
         key = ".".join(str(part) for part in item["loc"]) or "<top level>"
-        lines.append(f"{origin}: key '{key}': {item['msg']}")
+        lines.append(f"{origin}: key '{key}': {error_message(item, model)}")
     return "\n".join(lines)
+
+
+def error_message(item: Mapping[str, Any], model: type[BaseModel] | None) -> str:
+    """A pydantic error's message; for an unknown key (``extra_forbidden``) of ``model``,
+    followed by "did you mean 'K'?" when a field name there is close to it (difflib)."""
+    message = str(item["msg"])
+    loc = tuple(item.get("loc", ()))
+    if model is None or item.get("type") != "extra_forbidden" or not loc:
+        return message
+    close = difflib.get_close_matches(str(loc[-1]), sorted(_field_names(model, loc[:-1])), n=1)
+    return f"{message}; did you mean '{close[0]}'?" if close else message
+
+
+def _field_names(annotation: Any, loc: tuple[Any, ...]) -> set[str]:
+    """The field names (and aliases) of the models at ``loc`` (a pydantic error's place)
+    inside ``annotation``: through optional and union types, lists and dicts; a part that
+    names no field (a union's tag) is skipped."""
+    options = _options(annotation)
+    if not loc:
+        return {
+            name
+            for option in options
+            if isinstance(option, type) and issubclass(option, BaseModel)
+            for field_name, field in option.model_fields.items()
+            for name in (field_name, field.alias)
+            if name
+        }
+    part, rest = loc[0], loc[1:]
+    found: set[str] = set()
+    for option in options:
+        if isinstance(option, type) and issubclass(option, BaseModel):
+            for field_name, field in option.model_fields.items():
+                if part in (field_name, field.alias):
+                    found |= _field_names(field.annotation, rest)
+        elif get_origin(option) in (list, tuple, set, frozenset) and get_args(option):
+            if isinstance(part, int):
+                found |= _field_names(get_args(option)[0], rest)
+        elif get_origin(option) is dict and len(get_args(option)) == 2:
+            found |= _field_names(get_args(option)[1], rest)
+    return found or (_field_names(annotation, rest) if isinstance(part, str) else set())
+
+
+def _options(annotation: Any) -> list[Any]:
+    """The types ``annotation`` may be: a union's members, an ``Annotated``'s type."""
+    if get_origin(annotation) is Annotated:
+        return _options(get_args(annotation)[0])
+    if get_origin(annotation) in (Union, types.UnionType):
+        return [t for arg in get_args(annotation) for t in _options(arg)]
+    return [annotation]
 
 
 def read_config_text(file: ConfigFile, error: type[Exception] = ConfigError) -> str:
@@ -204,7 +258,7 @@ def validate_model(
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise error(format_validation_error(exc, origin)) from None
+        raise error(format_validation_error(exc, origin, model)) from None
 
 
 def load_yaml_model(file: ConfigFile, model: type[M], error: type[Exception] = ConfigError) -> M:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -255,10 +256,30 @@ def turning_circle(
     return log, figures
 
 
-def plot_manoeuvre(
-    model: ShipModel, kind: str, log: ManoeuvreLog, figures: dict[str, float], path: str
-) -> None:
-    """Track and heading/rudder time series of a manoeuvre, saved to ``path`` (PNG)."""
+#: the longest line [characters] of the time-series panel's title of figures
+TITLE_LINE_CHARS = 48
+
+
+def figures_title(figures: dict[str, float], width: int = TITLE_LINE_CHARS) -> str:
+    """The figures as "name value unit", comma-separated, broken between figures into lines
+    of at most ``width`` characters (a single longer figure keeps a line of its own)."""
+    lines: list[str] = []
+    for k, v in figures.items():
+        item = f"{k} {v:.4g} {FIGURE_UNITS.get(k, '')}".rstrip()
+        if lines and len(lines[-1]) + len(", ") + len(item) <= width:
+            lines[-1] += f", {item}"
+        else:
+            if lines:
+                lines[-1] += ","
+            lines.append(item)
+    return "\n".join(lines)
+
+
+def manoeuvre_figure(
+    model: ShipModel, kind: str, log: ManoeuvreLog, figures: dict[str, float]
+) -> Any:
+    """The figure of a manoeuvre: its track, and heading ψ and rudder δ [deg] over time
+    under the figures (:func:`figures_title`)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -270,9 +291,20 @@ def plot_manoeuvre(
     axes[0].set_aspect("equal", adjustable="datalim")
     axes[1].plot(log.t, np.degrees(log.psi), label="ψ [deg]")
     axes[1].plot(log.t, np.degrees(log.delta), label="δ [deg]")
-    title = ", ".join(f"{k} {v:.4g} {FIGURE_UNITS.get(k, '')}".rstrip() for k, v in figures.items())
-    axes[1].set(xlabel="t [s]", title=title[:90])
+    axes[1].set_xlabel("t [s]")
+    axes[1].set_title(figures_title(figures), fontsize=10)
     axes[1].legend()
     fig.tight_layout()
+    return fig
+
+
+def plot_manoeuvre(
+    model: ShipModel, kind: str, log: ManoeuvreLog, figures: dict[str, float], path: str
+) -> None:
+    """Track and heading/rudder time series of a manoeuvre (:func:`manoeuvre_figure`),
+    saved to ``path`` (PNG)."""
+    import matplotlib.pyplot as plt
+
+    fig = manoeuvre_figure(model, kind, log, figures)
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -56,7 +56,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("ship", help=f"ship model id ({', '.join(MODELS)})")
     p.add_argument("kind", choices=list(MANOEUVRES))
-    p.add_argument("--rudder", type=float, default=None, help="rudder angle [deg] (35 / 20)")
+    p.add_argument(
+        "--rudder",
+        type=float,
+        default=None,
+        help="rudder angle [deg] (default: 35 turning, limited to the ship's maximum rudder; "
+        "20 zig-zag; the output's first line says the angle used)",
+    )
     p.add_argument("--switch", type=float, default=None, help="zig-zag heading switch [deg]")
     p.add_argument("--variant", default=None, help="model variant (e.g. esso_osaka literal)")
     p.add_argument("--out", default="results/manoeuvres", help="directory of the plot")

@@ -5,7 +5,10 @@ metric, as ``--json`` prints it) and the leaderboard's figure of the episode (pa
 track, cross-track error, rudder angle) into ``--out``.  The episode is the trial that
 ``--seed`` draws with ``--suite``'s randomisation (default suite ``default``), so it equals
 that suite's leaderboard episode of the scenario and seed; the default seed is the
-leaderboard's first evaluation seed.
+leaderboard's first evaluation seed.  A learned agent runs the policy of
+``--training-seed`` (default: its first; the leaderboard runs each of
+:func:`~shipgym_baselines.registry.training_seeds`), named with all its training seeds in
+the output (``training_seed``, ``training_seeds``; None and [] for an untrained controller).
 """
 
 from __future__ import annotations
@@ -50,6 +53,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=EVAL_SEED_OFFSET,
         help=f"evaluation seed (default {EVAL_SEED_OFFSET}, the leaderboard's first; its "
         f"i-th seed is {EVAL_SEED_OFFSET} + i)",
+    )
+    p.add_argument(
+        "--training-seed",
+        type=int,
+        default=None,
+        metavar="K",
+        help="a learned agent's training seed to replay, one of those its leaderboard row "
+        "aggregates (default: the first)",
     )
     p.add_argument(
         "--suite",
@@ -97,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
-    from shipgym_baselines.registry import applies_to
+    from shipgym_baselines.registry import applies_to, training_seeds
     from shipgym_baselines.runs import check_out_dir, clear_outputs
     from shipgym_baselines.suite import load_suite
 
@@ -110,31 +121,58 @@ def run(args: argparse.Namespace) -> int:
         raise RunError(
             f"controller {label!r} does not apply to the {ship} ship of scenario {scenario.name!r}"
         )
+    trained = [k for k in training_seeds(args.controller) if k is not None]
+    training_seed = _training_seed(label, trained, args.training_seed)
     name = Path(args.scenario).stem if is_path(args.scenario) else args.scenario
     out = check_out_dir(args.out or default_out(name, label, args.seed), force=args.force)
     if args.force:
         clear_outputs(out, OUTPUTS)
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
-    result = evaluate(args.controller, trial, [args.seed])[0]
+    settings = {} if training_seed is None else {"training_seed": training_seed}
+    result = evaluate(args.controller, trial, [args.seed], **settings)[0]
     # as the leaderboard names them: a scenario file under its name:
     table_name = scenario.name if is_path(args.scenario) else args.scenario
     result.controller, result.scenario = label, table_name
     row = result.row()
+    # after "seed": which of the agent's policies ran (as the leaderboard's episodes name it)
+    at = list(row).index("seed") + 1
+    items = list(row.items())
+    row = dict([*items[:at], ("training_seed", training_seed), ("training_seeds", trained)])
+    row |= dict(items[at:])
     out.mkdir(parents=True, exist_ok=True)
     (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
     randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
     plot_results([result], out, {table_name: scenario}, randomize)
     plots = sorted(p.name for p in out.glob("*.png"))
     if video is not None:
-        _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}")
+        trained_with = "" if training_seed is None else f", training seed {training_seed}"
+        _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}{trained_with}")
     text = "\n".join(f"{k:24s} {_cell(v)}" for k, v in row.items())
     emit(args, row, text)
+    policy = "" if training_seed is None else f"; {_seed_phrase(training_seed, trained)}"
     sys.stderr.write(
-        f"wrote {out}: {METRICS_FILE}, {', '.join(plots)} (suite {suite.name!r}'s trial of "
-        f"seed {args.seed})\n"
+        f"wrote {out}: {METRICS_FILE}, {', '.join(plots)} (the trial of seed {args.seed} in "
+        f"suite {suite.name!r}{policy})\n"
     )
     return 0
+
+
+def _training_seed(label: str, trained: list[int], chosen: int | None) -> int | None:
+    """The training seed to run: ``chosen`` (checked against ``trained``, the controller's
+    training seeds), else the first of ``trained``; None for an untrained controller."""
+    if chosen is None:
+        return trained[0] if trained else None
+    if chosen not in trained:
+        valid = ", ".join(map(str, trained))
+        has = f"has the training seeds {valid}" if trained else "has no training seeds"
+        raise RunError(f"--training-seed {chosen}: controller {label!r} {has}")
+    return chosen
+
+
+def _seed_phrase(training_seed: int, trained: list[int]) -> str:
+    """ "training seed 1 of 3 (0, 1, 2)"."""
+    return f"training seed {training_seed} of {len(trained)} ({', '.join(map(str, trained))})"
 
 
 def _suite_file(scenario: str, suite: Any) -> str:

@@ -2,7 +2,8 @@
 
 ``--validate FILE…`` loads and checks each file and names every problem it finds (key and
 YAML line): one ``ok FILE`` line per good file, one ``FILE:LINE: key 'K': message`` line per
-problem of a bad one; exit code 2 when any file is bad.  A file whose top level has
+problem of a bad one, in line order; exit code 2 when any file is bad.  An unknown key
+close to a valid one is followed by "did you mean 'K'?".  A file whose top level has
 ``controllers``, ``scenarios`` or ``heldout_scenarios`` (or a packaged suite's name) is
 checked as a suite (:func:`shipgym_baselines.suite.check_suite_file`: its schema, every
 scenario it lists, every controller), any other as a scenario.  With ``--json``: a list of
@@ -62,6 +63,8 @@ def validate(args: argparse.Namespace) -> int:
     for file in args.validate:
         suite = is_suite_file(file)
         problems = check_suite_file(file) if suite else check_scenario_file(file)
+        # in the file's order: the file as a whole first, then by line (stable)
+        problems = sorted(problems, key=lambda p: p.line or 0)
         results.append(
             {
                 "file": file,

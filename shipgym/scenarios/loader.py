@@ -15,6 +15,7 @@ from pydantic import ValidationError
 from shipgym.config import (
     ConfigError,
     catalogue,
+    error_message,
     is_path,
     list_names,
     load_yaml_model,
@@ -290,7 +291,9 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
         nominal_nomoto(scenario)  # what construction builds (guidance mode, controllers)
     except ValidationError as exc:
         found = [
-            Problem(".".join(str(part) for part in item["loc"]), item["msg"])
+            Problem(
+                ".".join(str(part) for part in item["loc"]), error_message(item, ScenarioConfig)
+            )
             for item in exc.errors()
         ]
     except ScenarioError as exc:

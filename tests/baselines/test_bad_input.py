@@ -291,3 +291,39 @@ def test_a_bad_suite_is_named_with_file_and_key(
     for part in named:
         assert part in message
     assert not out.exists()
+
+
+def test_scenarios_validate_suggests_the_key_an_unknown_one_is_close_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An unknown key names the close field of its own model (top level and nested) in a
+    scenario file; a key close to none gets no suggestion."""
+    file = tmp_path / "typos.yaml"
+    file.write_text(
+        SCENARIO.format(**GOOD).replace("[15, 10]]}", "[15, 10]], acceptance_radius_l: 2}")
+        + "time_limt: 5\nwhatever: 1\n"
+    )
+    assert main(["scenarios", "--validate", str(file)]) == 2
+    assert capsys.readouterr().out.splitlines() == [
+        f"{file}:4: key 'path.acceptance_radius_l': Extra inputs are not permitted; did you "
+        "mean 'acceptance_radius_L'?",
+        f"{file}:8: key 'time_limt': Extra inputs are not permitted; did you mean 'time_limit'?",
+        f"{file}:9: key 'whatever': Extra inputs are not permitted",
+    ]
+
+
+def test_a_suites_problems_are_in_line_order_with_suggestions(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The schema's problem (found first) at the end of the file is printed last."""
+    file = tmp_path / "suite.yaml"
+    file.write_text(
+        "name: mine\nscenarios:\n  - nominal\n  - no_such_scenario\ncontrollers: [pid_los]\n"
+        "randomise:\n  start_offset_L: 0.1\n"
+    )
+    assert main(["scenarios", "--validate", str(file)]) == 2
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split(": key")[0] for line in lines] == [f"{file}:4", f"{file}:6"]
+    assert lines[1] == (
+        f"{file}:6: key 'randomise': Extra inputs are not permitted; did you mean 'randomize'?"
+    )

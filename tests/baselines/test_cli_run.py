@@ -120,3 +120,58 @@ def test_unknown_names_are_one_line(
     assert main(["run", *argv, "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and named in err
+
+
+def test_a_learned_agent_replays_the_leaderboards_episode_of_a_training_seed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--training-seed K`` runs the policy the leaderboard runs as training seed K (its
+    ``Job``), named in the output; without it the first training seed runs."""
+    from shipgym_baselines.leaderboard import Job, run_batch
+
+    argv = ("heldout:0", "ppo", "--seed", "10001", "--suite", "smoke")
+    first = run_json(capsys, *argv, "--out", str(tmp_path / "a"))
+    assert (first["training_seed"], first["training_seeds"]) == (0, [0, 1, 2])
+    doc = run_json(capsys, *argv, "--training-seed", "1", "--out", str(tmp_path / "b"))
+    assert list(doc)[:6] == [
+        "scenario",
+        "controller",
+        "kind",
+        "seed",
+        "training_seed",
+        "training_seeds",
+    ]
+    assert doc["training_seed"] == 1 and doc["cost"] != first["cost"]
+    randomize = load_suite("smoke").randomize.model_dump(mode="json")
+    (board,) = run_batch(Job("ppo", "heldout:0", (10001,), 1, randomize))
+    assert board.training_seed == 1
+    assert doc["cost"] == board.metrics["cost"] and doc["ace"] == board.metrics["ace"]
+    assert main(["run", *argv, "--training-seed", "1", "--out", str(tmp_path / "c")]) == 0
+    captured = capsys.readouterr()
+    assert "training_seed            1" in captured.out.splitlines()
+    assert captured.err.endswith(
+        "(the trial of seed 10001 in suite 'smoke'; training seed 1 of 3 (0, 1, 2))\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("controller", "says"),
+    [("ppo", "has the training seeds 0, 1, 2"), ("pid_los", "has no training seeds")],
+)
+def test_a_training_seed_it_lacks_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], controller: str, says: str
+) -> None:
+    out = tmp_path / "out"
+    argv = ["run", "nominal", controller, "--training-seed", "7", "--out", str(out)]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"shipgym run: error: --training-seed 7: controller {controller!r} {says}\n"
+    )
+    assert not out.exists()
+
+
+def test_an_untrained_controller_records_no_training_seed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    doc = run_json(capsys, "nominal", "zero_rudder", "--out", str(tmp_path / "out"))
+    assert (doc["training_seed"], doc["training_seeds"]) == (None, [])

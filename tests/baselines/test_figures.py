@@ -158,6 +158,18 @@ def test_a_controller_has_its_colour_in_every_figure(
     assert "cost ratio C / C_oracle [–] (log)" in ranking and "zero_rudder" not in ranking
 
 
+def test_without_pid_los_the_ranking_figure_has_no_panel_against_it(tmp_path: Path) -> None:
+    episodes = [
+        {"scenario": "a", "controller": c, "kind": k, "seed": seed, "cost": r + seed % 3}
+        for seed in (10000, 10001, 10002)
+        for c, k, r in (("oracle", "reference", 8.0), ("lqr", "classical", 12.0))
+    ]
+    aggregate = aggregate_ranking(episodes, {"a": "catalogue"}, {}, reps=50)
+    files = plot_ranking(tmp_path, aggregate, episodes, {"a": "catalogue"}, vector=True)
+    text = svg_text(files[1])
+    assert "IQM cost ratio" in text and "failure rate" in text and "pid_los" not in text
+
+
 def test_the_oracle_is_drawn_in_every_column_as_the_reference(scenario_files: list[Path]) -> None:
     """The oracle's track, e(t) and δ(t) in each family's column (PID, LQR, learned,
     references), named in the legends; it has no column of its own."""

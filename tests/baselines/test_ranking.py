@@ -141,7 +141,8 @@ def test_aggregate_ranking_known_answers() -> None:
     assert double["failure_rate"] == pytest.approx(0.2)
     low, high = double["failure_rate_ci95"]
     assert 0.0 <= low < 0.2 < high <= 1.0
-    assert by[("pid_los", "heldout")]["prob_improvement_over_pid_los"] == pytest.approx(0.5)
+    assert by[("pid_los", "heldout")]["prob_improvement_over_pid_los"] is None  # not itself
+    assert by[("pid_los", "heldout")]["prob_improvement_over_pid_los_ci95"] is None
     agent = by[("agent", "catalogue")]
     assert agent["kind"] == "learned" and agent["training_seeds"] == 3 and agent["runs"] == 15
     assert agent["cost_ratio_iqm"] == pytest.approx(1.25) and agent["scenarios"] == ["a"]
@@ -228,6 +229,30 @@ def test_a_controller_without_some_scenarios_is_ranked_in_the_partial_table() ->
         ("catalogue:partial", "nmpc", ["a", "b"]),
     ]
     assert rows[1]["prob_improvement_over_pid_los"] == 1.0  # against pid_los on its scenarios
+
+
+def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
+    """pid_los not ranked: every row's probability of improvement over it is None, and
+    leaderboard.md's and the page's tables print "–" (the page drops the column)."""
+    from shipgym_baselines.leaderboard import ranking_tables
+    from shipgym_baselines.pages import ranking_tables as page_tables
+
+    eps = _episodes({"nmpc": [1.1] * 3, "lqr": [1.3] * 3})
+    rows = aggregate_ranking(eps, {"a": "catalogue", "b": "catalogue"}, reps=100)
+    assert [r["controller"] for r in rows] == ["nmpc", "lqr"]
+    assert {(r["prob_improvement_over_pid_los"], r["prob_improvement_over_pid_los_ci95"])
+            for r in rows} == {(None, None)}  # fmt: skip
+    for line in ranking_tables(rows):
+        if line.startswith("| 1 |"):
+            assert line.split(" | ")[7] == "–"
+    assert "pid_los" not in page_tables(rows)
+    with_pid = aggregate_ranking(
+        _episodes({"nmpc": [1.1] * 3, "pid_los": [1.5] * 3}), {"a": "catalogue"}, reps=100
+    )
+    html = page_tables(with_pid)
+    assert "P(ratio &lt; pid_los&#x27;s)" in html
+    (pid_row,) = [r for r in html.split("<tr>") if "</span>pid_los</td>" in r]
+    assert pid_row.split("</td>")[8] == "<td>–"  # no P(improvement) over itself
 
 
 def test_resolution_compares_the_median_interval_width_with_the_iqm_range() -> None:

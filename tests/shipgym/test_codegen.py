@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import io
+import multiprocessing
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import casadi as ca
@@ -161,6 +164,45 @@ def test_functions_compiled_together_are_announced_together(
     (line,) = capfd.readouterr().err.splitlines()
     assert line.startswith("shipgym: compiling two functions to C (one-off, ≈ ")
     assert len(list(cache.glob("*.so"))) == 2
+
+
+def _compile_tiny(cache: str, barrier: object, results: object) -> None:
+    """In a child process: compile a tiny function into ``cache`` after ``barrier``; put
+    (what it wrote on stderr, whether it got a library, its value at 3) on ``results``."""
+    import os
+
+    os.environ["SHIPGYM_CACHE"] = cache
+    os.environ.pop("SHIPGYM_NO_COMPILE", None)
+    x = ca.SX.sym("x")
+    vm = ca.Function("tiny_square", [x], [x * x + 1])
+    sys.stderr = err = io.StringIO()
+    barrier.wait()  # type: ignore[attr-defined]
+    fast = codegen.compiled(vm, what="the tiny function")
+    results.put((err.getvalue(), fast is not vm, float(fast(3.0))))  # type: ignore[attr-defined]
+
+
+@needs_compiler
+def test_two_processes_compile_a_function_once(tmp_path: Path) -> None:
+    """Two processes asking for the same library at once into an empty cache: one compiles
+    and announces it, the other waits for the lock and loads the published library."""
+    ctx = multiprocessing.get_context("spawn")
+    barrier, results = ctx.Barrier(2), ctx.Queue()
+    children = [
+        ctx.Process(target=_compile_tiny, args=(str(tmp_path), barrier, results)) for _ in range(2)
+    ]
+    for child in children:
+        child.start()
+    outcomes = [results.get(timeout=120) for _ in children]
+    for child in children:
+        child.join(timeout=60)
+        assert child.exitcode == 0
+    announced = [line for err, _, _ in outcomes for line in err.splitlines()]
+    assert len(announced) == 1 and announced[0].startswith(
+        "shipgym: compiling the tiny function to C"
+    )
+    assert [(library, value) for _, library, value in outcomes] == [(True, 10.0)] * 2
+    (library,) = tmp_path.glob("*.so")
+    assert (tmp_path / f"{library.name}.lock").is_file()
 
 
 def test_the_estimate_grows_with_the_code_size() -> None:

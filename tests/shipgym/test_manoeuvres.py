@@ -64,3 +64,35 @@ def test_a_rudder_beyond_the_limit_is_an_error_not_clipped() -> None:
     _, at_limit = turning_circle(model, 30.0)
     _, default = turning_circle(model)  # 35° or the ship's smaller limit
     assert default == at_limit
+
+
+def test_the_figures_title_fits_the_figure() -> None:
+    """The turning circle's nine figures in lines of at most 48 characters, each figure
+    whole, and the rendered title inside the figure (no "tactical_dia…" cut)."""
+    from shipgym.manoeuvres import TITLE_LINE_CHARS, figures_title, manoeuvre_figure
+
+    model = Nomoto2()
+    log, figures = turning_circle(model, 20.0)
+    title = figures_title(figures)
+    assert all(len(line) <= TITLE_LINE_CHARS for line in title.splitlines())
+    assert title.replace("\n", " ").count(",") == len(figures) - 1
+    assert "tactical_diameter " in title and "speed_loss " in title
+    fig = manoeuvre_figure(model, "turning", log, figures)
+    try:
+        renderer = fig.canvas.get_renderer()
+        box = fig.axes[1].title.get_window_extent(renderer)
+        assert fig.axes[1].get_title() == title
+        assert 0 <= box.x0 and box.x1 <= fig.bbox.width and box.y1 <= fig.bbox.height
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+
+
+def test_the_rudder_help_says_the_turning_default_is_limited(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with pytest.raises(SystemExit):
+        main(["manoeuvre", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "35 turning, limited to the ship's maximum rudder; 20 zig-zag" in text
