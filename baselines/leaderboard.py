@@ -854,17 +854,30 @@ def _table_title(split: str, rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
-    """The ranking as markdown: one table per split, each followed by its partial table."""
+    """The ranking as markdown: one table per split, each followed by its partial table; the
+    column of the probability of improvement over ``pid_los`` only where a row has one (the
+    run has ``pid_los`` and another controller)."""
     lines: list[str] = []
     for split in dict.fromkeys(r["split"] for r in board):
         mine = [r for r in board if r["split"] == split]
+        with_prob = any(r[PROB] is not None for r in mine)
+        prob = [f"P(improvement over {BASELINE}) [95 % CI]"] if with_prob else []
+        header = [
+            "rank",
+            "controller",
+            "kind",
+            "training seeds",
+            "scenarios",
+            "cost ratio IQM [95 % CI]",
+            "geometric mean [95 % CI]",
+            *prob,
+            "failure rate [95 % CI]",
+        ]
         lines += [
             f"### {_table_title(split, mine)}",
             "",
-            "| rank | controller | kind | training seeds | scenarios | cost ratio IQM [95 % CI] "
-            f"| geometric mean [95 % CI] | P(improvement over {BASELINE}) [95 % CI] "
-            "| failure rate [95 % CI] |",
-            "|---|---|---|---|---|---|---|---|---|",
+            "| " + " | ".join(header) + " |",
+            "|" + "---|" * len(header),
         ]
         for rank, r in enumerate(mine, start=1):
             cells = [
@@ -875,7 +888,7 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
                 str(len(r["scenarios"])),
                 _interval(r["cost_ratio_iqm"], r["cost_ratio_iqm_ci95"], 3),
                 _interval(r["cost_ratio_gmean"], r["cost_ratio_gmean_ci95"], 3),
-                _interval(r[PROB], r[f"{PROB}_ci95"]),
+                *([_interval(r[PROB], r[f"{PROB}_ci95"])] if with_prob else []),
                 _interval(r["failure_rate"], r["failure_rate_ci95"]),
             ]
             lines.append("| " + " | ".join(cells) + " |")

@@ -100,6 +100,7 @@ def test_a_plugin_evaluated_on_smoke_gets_a_cost_ratio_and_a_rank(
     assert "| 1 | steer | classical |" in stdout
     head = (out / "leaderboard.md").read_text().split("## Cost ratio per scenario")[0]
     assert "| 1 | steer | classical |" in head
+    assert "P(improvement over" not in head + stdout  # no pid_los in the run
     for text in (stdout, head):
         assert "Ranked against the references only (`oracle`, `zero_rudder`, `random`)" in text
         # the command that compares with the suite's other controllers
@@ -176,6 +177,7 @@ def test_evaluate_runs_merge_into_one_ranking_reading_the_references_once(
     assert "shipgym: writing the tables, ranking and figures of 1 scenario (about " in err
     board = json.loads((tmp_path / "both" / "aggregate.json").read_text())
     assert sorted(r["controller"] for r in board) == ["pid_los", "steer"]
+    assert "P(improvement over pid_los)" in (tmp_path / "both" / "leaderboard.md").read_text()
     assert "Ranked against" not in (tmp_path / "both" / "leaderboard.md").read_text()
 
 

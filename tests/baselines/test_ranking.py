@@ -233,7 +233,7 @@ def test_a_controller_without_some_scenarios_is_ranked_in_the_partial_table() ->
 
 def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     """pid_los not ranked: every row's probability of improvement over it is None, and
-    leaderboard.md's and the page's tables print "–" (the page drops the column)."""
+    leaderboard.md's and the page's tables drop the column."""
     from shipgym_baselines.leaderboard import ranking_tables
     from shipgym_baselines.pages import ranking_tables as page_tables
 
@@ -242,9 +242,7 @@ def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     assert [r["controller"] for r in rows] == ["nmpc", "lqr"]
     assert {(r["prob_improvement_over_pid_los"], r["prob_improvement_over_pid_los_ci95"])
             for r in rows} == {(None, None)}  # fmt: skip
-    for line in ranking_tables(rows):
-        if line.startswith("| 1 |"):
-            assert line.split(" | ")[7] == "–"
+    assert "pid_los" not in "\n".join(ranking_tables(rows))
     assert "pid_los" not in page_tables(rows)
     with_pid = aggregate_ranking(
         _episodes({"nmpc": [1.1] * 3, "pid_los": [1.5] * 3}), {"a": "catalogue"}, reps=100
@@ -253,6 +251,8 @@ def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     assert "P(ratio &lt; pid_los&#x27;s)" in html
     (pid_row,) = [r for r in html.split("<tr>") if "</span>pid_los</td>" in r]
     assert pid_row.split("</td>")[8] == "<td>–"  # no P(improvement) over itself
+    (md_row,) = [line for line in ranking_tables(with_pid) if "| pid_los |" in line]
+    assert md_row.split(" | ")[7] == "–"
 
 
 def test_resolution_compares_the_median_interval_width_with_the_iqm_range() -> None:
