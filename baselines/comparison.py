@@ -2,9 +2,9 @@
 
 The ranking divides each episode's cost by the ``oracle``'s on the same trial
 (:mod:`shipgym_baselines.ranking`), so a run without the oracle has no ranking.
-Every run adds the references :data:`REFERENCES` its controllers lack (the packaged suites
-list them all; a suite of your own may not, ``evaluate`` and ``--controllers`` do not),
-unless ``--no-references``:
+``shipgym evaluate``, ``shipgym leaderboard --controllers`` and a suite that does not list
+the ``oracle`` add the references :data:`REFERENCES` the controllers lack, unless
+``--no-references`` (a suite that lists the oracle runs as it lists its controllers):
 
 * ``oracle``: the denominator of the cost ratio, read from its shipped reference table
   (:mod:`shipgym_baselines.references`: no episode to run on the packaged suites);

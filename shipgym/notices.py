@@ -1,13 +1,29 @@
-"""Lines for the person at the terminal: what a wait is for and how long it may take."""
+"""Lines for the person at the terminal: what a wait is for and how long it may take.
+
+``SHIPGYM_QUIET=1`` in the environment silences them (scripts; the test suite sets it, and
+the tests of the lines themselves unset it).
+"""
 
 from __future__ import annotations
 
+import os
 import sys
+
+#: the environment variable that silences :func:`notice` (any value but "" and "0")
+QUIET_ENV = "SHIPGYM_QUIET"
+
+
+def quiet() -> bool:
+    """Whether notices are silenced (:data:`QUIET_ENV`)."""
+    return os.environ.get(QUIET_ENV, "") not in ("", "0")
 
 
 def notice(line: str) -> None:
     """Write ``line`` on stderr, on a line of its own: on a terminal the line a progress
-    bar is drawing is cleared first (the bar draws itself again below)."""
+    bar is drawing is cleared first (the bar draws itself again below); nothing when
+    :func:`quiet`."""
+    if quiet():
+        return
     clear = "\r\x1b[K" if sys.stderr.isatty() else ""
     sys.stderr.write(f"{clear}{line}\n")
     sys.stderr.flush()
@@ -22,4 +38,4 @@ def duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-__all__ = ["duration", "notice"]
+__all__ = ["QUIET_ENV", "duration", "notice", "quiet"]

@@ -44,6 +44,15 @@ def user_cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.Mon
     test reads or writes the real one; compiled C libraries stay in the machine's cache
     (``$SHIPGYM_CACHE`` pinned to it), so that tests do not compile again."""
     monkeypatch.setenv("SHIPGYM_CACHE", str(codegen.cache_dir()))
+    # no notice lines (a cold compile cache would add them to the stderr tests compare);
+    # the tests of the notices unset it
+    monkeypatch.setenv("SHIPGYM_QUIET", "1")
     folder = tmp_path_factory.mktemp("user_cache")
     monkeypatch.setenv(codegen.CACHE_DIR_ENV, str(folder))
     return folder
+
+
+@pytest.fixture
+def loud(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The notice lines on (the suite silences them: :func:`user_cache`)."""
+    monkeypatch.delenv("SHIPGYM_QUIET", raising=False)

@@ -5,9 +5,9 @@ Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
 ``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for a suite's own
 controllers, ``results/evaluate/<suite>/<controllers>`` for the controllers given
 (``evaluate``'s policy, ``--controllers``: one folder per suite and set of controllers, outside
-the suite's).  Every run adds the references the controllers lack
-(:mod:`shipgym_baselines.comparison`; the packaged suites list them all), unless
-``--no-references``.
+the suite's).  The controllers given, and a suite that does not list the ``oracle``, run
+with the references they lack (:mod:`shipgym_baselines.comparison`), unless
+``--no-references``; a suite that lists the oracle runs as it lists its controllers.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from shipgym_baselines.cli.options import add_run_options, command_line, emit
 from shipgym_baselines.comparison import REFERENCES, RESULTS_ROOT, suite_folder
@@ -123,6 +124,13 @@ def evaluate_folder(
     return EVALUATE_ROOT / suite_folder(suite).name / name
 
 
+def lists_oracle(spec: Any) -> bool:
+    """Whether a suite lists the ``oracle`` (the packaged suites do)."""
+    from shipgym_baselines.registry import controller_label
+
+    return any(controller_label(c) == REFERENCES[0] for c in spec.controllers)
+
+
 def named(controller: ControllerSpec, name: str | None) -> ControllerSpec:
     """``controller`` shown as ``name`` (the long form), itself when ``name`` is None."""
     if name is None:
@@ -186,6 +194,7 @@ def run(args: argparse.Namespace) -> int:
     # before any work: an unusable --out, then a bad suite, then --out in use or not empty
     check_out_usable(out, resume=args.resume, force=args.force)
     spec = load_suite(args.suite)
+    explicit = controllers is not None
     if policy is None and args.name:
         controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
@@ -204,7 +213,7 @@ def run(args: argparse.Namespace) -> int:
         command=command_line(args),
         recompute_references=getattr(args, "recompute_references", False),
         vector_figures=args.vector_figures,
-        add_references=not args.no_references,
+        add_references=not args.no_references and (explicit or not lists_oracle(spec)),
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

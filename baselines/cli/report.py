@@ -37,10 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Merge the runs, write the report, print the table (or rows); say which runs were
     incomplete."""
-    from shipgym.notices import notice
     from shipgym_baselines.report import write_report
 
-    notice(f"shipgym: reading {len(args.runs)} run folder{'s' if len(args.runs) != 1 else ''}")
     rows, sources = write_report(
         args.runs,
         args.out,

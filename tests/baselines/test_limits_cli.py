@@ -74,6 +74,7 @@ def test_finding8_workers_beyond_the_jobs_are_clamped(tmp_path: Path, monkeypatc
         "--workers",
         "100",
         "--no-progress",
+        "--no-references",
         "--out",
         str(tmp_path / "out"),
         "--json",

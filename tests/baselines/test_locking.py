@@ -86,7 +86,7 @@ def test_finding1_two_runs_started_together_on_one_folder(tmp_path: Path) -> Non
     is refused in one line naming it; every episode is recorded once."""
     out, suite = tmp_path / "out", write_suite(tmp_path, seeds=3)
     command = [sys.executable, "-m", "shipgym_baselines.cli", "leaderboard", "--suite", suite]
-    command += ["--out", str(out), "--workers", "1", "--no-progress", "--json"]
+    command += ["--out", str(out), "--workers", "1", "--no-progress", "--no-references", "--json"]
     runs = [
         subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         for _ in range(2)

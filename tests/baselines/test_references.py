@@ -29,6 +29,9 @@ from shipgym_baselines.references import (
 )
 from shipgym_baselines.tuning.validation import oracle_costs, validation_trials
 
+#: these tests read the notice lines, which the suite silences
+pytestmark = pytest.mark.usefixtures("loud")
+
 
 def test_the_shipped_table_holds_every_validation_trial() -> None:
     """``shipgym tune`` scores on these 32 trials: none is computed on first use."""

@@ -301,6 +301,7 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
     monkeypatch.setattr(shipgym_baselines.leaderboard, "run_batch", third_is_interrupted)
     out = tmp_path / "out"
     args = ["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out), "--workers", "1"]
+    args.append("--no-references")  # the suite's two controllers only
     assert main([*args, "--no-progress"]) == 130
     assert capsys.readouterr().err == (
         f"shipgym leaderboard: interrupted: 4 of 8 episodes kept in {out / 'episodes.jsonl'}; "

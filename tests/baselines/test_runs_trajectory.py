@@ -36,6 +36,7 @@ def test_finding7_a_records_trajectory_names_only_a_file_in_its_run_folder(
                 "--workers",
                 "1",
                 "--no-progress",
+                "--no-references",
                 "--json",
             ]
         )

@@ -16,6 +16,9 @@ import pytest
 from shipgym import codegen
 from shipgym.models import Nomoto2
 
+#: these tests read the notice lines, which the suite silences
+pytestmark = pytest.mark.usefixtures("loud")
+
 needs_compiler = pytest.mark.skipif(
     shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C compiler"
 )

@@ -8,6 +8,9 @@ import pytest
 
 from shipgym.notices import duration, notice
 
+#: these tests read the notice lines, which the suite silences
+pytestmark = pytest.mark.usefixtures("loud")
+
 
 def test_durations_read_as_a_person_says_them() -> None:
     assert [duration(s) for s in (0.2, 40, 95, 200, 540, 5400, 9000)] == [

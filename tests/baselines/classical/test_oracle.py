@@ -376,7 +376,7 @@ def test_a_table_of_another_revision_is_ignored(tmp_path: Path) -> None:
 
 
 def test_shipgym_references_fills_a_table_and_resumes(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], loud: None
 ) -> None:
     """``shipgym references`` computes the trials a table lacks, and only those."""
     import json
