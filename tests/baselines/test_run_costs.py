@@ -70,10 +70,10 @@ def test_profile_splits_add_up(profile: dict) -> None:
 
 #: the default suite's whole run, CPU seconds (README: 1,028 CPU s on a quiet 2-core machine)
 DEFAULT_RUN_CPU_S = 1028.0
-#: how far the estimate may be from it, either way: the recorded costs were measured on a
-#: shared 2-core VM under load (estimate 1,603 CPU s with the tables', 1.56×), and a
-#: measurement moves by ±13 % from run to run (docs/leaderboard-cost.md)
-FACTOR = 1.75
+#: how far the estimate may be from it, either way: the recorded costs, measured on a quiet
+#: 2-core VM, estimate 1,055 CPU s with the tables' (1.03×), and a measurement moves by
+#: ±13 % from run to run (docs/leaderboard-cost.md)
+FACTOR = 1.25
 
 
 def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
