@@ -109,13 +109,11 @@ def _scenario_entry(entry: str, file: ConfigFile, index: int) -> str:
 def load_suite(name_or_path: str | os.PathLike) -> SuiteConfig:
     """A suite by name (``configs/suites/<name>.yaml``) or YAML path; errors name the file
     and the key (a scenario file's ``name:`` that cannot be its table name too:
-    :func:`name_scenarios`)."""
+    :func:`scenario_names`)."""
     file = resolve("suites", name_or_path, error=ConfigError)
     suite = load_yaml_model(file, SuiteConfig, ConfigError)
     scenarios = [_scenario_entry(s, file, i) for i, s in enumerate(suite.scenarios)]
-    problems = name_scenarios(scenarios, load_scenario).problems  # before any episode
-    if problems:
-        raise ConfigError("\n".join(f"{file}: key 'scenarios.{i}': {t}" for i, t in problems))
+    scenario_names(scenarios, load_scenario, where=f"{file}: ")  # before any episode
     controllers = [_controller_entry(c, file) for c in suite.controllers]
     return suite.model_copy(update={"scenarios": scenarios, "controllers": controllers})
 
@@ -201,11 +199,15 @@ def _file_name_problem(
     return None
 
 
-def scenario_names(entries: Sequence[str], load: Callable[[str], Scenario]) -> ScenarioNames:
-    """:func:`name_scenarios`, a :class:`ConfigError` listing every problem when there is any."""
+def scenario_names(
+    entries: Sequence[str], load: Callable[[str], Scenario], where: str = ""
+) -> ScenarioNames:
+    """:func:`name_scenarios`, a :class:`ConfigError` listing every problem when there is any
+    (each line starting with ``where``, e.g. the suite file)."""
     found = name_scenarios(entries, load)
     if found.problems:
-        raise ConfigError("\n".join(f"key 'scenarios.{i}': {text}" for i, text in found.problems))
+        lines = (f"{where}key 'scenarios.{i}': {text}" for i, text in found.problems)
+        raise ConfigError("\n".join(lines))
     return found
 
 

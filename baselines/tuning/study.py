@@ -366,6 +366,12 @@ def write_report(
         winner = {**config.fixed, **best.params} if improved else dict(config.default)
         settings = {k: v for k, v in winner.items() if k != "preset"}
         ratios = list(best.user_attrs["ratios"]) if improved else default
+        values = f"{best.value:.4g}, default {report['default_value']:.4g}"
+        choice = (
+            f"the best trial's settings (best {values})"
+            if improved
+            else f"the default settings (no trial beat them: best trial {values})"
+        )
         summary = {
             "study": plan.study_name,
             "report": str(plan.folder / REPORT_FILE),
@@ -379,7 +385,7 @@ def write_report(
             "section": plan.section,
             "settings": settings,
             "kept_default": not improved,
-            **write_chosen(plan, scorer, settings, ratios, summary, force, progress),
+            **write_chosen(plan, scorer, settings, ratios, summary, choice, force, progress),
         }
     plan.folder.mkdir(parents=True, exist_ok=True)
     staged = plan.folder / f"{REPORT_FILE}.{os.getpid()}.tmp"
@@ -394,74 +400,52 @@ def write_chosen(
     settings: dict[str, Any],
     ratios: list[float],
     summary: dict[str, Any],
+    choice: str,
     force: bool,
     progress: Progress | None,
 ) -> dict[str, Any]:
-    """Write the winner's ``settings`` into the plan's chosen folder unless the section
-    there holds settings that are better on the same trials (``force``: write anyway);
-    returns the report's ``chosen`` block: ``file``, ``written``, ``replaced``,
-    ``incumbent`` (the paired comparison, None for a new section) and ``refused``."""
+    """Write the winner's ``settings`` (``choice``: which they are, in words) into the plan's
+    chosen folder unless the section there holds settings that are better on the same
+    trials (``force``: write anyway); returns the report's ``chosen`` block: ``file``,
+    ``written``, ``replaced``, ``incumbent`` (the paired comparison, None for a new section)
+    and ``refused``."""
+    block: dict[str, Any] = {
+        "file": None,
+        "written": False,
+        "replaced": None,
+        "incumbent": None,
+        "refused": None,
+    }
     if plan.chosen_dir is None:
-        return {"file": None, "written": False, "replaced": None, "incumbent": None}
+        return block
     controller = plan.config.controller
     file = chosen_settings.chosen_file(controller, plan.chosen_dir)
     where = f"{file} [{plan.section}]"
+    block["file"] = str(file)
     held = chosen_settings.section_record(controller, plan.section, plan.chosen_dir)
-    incumbent = None
     if held is not None:
-        incumbent = _incumbent(plan, scorer, held, progress)
-        incumbent["comparison"] = promotion.compare(ratios, incumbent.pop("ratios"))
-        if not promotion.not_worse(incumbent["comparison"]) and not force:
-            c = incumbent["comparison"]
-            refused = (
+        incumbent = block["incumbent"] = _incumbent(plan, scorer, held, progress)
+        c = incumbent["comparison"] = promotion.compare(ratios, incumbent.pop("ratios"))
+        if not promotion.not_worse(c) and not force:
+            block["refused"] = (
                 f"{plan.study_name}: kept {where}: its settings score {c['incumbent_value']:.4g} "
                 f"on the same {c['trials']} validation trials, this study's choice "
-                f"({_choice(summary)}) {c['new_value']:.4g} (lower is better); --force "
-                "replaces them"
+                f"({choice}) {c['new_value']:.4g} (lower is better); --force replaces them"
             )
-            return {
-                "file": str(file),
-                "written": False,
-                "replaced": None,
-                "incumbent": incumbent,
-                "refused": refused,
-            }
-    written, replaced = chosen_settings.write_chosen(
+            return block
+    written, block["replaced"] = chosen_settings.write_chosen(
         controller, plan.section, settings, summary, plan.chosen_dir
     )
-    if incumbent is None:
-        say(
-            progress,
-            f"{plan.study_name}: chose {_choice(summary)}, objective {summary['value']:.4g}: "
-            f"written to {where} (a new section)",
-        )
+    block.update(file=str(written), written=True)
+    if held is None:
+        said = f", objective {summary['value']:.4g}: written to {where} (a new section)"
     else:
-        c = incumbent["comparison"]
-        say(
-            progress,
-            f"{plan.study_name}: chose {_choice(summary)}: replaced {where}: {replaced} "
-            f"(objective {c['incumbent_value']:.4g}) by {settings} ({c['new_value']:.4g}, the "
-            f"same {c['trials']} validation trials)",
+        said = (
+            f": replaced {where}: {block['replaced']} (objective {c['incumbent_value']:.4g}) by "
+            f"{settings} ({c['new_value']:.4g}, the same {c['trials']} validation trials)"
         )
-    return {
-        "file": str(written),
-        "written": True,
-        "replaced": replaced,
-        "incumbent": incumbent,
-        "refused": None,
-    }
-
-
-def _choice(summary: dict[str, Any]) -> str:
-    """What a study chose, in words: its best trial's settings, or the default ones when no
-    trial beat them (with both objectives)."""
-    best, default = summary["best_value"], summary["default_value"]
-    if best >= default:
-        return (
-            f"the default settings (no trial beat them: best trial {best:.4g}, default "
-            f"{default:.4g})"
-        )
-    return f"the best trial's settings (best {best:.4g}, default {default:.4g})"
+    say(progress, f"{plan.study_name}: chose {choice}{said}")
+    return block
 
 
 def _incumbent(
