@@ -159,11 +159,12 @@ def _store(args: tuple[str, list[int]]) -> None:
 
 def test_concurrent_stores_keep_every_entry(tmp_path: Path) -> None:
     """Four processes storing at once: each store re-reads and merges under the lock, so
-    no entry is lost."""
+    no entry is lost.  Spawned, not forked: a fork of a test process that ran Ray or torch
+    threads may inherit a held lock and hang."""
     path = str(tmp_path / "refs.json.gz")
     work = [(path, list(range(k, 40, 4))) for k in range(4)]
-    with multiprocessing.get_context("fork").Pool(4) as pool:
-        pool.map(_store, work)
+    with multiprocessing.get_context("spawn").Pool(4) as pool:
+        pool.map_async(_store, work).get(timeout=300)
     scenario = load_scenario("nominal")
     table = ReferenceTable.load(path)
     assert set(table.entries) == {entry_key(scenario, seed) for seed in range(40)}
