@@ -8,6 +8,8 @@ the ``oracle`` add the references :data:`REFERENCES` the controllers lack, unles
 
 * ``oracle``: the denominator of the cost ratio, read from its shipped reference table
   (:mod:`shipgym_baselines.references`: no episode to run on the packaged suites);
+* ``oracle_frozen``: the same NMPC with its truth frozen at the episode's start, the optimum
+  of a controller that never adapts (the gap metrics' other end), read from its table too;
 * ``zero_rudder`` and ``random``: what doing nothing and acting at random cost on the
   same trials, the cheapest controllers of the suite (a line of the cost-ratio table each;
   never ranked).
@@ -29,7 +31,7 @@ from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.ranking import REFERENCE_KIND
 
 #: the references added to a run's controllers (the cost ratio's denominator first)
-REFERENCES = ("oracle", "zero_rudder", "random")
+REFERENCES = ("oracle", "oracle_frozen", "zero_rudder", "random")
 #: the key of ``run.json``'s suite record that :func:`references_record` fills
 RECORD_KEY = "references"
 #: the folder of the leaderboard's default ``--out`` (:func:`suite_folder`)

@@ -244,14 +244,16 @@ def run_batch(job: Job) -> list[EpisodeResult]:
 
 
 def reference_work(job: Job) -> list[EpisodeResult]:
-    """The oracle's episodes of ``job``: each trial's entry of the shipped reference table
-    or of the per-user cache (:mod:`shipgym_baselines.references`), the oracle run for a
-    trial both lack (and stored in the cache)."""
-    cache, out = ReferenceCache(), []
+    """A privileged reference's episodes of ``job`` (``oracle`` or ``oracle_frozen``): each
+    trial's entry of the reference's shipped table or of its per-user cache
+    (:mod:`shipgym_baselines.references`), the reference run for a trial both lack (and
+    stored in the cache)."""
+    reference = controller_label(job.controller)
+    cache, out = ReferenceCache(reference=reference), []
     for seed, trial in zip(job.seeds, trials(job), strict=True):
-        entry = lookup(trial, seed, cache)
+        entry = lookup(trial, seed, cache, reference)
         if entry is not None:
-            out.append(result_from_entry(entry, job.scenario, seed))
+            out.append(result_from_entry(entry, job.scenario, seed, reference))
         else:
             (result,) = _named(evaluation.evaluate(job.controller, trial, [seed]), job)
             cache.store(trial, result)
@@ -260,25 +262,31 @@ def reference_work(job: Job) -> list[EpisodeResult]:
 
 
 def announce_references(jobs: Iterable[Job]) -> None:
-    """One line on stderr before the oracle's episodes of ``jobs`` that are computed, not
-    read (a trial neither table holds; every trial with ``--recompute-references``): how
-    many, the estimated CPU time."""
-    cache, pending = ReferenceCache(), []
-    where = f"once: cached in {cache.path}"
+    """One line on stderr per privileged reference before its episodes of ``jobs`` that are
+    computed, not read (a trial neither table holds; every trial with
+    ``--recompute-references``): how many, the estimated CPU time."""
+    pending: dict[str, list[Scenario]] = defaultdict(list)
+    where: dict[str, str] = {}
     for job in jobs:
         if not grants_truth(job.controller):
             continue
+        reference = controller_label(job.controller)
+        cache = ReferenceCache(reference=reference)
+        where.setdefault(reference, f"once: cached in {cache.path}")
         for seed, trial in zip(job.seeds, trials(job), strict=True):
             if job.references == "recompute":
-                pending.append(trial)
-                where = "--recompute-references: every trial, the cache neither read nor written"
-            elif lookup(trial, seed, cache) is None:
-                pending.append(trial)
-    announce(pending, where)
+                pending[reference].append(trial)
+                where[reference] = (
+                    "--recompute-references: every trial, the cache neither read nor written"
+                )
+            elif lookup(trial, seed, cache, reference) is None:
+                pending[reference].append(trial)
+    for reference, todo in pending.items():
+        announce(todo, where[reference], reference)
 
 
 def work(job: Job) -> list[EpisodeResult]:
-    """A job's episodes: the oracle's from the reference table (:func:`reference_work`), a
+    """A job's episodes: a privileged reference's from its table (:func:`reference_work`), a
     single seed through :func:`run_job`, several through :func:`run_batch`."""
     if job.references == "table" and grants_truth(job.controller):
         return reference_work(job)

@@ -1,11 +1,12 @@
-"""The one privileged channel: the true plant, for the built-in ``oracle`` reference only.
+"""The one privileged channel: the true plant, for the built-in references only.
 
 The evaluation loop gives every controller the observation, ``info`` and the controller
-context, nothing else.  The ``oracle`` reference (:mod:`shipgym_baselines.classical.oracle`) is the
-one exception: when, and only when, a run names the registered ``oracle`` itself (not an
-instance, a spec, a renamed long form or one with settings), the loop hands it the env's
+context, nothing else.  The references ``oracle`` and ``oracle_frozen``
+(:mod:`shipgym_baselines.classical.oracle`) are the one exception: when, and only when, a
+run names one of them itself (not an instance, a spec, a renamed long form or one with
+settings), the loop hands it the env's
 :meth:`~shipgym.envs.path_follow.ShipPathFollowEnv.plant_truth` through
-``reset_privileged``.  A plug-in cannot take the name (a registered name is never
+``reset_privileged``.  A plug-in cannot take the names (a registered name is never
 re-registered) and nothing of the truth reaches ``info`` or the context.
 """
 
@@ -15,28 +16,31 @@ from typing import Any
 
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.plugins import ControllerEntry, as_entry
+from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.registry import CONTROLLERS
 
-ORACLE = "oracle"
+#: the names that receive the truth
+PRIVILEGED_NAMES = (ORACLE, ORACLE_FROZEN)
 
 
 def grants_truth(controller: Any) -> bool:
-    """True only for the built-in oracle named as such (module doc)."""
+    """True only for a built-in reference named as such (module doc)."""
     if not isinstance(controller, str | ControllerEntry):
         return False
     entry = as_entry(controller)
-    if entry.controller != ORACLE or entry.settings or entry.name not in (None, ORACLE):
+    name = entry.controller
+    if name not in PRIVILEGED_NAMES or entry.settings or entry.name not in (None, name):
         return False
-    from shipgym_baselines.classical.oracle import Oracle
+    from shipgym_baselines.classical.oracle import PRIVILEGED
 
-    record = CONTROLLERS.get(ORACLE)
-    return record is not None and record.factory is Oracle
+    record = CONTROLLERS.get(name)
+    return record is not None and record.factory is PRIVILEGED[name]
 
 
 def reset_with_truth(policy: Any, context: Any, env: Any, seed: int | None) -> None:
-    """Start the oracle's episode with the env's truth (the caller checked the grant)."""
-    from shipgym_baselines.classical.oracle import Oracle
+    """Start a reference's episode with the env's truth (the caller checked the grant)."""
+    from shipgym_baselines.classical.oracle import PRIVILEGED
 
-    if type(policy) is not Oracle:
-        raise ControllerError(f"only the built-in oracle reads the true plant, not {policy!r}")
+    if type(policy) not in PRIVILEGED.values():
+        raise ControllerError(f"only the built-in references read the true plant, not {policy!r}")
     policy.reset_privileged(context, env.plant_truth, seed=seed)

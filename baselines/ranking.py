@@ -47,6 +47,8 @@ import numpy as np
 
 #: the reference of the cost ratio (its cost is the denominator)
 ORACLE = "oracle"
+#: the reference that never adapts (its truth frozen at the episode's start)
+ORACLE_FROZEN = "oracle_frozen"
 #: the controller of the probability of improvement
 BASELINE = "pid_los"
 #: the kind of the controllers shown on every scenario but never ranked

@@ -1,27 +1,31 @@
-"""Reference data: the ``oracle``'s episodes, computed once and shipped (as D4RL's scores).
+"""Reference data: the privileged references' episodes, computed once and shipped (as D4RL's
+scores).
 
-The oracle (:mod:`shipgym_baselines.classical.oracle`) is the denominator of the leaderboard's cost
-ratio on every scenario trial.  Its episodes are deterministic given the trial (the resolved
-scenario a suite's seed draws) and the env seed, so they are computed once per trial, frozen
-per env revision (:data:`shipgym.envs.core.ENV_REVISION`), oracle revision and settings, and
-shipped
-in ``baselines/reference_data/oracle.json.gz``:
+The ``oracle`` (:mod:`shipgym_baselines.classical.oracle`) is the denominator of the
+leaderboard's cost ratio on every scenario trial, and ``oracle_frozen`` (the same NMPC with its
+truth frozen at the episode's start) says what a controller that never adapts can reach.  Their
+episodes are deterministic given the trial (the resolved scenario a suite's seed draws) and the
+env seed, so they are computed once per trial, frozen per env revision
+(:data:`shipgym.envs.core.ENV_REVISION`), oracle revision and settings, and shipped, one table
+per reference, in ``baselines/reference_data/<reference>.json.gz``:
 
-    {"format": 1, "env_revision": R, "oracle": {settings}, "entries": {
+    {"format": 2, "env_revision": R, "reference": "oracle", "oracle": {settings},
+     "entries": {
         "<scenario content hash>:<seed>": {"scenario": name, "metrics": {...},
                                            "trace": {"t": [...], "x": [...], ...}}}}
 
 The content hash is the SHA-256 of the resolved scenario's settings as canonical JSON
 (:func:`scenario_key`), so an edited scenario never meets a stale entry.  ``trace`` holds
 the figure's columns (:data:`TRACE_KEYS`) thinned to at most :data:`TRACE_POINTS` points.
-The leaderboard reads an entry for each oracle episode and runs the oracle only for a trial
-missing from the table (``--recompute-references``: for every trial); ``shipgym references``
-fills the table (resumable: it writes after every episode).  A table of another env revision
-or other oracle settings is ignored as a whole (every trial is then computed).
+The leaderboard reads an entry for each reference episode and runs the reference only for a
+trial missing from its table (``--recompute-references``: for every trial); ``shipgym
+references`` fills the tables (resumable: it writes after every episode).  A table of another
+env revision, oracle revision or other oracle settings is ignored as a whole (every trial is
+then computed).
 
 A trial the shipped table lacks (an own scenario, a suite's extra seeds) is computed once per
 user: :class:`ReferenceCache` keeps its entry in a table of the same format at
-:func:`user_cache_path`, ``references/oracle.json.gz`` in the per-user cache folder
+:func:`user_cache_path`, ``references/<reference>.json.gz`` in the per-user cache folder
 (:func:`shipgym.codegen.user_cache_dir`: ``$SHIPGYM_CACHE_DIR``, else
 ``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``).  Lookups go shipped table → user
 cache → compute and store.  Several processes may store at once: each store re-reads the
@@ -52,13 +56,17 @@ from shipgym.envs.core import ENV_REVISION
 from shipgym.notices import duration, notice
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.runs import _number, _plain
 
 if TYPE_CHECKING:
     from shipgym_baselines.evaluation import EpisodeResult
 
+#: the references with a table, in the order they are computed
+REFERENCES = (ORACLE, ORACLE_FROZEN)
+#: the oracle's table file (each reference's: :func:`table_file`)
 TABLE_FILE = "oracle.json.gz"
-FORMAT = 1
+FORMAT = 2
 #: the columns of a reference episode's trajectory kept in the table (the figures' traces)
 TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
 #: at most this many points per trace (evenly thinned, the last kept)
@@ -67,9 +75,16 @@ TRACE_POINTS = 200
 TRACE_DIGITS = 6
 
 
-def table_path() -> Path:
-    """The shipped table's path (inside the installed package)."""
-    return Path(__file__).parent / "reference_data" / TABLE_FILE
+def table_file(reference: str = ORACLE) -> str:
+    """The file name of ``reference``'s table: ``<reference>.json.gz``."""
+    if reference not in REFERENCES:
+        raise ValueError(f"no reference table for {reference!r}: one of {REFERENCES}")
+    return f"{reference}.json.gz"
+
+
+def table_path(reference: str = ORACLE) -> Path:
+    """The shipped table's path of ``reference`` (inside the installed package)."""
+    return Path(__file__).parent / "reference_data" / table_file(reference)
 
 
 def scenario_key(scenario: Scenario) -> str:
@@ -83,13 +98,15 @@ def entry_key(scenario: Scenario, seed: int) -> str:
     return f"{scenario_key(scenario)}:{int(seed)}"
 
 
-def oracle_header() -> dict[str, Any]:
-    """The header a table must carry to be valid now (env revision, oracle settings)."""
+def oracle_header(reference: str = ORACLE) -> dict[str, Any]:
+    """The header ``reference``'s table must carry to be valid now (format, env revision,
+    the reference, oracle revision and settings)."""
     from shipgym_baselines.classical.oracle import ORACLE_REVISION, OracleSettings
 
     return {
         "format": FORMAT,
         "env_revision": ENV_REVISION,
+        "reference": reference,
         "oracle": {"revision": ORACLE_REVISION, **dataclasses.asdict(OracleSettings())},
     }
 
@@ -107,37 +124,39 @@ def thin_trace(trajectory: Mapping[str, np.ndarray]) -> dict[str, list[float]]:
 
 @dataclasses.dataclass
 class ReferenceTable:
-    """The oracle's reference episodes (module doc), by :func:`entry_key`."""
+    """A reference's episodes (module doc), by :func:`entry_key`."""
 
     entries: dict[str, dict[str, Any]]
     path: Path | None = None
+    reference: str = ORACLE
 
     @classmethod
-    def load(cls, path: str | os.PathLike | None = None) -> ReferenceTable:
-        """The table at ``path`` (default: the shipped one); empty if there is none, or if
-        it was computed for another env revision or other oracle settings."""
-        file = Path(path) if path is not None else table_path()
+    def load(cls, path: str | os.PathLike | None = None, reference: str = ORACLE) -> ReferenceTable:
+        """``reference``'s table at ``path`` (default: the shipped one); empty if there is
+        none, or if it was computed for another reference, env revision, oracle revision
+        or other oracle settings."""
+        file = Path(path) if path is not None else table_path(reference)
         if not file.is_file():
-            return cls({}, file)
+            return cls({}, file, reference)
         with gzip.open(file, "rt", encoding="utf-8") as f:
             data = json.load(f)
-        header = {k: data.get(k) for k in ("format", "env_revision", "oracle")}
-        if header != oracle_header():
-            return cls({}, file)
-        return cls(dict(data.get("entries", {})), file)
+        wanted = oracle_header(reference)
+        if {k: data.get(k) for k in wanted} != wanted:
+            return cls({}, file, reference)
+        return cls(dict(data.get("entries", {})), file, reference)
 
     def lookup(self, scenario: Scenario, seed: int) -> dict[str, Any] | None:
         return self.entries.get(entry_key(scenario, seed))
 
     def add(self, scenario: Scenario, result: EpisodeResult) -> None:
-        """Record the oracle's episode ``result`` of ``scenario`` (a trial)."""
+        """Record the reference's episode ``result`` of ``scenario`` (a trial)."""
         self.entries[entry_key(scenario, result.seed)] = table_entry(result)
 
     def save(self, path: str | os.PathLike | None = None) -> Path:
         """Write the table atomically (sorted keys: the same entries give the same bytes)."""
-        file = Path(path) if path is not None else (self.path or table_path())
+        file = Path(path) if path is not None else (self.path or table_path(self.reference))
         file.parent.mkdir(parents=True, exist_ok=True)
-        data = {**oracle_header(), "entries": dict(sorted(self.entries.items()))}
+        data = {**oracle_header(self.reference), "entries": dict(sorted(self.entries.items()))}
         staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
         # no file name or time in the gzip header: the same entries give the same bytes
         with (
@@ -150,7 +169,7 @@ class ReferenceTable:
 
 
 def table_entry(result: EpisodeResult) -> dict[str, Any]:
-    """The table's entry of the oracle's episode ``result``."""
+    """The table's entry of a reference's episode ``result``."""
     return {
         "scenario": result.scenario,
         "metrics": _plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
@@ -158,19 +177,21 @@ def table_entry(result: EpisodeResult) -> dict[str, Any]:
     }
 
 
-@functools.lru_cache(maxsize=1)
-def shipped_table() -> ReferenceTable:
-    """The shipped table, loaded once per process."""
-    return ReferenceTable.load()
+@functools.lru_cache(maxsize=len(REFERENCES))
+def shipped_table(reference: str = ORACLE) -> ReferenceTable:
+    """``reference``'s shipped table, loaded once per process."""
+    return ReferenceTable.load(reference=reference)
 
 
-def result_from_entry(entry: Mapping[str, Any], scenario: str, seed: int) -> EpisodeResult:
-    """The oracle's :class:`EpisodeResult` of a table entry (its trajectory: the trace)."""
+def result_from_entry(
+    entry: Mapping[str, Any], scenario: str, seed: int, reference: str = ORACLE
+) -> EpisodeResult:
+    """``reference``'s :class:`EpisodeResult` of a table entry (its trajectory: the trace)."""
     from shipgym_baselines.evaluation import EpisodeResult
 
     metrics = {k: _number(v) for k, v in entry["metrics"].items()}
     return EpisodeResult(
-        controller="oracle",
+        controller=reference,
         kind="reference",
         scenario=scenario,
         seed=int(seed),
@@ -190,9 +211,9 @@ def missing_trials(
 # --- the per-user cache ----------------------------------------------------------------------
 
 
-def user_cache_path() -> Path:
-    """The per-user cache of computed references (module doc)."""
-    return user_cache_dir() / "references" / TABLE_FILE
+def user_cache_path(reference: str = ORACLE) -> Path:
+    """The per-user cache of ``reference``'s computed episodes (module doc)."""
+    return user_cache_dir() / "references" / table_file(reference)
 
 
 @contextlib.contextmanager
@@ -208,13 +229,14 @@ def _locked(file: Path) -> Iterator[None]:
 
 
 class ReferenceCache:
-    """The per-user cache (module doc): a :class:`ReferenceTable` file, re-read when another
-    process replaced it, stored to under a lock.  ``path``: its file (default:
-    :func:`user_cache_path`)."""
+    """The per-user cache (module doc) of ``reference``'s episodes: a
+    :class:`ReferenceTable` file, re-read when another process replaced it, stored to under
+    a lock.  ``path``: its file (default: :func:`user_cache_path`)."""
 
-    def __init__(self, path: str | os.PathLike | None = None) -> None:
-        self.path = Path(path) if path is not None else user_cache_path()
-        self._table = ReferenceTable({}, self.path)
+    def __init__(self, path: str | os.PathLike | None = None, reference: str = ORACLE) -> None:
+        self.reference = reference
+        self.path = Path(path) if path is not None else user_cache_path(reference)
+        self._table = ReferenceTable({}, self.path, reference)
         self._stamp: tuple[int, int, int] | None = None
 
     def _load(self) -> ReferenceTable:
@@ -222,12 +244,12 @@ class ReferenceCache:
         try:
             stat = self.path.stat()
         except FileNotFoundError:
-            self._table, self._stamp = ReferenceTable({}, self.path), None
+            self._table, self._stamp = ReferenceTable({}, self.path, self.reference), None
             return self._table
         stamp = (stat.st_ino, stat.st_mtime_ns, stat.st_size)
         if stamp != self._stamp:
             try:
-                self._table = ReferenceTable.load(self.path)
+                self._table = ReferenceTable.load(self.path, self.reference)
             except (OSError, EOFError, ValueError) as exc:
                 raise RunError(
                     f"the reference cache {self.path} is unreadable ({exc}): delete it "
@@ -240,7 +262,7 @@ class ReferenceCache:
         return self._load().lookup(scenario, seed)
 
     def store(self, scenario: Scenario, result: EpisodeResult) -> dict[str, Any]:
-        """Add the oracle's episode ``result`` of ``scenario``: re-read, merge and replace
+        """Add the reference's episode ``result`` of ``scenario``: re-read, merge and replace
         the file under its lock (entries stored meanwhile by other processes are kept; a
         file of another revision is replaced).  Returns the entry."""
         entry = table_entry(result)
@@ -255,10 +277,13 @@ class ReferenceCache:
 
 
 def lookup(
-    scenario: Scenario, seed: int, cache: ReferenceCache | None = None
+    scenario: Scenario, seed: int, cache: ReferenceCache | None = None, reference: str = ORACLE
 ) -> dict[str, Any] | None:
-    """The trial's entry: the shipped table's, else the user cache's (None: neither)."""
-    entry = shipped_table().lookup(scenario, seed)
+    """``reference``'s entry of the trial: the shipped table's, else the user cache's (None:
+    neither); ``cache`` holds the same reference's episodes."""
+    if cache is not None and cache.reference != reference:
+        raise ValueError(f"a cache of {cache.reference} looked up for {reference}")
+    entry = shipped_table(reference).lookup(scenario, seed)
     if entry is None and cache is not None:
         entry = cache.lookup(scenario, seed)
     return entry
@@ -290,13 +315,13 @@ def estimate_cpu_s(trials: Iterable[Scenario]) -> float:
     return total
 
 
-def announce(trials: Sequence[Scenario], where: str) -> None:
-    """One line on stderr before the oracle runs on ``trials``: how many, the estimated CPU
-    time, ``where`` the results go."""
+def announce(trials: Sequence[Scenario], where: str, reference: str = ORACLE) -> None:
+    """One line on stderr before ``reference`` runs on ``trials``: how many, the estimated
+    CPU time, ``where`` the results go."""
     if not trials:
         return
     n = len(trials)
     notice(
-        f"shipgym: computing {n} oracle reference{'s' if n != 1 else ''} "
+        f"shipgym: computing {n} {reference} reference{'s' if n != 1 else ''} "
         f"(≈ {duration(estimate_cpu_s(trials))} CPU; {where})"
     )

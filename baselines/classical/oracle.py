@@ -1,15 +1,27 @@
-"""``oracle``: the privileged reference — NMPC on the true plant (issue 17).
+"""``oracle`` and ``oracle_frozen``: the privileged references — NMPC on the true plant.
 
-What is achievable on a scenario when the plant is known.  At every control step the oracle
-reads, through the evaluation loop's privileged channel (:mod:`shipgym_baselines.privileged`; no
-other controller can reach it), the true state, the true parameters acting now (after every
-jump so far, never the future schedule) and the disturbance forecast of
-:class:`shipgym.envs.truth.PlantTruth` (the deterministic current ahead, the present
-stochastic deviation held).  It is a reference (``kind = "reference"``): shown on every
-scenario, never ranked; its costs are the denominator of the leaderboard's cost ratio.
+What is achievable on a scenario when the plant is known, and when it is known only as it
+was at the start.  At every control step the references read, through the evaluation
+loop's privileged channel (:mod:`shipgym_baselines.privileged`; no other controller can
+reach it), the true plant now (:class:`shipgym.envs.truth.PlantTruth`).  It is causal: the
+true state, the true parameters acting now (after every jump so far) and the disturbances
+acting now, never a scheduled event or the current ahead.
+
+* ``oracle`` (revision 4) predicts with the parameters and disturbances acting now, held
+  over the horizon: the best a controller that knows the change as it happens can do.
+  Revision 3 read the scheduled current ahead, which no controller can know (on the
+  current shifts that lowered its cost by up to 1.6×).
+* ``oracle_frozen`` predicts with the parameters and disturbances of the episode's start
+  (t = 0), held for the whole episode, from the true state at every step: the best a
+  controller that never adapts can do on the env's own cost.
+
+Both are references (``kind = "reference"``): shown on every scenario, never ranked; the
+oracle's costs are the denominator of the leaderboard's cost ratio, and the frozen one's
+over the oracle's is what knowing the change is worth on a trial (its headroom).
 
 **Model.**  The env's own model: the ship's one right-hand side (:meth:`ShipModel.rhs`, its
-CasADi form) with the true parameter vector and the disturbance inputs, integrated by RK4
+CasADi form) with the parameter vector and disturbances named above (held over the
+horizon), integrated by RK4
 at the prediction step h_p (below), rudder servo, rate and angle limits included.
 
 **Objective.**  The env's own stage cost (:func:`shipgym.envs.core.step_reward`), summed
@@ -29,7 +41,10 @@ The goal bonus is not in the objective (it is not in the cost either).
 the horizon's end held for the control steps still to go after it:
 N_tail = max(0, S/(U·Ts) − N_H), S the path left to the goal from the ship's present
 point on the route [m] (the rest of the active leg and the legs after it, or the arc
-length left on a PCHIP route), U the cruise speed, N_H the horizon's steps.  Reason
+length left on a PCHIP route), N_H the horizon's steps and U the ship's true speed over
+ground now, at least half the cruise speed (revision 4, ``tail_speed = "measured"``: a
+ship that is slow has more steps still to go; revisions 1–3 took the cruise speed,
+``tail_speed = "cruise"``).  Reason
 (measured, revision 1 missed the goal on 58 of 472 reference trials): the env's cost has
 no price on time, so a ship that turns the wrong way onto a leg and runs along it with
 e = 0, |ψ̃| = π pays only w_ψ·π ≈ 0.31 a step, which within one horizon is cheaper than the
@@ -124,7 +139,9 @@ from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
-ORACLE_REVISION = 3
+ORACLE_REVISION = 4
+#: the tail's speed rules (module doc, "Tail")
+TAIL_SPEEDS = ("measured", "cruise")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -142,6 +159,7 @@ class OracleSettings:
     max_iter: int = 10  # generalised Gauss–Newton iterations per control step
     step_tolerance: float = 1e-4  # rad: stop when the accepted step is smaller
     cost_tolerance: float = 1e-3  # stop when an iteration lowers the cost by less (relative)
+    tail_speed: str = "measured"  # U of the tail: the true speed now ("cruise": revisions 1–3)
     compile: bool = True  # compile z and its Jacobian to C (cached); VM otherwise
 
 
@@ -651,7 +669,7 @@ def tail_steps(
     remaining_m: float, speed: float, control_period: float, horizon_steps: int
 ) -> float:
     """The control steps still to go after the horizon [-]: the time to cover the remaining
-    path [m] at cruise speed U [m/s], less the horizon's steps, at least 0."""
+    path [m] at speed U [m/s] (:func:`tail_speed`), less the horizon's steps, at least 0."""
     return max(0.0, remaining_m / (speed * control_period) - horizon_steps)
 
 
@@ -665,22 +683,47 @@ def shifted_plan(plan: np.ndarray, lengths: tuple[int, ...]) -> np.ndarray:
     return np.add.reduceat(shifted, edges[:-1]) / np.asarray(lengths, dtype=float)
 
 
+def speed_over_ground(model: ShipModel, truth: PlantTruth, command: float) -> float:
+    """The true speed over ground now [m/s]: |(ẋ, ẏ)| of the model's right-hand side at
+    the true state, parameters and disturbances, with the rudder command ``command`` [rad]."""
+    xdot = np.asarray(
+        model.casadi_rhs(truth.state, command, truth.disturbance_now, truth.params.to_vector())
+    ).ravel()
+    return float(np.hypot(xdot[model.state_index("x")], xdot[model.state_index("y")]))
+
+
+def tail_speed(
+    settings: OracleSettings, model: ShipModel, truth: PlantTruth, command: float, cruise: float
+) -> float:
+    """U of the tail [m/s] (module doc): the true speed over ground now, at least half the
+    cruise speed ``cruise`` (``tail_speed = "measured"``), or the cruise speed itself."""
+    if settings.tail_speed == "cruise":
+        return cruise
+    return max(0.5 * cruise, speed_over_ground(model, truth, command))
+
+
 @register_controller("oracle")
 class Oracle:
-    """``oracle``: NMPC on the true plant through the privileged channel (module doc)."""
+    """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
 
     name: ClassVar[str]  # set by the registration
     kind: ClassVar[str] = "reference"
+    #: predict with the truth of the episode's start (``oracle_frozen``) instead of now
+    frozen: ClassVar[bool] = False
 
     def __init__(self, settings: OracleSettings | None = None) -> None:
         self.settings = settings if settings is not None else OracleSettings()
+        if self.settings.tail_speed not in TAIL_SPEEDS:
+            raise ValueError(
+                f"tail_speed must be one of {TAIL_SPEEDS}, got {self.settings.tail_speed!r}"
+            )
         self._truth = None
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         raise ControllerError(
-            "oracle reads the true plant through the evaluation loop's privileged channel, "
-            "which only the built-in oracle run by its name 'oracle' receives; it cannot run "
-            "as an instance, a spec or under another name"
+            f"{self.name} reads the true plant through the evaluation loop's privileged "
+            f"channel, which only the built-in references run by their own names receive; it "
+            "cannot run as an instance, a spec or under another name"
         )
 
     def reset_privileged(
@@ -689,6 +732,7 @@ class Oracle:
         """Start an episode; ``truth()`` returns the :class:`PlantTruth` now."""
         self.ctx = context
         self._truth = truth
+        self._start: PlantTruth | None = None  # the truth at the episode's first step
         reward = context.reward
         self.weights = (reward.heading_weight, reward.rudder_weight, reward.rudder_rate_weight)
         self.solver = get_solver(context, self.settings, self.weights)
@@ -700,37 +744,45 @@ class Oracle:
         self.solve_times: list[float] = []  # wall clock [s]
         self.solve_cpu_times: list[float] = []  # this thread's CPU time [s]
 
+    def predicted_plant(self, truth: PlantTruth) -> PlantTruth:
+        """The truth the prediction uses: the plant now (``oracle``), or its parameters and
+        disturbances as at the episode's start with the true state now
+        (``oracle_frozen``)."""
+        if self._start is None:
+            self._start = truth
+        if not self.frozen:
+            return truth
+        return dataclasses.replace(
+            truth, params=self._start.params, disturbance_now=self._start.disturbance_now
+        )
+
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         if self._truth is None:
-            raise ControllerError("oracle: reset_privileged() first (the privileged channel)")
-        truth: PlantTruth = self._truth()
+            raise ControllerError(f"{self.name}: reset_privileged() first (the privileged channel)")
+        plant = self.predicted_plant(self._truth())
         ctx, grid = self.ctx, self.solver.grid
         model = ctx.nominal_model
-        px = float(truth.state[model.state_index("x")])
-        py = float(truth.state[model.state_index("y")])
+        px = float(plant.state[model.state_index("x")])
+        py = float(plant.state[model.state_index("y")])
         frame = self.tracker.update(px, py) if self._started else self.tracker.reset(px, py)
         self._started = True
         legs, radius = legs_ahead(
             ctx, self.tracker, frame, grid.horizon_s * ctx.nominal_speed, self.settings.legs
         )
-        starts = np.cumsum([0, *grid.lengths[:-1]]) * ctx.control_period
-        mids = truth.t + starts + 0.5 * np.array(grid.lengths) * ctx.control_period
         p = self.solver.parameters(
-            truth.state,
+            plant.state,
             self.command,
             radius,
             ctx.switching == "circle" and not self.tracker.is_curve,
             legs,
-            truth.params.to_vector(),
-            truth.disturbance_forecast(mids),
+            plant.params.to_vector(),
+            np.tile(plant.disturbance_now, (self.solver.n_u, 1)),  # held over the horizon
         )
         guess = shifted_plan(self.plan, grid.lengths)
         start, cpu = time.perf_counter(), time.thread_time()
+        speed = tail_speed(self.settings, model, plant, self.command, ctx.nominal_speed)
         tail = tail_steps(
-            remaining_path(ctx, self.tracker, frame),
-            ctx.nominal_speed,
-            ctx.control_period,
-            grid.steps,
+            remaining_path(ctx, self.tracker, frame), speed, ctx.control_period, grid.steps
         )
         plan, ok, _ = self.solver.solve_multistart(p, guess, tail)
         self.solve_times.append(time.perf_counter() - start)
@@ -750,3 +802,15 @@ class Oracle:
             "solve_ms_median": 1e3 * float(np.median(times)),
             "solve_ms_p99": 1e3 * float(np.percentile(times, 99)),
         }
+
+
+@register_controller("oracle_frozen")
+class OracleFrozen(Oracle):
+    """``oracle_frozen``: the oracle with its truth frozen at the episode's start (module
+    doc): the optimum of a controller that never adapts."""
+
+    frozen: ClassVar[bool] = True
+
+
+#: the built-in references that read the true plant, by name
+PRIVILEGED: dict[str, type[Oracle]] = {"oracle": Oracle, "oracle_frozen": OracleFrozen}

@@ -449,8 +449,8 @@ class ShipPathFollowEnv(gym.Env):
 
     def plant_truth(self) -> PlantTruth:
         """The true plant now (:mod:`shipgym.envs.truth`): privileged.  Never in ``info`` or
-        the controller context; the evaluation loop passes it to the built-in ``oracle``
-        reference only."""
+        the controller context; the evaluation loop passes it to the built-in references
+        ``oracle`` and ``oracle_frozen`` only."""
         if self._state is None:
             raise RuntimeError("call reset() before plant_truth()")
         sc = self.scenario
@@ -463,7 +463,6 @@ class ShipPathFollowEnv(gym.Env):
             state=self._state.copy(),
             params=sc.schedule.record_at(self._t),
             disturbance_now=now,
-            mean_disturbance=self._disturbances.mean_rows,
         )
 
     @property

@@ -1,4 +1,5 @@
-"""The privileged ``oracle`` reference: its optimiser, its channel, its reference table."""
+"""The privileged references ``oracle`` and ``oracle_frozen``: their optimiser, their channel,
+their reference tables."""
 
 from __future__ import annotations
 
@@ -14,10 +15,12 @@ import numpy as np
 import pytest
 
 from shipgym.envs.context import ControllerContext
+from shipgym.envs.truth import PlantTruth
 from shipgym.scenarios import load_scenario
 from shipgym_baselines.classical.oracle import (
     LAST_LEG,
     Oracle,
+    OracleFrozen,
     OracleSettings,
     OracleSolver,
     block_lengths,
@@ -26,6 +29,8 @@ from shipgym_baselines.classical.oracle import (
     oracle_grid,
     remaining_path,
     shifted_plan,
+    speed_over_ground,
+    tail_speed,
     tail_steps,
 )
 from shipgym_baselines.errors import ControllerError
@@ -191,6 +196,83 @@ def test_the_tail_counts_the_steps_still_to_go_after_the_horizon() -> None:
     assert remaining_path(ctx, tracker, frame) == pytest.approx(total - 3.0)
 
 
+def test_the_tail_speed_is_the_true_speed_over_ground_now() -> None:
+    """``measured``: |(ẋ, ẏ)| at the true state, parameters and disturbances (at cruise in
+    calm water the cruise speed; a following current of 0.3 m/s adds to it), at least half
+    the cruise speed; ``cruise``: the cruise speed (revisions 1–3)."""
+    sc = load_scenario("blanke_nominal")
+    model = sc.model
+    u0 = ControllerContext.of(sc, "rudder").nominal_speed
+    calm = np.zeros(model.n_disturbances)
+    truth = PlantTruth(0.0, model.cruise_state(), sc.nominal_params, calm)
+    assert speed_over_ground(model, truth, 0.0) == pytest.approx(u0, rel=1e-9)
+    current = calm.copy()
+    current[model.disturbance_names.index("current_x")] = 0.3  # along the heading ψ = 0
+    carried = dataclasses.replace(truth, disturbance_now=current)
+    assert speed_over_ground(model, carried, 0.0) == pytest.approx(u0 + 0.3, rel=1e-9)
+    measured, cruise = OracleSettings(), OracleSettings(tail_speed="cruise")
+    assert tail_speed(measured, model, carried, 0.0, u0) == pytest.approx(u0 + 0.3, rel=1e-9)
+    assert tail_speed(cruise, model, carried, 0.0, u0) == u0
+    stopped = dataclasses.replace(truth, state=np.zeros(model.n_states))
+    assert tail_speed(measured, model, stopped, 0.0, u0) == 0.5 * u0
+    with pytest.raises(ValueError, match="tail_speed must be one of"):
+        Oracle(OracleSettings(tail_speed="predicted"))
+
+
+#: the oracle of revision 3 (main a27de38), cost on catalogue trials without a current, seed 0
+REVISION_3_COSTS = {"maneuverability_change": 36.49362870705069, "rudder_aging": 22.295715849395073}
+
+
+@pytest.mark.parametrize("scenario", sorted(REVISION_3_COSTS))
+def test_the_causal_oracle_equals_revision_3_without_a_current(scenario: str) -> None:
+    """Revision 4 differs from 3 in two things: the disturbances held over the horizon
+    instead of the scheduled current ahead (the same on a trial without a current) and the
+    tail's speed (``tail_speed = "cruise"`` is revision 3's).  With revision 3's tail it
+    reproduces revision 3's cost to 1e-9."""
+    sc = load_scenario(scenario)
+    settings = OracleSettings(tail_speed="cruise")
+    result = run_episode(Oracle(settings), sc, seed=0, privileged=True)
+    assert result.metrics["cost"] == pytest.approx(REVISION_3_COSTS[scenario], rel=1e-9)
+
+
+def test_the_frozen_oracle_equals_the_oracle_without_a_change_or_a_current() -> None:
+    """On a trial whose plant never changes (no event, no current) freezing the truth at
+    t = 0 changes nothing: the same cost to 1e-9.  After nomoto2's manoeuvrability jump the
+    frozen oracle predicts with the old ship and spins the yaw-unstable new one: more than
+    ten times the oracle's cost (what knowing the change is worth there)."""
+    (oracle,) = evaluate("oracle", "nominal", seeds=[0])
+    (frozen,) = evaluate("oracle_frozen", "nominal", seeds=[0])
+    assert frozen.controller == "oracle_frozen" and frozen.kind == "reference"
+    assert frozen.metrics["cost"] == pytest.approx(oracle.metrics["cost"], rel=1e-9, abs=1e-9)
+    (oracle,) = evaluate("oracle", "maneuverability_change", seeds=[0])
+    (frozen,) = evaluate("oracle_frozen", "maneuverability_change", seeds=[0])
+    assert frozen.metrics["cost"] > 10.0 * oracle.metrics["cost"]
+
+
+def test_the_frozen_oracle_predicts_with_the_start_and_the_true_state_now() -> None:
+    """``predicted_plant``: the parameters and disturbances of the first truth it saw, the
+    state of the truth now; the oracle predicts with the truth now."""
+    sc = load_scenario("maneuverability_change")
+    (event,) = sc.config.events
+    model = sc.model
+    start = PlantTruth(0.0, model.cruise_state(), sc.nominal_params, np.zeros(model.n_disturbances))
+    later_state = model.cruise_state() + 1.0
+    later = PlantTruth(
+        event.time + 1.0,
+        later_state,
+        sc.schedule.record_at(event.time + 1.0),
+        np.ones(model.n_disturbances),
+    )
+    frozen, oracle = OracleFrozen(), Oracle()
+    frozen._start = oracle._start = None
+    for policy in (frozen, oracle):
+        policy.predicted_plant(start)
+    seen = frozen.predicted_plant(later)
+    assert seen.params == sc.nominal_params and not np.any(seen.disturbance_now)
+    assert np.array_equal(seen.state, later_state) and seen.t == later.t
+    assert oracle.predicted_plant(later) is later
+
+
 def _default_trial(scenario: str, seed: int, suite: str = "default") -> Any:
     spec = load_suite(suite)
     (trial,) = trials(
@@ -290,15 +372,22 @@ def test_the_privileged_channel_is_unreachable_from_a_plugin(spy_module: Path) -
         f"{spy_module}:Imitator",
         f"{spy_module}:borrowed",
         "shipgym_baselines.classical.oracle:Oracle",
+        "shipgym_baselines.classical.oracle:OracleFrozen",
         ControllerEntry(controller="oracle", name="my_oracle"),
+        ControllerEntry(controller="oracle_frozen", name="my_frozen"),
         ControllerEntry(controller="oracle", settings={"settings": OracleSettings(blocks=5)}),
+        ControllerEntry(controller="oracle_frozen", settings={"settings": OracleSettings()}),
     ):
         assert not grants_truth(spec)
         with pytest.raises(ControllerError, match="privileged channel"):
             evaluate(spec, "nominal", seeds=[0])
-    with pytest.raises(ControllerError, match="privileged channel"):
-        run_episode(Oracle(), "nominal", seed=0)  # an instance: no truth either
-    assert grants_truth("oracle")
+    for instance in (Oracle(), OracleFrozen()):
+        with pytest.raises(ControllerError, match="privileged channel"):
+            run_episode(instance, "nominal", seed=0)  # an instance: no truth either
+    # exactly these two names of the registry receive the truth
+    from shipgym_baselines.registry import CONTROLLERS
+
+    assert [name for name in CONTROLLERS if grants_truth(name)] == ["oracle", "oracle_frozen"]
 
 
 def test_the_truth_reaches_neither_info_nor_the_context() -> None:
@@ -405,3 +494,49 @@ def test_shipgym_references_fills_a_table_and_resumes(
     assert (again["computed"], again["held"]) == (0, 1) and "computing" not in err
     (entry,) = ReferenceTable.load(table).entries.values()
     assert entry["metrics"]["termination_reason"] == "goal" and entry["metrics"]["cost"] > 0
+
+
+def test_each_reference_has_its_own_table_and_ignores_the_others(tmp_path: Path) -> None:
+    """``<reference>.json.gz``, shipped and cached; a table of the oracle read as the frozen
+    oracle's (or the reverse) is empty: the header names its reference."""
+    from shipgym_baselines.references import user_cache_path
+
+    assert table_path("oracle_frozen").name == "oracle_frozen.json.gz"
+    assert user_cache_path("oracle_frozen").name == "oracle_frozen.json.gz"
+    sc = load_scenario("nominal")
+    file = tmp_path / "t.json.gz"
+    ReferenceTable({entry_key(sc, 1): {"metrics": {"cost": 1.0}}}, file, "oracle_frozen").save()
+    assert ReferenceTable.load(file, "oracle_frozen").lookup(sc, 1) is not None
+    assert ReferenceTable.load(file).lookup(sc, 1) is None
+    with pytest.raises(ValueError, match="no reference table for 'pid_los'"):
+        table_path("pid_los")
+
+
+def test_shipgym_references_fills_one_table_per_reference(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--table`` names one file: with two references it is refused before any work; with
+    ``--reference oracle_frozen`` it fills the frozen oracle's table."""
+    import json
+
+    import yaml
+
+    from shipgym_baselines.cli import main
+
+    suite = tmp_path / "tiny.yaml"
+    suite.write_text(
+        yaml.safe_dump(
+            {"name": "tiny", "scenarios": ["nominal"], "controllers": ["oracle"], "seeds": 1}
+        )
+    )
+    table = tmp_path / "frozen.json.gz"
+    args = ["references", "--suite", str(suite), "--table", str(table), "--workers", "1"]
+    assert main([*args, "--reference", "oracle", "oracle_frozen"]) == 2
+    assert "--table names one file" in capsys.readouterr().err and not table.exists()
+    assert main([*args, "--reference", "oracle_frozen", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["tables"] == {"oracle_frozen": str(table)} and summary["computed"] == 1
+    (entry,) = ReferenceTable.load(table, "oracle_frozen").entries.values()
+    assert ReferenceTable.load(table).entries == {}
+    (oracle,) = evaluate("oracle", "nominal", seeds=[10_000])
+    assert entry["metrics"]["cost"] == pytest.approx(oracle.metrics["cost"], rel=1e-9)

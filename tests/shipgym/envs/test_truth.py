@@ -33,20 +33,25 @@ def test_the_truth_carries_the_parameters_acting_now_never_the_schedule() -> Non
     assert not np.array_equal(after.state, env.unwrapped._state)
 
 
-def test_the_disturbance_forecast_knows_the_scheduled_current_switch() -> None:
-    """A two-phase current (calm, then 0.5 m/s from 150 s, no fluctuation): the forecast is
-    the mean current at each future time, the mean rows equal the constant row before the
-    switch, and the second speed after it."""
+def test_the_truth_is_causal_it_holds_the_current_now_never_the_switch_ahead() -> None:
+    """A two-phase current (calm, then 0.5 m/s from 150 s, no fluctuation): before the
+    switch the truth's disturbance is the calm row and it carries nothing of the switch
+    ahead (its fields are the plant now); after it, the 0.5 m/s current."""
+    import dataclasses
+
     env = gym.make("ShipPathFollow-v0", scenario="blanke_current_shift")
     env.reset(seed=0)
     dist = env.unwrapped._disturbances
     truth = env.unwrapped.plant_truth()
-    times = np.array([0.0, 149.0, 151.0, 400.0])
-    forecast = truth.disturbance_forecast(times)
-    assert np.allclose(forecast[:2], dist.constant_row())
-    speed = np.hypot(forecast[:, 0], forecast[:, 1])
-    assert speed[2:] == pytest.approx([0.5, 0.5])
+    assert [f.name for f in dataclasses.fields(truth)] == [
+        "t",
+        "state",
+        "params",
+        "disturbance_now",
+    ]
+    assert np.allclose(truth.disturbance_now, dist.constant_row())
+    _run_to(env, 149.0)
+    assert np.hypot(*env.unwrapped.plant_truth().disturbance_now[:2]) == pytest.approx(0.0)
     _run_to(env, 200.0)
     late = env.unwrapped.plant_truth()
     assert np.hypot(*late.disturbance_now[:2]) == pytest.approx(0.5)
-    assert np.allclose(late.disturbance_forecast(np.array([300.0])), late.disturbance_now)
