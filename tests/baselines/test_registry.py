@@ -41,9 +41,10 @@ BUILTINS = {
     "zero_rudder": ("rudder", None),
     "random": ("rudder", None),
     "oracle": ("rudder", None),
+    "oracle_frozen": ("rudder", None),
 }
 #: the references: shown on every scenario, never ranked
-REFERENCES = {"zero_rudder", "random", "oracle"}
+REFERENCES = {"zero_rudder", "random", "oracle", "oracle_frozen"}
 
 
 def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:

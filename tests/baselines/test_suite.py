@@ -26,7 +26,14 @@ def test_packaged_suites_load() -> None:
         name="smoke",
         scenarios=["rudder_aging", "mariner_track"],
         heldout_scenarios=1,
-        controllers=["nmpc_lambda_lssvm", "pid_los", "ppo", "oracle", "zero_rudder"],
+        controllers=[
+            "nmpc_lambda_lssvm",
+            "pid_los",
+            "ppo",
+            "oracle",
+            "oracle_frozen",
+            "zero_rudder",
+        ],
         seeds=2,
         randomize=smoke.randomize,
     )

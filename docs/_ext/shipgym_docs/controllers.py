@@ -221,7 +221,7 @@ def page(record: ControllerRecord) -> str:
         ("source", SOURCES.get(module, "—")),
         ("defined in", f"`{module}.{factory.__qualname__}`"),
     ]
-    if record.name == "oracle":
+    if record.name in ("oracle", "oracle_frozen"):
         rows[2] = ("reads", READS["rudder"] + "; and the plant's truth (privileged channel)")
     parts = [
         f"# {record.name}\n",

@@ -458,15 +458,21 @@ def test_unrecorded_settings_are_scored_on_the_same_trials(tiny: Path, tmp_path:
 
 def test_the_packaged_records_reproduce_their_ratios() -> None:
     """A packaged chosen section's recorded validation ratios are what its settings score
-    now (pid_los on nomoto2; the denominators from its report's oracle costs)."""
-    from shipgym_baselines.tuning.promotion import incumbent_settings, recorded_ratios
+    now (pid_los on nomoto2; the denominators from its report's oracle costs, of the oracle
+    revision the record names).  A record of another oracle revision is not used for a
+    promotion (the incumbent is scored again)."""
+    from shipgym_baselines.tuning.promotion import incumbent_settings, recorded_ratios, revisions
 
     settings, summary = chosen.section_record("pid_los", "nomoto2")
     config = load_tuning("pid_los")
     v = config.validation
     trials = validation_trials(v.distribution, "nomoto2", v.per_ship, config.ships)
-    recorded = recorded_ratios(summary, trials)
-    assert recorded is not None and geometric_mean(recorded) == pytest.approx(summary["value"])
+    record = summary["validation"]
+    recorded = [float(r) for r in record["ratios"]]
+    assert geometric_mean(recorded) == pytest.approx(summary["value"])
+    assert record["trials"] == [t.name for t in trials]
+    current = all(record.get(k) == value for k, value in revisions().items())
+    assert (recorded_ratios(summary, trials) is not None) == current
     report = json.loads((Path(__file__).parents[3] / summary["report"]).read_text())
     oracle = report["validation"]["oracle_costs"]
     now = controller_ratios("pid_los", incumbent_settings(config, settings), trials, oracle)
