@@ -103,7 +103,10 @@ def test_a_plugin_evaluated_on_smoke_gets_a_cost_ratio_and_a_rank(
     assert "| 1 | steer | classical |" in head
     assert "P(improvement over" not in head + stdout  # no pid_los in the run
     for text in (stdout, head):
-        assert "Ranked against the references only (`oracle`, `zero_rudder`, `random`)" in text
+        assert (
+            "Ranked against the references only "
+            "(`oracle`, `oracle_frozen`, `zero_rudder`, `random`)" in text
+        )
         # the command that compares with the suite's other controllers
         assert (
             "shipgym leaderboard --suite smoke --controllers nmpc_lambda_lssvm pid_los ppo" in text
@@ -111,7 +114,7 @@ def test_a_plugin_evaluated_on_smoke_gets_a_cost_ratio_and_a_rank(
         assert f"shipgym report results/smoke {out}" in text
     page = (out / "leaderboard.html").read_text()
     assert 'id="ranked-against"' in page
-    assert "Ranked against the references only (oracle, zero_rudder, random)" in page
+    assert "Ranked against the references only (oracle, oracle_frozen, zero_rudder, random)" in page
     episodes = read_episodes(out)
     assert {e["controller"] for e in episodes} == {"steer", *REFERENCES}
 
@@ -122,8 +125,8 @@ def test_the_leaderboard_announces_its_time_before_the_first_episode(
     _, _, stderr = evaluated
     # the first line but a cold cache's compilations (each announced on its own line)
     first = next(x for x in stderr.splitlines() if not x.startswith("shipgym: compiling"))
-    # smoke: 3 scenarios × 2 seeds × 4 controllers (the oracle's read from its table)
-    assert first.startswith("leaderboard: 24 episodes on 1 worker, about ")
+    # smoke: 3 scenarios × 2 seeds × 5 controllers (the references' read from their tables)
+    assert first.startswith("leaderboard: 30 episodes on 1 worker, about ")
     assert first.endswith(
         " (recorded costs; one-off C compilations on a new machine come on top, each announced)"
     )
@@ -171,7 +174,10 @@ def test_evaluate_runs_merge_into_one_ranking_reading_the_references_once(
         _run(["evaluate", policy, "--suite", one_scenario, "--out", str(folders[-1])], capsys)
     note = (folders[1] / "leaderboard.md").read_text()
     # pid_los is the suite's one competitor: nothing of the suite is left out
-    assert "References added for the cost ratio: `oracle`, `zero_rudder`, `random`" in note
+    assert (
+        "References added for the cost ratio: `oracle`, `oracle_frozen`, `zero_rudder`, `random`"
+        in note
+    )
     assert "Ranked against" not in note
     assert main(["report", *map(str, folders), "--out", str(tmp_path / "both")]) == 0
     capsys.readouterr()
@@ -184,7 +190,8 @@ def test_evaluate_runs_merge_into_one_ranking_reading_the_references_once(
 def test_with_references_adds_those_missing_in_order() -> None:
     assert with_references(["pid_los"]) == (["pid_los", *REFERENCES], list(REFERENCES))
     names, added = with_references(["random", "pid_los", "oracle"])
-    assert names == ["random", "pid_los", "oracle", "zero_rudder"] and added == ["zero_rudder"]
+    assert names == ["random", "pid_los", "oracle", "oracle_frozen", "zero_rudder"]
+    assert added == ["oracle_frozen", "zero_rudder"]
     assert with_references(list(REFERENCES)) == (list(REFERENCES), [])
 
 
@@ -197,7 +204,9 @@ def test_the_note_says_what_the_run_is_ranked_against() -> None:
     quick = ["pid_los", "lqr", "oracle", "zero_rudder", "random"]
     mine = references_record("quick", quick, ["mine.py:Ctrl"], list(REFERENCES))
     note = comparison_note(_suite(mine, ["Ctrl"]), "results/evaluate/quick/Ctrl")
-    assert note.startswith("Ranked against the references only (`oracle`, `zero_rudder`, ")
+    assert note.startswith(
+        "Ranked against the references only (`oracle`, `oracle_frozen`, `zero_rudder`, "
+    )
     assert "not against the suite's other controllers (2)" in note
     assert "`shipgym leaderboard --suite quick --controllers pid_los lqr mine.py:Ctrl`" in note
     assert (
@@ -211,7 +220,7 @@ def test_the_note_says_what_the_run_is_ranked_against() -> None:
     # the suite's own controllers: the references it lacks are named, nothing is left out
     whole = references_record("my.yaml", ["pid_los"], None, list(REFERENCES))
     assert comparison_note(_suite(whole, ["pid_los"])) == (
-        "References added for the cost ratio: `oracle`, `zero_rudder`, `random` "
+        "References added for the cost ratio: `oracle`, `oracle_frozen`, `zero_rudder`, `random` "
         "(`--no-references`: none)."
     )
     assert comparison_note(_suite(references_record("quick", quick, None, []), ["x"])) == ""
@@ -255,7 +264,10 @@ def test_a_suite_of_your_own_without_the_oracle_gets_it_and_a_ranking(
     file.write_text(yaml.safe_dump(suite))
     out, _ = _run(["leaderboard", "--suite", str(file), "--out", str(tmp_path / "a")], capsys)
     assert "| 1 | pid_los | classical |" in out
-    assert "References added for the cost ratio: `oracle`, `zero_rudder`, `random`" in out
+    assert (
+        "References added for the cost ratio: `oracle`, `oracle_frozen`, `zero_rudder`, `random`"
+        in out
+    )
     assert read_run(tmp_path / "a")["suite"]["references"]["added"] == list(REFERENCES)
     argv = ["leaderboard", "--suite", str(file), "--out", str(tmp_path / "b")]
     out, _ = _run([*argv, "--no-references"], capsys)
