@@ -273,9 +273,9 @@ def gap_sentences(
     n = leader.get("gap_trials")
     closed = (
         f"The leader, {name}, captures {_percent(gap)}"
-        f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of it (gap closed: the "
-        f"IQM over the {n} trials worth {GAP_HEADROOM:g}× or more of log(C_frozen / C) / "
-        f"log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle) and {beaten}"
+        f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of it (gap closed "
+        "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: "
+        f"its IQM over the {n} trials worth {GAP_HEADROOM:g}× or more) and {beaten}"
     )
     rows = [r for r in table if r.get("gap_closed_iqm") is not None]
     best = max(rows, key=lambda r: (r["gap_closed_iqm"], -table.index(r)))
