@@ -554,8 +554,11 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
         f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
         f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
         f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials of each ship "
-        f"and change family. 1: adapting is worth nothing; a controller's gap closed is "
-        f"measured on the trials worth {GAP_HEADROOM:g}× or more."
+        "and change family. 1: adapting is worth nothing. In the ranking: the adaptation "
+        "gain C_frozen / C (geometric mean; above 1: better than the optimum that never "
+        "adapts), P(C < C_frozen) over the trials (ties count half) and the gap closed, "
+        "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
+        f"its IQM over the trials worth {GAP_HEADROOM:g}× or more."
     )
     return (
         '<h3 id="headroom">Headroom per ship and change family</h3>'
