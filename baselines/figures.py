@@ -25,7 +25,8 @@ Functions (each returns the written files, PNG then SVG):
   ship_length=None, kinds=None, chosen_by="median-ACE")`` — one scenario: a grid with one
   column per controller family (at most :data:`PANEL_CONTROLLERS` controllers a column) and
   three rows with the same axes in every column: track x–y over the path, e(t), δ(t); the
-  oracle's episode (controller ``oracle``) drawn in every column as the reference; the
+  oracle's episode (controller ``oracle``) drawn in every column as the reference, and the
+  frozen optimum's (``oracle_frozen``, dash-dotted, "never adapts"); the
   parameter-change time as a labelled vertical line ("change at t = … s") and each ship's
   position at that time; the title and legends say which episode is drawn.  File
   ``scenario_<name>``.
@@ -35,7 +36,9 @@ Functions (each returns the written files, PNG then SVG):
   ``scenarios[name]``, else of the name).
 * :func:`plot_ranking` ``(out_dir, aggregate, episodes, splits, kinds=None)`` — per split: rliable's
   interval estimates (IQM and geometric mean of the cost ratio C / C_oracle on a log axis,
-  P(improvement over pid_los) and the failure rate, 95 % intervals; file
+  P(improvement over pid_los) and the failure rate, 95 % intervals; with the frozen
+  optimum's episodes, a dash-dotted line on each cost-ratio panel where it lies: the IQM
+  and the geometric mean of its ratios C_frozen / C_oracle over the split's trials; file
   ``ranking_<split>``) and performance profiles of the cost ratio (one panel per family,
   file ``profile_<split>``).
 
@@ -57,7 +60,7 @@ import numpy as np
 
 from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
-from shipgym_baselines.ranking import ORACLE
+from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 
@@ -81,7 +84,8 @@ LIGHT_FIGURES = {
 #: compressed bytes follow the lines' length in pixels, not the area)
 PAGE_WIDTH = 1400
 #: a scenario figure's PNG text chunks for the page (issue 20): its legends as JSON (a list
-#: of [column title, [[controller, label], …]]; the oracle's label ends ", the reference")
+#: of [column title, [[controller, label], …]]; the oracle's label ends ", the reference",
+#: the frozen optimum's ", never adapts")
 #: and where they start (the fraction of the height from the top); the page shows the
 #: image above that line and the legends as text (crisp at any zoom, and ≈ 15 % of the
 #: image's bytes)
@@ -96,11 +100,26 @@ PAGE_COLOURS = 256
 PAGE_GREYS = 9
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
-REFERENCES = ("zero_rudder", "random", ORACLE)
+REFERENCES = ("zero_rudder", "random", ORACLE, ORACLE_FROZEN)
 _LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3")
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
 #: the oracle's episode, drawn in every column as the reference
 _ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}
+#: the frozen optimum's episode (``oracle_frozen``: the oracle's truth frozen at the start),
+#: drawn in every column beside the oracle's: its fixed colour, dash-dotted
+_FROZEN_STYLE = {
+    "color": controller_style(ORACLE_FROZEN).color,
+    "linestyle": (0, (5, 1.5, 1, 1.5)),
+    "alpha": 0.85,
+    "zorder": 1.4,
+}
+#: the two references drawn in every column: style, legend suffix, widths (track, e, δ)
+_REFERENCE_LINES = {
+    ORACLE: (_ORACLE_STYLE, ", the reference", (1.2, 1.1, 1.4)),
+    ORACLE_FROZEN: (_FROZEN_STYLE, ", never adapts", (1.1, 1.0, 1.2)),
+}
+#: the label of the frozen optimum's marks in the ranking figure
+FROZEN_LABEL = "optimum that never adapts"
 
 
 class DrawnEpisode(NamedTuple):
@@ -509,7 +528,10 @@ def plot_scenario(
     the PNG (and SVGZ) paths."""
     plt = pyplot()
     everything = {name: _as_drawn(ep) for name, ep in drawn.items()}
-    episodes = {name: ep for name, ep in everything.items() if name != ORACLE}
+    episodes = {name: ep for name, ep in everything.items() if name not in _REFERENCE_LINES}
+    refs = [name for name in _REFERENCE_LINES if name in everything]
+    # the shared scale fits the oracle, not the frozen optimum (which may spin a ship that
+    # changed: it would flatten every column; it leaves the panels instead)
     oracle = [ORACLE] if ORACLE in everything else []
     panels = family_panels(episodes, kinds) or [("no episode kept", [])]
     lines = {  # M4: every pixel column keeps its extent (a limit cycle stays one)
@@ -525,31 +547,28 @@ def plot_scenario(
     shared = _scales(lines, (controlled or list(episodes)) + oracle, path, pad)
     own_scale = [bool(controlled) and title.startswith("references") for title, _ in panels]
     fig = plt.figure()
-    most = max(len(members) for _, members in panels) + len(oracle)
+    most = max(len(members) for _, members in panels) + len(refs)
     columns = _column_axes(fig, _ROWS_H, own_scale, legend_lines=max(most, 1))
     legends: list[tuple[str, list[tuple[str, str]]]] = []
     for col, ((title, members), (ax_track, ax_e, ax_d)) in enumerate(
         zip(panels, columns, strict=True)
     ):
         legend: list[tuple[str, str]] = []
-        lim = _scales(lines, members + oracle, path, pad) if own_scale[col] else shared
+        lim = _scales(lines, members + refs, path, pad) if own_scale[col] else shared
         handles: list[Any] = []
         if path.size:
             ax_track.plot(path[:, 0], path[:, 1], color="0.55", lw=2.2, alpha=0.5, zorder=1)
-        for name in oracle:  # the reference in every column
+        for name in refs:  # the references in every column
             tr = lines[name]
-            label = _episode_label(name, everything[name]) + ", the reference"
+            style, suffix, (w_track, w_e, w_d) = _REFERENCE_LINES[name]
+            label = _episode_label(name, everything[name]) + suffix
             legend.append((name, label))
             handles += ax_track.plot(
-                tr["x"], tr["y"], lw=1.2, label=label, gid=f"{name}/track", **_ORACLE_STYLE
+                tr["x"], tr["y"], lw=w_track, label=label, gid=f"{name}/track", **style
             )
-            ax_e.plot(tr["t"], tr["cross_track_error"], lw=1.1, gid=f"{name}/e", **_ORACLE_STYLE)
+            ax_e.plot(tr["t"], tr["cross_track_error"], lw=w_e, gid=f"{name}/e", **style)
             ax_d.plot(
-                tr["t"],
-                np.degrees(tr["rudder_angle"]),
-                lw=1.4,
-                gid=f"{name}/rudder",
-                **_ORACLE_STYLE,
+                tr["t"], np.degrees(tr["rudder_angle"]), lw=w_d, gid=f"{name}/rudder", **style
             )
         for name in members:
             tr, style = lines[name], controller_style(name)
@@ -707,12 +726,15 @@ def plot_ranking(
     saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
     ratio from ``episodes``, one panel per family); see the module doc; ``vector``: their
     SVG copies too.  Returns every written file."""
-    from shipgym_baselines.ranking import PARTIAL
+    from shipgym_baselines.ranking import PARTIAL, trial_headroom
 
     files: list[Path] = []
+    headroom = trial_headroom(episodes)
     for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in aggregate):
         rows = [r for r in aggregate if r["split"].removesuffix(PARTIAL) == split]
-        files += _plot_intervals(out_dir, split, rows, vector)
+        common = max((r["scenarios"] for r in rows), key=len)
+        frozen = [h for (s, _), h in headroom.items() if s in set(common)]
+        files += _plot_intervals(out_dir, split, rows, vector, frozen)
         files += _plot_profiles(out_dir, split, episodes, splits, kinds, vector)
     return files
 
@@ -723,11 +745,32 @@ def _ranking_label(row: Mapping[str, Any], common: int) -> str:
     return row["controller"] if n == common else f"{row['controller']} ({n} of {common} scen.)"
 
 
+def frozen_marks(headroom: Sequence[float]) -> dict[str, float]:
+    """Where the frozen optimum lies on the cost-ratio panels: the IQM and the geometric mean
+    of its ratios C_frozen / C_oracle (``headroom``, one per trial); empty without any."""
+    from shipgym_baselines.ranking import geometric_mean, interquartile_mean
+
+    if not len(headroom):
+        return {}
+    values = np.asarray(headroom, dtype=np.float64)
+    return {
+        "cost_ratio_iqm": float(interquartile_mean(values)),
+        "cost_ratio_gmean": float(geometric_mean(values)),
+    }
+
+
 def _plot_intervals(
-    out_dir: str | Path, split: str, rows: Sequence[Mapping[str, Any]], vector: bool = False
+    out_dir: str | Path,
+    split: str,
+    rows: Sequence[Mapping[str, Any]],
+    vector: bool = False,
+    frozen: Sequence[float] = (),
 ) -> list:
+    """The interval estimates of ``rows`` (one split's); ``frozen``: the frozen optimum's
+    ratios on the split's trials (:func:`frozen_marks`)."""
     from rliable import plot_utils
 
+    marks = frozen_marks(frozen)
     plt = pyplot()
     rows = sorted(rows, key=lambda r: (-r["cost_ratio_iqm"], r["controller"]))  # best on top
     common = max(len(r["scenarios"]) for r in rows)
@@ -749,13 +792,19 @@ def _plot_intervals(
             xlabel="",
         )
     for ax, (key, _, label, refs) in zip(axes, panels, strict=True):
+        if marks:  # a band above the top row for the frozen optimum's labels, in every panel
+            low, high = ax.get_ylim()
+            ax.set_ylim(low, high + 0.8)
         if key.startswith("cost_ratio"):
-            _log_ratio_axis(ax, [v for r in rows for v in (*_interval(r, key), _value(r, key))])
+            values = [v for r in rows for v in (*_interval(r, key), _value(r, key))]
+            _log_ratio_axis(ax, values + ([marks[key]] if key in marks else []))
         ax.set_xlabel(label, fontsize=9)
         ax.title.set_fontsize(11)
         ax.tick_params(labelsize=8)
         for x in refs:
             ax.axvline(x, color="0.45", lw=0.8, ls="--", zorder=0)
+        if key in marks:
+            _frozen_line(ax, marks[key], key)
     axes[0].set_yticklabels([plain_text(_ranking_label(r, common)) for r in rows], fontsize=9)
     for i, ax in enumerate(axes):
         for bars in ax.containers:  # rliable labels each interval bar with its controller
@@ -769,6 +818,24 @@ def _plot_intervals(
     )
     stem = "ranking_" + figure_stem(split)
     return save_figure(fig, out_dir, stem, tight=True, vector=".svg" if vector else None)
+
+
+def _frozen_line(ax: Any, x: float, key: str) -> None:
+    """The frozen optimum's place ``x`` [cost ratio] on a panel: a dash-dotted vertical line
+    labelled :data:`FROZEN_LABEL` in the band :func:`_plot_intervals` adds above the top row
+    (clear of the bars and of the panel's title)."""
+    style = {k: v for k, v in _FROZEN_STYLE.items() if k != "zorder"}
+    ax.axvline(x, lw=1.1, zorder=0.5, gid=f"{ORACLE_FROZEN}/{key}", **style)
+    low_x, high_x = ax.get_xlim()
+    ax.text(
+        x,
+        ax.get_ylim()[1] - 0.4,
+        f" {FROZEN_LABEL} ({x:.2f}) ",
+        fontsize=7,
+        color=_FROZEN_STYLE["color"],
+        va="center",
+        ha="right" if x > math.sqrt(low_x * high_x) else "left",
+    )
 
 
 def _log_ratio_axis(ax: Any, values: Iterable[float]) -> None:

@@ -62,14 +62,20 @@ from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
     BASELINE,
+    CHANGE_FAMILIES,
+    GAP_HEADROOM,
     ORACLE,
+    ORACLE_FROZEN,
+    OTHER_FAMILY,
     PARTIAL,
     SCORE_EXPLAINED,
     aggregate_ranking,
+    headroom_table,
     is_partial,
     no_ranking,
     resolution_lines,
     row_intervals,
+    scenario_ships,
 )
 from shipgym_baselines.ranking import scenario_scores as score_table
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
@@ -682,7 +688,10 @@ def write_results(
         (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         note = comparison_note(suite, out)
-        head = ranking_markdown(board, scores, list(suite["scenarios"]), left_out, ranked, note)
+        headroom = headroom_table(ranked, scenario_ships(suite["scenarios"]), splits)
+        head = ranking_markdown(
+            board, scores, list(suite["scenarios"]), left_out, ranked, note, headroom
+        )
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
@@ -697,6 +706,7 @@ def write_results(
         subtitle=subtitle(suite, results),
         verdict=lead,
         note=note if board else "",
+        headroom=headroom,
     )
     return rows
 
@@ -864,12 +874,16 @@ def _table_title(split: str, rows: Sequence[Mapping[str, Any]]) -> str:
 def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
     """The ranking as markdown: one table per split, each followed by its partial table; the
     column of the probability of improvement over ``pid_los`` only where a row has one (the
-    run has ``pid_los`` and another controller)."""
+    run has ``pid_los`` and another controller), the columns against the frozen optimum
+    (adaptation gain, P(beats it), gap closed) only where a row has them (the run has
+    ``oracle_frozen``)."""
     lines: list[str] = []
     for split in dict.fromkeys(r["split"] for r in board):
         mine = [r for r in board if r["split"] == split]
         with_prob = any(r[PROB] is not None for r in mine)
         prob = [f"P(improvement over {BASELINE}) [95 % CI]"] if with_prob else []
+        with_gap = any(r.get(GAIN) is not None for r in mine)
+        gap = list(GAP_HEADERS) if with_gap else []
         header = [
             "rank",
             "controller",
@@ -880,6 +894,7 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
             "geometric mean [95 % CI]",
             *prob,
             "failure rate [95 % CI]",
+            *gap,
         ]
         lines += [
             f"### {_table_title(split, mine)}",
@@ -898,10 +913,32 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
                 _interval(r["cost_ratio_gmean"], r["cost_ratio_gmean_ci95"], 3),
                 *([_interval(r[PROB], r[f"{PROB}_ci95"])] if with_prob else []),
                 _interval(r["failure_rate"], r["failure_rate_ci95"]),
+                *(_gap_cells(r) if with_gap else []),
             ]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     return lines
+
+
+#: an aggregate row's adaptation gain (None: no frozen optimum's episodes)
+GAIN = "adaptation_gain_gmean"
+#: the ranking tables' columns against the frozen optimum
+GAP_HEADERS = (
+    "adaptation gain [95 % CI]",
+    "P(C < C_frozen) [95 % CI]",
+    "gap closed IQM [95 % CI] (trials)",
+)
+
+
+def _gap_cells(row: Mapping[str, Any]) -> list[str]:
+    """A ranking row's cells against the frozen optimum (:data:`GAP_HEADERS`)."""
+    trials = row.get("gap_trials")
+    gap = _interval(row.get("gap_closed_iqm"), row.get("gap_closed_iqm_ci95"))
+    return [
+        _interval(row.get(GAIN), row.get(f"{GAIN}_ci95")),
+        _interval(row.get("prob_beats_frozen"), row.get("prob_beats_frozen_ci95")),
+        gap + (f" ({trials})" if gap != "–" and trials else ""),
+    ]
 
 
 def ranking_markdown(
@@ -911,12 +948,14 @@ def ranking_markdown(
     left_out: Sequence[str] = (),
     episodes: Sequence[Mapping[str, Any]] = (),
     note: str = "",
+    headroom: Sequence[Mapping[str, Any]] = (),
 ) -> str:
     """The head of ``leaderboard.md``: the score in two sentences, the ranking per split
-    (and its partial tables), the resolution and the controller × scenario table of cost
-    ratios; ``episodes``: the ranked ones (to name the scenarios without the oracle's);
-    ``note``: what the run is ranked against
-    (:func:`~shipgym_baselines.comparison.comparison_note`), under the score's sentences."""
+    (and its partial tables), the resolution, the headroom per ship × change family and the
+    controller × scenario table of cost ratios; ``episodes``: the ranked ones (to name the
+    scenarios without the oracle's); ``note``: what the run is ranked against
+    (:func:`~shipgym_baselines.comparison.comparison_note`), under the score's sentences;
+    ``headroom``: :func:`~shipgym_baselines.ranking.headroom_table`'s rows."""
     lead = verdict(board, episodes)
     lines = ["# Leaderboard", "", *([lead, ""] if lead else []), "## Ranking", ""]
     if not board:
@@ -934,9 +973,42 @@ def ranking_markdown(
             f"{', '.join(unranked)}.",
             "",
         ]
-    lines += ranking_tables(board) + resolution_lines(board)
+    lines += ranking_tables(board) + resolution_lines(board) + headroom_markdown(headroom)
     lines += scores_markdown(board, scores, scenarios)
     return "\n".join(lines)
+
+
+def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The headroom table (:func:`~shipgym_baselines.ranking.headroom_table` rows): a row per
+    ship, a column per change family, each cell the geometric mean of C_frozen / C_oracle
+    and its trials; no lines without rows."""
+    if not headroom:
+        return []
+    order = (*CHANGE_FAMILIES, OTHER_FAMILY)
+    families = sorted({r["family"] for r in headroom}, key=order.index)
+    cells = {(r["ship"], r["family"]): r for r in headroom}
+    lines = [
+        "### Headroom per ship and change family",
+        "",
+        f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
+        f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
+        f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials (how many in "
+        "parentheses). 1: adapting is worth nothing. In the ranking: the adaptation gain "
+        "C_frozen / C (geometric mean; above 1: better than the optimum that never adapts), "
+        "P(C < C_frozen) over the trials (ties count half) and the gap closed, "
+        "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
+        f"its IQM over the trials worth {GAP_HEADROOM:g}× or more (how many in parentheses).",
+        "",
+        "| ship | " + " | ".join(f.replace("_", " ") for f in families) + " |",
+        "|---|" + "---|" * len(families),
+    ]
+    for ship in dict.fromkeys(r["ship"] for r in headroom):
+        row = [md_cell(ship)]
+        for family in families:
+            found = cells.get((ship, family))
+            row.append(f"{found['headroom_gmean']:.2f} ({found['trials']})" if found else "–")
+        lines.append("| " + " | ".join(row) + " |")
+    return [*lines, ""]
 
 
 def scores_markdown(

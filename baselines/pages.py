@@ -6,8 +6,10 @@ data URI (the SVG copy where there is one, else the PNG).  The page holds, in or
 
 1. the **ranking** per split (``aggregate.json`` rows: IQM and geometric mean of the cost
    ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
-   rate, 95 % intervals; a split's partial table below it), the resolution of each split
-   and the figures (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.figures`);
+   rate, 95 % intervals; a split's partial table below it), the resolution of each split,
+   the headroom per ship × change family (what knowing the change is worth: C_frozen /
+   C_oracle, :func:`shipgym_baselines.ranking.headroom_table`) and the figures
+   (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.figures`);
 2. the **controller × scenario table**: the oracle's mean cost, then each controller's
    geometric-mean cost ratio with its interval (``scenario_scores.json``,
    :func:`shipgym_baselines.ranking.scenario_scores`), shaded from 1 (the oracle, green) to ≥ 4
@@ -24,7 +26,7 @@ click's order) or ``#sort=<column>:asc`` / ``:desc``, where a column is ``contro
 names are user input: plug-ins) is HTML-escaped.
 
 :func:`write_html` ``(out_dir, rows, aggregate, scores, figures, title=…, subtitle=None,
-verdict=None)``
+verdict=None, note="", headroom=())``
 writes the page and returns its path.
 """
 
@@ -50,7 +52,11 @@ from shipgym_baselines.figures import (
 )
 from shipgym_baselines.ranking import (
     BASELINE,
+    CHANGE_FAMILIES,
+    GAP_HEADROOM,
     ORACLE,
+    ORACLE_FROZEN,
+    OTHER_FAMILY,
     PARTIAL,
     SCORE_EXPLAINED,
     is_partial,
@@ -62,6 +68,8 @@ from shipgym_baselines.style import controller_style
 
 #: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)
 PROB = f"prob_improvement_over_{BASELINE}"
+#: the aggregate rows' adaptation gain (None: no frozen optimum's episodes)
+GAIN = "adaptation_gain_gmean"
 
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
@@ -375,7 +383,9 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
     cost ratio's IQM, lowest first); a split's partial table is titled as such.  A table
     whose rows have no probability of improvement (``pid_los`` not ranked there) has no
-    such column; a row without one (``pid_los`` itself) shows "–"."""
+    such column; a row without one (``pid_los`` itself) shows "–".  The columns against
+    the frozen optimum (adaptation gain, P(beats it), gap closed) only where a row has
+    them."""
     columns = [
             ("controller", "controller", "text"),
             ("rank", "rank", "number"),
@@ -387,6 +397,9 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("cost_ratio_gmean", "geometric mean", "lower"),
             ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
             ("failure_rate", "failure rate", "lower"),
+            (GAIN, "adaptation gain C_frozen / C", "number"),
+            ("prob_beats_frozen", "P(C &lt; C_frozen)", "number"),
+            ("gap_closed_iqm", "gap closed IQM (trials)", "number"),
     ]  # fmt: skip
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):
@@ -410,21 +423,36 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
                         r.get(f"{PROB}_ci95"),
                     ),
                     _cell(r.get("failure_rate"), r.get("failure_rate_ci95")),
+                    _cell(r.get(GAIN), r.get(f"{GAIN}_ci95")),
+                    _cell(r.get("prob_beats_frozen"), r.get("prob_beats_frozen_ci95")),
+                    _gap_cell(r),
                 ]
             )
         base = split.removesuffix(PARTIAL)
         title = SPLIT_TITLES.get(base, base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        mine = columns
+        keys = [c[0] for c in columns]
+        skip = set()
         if all(r.get(PROB) is None for r in rows):  # pid_los not ranked here: no comparison
-            skip = [c[0] for c in columns].index("prob")
-            mine = columns[:skip] + columns[skip + 1 :]
-            body = [cells[:skip] + cells[skip + 1 :] for cells in body]
+            skip.add(keys.index("prob"))
+        if all(r.get(GAIN) is None for r in rows):  # no frozen optimum: no gap columns
+            skip |= {keys.index(k) for k in (GAIN, "prob_beats_frozen", "gap_closed_iqm")}
+        mine = [c for i, c in enumerate(columns) if i not in skip]
+        body = [[td for i, td in enumerate(cells) if i not in skip] for cells in body]
         table = _table(f"ranking-{split}", mine, body, compact=True, cls="ranking")
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
     notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
+
+
+def _gap_cell(row: Mapping[str, Any]) -> _Td:
+    """A ranking row's gap closed: the IQM, its interval and the qualifying trials."""
+    td = _cell(row.get("gap_closed_iqm"), row.get("gap_closed_iqm_ci95"))
+    trials = row.get("gap_trials")
+    if row.get("gap_closed_iqm") is None or not trials:
+        return td
+    return td._replace(html=f"{td.html}<i>{_e(trials)} trials</i>")
 
 
 def _controller_order(
@@ -487,10 +515,55 @@ def score_table(
 
 
 def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
-    """A scenario header's line on the oracle's mean cost (the ratios' denominator)."""
+    """A scenario header's line on the oracle's mean cost (the ratios' denominator), and
+    the frozen optimum's where it ran."""
     if not entry:
         return ""
-    return f"<br>{_e(ORACLE)} cost {_e(_number(entry.get('oracle_cost')))}"
+    text = f"<br>{_e(ORACLE)} cost {_e(_number(entry.get('oracle_cost')))}"
+    if entry.get("oracle_frozen_cost") is not None:
+        text += f"<br>{_e(ORACLE_FROZEN)} cost {_e(_number(entry['oracle_frozen_cost']))}"
+    return text
+
+
+def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
+    """The headroom table (:func:`shipgym_baselines.ranking.headroom_table` rows): one row per
+    ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
+    over its trials (how many beside it); empty without rows."""
+    if not headroom:
+        return ""
+    present = {r["family"] for r in headroom}
+    families = [f for f in (*CHANGE_FAMILIES, OTHER_FAMILY) if f in present]
+    cells = {(r["ship"], r["family"]): r for r in headroom}
+    columns = [("ship", "ship", "text")]
+    columns += [(f, _e(f.replace("_", " ")), "number") for f in families]
+    body = []
+    for ship in dict.fromkeys(r["ship"] for r in headroom):
+        tds = [_text_cell(ship)]
+        for family in families:
+            found = cells.get((ship, family))
+            if found is None:
+                tds.append(_Td("–"))
+                continue
+            trials = found["trials"]
+            value = _finite(found["headroom_gmean"])
+            text = _number(found["headroom_gmean"])
+            small = f"<i>{trials} trial{'s' if trials != 1 else ''}</i>"
+            tds.append(_Td(f"{_e(text)}{small}", value, _leading_number(text)))
+        body.append(tds)
+    note = (
+        f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
+        f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
+        f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials of each ship "
+        "and change family. 1: adapting is worth nothing. In the ranking: the adaptation "
+        "gain C_frozen / C (geometric mean; above 1: better than the optimum that never "
+        "adapts), P(C < C_frozen) over the trials (ties count half) and the gap closed, "
+        "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
+        f"its IQM over the trials worth {GAP_HEADROOM:g}× or more."
+    )
+    return (
+        '<h3 id="headroom">Headroom per ship and change family</h3>'
+        f'<p class="note">{_e(note)}</p>{_table("headroom", columns, body, compact=True)}'
+    )
 
 
 def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
@@ -599,15 +672,22 @@ def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
     return out
 
 
-#: the oracle's line in the scenario figures (black, dashed), as a legend swatch
+#: the oracle's line in the scenario figures (black, dashed) and the frozen optimum's (its
+#: grey, dash-dotted: dashed here, CSS has no dash-dot), as legend swatches
 _REFERENCE_SWATCH = "kref"
-_REFERENCE_CSS = f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
+_FROZEN_SWATCH = "kfrozen"
+_REFERENCE_CSS = (
+    f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
+    f".{_FROZEN_SWATCH}{{border-top-style:dashed;"
+    f"border-top-color:{controller_style(ORACLE_FROZEN).color}}}"
+)
+_REFERENCE_SWATCHES = {ORACLE: _REFERENCE_SWATCH, ORACLE_FROZEN: _FROZEN_SWATCH}
 
 
 def _legend_swatch(name: str) -> str:
-    """The swatch class of a legend entry: the oracle's reference line, else the
-    controller's."""
-    return _REFERENCE_SWATCH if name == ORACLE else _swatch_class(name)[0]
+    """The swatch class of a legend entry: the oracle's or the frozen optimum's reference
+    line, else the controller's."""
+    return _REFERENCE_SWATCHES.get(name) or _swatch_class(name)[0]
 
 
 def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
@@ -668,10 +748,13 @@ def page(
     subtitle: str | None = None,
     verdict: str | None = None,
     note: str = "",
+    headroom: Sequence[Mapping[str, Any]] = (),
 ) -> str:
-    """The page's HTML (module doc); ``verdict``: the run's two sentences
+    """The page's HTML (module doc); ``verdict``: the run's sentences
     (:mod:`shipgym_baselines.verdict`), the page's first paragraph; ``note``: what the run
-    is ranked against (:func:`~shipgym_baselines.comparison.comparison_note`), under it."""
+    is ranked against (:func:`~shipgym_baselines.comparison.comparison_note`), under it;
+    ``headroom``: the headroom table's rows
+    (:func:`~shipgym_baselines.ranking.headroom_table`), after the ranking."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
         figures, (r["scenario"] for r in rows)
     )
@@ -690,10 +773,12 @@ def page(
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
         f"{ranking_tables(aggregate) if aggregate else _no_ranking(scores)}"
+        f"{headroom_html(headroom)}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
         "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
         "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
-        "name the oracle's mean cost. n/a: the controller does not apply to the scenario's "
+        f"name the oracle's mean cost{_frozen_note(scores)}. n/a: the controller does not "
+        "apply to the scenario's "
         "ship. "
         "Click a header to sort; a scenario's name links to its figure.</p>"
         f"{score_table(rows, aggregate, scores)}"
@@ -704,6 +789,16 @@ def page(
         "<noscript><p>The rows need the page's script; they are also in leaderboard.md and "
         "leaderboard.csv.</p></noscript></details>"
         f"<script>{_JS}</script></body></html>\n"
+    )
+
+
+def _frozen_note(scores: Sequence[Mapping[str, Any]]) -> str:
+    """The score table's note on the frozen optimum, where it ran."""
+    if all(s.get("oracle_frozen_cost") is None for s in scores):
+        return ""
+    return (
+        f" and {ORACLE_FROZEN}'s (the optimum that never adapts; its row's ratios are the "
+        "headroom, what knowing the change is worth)"
     )
 
 
@@ -721,18 +816,21 @@ def write_html(
     subtitle: str | None = None,
     verdict: str | None = None,
     note: str = "",
+    headroom: Sequence[Mapping[str, Any]] = (),
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
     :func:`shipgym_baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
     :mod:`shipgym_baselines.figures`; ``subtitle``: a line under the title (e.g. the suite
     and seeds); ``verdict``: the paragraph the page opens with; ``note``: what the run is
-    ranked against.  Returns the page's path."""
+    ranked against; ``headroom``: the headroom table's rows.  Returns the page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
     write_bytes(
         path,
-        page(rows, aggregate, scores, figures, title, subtitle, verdict, note).encode("utf-8"),
+        page(rows, aggregate, scores, figures, title, subtitle, verdict, note, headroom).encode(
+            "utf-8"
+        ),
     )
     return path

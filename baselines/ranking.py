@@ -22,11 +22,24 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   itself and where ``pid_los`` lacks a scenario of the row) and the failure rate,
   each with a 95 % stratified-bootstrap interval (runs = training seeds × evaluation seeds,
   tasks = scenarios; :func:`aggregate_ranking`), ranked by the IQM, ascending.  References
-  (kind ``reference``: ``oracle``, ``zero_rudder``, ``random``) are not ranked.  Every
-  competitor of the main table of a split is ranked on the same scenarios; one that lacks
-  some (it does not apply to a ship) is ranked on its own scenarios in the separate table
-  ``split`` = ``"<split>:partial"``.  The performance profile (fraction of runs with ratio
-  > τ) comes from ``rliable`` too (:func:`performance_profiles`).
+  (kind ``reference``: ``oracle``, ``oracle_frozen``, ``zero_rudder``, ``random``) are not
+  ranked.  Every competitor of the main table of a split is ranked on the same scenarios;
+  one that lacks some (it does not apply to a ship) is ranked on its own scenarios in the
+  separate table ``split`` = ``"<split>:partial"``.  The performance profile (fraction of
+  runs with ratio > τ) comes from ``rliable`` too (:func:`performance_profiles`).
+* **What adaptation is worth**: the second reference ``oracle_frozen`` is the same NMPC
+  with its truth frozen at the episode's start (the optimum that never adapts).  Per trial,
+  ``headroom`` = C_frozen / C_oracle (:func:`trial_headroom`): what knowing the change is
+  worth.  Per controller and split (:func:`ranking_row`, the same bootstrap as the rest):
+  the geometric mean of C_frozen / C (``adaptation_gain_gmean``: > 1, better than never
+  adapting), P(C < C_frozen) + ½ P(C = C_frozen) over the trials
+  (``prob_beats_frozen``) and the IQM of the gap closed, log(C_frozen / C) /
+  log(C_frozen / C_oracle), over the trials whose headroom is at least
+  :data:`GAP_HEADROOM` (``gap_closed_iqm``: 0 = no better than never adapting, 1 = the
+  oracle; ``gap_trials`` of them).  The gap's run matrix holds NaN on the trials that do
+  not qualify and its IQM is over the finite entries, so each bootstrap sample redraws
+  the qualifying trials with the rest (the interval is None if one sample draws none).
+  :func:`headroom_table`: the headroom per ship × change family.
 
 **Reproducible**: rliable 1.2's bootstraps draw from numpy's *global* generator (its
 ``update_indices`` calls ``np.random.choice``; the ``random_state`` it hands to arch is
@@ -47,7 +60,8 @@ import numpy as np
 
 #: the reference of the cost ratio (its cost is the denominator)
 ORACLE = "oracle"
-#: the reference that never adapts (its truth frozen at the episode's start)
+#: the second reference: the same NMPC with its truth frozen at the episode's start (the
+#: optimum that never adapts); C_frozen / C_oracle is what knowing the change is worth
 ORACLE_FROZEN = "oracle_frozen"
 #: the controller of the probability of improvement
 BASELINE = "pid_los"
@@ -62,6 +76,9 @@ CONFIDENCE = 0.95
 #: bootstrap replications of row intervals (numpy) and of the aggregate (rliable)
 ROW_REPS = 4000
 AGGREGATE_REPS = 2000
+#: the gap closed is averaged over the trials where knowing the change is worth at least
+#: this factor (headroom C_frozen / C_oracle)
+GAP_HEADROOM = 1.2
 #: the fields of an ``aggregate.json`` object, in order
 AGGREGATE_FIELDS = (
     "controller",
@@ -78,7 +95,18 @@ AGGREGATE_FIELDS = (
     f"prob_improvement_over_{BASELINE}_ci95",
     "failure_rate",
     "failure_rate_ci95",
+    "adaptation_gain_gmean",
+    "adaptation_gain_gmean_ci95",
+    "prob_beats_frozen",
+    "prob_beats_frozen_ci95",
+    "gap_closed_iqm",
+    "gap_closed_iqm_ci95",
+    "gap_trials",
 )
+#: the gap fields of a row without the frozen optimum's episodes
+NO_GAP: dict[str, Any] = {
+    key: None for key in AGGREGATE_FIELDS[AGGREGATE_FIELDS.index("adaptation_gain_gmean") :]
+}
 
 
 #: leaderboard.md's two sentences on the score
@@ -324,16 +352,147 @@ def controller_kinds(
     episodes: Iterable[Mapping[str, Any]], kinds: Mapping[str, str] | None = None
 ) -> dict[str, str]:
     """controller → kind: ``kinds`` first, else the episodes' ``kind`` (``classical`` when
-    neither says); the oracle is a reference whatever it is called elsewhere."""
+    neither says); the two oracles are references whatever they are called elsewhere."""
     out = {ep["controller"]: ep.get("kind") or "classical" for ep in episodes}
     out.update({c: k for c, k in (kinds or {}).items() if c in out})
-    if ORACLE in out:
-        out[ORACLE] = REFERENCE_KIND
+    for reference in (ORACLE, ORACLE_FROZEN):
+        if reference in out:
+            out[reference] = REFERENCE_KIND
     return out
 
 
 def _pairs(values: np.ndarray, i: int) -> list[float]:
     return [float(values[0, i]), float(values[1, i])]
+
+
+def _finite_pairs(values: np.ndarray, i: int) -> list[float] | None:
+    """:func:`_pairs`, None when a bound is not finite (a bootstrap sample without a value)."""
+    pair = _pairs(values, i)
+    return pair if all(math.isfinite(v) for v in pair) else None
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+# --------------------------------------------------------------- what adaptation is worth
+def _trial_costs(episodes: Iterable[Mapping[str, Any]], controller: str) -> dict:
+    """(scenario, seed) → the cost of ``controller``'s episode of that trial (a reference's:
+    one per trial)."""
+    return {
+        (ep["scenario"], int(ep["seed"])): _number(ep.get("cost"))
+        for ep in episodes
+        if ep["controller"] == controller
+    }
+
+
+def trial_headroom(episodes: Iterable[Mapping[str, Any]]) -> dict[tuple[str, int], float]:
+    """(scenario, seed) → headroom C_frozen / C_oracle of every trial with both references'
+    episodes, both costs finite and positive: what knowing the change is worth there."""
+    episodes = list(episodes)
+    oracle = _trial_costs(episodes, ORACLE)
+    out = {}
+    for trial, frozen in _trial_costs(episodes, ORACLE_FROZEN).items():
+        c_ref = oracle.get(trial, math.nan)
+        if math.isfinite(c_ref) and c_ref > 0.0 and math.isfinite(frozen) and frozen > 0.0:
+            out[trial] = frozen / c_ref
+    return out
+
+
+def gmean_headroom(
+    headroom: Mapping[tuple[str, int], float], scenarios: Iterable[str]
+) -> tuple[float, int] | None:
+    """(geometric mean of the headroom, trials) over the trials of ``scenarios`` in
+    ``headroom`` (:func:`trial_headroom`); None without any."""
+    wanted = set(scenarios)
+    values = [h for (s, _), h in headroom.items() if s in wanted]
+    if not values:
+        return None
+    return float(geometric_mean(np.array(values))), len(values)
+
+
+def _finite_iqm(scores: np.ndarray) -> float:
+    """:func:`interquartile_mean` over the finite entries (NaN: none)."""
+    a = np.asarray(scores, dtype=np.float64)
+    a = a[np.isfinite(a)]
+    return interquartile_mean(a) if a.size else math.nan
+
+
+def _gain_estimates(gains: np.ndarray) -> np.ndarray:
+    """[geometric mean of C_frozen / C, P(C < C_frozen) + ½ P(C = C_frozen)]: for positive
+    finite costs C_frozen / C > 1 exactly when C < C_frozen and = 1 exactly when equal
+    (IEEE division is correctly rounded), so one matrix gives both."""
+    beats = np.mean((gains > 1.0) + 0.5 * (gains == 1.0))
+    return np.array([geometric_mean(gains), beats])
+
+
+def _gap_estimate(gaps: np.ndarray) -> np.ndarray:
+    return np.array([_finite_iqm(gaps)])
+
+
+def gap_matrices(
+    scored: Sequence[Mapping[str, Any]], controller: str, tasks: list[str]
+) -> dict[str, np.ndarray] | None:
+    """The (runs, tasks) matrices of ``controller`` against the frozen optimum, runs as
+    :func:`run_matrix` orders them: ``gain`` C_frozen / C, ``beats`` 1 where C < C_frozen
+    (½ where equal, else 0), ``gap`` log(C_frozen / C) / log(C_frozen / C_oracle) where the
+    trial's headroom is at least :data:`GAP_HEADROOM` (NaN elsewhere) and ``seed`` the
+    evaluation seeds.  None unless ``oracle_frozen`` has every trial of the row with a
+    finite positive cost."""
+    headroom = trial_headroom(scored)
+    frozen_cost = _trial_costs(scored, ORACLE_FROZEN)
+    seeds = run_matrix(scored, controller, tasks, "seed").astype(np.int64)
+    keys = [[(task, int(seed)) for task, seed in zip(tasks, row, strict=True)] for row in seeds]
+    if not all(key in headroom for row in keys for key in row):
+        return None
+    cost = run_matrix(scored, controller, tasks, "cost")
+    frozen = np.array([[frozen_cost[key] for key in row] for row in keys], dtype=np.float64)
+    room = np.array([[headroom[key] for key in row] for row in keys], dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = frozen / cost
+        gap = np.where(room >= GAP_HEADROOM, np.log(gain) / np.log(room), math.nan)
+    beats = (cost < frozen) + 0.5 * (cost == frozen)
+    return {"gain": gain, "beats": beats.astype(np.float64), "gap": gap, "seed": seeds}
+
+
+def gap_fields(
+    scored: Sequence[Mapping[str, Any]],
+    controller: str,
+    tasks: list[str],
+    reps: int = AGGREGATE_REPS,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """The gap fields of an ``aggregate.json`` row (module doc; :data:`NO_GAP` without the
+    frozen optimum's episodes on every trial of the row): each with rliable's stratified
+    bootstrap (the same seed and so the same resamples as the row's other fields)."""
+    m = gap_matrices(scored, controller, tasks)
+    if m is None:
+        return dict(NO_GAP)
+    point, interval = interval_estimate(m["gain"], _gain_estimates, reps, seed)
+    qualified = np.isfinite(m["gap"])
+    out = {
+        "adaptation_gain_gmean": _finite_or_none(point[0]),
+        "adaptation_gain_gmean_ci95": _finite_pairs(interval, 0),
+        "prob_beats_frozen": float(point[1]),
+        "prob_beats_frozen_ci95": _pairs(interval, 1),
+        "gap_closed_iqm": None,
+        "gap_closed_iqm_ci95": None,
+        "gap_trials": 0,
+    }
+    if qualified.any():
+        gap_point, gap_interval = interval_estimate(m["gap"], _gap_estimate, reps, seed)
+        trials = {(t, int(s)) for t, s, q in _cells(tasks, m["seed"], qualified) if q}
+        out["gap_closed_iqm"] = _finite_or_none(gap_point[0])
+        out["gap_closed_iqm_ci95"] = _finite_pairs(gap_interval, 0)
+        out["gap_trials"] = len(trials)
+    return out
+
+
+def _cells(tasks: list[str], seeds: np.ndarray, mask: np.ndarray) -> Iterator[tuple]:
+    """(task, seed, mask value) of every cell of a (runs, tasks) matrix."""
+    for r in range(seeds.shape[0]):
+        for c, task in enumerate(tasks):
+            yield task, seeds[r, c], bool(mask[r, c])
 
 
 def ranking_row(
@@ -375,6 +534,7 @@ def ranking_row(
         f"prob_improvement_over_{BASELINE}_ci95": prob_ci,
         "failure_rate": float(fail_point[0]),
         "failure_rate_ci95": _pairs(fail_interval, 0),
+        **gap_fields(scored, controller, tasks, reps, seed),
     }
 
 
@@ -480,9 +640,11 @@ def scenario_scores(
     seed: int = 0,
 ) -> list[dict[str, Any]]:
     """``scenario_scores.json``: per scenario with the oracle's episodes, the oracle's mean
-    cost with its 95 % interval and, per other controller (references included), its mean
-    cost and the geometric mean of its cost ratios with a 95 % interval (stratified over
-    training seeds), over the row's episodes."""
+    cost with its 95 % interval, the frozen optimum's (``oracle_frozen_cost``, None without
+    its episodes) and the headroom (the geometric mean of C_frozen / C_oracle over the
+    scenario's trials, with its interval as a cell's), and, per other controller
+    (references included), its mean cost and the geometric mean of its cost ratios with a
+    95 % interval (stratified over training seeds), over the row's episodes."""
     scored = scored_episodes(episodes)
     kind_of = controller_kinds(episodes, kinds)
     groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
@@ -511,10 +673,100 @@ def scenario_scores(
                 "oracle_cost": float(np.mean([ep["cost"] for ep in oracle])),
                 "oracle_cost_ci95": row_intervals(oracle, ["cost"], seed=seed)["cost_ci95"],
                 "oracle_episodes": len(oracle),
+                **_frozen_cells(groups.get((scenario, ORACLE_FROZEN), []), seed),
                 "controllers": cells,
             }
         )
     return out
+
+
+def _frozen_cells(frozen: Sequence[Mapping[str, Any]], seed: int) -> dict[str, Any]:
+    """A scenario's ``oracle_frozen_cost`` (mean, 95 % interval) and ``headroom`` (the
+    geometric mean of its cost ratios C_frozen / C_oracle, 95 % interval), None without
+    its episodes."""
+    if not frozen:
+        return {
+            "oracle_frozen_cost": None,
+            "oracle_frozen_cost_ci95": None,
+            "headroom": None,
+            "headroom_ci95": None,
+        }
+    cell = _log_ratio_cell(frozen, seed)
+    return {
+        "oracle_frozen_cost": float(np.mean([ep["cost"] for ep in frozen])),
+        "oracle_frozen_cost_ci95": row_intervals(frozen, ["cost"], seed=seed)["cost_ci95"],
+        "headroom": cell["cost_ratio_gmean"],
+        "headroom_ci95": cell["cost_ratio_gmean_ci95"],
+    }
+
+
+#: the change families of the catalogue's scenario names, in the headroom table's order
+#: (``{ship}_{family}[_{variant}]``; nomoto2's without the ship: ``{family}[_{variant}]``)
+CHANGE_FAMILIES = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
+#: the family of a scenario whose name has none of them (e.g. ``osaka_curved``)
+OTHER_FAMILY = "other"
+
+
+def change_family(scenario: str) -> str:
+    """The change family a scenario's name states (:data:`CHANGE_FAMILIES`, by the
+    catalogue's naming rule: the family as a whole ``_``-separated part of the name), else
+    :data:`OTHER_FAMILY`."""
+    parts = f"_{scenario}_"
+    for family in CHANGE_FAMILIES:
+        if f"_{family}_" in parts:
+            return family
+    return OTHER_FAMILY
+
+
+def scenario_ships(settings: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
+    """scenario → its ship (the model's name) from scenario settings as ``run.json`` keeps
+    them (``scenarios``: name → the scenario's settings, ``ship.model``)."""
+    out = {}
+    for name, config in settings.items():
+        ship = config.get("ship") if isinstance(config, Mapping) else None
+        if not isinstance(ship, Mapping) or not isinstance(ship.get("model"), str):
+            raise ValueError(f"scenario {name!r}: its settings name no ship model (ship.model)")
+        out[name] = ship["model"]
+    return out
+
+
+def headroom_table(
+    episodes: Sequence[Mapping[str, Any]],
+    ships: Mapping[str, str],
+    splits: Mapping[str, str],
+    split: str = "catalogue",
+) -> list[dict[str, Any]]:
+    """The headroom per ship × change family over the trials of ``split``'s scenarios:
+    rows ``ship``, ``family`` (:func:`change_family`), ``scenarios`` (their names),
+    ``trials`` and ``headroom_gmean`` (the geometric mean of C_frozen / C_oracle over the
+    trials, :func:`trial_headroom`); ships in the order of ``ships``, families in
+    :data:`CHANGE_FAMILIES` order then :data:`OTHER_FAMILY`.  ``ships``: scenario → ship
+    (:func:`scenario_ships`); a scenario of the split missing from it raises ValueError.
+    Empty without both references' episodes."""
+    headroom = trial_headroom(episodes)
+    mine = sorted({s for s, _ in headroom if splits.get(s, "catalogue") == split})
+    missing = [s for s in mine if s not in ships]
+    if missing:
+        raise ValueError(f"headroom_table: no ship for scenario(s) {', '.join(missing)}")
+    order = list(dict.fromkeys(ships.values()))
+    families = (*CHANGE_FAMILIES, OTHER_FAMILY)
+    cells: dict[tuple[str, str], list[str]] = defaultdict(list)
+    for s in mine:
+        cells[(ships[s], change_family(s))].append(s)
+    rows = []
+    for ship, family in sorted(cells, key=lambda k: (order.index(k[0]), families.index(k[1]))):
+        names = cells[(ship, family)]
+        gmean, trials = gmean_headroom(headroom, names) or (math.nan, 0)
+        rows.append(
+            {
+                "ship": ship,
+                "family": family,
+                "scenarios": names,
+                "trials": trials,
+                "headroom_gmean": gmean,
+            }
+        )
+    return rows
 
 
 def performance_profiles(

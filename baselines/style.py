@@ -45,6 +45,7 @@ _FIXED: dict[str, Style] = {
     "td3": Style("#c49c94", ":", "*"),
     "zero_rudder": Style("#7f7f7f", ":", "."),
     "random": Style("#c7c7c7", ":", "."),
+    "oracle_frozen": Style("#525252", "-.", "x"),
 }
 
 _PALETTE = (

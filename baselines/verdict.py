@@ -14,6 +14,16 @@
    episodes (more than half), with their share of all failed episodes; when there are none,
    the scenario with the most failed episodes.
 
+When the record has the episodes of both references (``oracle`` and ``oracle_frozen``, the
+same NMPC with its truth frozen at the episode's start), two more sentences decompose it:
+
+3. **What knowing the change is worth**: the geometric mean, over the table's trials, of
+   the headroom C_frozen / C_oracle (:func:`shipgym_baselines.ranking.trial_headroom`).
+4. **How much of it the leader captures**: its gap closed (IQM of log(C_frozen / C) /
+   log(C_frozen / C_oracle) over the trials whose headroom is at least 1.2, with its 95 %
+   interval) and how often it beats the optimum that never adapts (P(C < C_frozen)); and
+   the controller that closes most of the gap, when that is another.
+
 No ranking (no ``aggregate.json`` rows): no verdict.
 """
 
@@ -27,7 +37,15 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.ranking import is_failure, is_partial
+from shipgym_baselines.ranking import (
+    GAP_HEADROOM,
+    ORACLE,
+    ORACLE_FROZEN,
+    gmean_headroom,
+    is_failure,
+    is_partial,
+    trial_headroom,
+)
 
 #: the kinds the second half of the first sentence compares
 LEARNED, CLASSICAL = "learned", "classical"
@@ -215,19 +233,75 @@ def _most_fail(
     return failing > MOST * len(controllers)
 
 
+def _percent_interval(ci: Sequence[float] | None) -> str:
+    return f" [{_percent(ci[0])}, {_percent(ci[1])}]" if ci else ""
+
+
+def gap_sentences(
+    table: Sequence[Mapping[str, Any]],
+    episodes: Sequence[Mapping[str, Any]],
+    code: Callable[[str], str],
+) -> str | None:
+    """Sentences 3 and 4 (module doc) for ``table`` (ranked rows of one split) from the
+    episodes' headroom on its scenarios and the rows' gap fields; None without both
+    references' episodes there."""
+    found = gmean_headroom(trial_headroom(episodes), table[0]["scenarios"])
+    if found is None:
+        return None
+    headroom, trials = found
+    label = "held-out" if table[0]["split"] == "heldout" else table[0]["split"]
+    worth = (
+        f"Knowing the change is worth {headroom:.2f}× here: the cost of {code(ORACLE_FROZEN)}, "
+        f"the optimum that never adapts, over {code(ORACLE)}'s (geometric mean over the "
+        f"{trials} trial{'s' if trials != 1 else ''} of the {label} scenarios)."
+    )
+    leader = table[0]
+    name = code(leader["controller"])
+    beats = leader.get("prob_beats_frozen")
+    beaten = (
+        f"beats the optimum that never adapts on {_percent(beats)}"
+        f"{_percent_interval(leader.get('prob_beats_frozen_ci95'))} of trials"
+        if beats is not None
+        else "has no comparison with the optimum that never adapts"
+    )
+    gap = leader.get("gap_closed_iqm")
+    if gap is None:
+        return (
+            f"{worth} No trial is worth {GAP_HEADROOM:g}× or more, so no gap closed is "
+            f"measured; the leader, {name}, {beaten}."
+        )
+    n = leader.get("gap_trials")
+    closed = (
+        f"The leader, {name}, captures {_percent(gap)}"
+        f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of it (gap closed "
+        "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: "
+        f"its IQM over the {n} trials worth {GAP_HEADROOM:g}× or more) and {beaten}"
+    )
+    rows = [r for r in table if r.get("gap_closed_iqm") is not None]
+    best = max(rows, key=lambda r: (r["gap_closed_iqm"], -table.index(r)))
+    if best is not leader:
+        closed += (
+            f"; {code(best['controller'])} captures the most, {_percent(best['gap_closed_iqm'])}"
+        )
+    return f"{worth} {closed}."
+
+
 def verdict(
     board: Sequence[Mapping[str, Any]],
     episodes: Sequence[Mapping[str, Any]],
     code: Callable[[str], str] = md_code,
 ) -> str | None:
     """The two sentences (module doc) from ``board`` (``aggregate.json`` rows) and the run's
-    ``episodes`` (dicts with ``controller``, ``scenario``, ``termination_reason`` and
-    ``cost``); ``code`` writes a controller or scenario name (default: a Markdown code span;
+    ``episodes`` (dicts with ``controller``, ``scenario``, ``seed``, ``termination_reason``
+    and ``cost``), and two more with both references' episodes (:func:`gap_sentences`);
+    ``code`` writes a controller or scenario name (default: a Markdown code span;
     :func:`plain_name` for HTML).  None without a ranking."""
     table = main_table(board)
     if not table:
         return None
-    return f"{lead_sentence(table, code)} {failure_sentence(table, episodes, code)}"
+    text = f"{lead_sentence(table, code)} {failure_sentence(table, episodes, code)}"
+    gap = gap_sentences(table, episodes, code)
+    return f"{text} {gap}" if gap else text
 
 
 def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_code) -> str | None:
@@ -260,6 +334,7 @@ def recorded_verdict(markdown: Path) -> str | None:
 __all__ = [
     "failure_sentence",
     "folder_verdict",
+    "gap_sentences",
     "lead_sentence",
     "main_table",
     "md_code",

@@ -219,3 +219,67 @@ def test_a_big_family_is_split_over_panels() -> None:
     ]
     assert all(len(members) <= figures.PANEL_CONTROLLERS for _, members in panels)
     assert sorted(n for _, members in panels for n in members) == sorted(names)
+
+
+def test_both_references_are_drawn_in_every_column(tmp_path: Path) -> None:
+    """The frozen optimum's episode beside the oracle's in each column, in its own colour
+    and line, labelled; it has no column of its own and does not set the shared scale (a
+    references column, with its own scale, would fit it)."""
+    drawn = {
+        "pid_los": DrawnEpisode(10003, trajectory(5.0), None),
+        "lqr": DrawnEpisode(10003, trajectory(3.0), None),
+        "oracle": DrawnEpisode(10003, trajectory(0.5), None),
+        "oracle_frozen": DrawnEpisode(10003, trajectory(400.0), None),  # spins far away
+    }
+    path = np.array([[0.0, 0.0], [240.0, 0.0]])
+    png, svgz = plot_scenario(
+        tmp_path, "s", drawn, change_time=60.0, path_xy=path, ship_length=3.25, vector=True
+    )
+    root = parse(svgz).getroot()
+    for name in ("oracle", "oracle_frozen"):
+        assert len([g for g in root.iter(f"{SVG}g") if g.get("id") == f"{name}/track"]) == 2
+    assert stroke(svgz, "oracle_frozen/track") == controller_style("oracle_frozen").color
+    assert stroke(svgz, "oracle_frozen/track") != stroke(svgz, "oracle/track")
+    text = svg_text(svgz)
+    assert text.count("oracle_frozen (seed 10003), never adapts") == 2
+    assert text.count("oracle (seed 10003), the reference") == 2
+    with Image.open(png) as image:
+        legends = json.loads(image.text[LEGEND_KEY])
+    assert [title for title, _ in legends] == ["PID", "LQR"]
+    assert all(("oracle_frozen", "oracle_frozen (seed 10003), never adapts") in [
+        tuple(e) for e in entries] for _, entries in legends)  # fmt: skip
+    # the shared scale fits the oracle and the controllers (e ≤ 5 m), not the frozen
+    # optimum's 400 m
+    ticks = {t.text.strip() for t in root.iter(f"{SVG}text") if (t.text or "").strip()}
+    assert "5" in ticks and not {"300", "400"} & ticks
+
+
+def test_the_ranking_figure_marks_the_frozen_optimum(tmp_path: Path) -> None:
+    """A dash-dotted line on each cost-ratio panel at the frozen optimum's IQM and geometric
+    mean of C_frozen / C_oracle over the split's trials, labelled; none without it."""
+    episodes = [
+        {"scenario": s, "controller": c, "kind": k, "seed": seed, "cost": r + seed % 3}
+        for s in ("a", "b")
+        for seed in (10000, 10001, 10002)
+        for c, k, r in (
+            ("oracle", "reference", 8.0),
+            ("oracle_frozen", "reference", 24.0),
+            ("pid_los", "classical", 10.0),
+            ("lqr", "classical", 12.0),
+        )
+    ]
+    splits = {"a": "catalogue", "b": "catalogue"}
+    aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
+    assert {r["controller"] for r in aggregate} == {"pid_los", "lqr"}
+    files = plot_ranking(tmp_path, aggregate, episodes, splits, vector=True)
+    ratios = np.array([(24.0 + k) / (8.0 + k) for k in (1, 2, 0)] * 2)  # seeds 10000-10002
+    marks = figures.frozen_marks(ratios)
+    assert marks["cost_ratio_gmean"] == pytest.approx(np.exp(np.mean(np.log(ratios))))
+    text = svg_text(files[1])
+    for key in ("cost_ratio_iqm", "cost_ratio_gmean"):
+        assert stroke(files[1], f"oracle_frozen/{key}") == controller_style("oracle_frozen").color
+        assert f"optimum that never adapts ({marks[key]:.2f})" in text
+    assert "oracle_frozen" in svg_text(files[3])  # its profile among the references
+    without = [e for e in episodes if e["controller"] != "oracle_frozen"]
+    files = plot_ranking(tmp_path / "bare", aggregate, without, splits, vector=True)
+    assert "optimum that never adapts" not in svg_text(files[1])

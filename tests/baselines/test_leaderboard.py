@@ -42,6 +42,13 @@ AGGREGATE_KEYS = {
     "prob_improvement_over_pid_los_ci95",
     "failure_rate",
     "failure_rate_ci95",
+    "adaptation_gain_gmean",
+    "adaptation_gain_gmean_ci95",
+    "prob_beats_frozen",
+    "prob_beats_frozen_ci95",
+    "gap_closed_iqm",
+    "gap_closed_iqm_ci95",
+    "gap_trials",
 }
 #: the stand-in oracle's cost: this fraction of pid_los's on the same trial
 STAND_IN = 0.8
@@ -558,3 +565,64 @@ def test_a_copy_of_a_catalogue_scenario_is_that_scenario(tmp_path: Path) -> None
     assert list(scenarios) == ["nominal", "rudder_aging"]
     record = suite_record(spec, ["pid_los"], scenarios, [10_000], {"pid_los": [None]})
     assert "scenario_files" not in record  # grouped with the catalogue
+
+
+#: the stand-in frozen optimum's cost: this factor times pid_los's on the same trial (so the
+#: headroom is FROZEN / STAND_IN = 2.5 on every trial)
+FROZEN = 2.0
+
+
+def with_stand_in_references(run_folder: Path, out: Path) -> Path:
+    """:func:`with_stand_in_oracle`'s record with a stand-in ``oracle_frozen`` too (kind
+    reference): each pid_los episode again, its cost × :data:`FROZEN`; the report of it in
+    ``out / "gap"``, whose folder is returned."""
+    from shipgym_baselines.report import write_report
+
+    with_stand_in_oracle(run_folder, out)
+    record = out / "record"
+    run_json = json.loads((record / "run.json").read_text())
+    entry = {"name": "oracle_frozen", "controller": "oracle_frozen", "kind": "reference"}
+    run_json["suite"]["controllers"].append({**entry, "training_seeds": [None]})
+    (record / "run.json").write_text(json.dumps(run_json))
+    lines = (record / "episodes.jsonl").read_text().splitlines()
+    for line in list(lines):
+        episode = json.loads(line)
+        if episode["controller"] == "pid_los":
+            frozen = {**episode, "controller": "oracle_frozen", "kind": "reference"}
+            lines.append(json.dumps({**frozen, "cost": FROZEN * episode["cost"]}))
+    (record / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    write_report([record], out / "gap")
+    return out / "gap"
+
+
+def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_path: Path) -> None:
+    """With both references: aggregate.json's gap fields, scenario_scores.json's headroom,
+    the headroom table after the ranking and the verdict's two more sentences."""
+    import math
+
+    from shipgym_baselines.leaderboard import terminal_summary
+
+    gap = with_stand_in_references(randomised, tmp_path)
+    (pid,) = json.loads((gap / "aggregate.json").read_text())  # oracle_frozen is not ranked
+    assert set(pid) == AGGREGATE_KEYS and pid["controller"] == "pid_los"
+    assert pid["adaptation_gain_gmean"] == pytest.approx(FROZEN)
+    assert pid["adaptation_gain_gmean_ci95"] == pytest.approx([FROZEN, FROZEN])
+    assert pid["prob_beats_frozen"] == 1.0 and pid["gap_trials"] == 6
+    closed = math.log(FROZEN) / math.log(FROZEN / STAND_IN)  # log 2 / log 2.5 = 0.756
+    assert pid["gap_closed_iqm"] == pytest.approx(closed)
+    for entry in json.loads((gap / "scenario_scores.json").read_text()):
+        assert entry["headroom"] == pytest.approx(FROZEN / STAND_IN)
+        assert entry["oracle_frozen_cost"] == pytest.approx(entry["oracle_cost"] * 2.5)
+    text = (gap / "leaderboard.md").read_text()
+    assert "Knowing the change is worth 2.50× here" in text.split("\n\n")[1]  # the verdict
+    assert "captures 75.6 % [75.6 %, 75.6 %] of it" in text
+    ranking, _ = text.split("## Cost ratio per scenario", 1)
+    assert "| 2.00 [2.00, 2.00] | 1.00 [1.00, 1.00] | 0.76 [0.76, 0.76] (6) |" in ranking
+    headroom = ranking.split("### Headroom per ship and change family", 1)[1]
+    assert (
+        "| ship | nominal | rudder aging |\n|---|---|---|\n| nomoto2 | 2.50 (3) | 2.50 (3) |"
+        in (headroom)
+    )
+    assert terminal_summary(gap).startswith(text.split("\n\n")[1])
+    html = (gap / "leaderboard.html").read_text()
+    assert 'id="headroom"' in html and "2.500<i>3 trials</i>" in html

@@ -327,3 +327,55 @@ def _order(keys: list[Any]) -> list[int]:
     """The row order a stable ascending sort gives (None last), as the script does."""
     present = sorted((i for i, k in enumerate(keys) if k is not None), key=lambda i: keys[i])
     return present + [i for i, k in enumerate(keys) if k is None]
+
+
+def _with_the_frozen_optimum() -> tuple[list, list, list, list]:
+    """synthetic_tables() with the gap fields, the frozen optimum's costs and a headroom
+    table (rows as headroom_table gives them)."""
+    rows, aggregate, scores = synthetic_tables()
+    for i, r in enumerate(aggregate):
+        r |= {"adaptation_gain_gmean": 1.5 - 0.01 * i, "adaptation_gain_gmean_ci95": [1.3, 1.7]}
+        r |= {"prob_beats_frozen": 0.625, "prob_beats_frozen_ci95": [0.5, 0.75]}
+        r |= {"gap_closed_iqm": 0.375, "gap_closed_iqm_ci95": [0.25, 0.5], "gap_trials": 17}
+    for s in scores:
+        s |= {"oracle_frozen_cost": 240.0, "oracle_frozen_cost_ci95": [200.0, 280.0]}
+        s |= {"headroom": 3.0, "headroom_ci95": [2.5, 3.5]}
+    headroom = [
+        {"ship": "nomoto2", "family": "nominal", "scenarios": ["nominal"], "trials": 10}
+        | {"headroom_gmean": 1.0},
+        {"ship": "nomoto2", "family": "rudder_aging", "scenarios": ["rudder_aging"]}
+        | {"trials": 10, "headroom_gmean": 2.875},
+        {"ship": "mariner", "family": "current_shift", "scenarios": ["mariner_current_shift"]}
+        | {"trials": 1, "headroom_gmean": 1.25},
+    ]
+    return rows, aggregate, scores, headroom
+
+
+def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
+    rows, aggregate, scores, headroom = _with_the_frozen_optimum()
+    text = page(rows, aggregate, scores, headroom=headroom)
+    assert "adaptation gain C_frozen / C" in text and "P(C &lt; C_frozen)" in text
+    assert "0.375<i>[0.250, 0.500]</i><i>17 trials</i>" in text  # the gap closed's cell
+    assert "oracle_frozen cost 240.000" in text  # under each scenario's name
+    assert text.index('id="ranking-catalogue"') < text.index('id="headroom"')
+    table = text[text.index('id="headroom"') :]
+    table = table[: table.index("</table>")]
+    assert "<th" in table and "rudder aging" in table and "current shift" in table
+    assert "2.875<i>10 trials</i>" in table and "1.250<i>1 trial</i>" in table
+    assert table.index(">nomoto2<") < table.index(">mariner<")  # ships in the rows' order
+    assert "maneuverability" not in table  # no column for a family without trials
+    # without the frozen optimum: no gap column, no headroom table, no frozen cost
+    bare = page(*synthetic_tables())
+    assert "C_frozen" not in bare and 'id="headroom"' not in bare
+    assert "oracle_frozen cost" not in bare
+
+
+def test_the_frozen_optimum_has_its_own_legend_swatch() -> None:
+    from shipgym_baselines.pages import _legend_html
+    from shipgym_baselines.style import controller_style
+
+    html = _legend_html([("PID", [("oracle", "o"), ("oracle_frozen", "f"), ("pid_los", "p")])])
+    assert '<span class="kref"></span>o' in html and '<span class="kfrozen"></span>f' in html
+    text = page(*synthetic_tables())
+    grey = controller_style("oracle_frozen").color
+    assert f".kfrozen{{border-top-style:dashed;border-top-color:{grey}}}" in text
