@@ -397,9 +397,9 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("cost_ratio_gmean", "geometric mean", "lower"),
             ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
             ("failure_rate", "failure rate", "lower"),
-            (GAIN, "adaptation gain C_frozen / C", "number"),
+            (GAIN, "adaptation gain", "number"),
             ("prob_beats_frozen", "P(C &lt; C_frozen)", "number"),
-            ("gap_closed_iqm", "gap closed IQM (trials)", "number"),
+            ("gap_closed_iqm", "gap closed IQM", "number"),
     ]  # fmt: skip
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):

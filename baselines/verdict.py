@@ -272,7 +272,7 @@ def gap_sentences(
         )
     n = leader.get("gap_trials")
     closed = (
-        f"The leader, {name}, captures {_percent(gap)}"
+        f"{name}, the leader, captures {_percent(gap)}"
         f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of it (gap closed "
         "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: "
         f"its IQM over the {n} trials worth {GAP_HEADROOM:g}× or more) and {beaten}"

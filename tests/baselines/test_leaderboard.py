@@ -615,7 +615,8 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
         assert entry["oracle_frozen_cost"] == pytest.approx(entry["oracle_cost"] * 2.5)
     text = (gap / "leaderboard.md").read_text()
     assert "Knowing the change is worth 2.50× here" in text.split("\n\n")[1]  # the verdict
-    assert "captures 75.6 % [75.6 %, 75.6 %] of it" in text
+    assert "`pid_los`, the leader, captures 75.6 % [75.6 %, 75.6 %] of it" in text
+    assert len(text.split("\n\n")[1].split(". The ")) == 2  # only the failure sentence opens so
     ranking, _ = text.split("## Cost ratio per scenario", 1)
     assert "| 2.00 [2.00, 2.00] | 1.00 [1.00, 1.00] | 0.76 [0.76, 0.76] (6) |" in ranking
     headroom = ranking.split("### Headroom per ship and change family", 1)[1]

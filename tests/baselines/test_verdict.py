@@ -243,7 +243,7 @@ def test_with_the_frozen_optimum_two_more_sentences_decompose_the_gap() -> None:
     assert (
         " Knowing the change is worth 1.81× here: the cost of `oracle_frozen`, the optimum that "
         "never adapts, over `oracle`'s (geometric mean over the 16 trials of the catalogue "
-        "scenarios). The leader, `nmpc`, captures 28 % [20 %, 35 %] of it (gap closed "
+        "scenarios). `nmpc`, the leader, captures 28 % [20 %, 35 %] of it (gap closed "
         "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: its "
         "IQM over the 4 trials worth 1.2× or more) and beats the optimum that never adapts on "
         "56.2 % [43.8 %, 68.8 %] of trials; `lqr` captures the most, 40 %."
