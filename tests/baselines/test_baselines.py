@@ -57,7 +57,7 @@ def test_leaderboard_writes_tables_with_contract_keys(smoke: tuple[Path, list[di
     for name in ("leaderboard.md", "leaderboard.csv", "leaderboard.json", "generalisation.json"):
         assert (tmp_path / name).is_file()
     on_disk = json.loads((tmp_path / "leaderboard.json").read_text())
-    assert len(on_disk) == len(rows) == 3 * 5  # rudder_aging, mariner_track, heldout:0
+    assert len(on_disk) == len(rows) == 3 * 6  # rudder_aging, mariner_track, heldout:0
     required = {
         "scenario",
         "controller",
