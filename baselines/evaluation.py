@@ -164,7 +164,8 @@ def run_episode(
     Controller compute time is measured here, around each ``act`` call, never by the env:
     ``compute_ms`` [ms] is its mean per step and ``compute_ms_max`` [ms] its maximum.
     ``privileged``: set by :func:`evaluate` / :func:`evaluate_batch` for the built-in
-    ``oracle`` only (:mod:`shipgym_baselines.privileged`): it then reads the true plant.
+    references ``oracle`` and ``oracle_frozen`` only (:mod:`shipgym_baselines.privileged`):
+    they then read the true plant.
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
@@ -224,7 +225,7 @@ def evaluate_batch(
     * a controller given by name or spec is made afresh per episode (as :func:`evaluate`
       does) and each instance's ``act`` is timed on its own.
 
-    One by one (:func:`run_episode`) run the privileged ``oracle`` (it reads its env's
+    One by one (:func:`run_episode`) run the privileged references (they read their env's
     truth) and a non-batch Policy *instance* (one instance cannot act for several
     episodes at once).
     """

@@ -63,9 +63,9 @@ from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
     BASELINE,
     CHANGE_FAMILIES,
-    GAP_HEADROOM,
+    GAIN,
+    HEADROOM_EXPLAINED,
     ORACLE,
-    ORACLE_FROZEN,
     OTHER_FAMILY,
     PARTIAL,
     SCORE_EXPLAINED,
@@ -920,8 +920,6 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
-#: an aggregate row's adaptation gain (None: no frozen optimum's episodes)
-GAIN = "adaptation_gain_gmean"
 #: the ranking tables' columns against the frozen optimum
 GAP_HEADERS = (
     "adaptation gain [95 % CI]",
@@ -990,14 +988,7 @@ def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
     lines = [
         "### Headroom per ship and change family",
         "",
-        f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
-        f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
-        f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials (how many in "
-        "parentheses). 1: adapting is worth nothing. In the ranking: the adaptation gain "
-        "C_frozen / C (geometric mean; above 1: better than the optimum that never adapts), "
-        "P(C < C_frozen) over the trials (ties count half) and the gap closed, "
-        "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
-        f"its IQM over the trials worth {GAP_HEADROOM:g}× or more (how many in parentheses).",
+        HEADROOM_EXPLAINED,
         "",
         "| ship | " + " | ".join(f.replace("_", " ") for f in families) + " |",
         "|---|" + "---|" * len(families),

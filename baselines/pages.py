@@ -53,7 +53,8 @@ from shipgym_baselines.figures import (
 from shipgym_baselines.ranking import (
     BASELINE,
     CHANGE_FAMILIES,
-    GAP_HEADROOM,
+    GAIN,
+    HEADROOM_EXPLAINED,
     ORACLE,
     ORACLE_FROZEN,
     OTHER_FAMILY,
@@ -68,8 +69,6 @@ from shipgym_baselines.style import controller_style
 
 #: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)
 PROB = f"prob_improvement_over_{BASELINE}"
-#: the aggregate rows' adaptation gain (None: no frozen optimum's episodes)
-GAIN = "adaptation_gain_gmean"
 
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
@@ -550,16 +549,7 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
             small = f"<i>{trials} trial{'s' if trials != 1 else ''}</i>"
             tds.append(_Td(f"{_e(text)}{small}", value, _leading_number(text)))
         body.append(tds)
-    note = (
-        f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
-        f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
-        f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials of each ship "
-        "and change family. 1: adapting is worth nothing. In the ranking: the adaptation "
-        "gain C_frozen / C (geometric mean; above 1: better than the optimum that never "
-        "adapts), P(C < C_frozen) over the trials (ties count half) and the gap closed, "
-        "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
-        f"its IQM over the trials worth {GAP_HEADROOM:g}× or more."
-    )
+    note = HEADROOM_EXPLAINED
     return (
         '<h3 id="headroom">Headroom per ship and change family</h3>'
         f'<p class="note">{_e(note)}</p>{_table("headroom", columns, body, compact=True)}'

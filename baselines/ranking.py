@@ -103,6 +103,19 @@ AGGREGATE_FIELDS = (
     "gap_closed_iqm_ci95",
     "gap_trials",
 )
+#: an aggregate row's adaptation gain (None: no frozen optimum's episodes)
+GAIN = "adaptation_gain_gmean"
+#: what the headroom table and the gap columns mean (leaderboard.md and the page)
+HEADROOM_EXPLAINED = (
+    f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
+    f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
+    f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials of each ship "
+    "and change family (how many below). 1: adapting is worth nothing. In the ranking: the "
+    "adaptation gain C_frozen / C (geometric mean; above 1: better than the optimum that "
+    "never adapts), P(C < C_frozen) over the trials (ties count half) and the gap closed, "
+    "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
+    f"its IQM over the trials worth {GAP_HEADROOM:g}× or more."
+)
 #: the gap fields of a row without the frozen optimum's episodes
 NO_GAP: dict[str, Any] = {
     key: None for key in AGGREGATE_FIELDS[AGGREGATE_FIELDS.index("adaptation_gain_gmean") :]

@@ -177,7 +177,7 @@ def table_entry(result: EpisodeResult) -> dict[str, Any]:
     }
 
 
-@functools.lru_cache(maxsize=len(REFERENCES))
+@functools.cache
 def shipped_table(reference: str = ORACLE) -> ReferenceTable:
     """``reference``'s shipped table, loaded once per process."""
     return ReferenceTable.load(reference=reference)

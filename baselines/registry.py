@@ -63,7 +63,7 @@ BUILTIN_MODULES = (
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])
 
-#: what a controller is (SPEC §9b); a "reference" (zero_rudder, random, oracle) is shown on
+#: what a controller is; a "reference" (zero_rudder, random, oracle, oracle_frozen) is shown on
 #: every scenario but never ranked as a competitor
 KINDS = ("classical", "learned", "reference")
 

@@ -169,7 +169,7 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
 
 # --- recorded costs: the leaderboard's first estimate ----------------------------------------
 
-#: the recorded costs (:func:`record_costs`), shipped beside the oracle's reference table
+#: the recorded costs (:func:`record_costs`), shipped beside the references' tables
 COSTS_FILE = Path(__file__).parent / "reference_data" / "leaderboard_costs.json"
 #: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
 LEARNED_SEEDS = 10
@@ -285,7 +285,8 @@ def step_cost(
 ) -> float:
     """The recorded CPU seconds per control step of the time limit of ``job``'s controller
     on ``ship``: its own (by spec), the oracle's computed cost when it does not read its
-    table (``from_table`` False, or the job recomputes), else its kind's median (a plug-in,
+    table (``from_table`` False, or the job recomputes), a privileged reference read from its
+    table at the oracle's table cost unless recorded itself, else its kind's median (a plug-in,
     a trained agent: :data:`FALLBACK_KINDS`; a ship not recorded: the median over ships)."""
     from shipgym_baselines.privileged import grants_truth
     from shipgym_baselines.registry import controller_kind, controller_label
@@ -294,6 +295,9 @@ def step_cost(
     spec = job.controller if isinstance(job.controller, str) else job.controller.controller
     if grants_truth(job.controller) and (job.references == "recompute" or not from_table):
         per_ship = costs["oracle_computed"]
+    elif grants_truth(job.controller) and spec not in costs["cpu_s_per_limit_step"]:
+        # a reference read from its table costs what reading the oracle's does
+        per_ship = costs["cpu_s_per_limit_step"]["oracle"]
     elif spec in costs["cpu_s_per_limit_step"]:
         per_ship = costs["cpu_s_per_limit_step"][spec]
     else:

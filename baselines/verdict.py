@@ -1,4 +1,4 @@
-"""The verdict of a leaderboard run in two sentences, written from the run's own numbers.
+"""The verdict of a leaderboard run in two sentences (four with the frozen optimum).
 
 ``leaderboard.md``, ``leaderboard.html`` and the terminal summary open with them:
 
@@ -244,7 +244,9 @@ def gap_sentences(
 ) -> str | None:
     """Sentences 3 and 4 (module doc) for ``table`` (ranked rows of one split) from the
     episodes' headroom on its scenarios and the rows' gap fields; None without both
-    references' episodes there."""
+    references' episodes on every trial there (the rows' gap fields are None then)."""
+    if table[0].get("gap_trials") is None:
+        return None
     found = gmean_headroom(trial_headroom(episodes), table[0]["scenarios"])
     if found is None:
         return None

@@ -713,6 +713,7 @@ class Oracle:
 
     def __init__(self, settings: OracleSettings | None = None) -> None:
         self.settings = settings if settings is not None else OracleSettings()
+        self._start: PlantTruth | None = None  # the truth at the episode's first step
         if self.settings.tail_speed not in TAIL_SPEEDS:
             raise ValueError(
                 f"tail_speed must be one of {TAIL_SPEEDS}, got {self.settings.tail_speed!r}"
@@ -732,7 +733,7 @@ class Oracle:
         """Start an episode; ``truth()`` returns the :class:`PlantTruth` now."""
         self.ctx = context
         self._truth = truth
-        self._start: PlantTruth | None = None  # the truth at the episode's first step
+        self._start = None  # a new episode: its first truth is captured at the first step
         reward = context.reward
         self.weights = (reward.heading_weight, reward.rudder_weight, reward.rudder_rate_weight)
         self.solver = get_solver(context, self.settings, self.weights)
@@ -813,4 +814,4 @@ class OracleFrozen(Oracle):
 
 
 #: the built-in references that read the true plant, by name
-PRIVILEGED: dict[str, type[Oracle]] = {"oracle": Oracle, "oracle_frozen": OracleFrozen}
+PRIVILEGED: dict[str, type[Oracle]] = {cls.name: cls for cls in (Oracle, OracleFrozen)}

@@ -21,10 +21,10 @@ import time
 from contextlib import closing
 
 from shipgym_baselines.cli.options import add_json_option, emit
-from shipgym_baselines.ranking import ORACLE
+from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
 
 #: the references with a table (:data:`shipgym_baselines.references.REFERENCES`)
-REFERENCES = (ORACLE, "oracle_frozen")
+REFERENCES = (ORACLE, ORACLE_FROZEN)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -106,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
             settings = v.scenario.config.model_dump(mode="json")
             job = Job(ORACLE, v.name, (v.seed,), None, None, settings, references="recompute")
             add(ORACLE, job, v.name, v.seed, v.scenario)
+    if args.validation and ORACLE not in chosen:
+        sys.stderr.write("references: --validation fills the oracle's table only: ignored\n")
     for ref in chosen:
         announce(todo[ref], f"written to {tables[ref].path} after each", ref)
     start = time.perf_counter()

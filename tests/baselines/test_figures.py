@@ -122,20 +122,22 @@ def test_the_figure_says_what_is_drawn_with_units(scenario_files: list[Path]) ->
         assert unit in text
 
 
-def test_a_controller_has_its_colour_in_every_figure(
-    scenario_files: list[Path], tmp_path: Path
-) -> None:
-    episodes = [
+def two_scenario_episodes(*extra: tuple[str, str, float]) -> list[dict]:
+    """Synthetic episodes on scenarios ``a`` and ``b``, seeds 10000–10002: the oracle (cost
+    8), ``extra`` (name, kind, cost), pid_los (10) and lqr (12), each cost plus seed % 3."""
+    rows = (("oracle", "reference", 8.0), *extra, ("pid_los", "classical", 10.0))
+    return [
         {"scenario": s, "controller": c, "kind": k, "seed": seed, "cost": r + seed % 3}
         for s in ("a", "b")
         for seed in (10000, 10001, 10002)
-        for c, k, r in (
-            ("oracle", "reference", 8.0),
-            ("zero_rudder", "reference", 50.0),
-            ("pid_los", "classical", 10.0),
-            ("lqr", "classical", 12.0),
-        )
+        for c, k, r in (*rows, ("lqr", "classical", 12.0))
     ]
+
+
+def test_a_controller_has_its_colour_in_every_figure(
+    scenario_files: list[Path], tmp_path: Path
+) -> None:
+    episodes = two_scenario_episodes(("zero_rudder", "reference", 50.0))
     splits = {"a": "catalogue", "b": "catalogue"}
     aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
     files = plot_ranking(tmp_path, aggregate, episodes, splits, vector=True)
@@ -257,17 +259,7 @@ def test_both_references_are_drawn_in_every_column(tmp_path: Path) -> None:
 def test_the_ranking_figure_marks_the_frozen_optimum(tmp_path: Path) -> None:
     """A dash-dotted line on each cost-ratio panel at the frozen optimum's IQM and geometric
     mean of C_frozen / C_oracle over the split's trials, labelled; none without it."""
-    episodes = [
-        {"scenario": s, "controller": c, "kind": k, "seed": seed, "cost": r + seed % 3}
-        for s in ("a", "b")
-        for seed in (10000, 10001, 10002)
-        for c, k, r in (
-            ("oracle", "reference", 8.0),
-            ("oracle_frozen", "reference", 24.0),
-            ("pid_los", "classical", 10.0),
-            ("lqr", "classical", 12.0),
-        )
-    ]
+    episodes = two_scenario_episodes(("oracle_frozen", "reference", 24.0))
     splits = {"a": "catalogue", "b": "catalogue"}
     aggregate = aggregate_ranking(episodes, splits, {}, reps=50)
     assert {r["controller"] for r in aggregate} == {"pid_los", "lqr"}

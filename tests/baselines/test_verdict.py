@@ -268,3 +268,16 @@ def test_no_trial_worth_the_gap_and_no_frozen_optimum() -> None:
     eps = _with_references(episodes(NAMES, FAILING), 110.0)
     eps = [e for e in eps if e["controller"] != "oracle_frozen"]
     assert verdict(BOARD, eps) == verdict(BOARD, episodes(NAMES, FAILING))
+
+
+def test_a_frozen_optimum_on_some_trials_only_gives_no_gap_sentences() -> None:
+    """A record whose frozen optimum lacks trials (e.g. a report merging a folder without
+    it) has no gap fields (None); the verdict then states no headroom over the trials it
+    happens to cover."""
+    board = [dict(r) for r in BOARD]
+    for r in board:
+        r |= {key: None for key in ("adaptation_gain_gmean", "prob_beats_frozen")}
+        r |= {"gap_closed_iqm": None, "gap_trials": None}
+    eps = _with_references(episodes(NAMES, FAILING), 800.0)
+    eps = [e for e in eps if e["controller"] != "oracle_frozen" or e["scenario"] == "nomoto2_a"]
+    assert verdict(board, eps) == verdict(BOARD, episodes(NAMES, FAILING))

@@ -264,7 +264,6 @@ def test_the_frozen_oracle_predicts_with_the_start_and_the_true_state_now() -> N
         np.ones(model.n_disturbances),
     )
     frozen, oracle = OracleFrozen(), Oracle()
-    frozen._start = oracle._start = None
     for policy in (frozen, oracle):
         policy.predicted_plant(start)
     seen = frozen.predicted_plant(later)
