@@ -62,14 +62,13 @@ from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
     BASELINE,
-    CHANGE_FAMILIES,
     GAIN,
     HEADROOM_EXPLAINED,
     ORACLE,
-    OTHER_FAMILY,
     PARTIAL,
     SCORE_EXPLAINED,
     aggregate_ranking,
+    headroom_grid,
     headroom_table,
     is_partial,
     no_ranking,
@@ -982,9 +981,7 @@ def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
     and its trials; no lines without rows."""
     if not headroom:
         return []
-    order = (*CHANGE_FAMILIES, OTHER_FAMILY)
-    families = sorted({r["family"] for r in headroom}, key=order.index)
-    cells = {(r["ship"], r["family"]): r for r in headroom}
+    ships, families, cells = headroom_grid(headroom)
     lines = [
         "### Headroom per ship and change family",
         "",
@@ -993,7 +990,7 @@ def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
         "| ship | " + " | ".join(f.replace("_", " ") for f in families) + " |",
         "|---|" + "---|" * len(families),
     ]
-    for ship in dict.fromkeys(r["ship"] for r in headroom):
+    for ship in ships:
         row = [md_cell(ship)]
         for family in families:
             found = cells.get((ship, family))

@@ -52,14 +52,13 @@ from shipgym_baselines.figures import (
 )
 from shipgym_baselines.ranking import (
     BASELINE,
-    CHANGE_FAMILIES,
     GAIN,
     HEADROOM_EXPLAINED,
     ORACLE,
     ORACLE_FROZEN,
-    OTHER_FAMILY,
     PARTIAL,
     SCORE_EXPLAINED,
+    headroom_grid,
     is_partial,
     no_ranking,
     resolution_lines,
@@ -530,13 +529,11 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
     over its trials (how many beside it); empty without rows."""
     if not headroom:
         return ""
-    present = {r["family"] for r in headroom}
-    families = [f for f in (*CHANGE_FAMILIES, OTHER_FAMILY) if f in present]
-    cells = {(r["ship"], r["family"]): r for r in headroom}
+    ships, families, cells = headroom_grid(headroom)
     columns = [("ship", "ship", "text")]
     columns += [(f, _e(f.replace("_", " ")), "number") for f in families]
     body = []
-    for ship in dict.fromkeys(r["ship"] for r in headroom):
+    for ship in ships:
         tds = [_text_cell(ship)]
         for family in families:
             found = cells.get((ship, family))
@@ -549,10 +546,10 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
             small = f"<i>{trials} trial{'s' if trials != 1 else ''}</i>"
             tds.append(_Td(f"{_e(text)}{small}", value, _leading_number(text)))
         body.append(tds)
-    note = HEADROOM_EXPLAINED
     return (
         '<h3 id="headroom">Headroom per ship and change family</h3>'
-        f'<p class="note">{_e(note)}</p>{_table("headroom", columns, body, compact=True)}'
+        f'<p class="note">{_e(HEADROOM_EXPLAINED)}</p>'
+        f"{_table('headroom', columns, body, compact=True)}"
     )
 
 

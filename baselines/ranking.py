@@ -782,6 +782,18 @@ def headroom_table(
     return rows
 
 
+def headroom_grid(
+    headroom: Sequence[Mapping[str, Any]],
+) -> tuple[list[str], list[str], dict[tuple[str, str], Mapping[str, Any]]]:
+    """The layout of :func:`headroom_table`'s rows as a table: the ships in row order, the
+    families present in :data:`CHANGE_FAMILIES` order (then :data:`OTHER_FAMILY`) and the
+    row of each (ship, family)."""
+    present = {r["family"] for r in headroom}
+    families = [f for f in (*CHANGE_FAMILIES, OTHER_FAMILY) if f in present]
+    ships = list(dict.fromkeys(r["ship"] for r in headroom))
+    return ships, families, {(r["ship"], r["family"]): r for r in headroom}
+
+
 def performance_profiles(
     episodes: Sequence[Mapping[str, Any]],
     splits: Mapping[str, str],
