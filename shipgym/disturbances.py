@@ -312,6 +312,7 @@ class Disturbances:
         self._x_speed = np.zeros(self.batch)  # speed deviation at the last sample [m/s]
         self._x_dir = np.zeros(self.batch)  # direction deviation [rad]
         self._zi = np.zeros((self.batch, 2))  # wave filter state (lfilter's DF-II-T)
+        self._wave_last = np.zeros(self.batch)  # yaw_disturbance's wave load at the last sample
 
     @property
     def steady_from(self) -> float:
@@ -369,6 +370,15 @@ class Disturbances:
             y1, y2, eps = self._wave_root @ z[k : k + 3]
             b1, a1, a2 = self._wave_b[1], self._wave_a[1], self._wave_a[2]
             self._zi[i] = (b1 * eps - a1 * y1 - a2 * y2, -a2 * y1)
+            self._wave_last[i] = 0.0
+
+    def wave_row(self, i: int = 0) -> np.ndarray:
+        """(n_w,) ship i's wave load in its last filled sample: its part of
+        ``yaw_disturbance`` (zero elsewhere, and without waves or before the first fill)."""
+        row = np.zeros(self._n_w)
+        if self._waves is not None:
+            row[self._cols["yaw_disturbance"]] = self._wave_last[i]
+        return row
 
     def draw(self, rng: np.random.Generator) -> np.ndarray | None:
         """One ship's standard-normal noise of one period, (n_noise, n_sub), or None."""
@@ -421,6 +431,7 @@ class Disturbances:
                     self._wave_b, self._wave_a, noise[:, ch], axis=-1, zi=self._zi[rows]
                 )
                 yaw = self._wave_gain * y
+                self._wave_last[rows] = yaw[:, -1]
             if self._k_bias:
                 yaw = yaw + self._k_bias * speed
             block[rows, :, self._cols["yaw_disturbance"]] = yaw

@@ -456,13 +456,16 @@ class ShipPathFollowEnv(gym.Env):
         sc = self.scenario
         if self._disturbances.time_varying and self._step_count > 0:
             now = self._w_block[-1].copy()  # the last substep's disturbances
+            waves = self._disturbances.wave_row()
         else:
             now = self._disturbances.mean_rows(np.array([self._t]))[0]
+            waves = np.zeros_like(now)
         return PlantTruth(
             t=self._t,
             state=self._state.copy(),
             params=sc.schedule.record_at(self._t),
             disturbance_now=now,
+            wave_now=waves,
         )
 
     @property

@@ -12,6 +12,8 @@ It is causal: the plant *now*, never its future.
 * ``state``: the true plant state (SI, rad).
 * ``disturbance_now``: the disturbances acting now (the current, the wave load and the yaw
   bias); never the scheduled current ahead.
+* ``wave_now``: the wave load's part of ``disturbance_now`` (zero without waves): a
+  zero-mean load that oscillates with the sea's period (seconds), unlike the current.
 """
 
 from __future__ import annotations
@@ -31,3 +33,12 @@ class PlantTruth:
     state: np.ndarray  # (n_x,) true state, SI / rad
     params: ParameterRecord  # the true parameters acting at t
     disturbance_now: np.ndarray  # (n_w,) disturbances acting at t, model.disturbance_names
+    wave_now: np.ndarray | None = None  # (n_w,) the wave load's part of it (None: no waves)
+
+    @property
+    def without_waves(self) -> np.ndarray:
+        """(n_w,) the disturbances acting now less the wave load: the current and the yaw
+        bias as they act now."""
+        return (
+            self.disturbance_now if self.wave_now is None else self.disturbance_now - self.wave_now
+        )

@@ -19,14 +19,17 @@ from shipgym.envs.truth import PlantTruth
 from shipgym.scenarios import load_scenario
 from shipgym_baselines.classical.oracle import (
     LAST_LEG,
+    TAIL_TERMS,
     Oracle,
     OracleFrozen,
     OracleSettings,
     OracleSolver,
+    _approach_function,
     block_lengths,
     growth_ratio,
     horizon_seconds,
     oracle_grid,
+    predicted_disturbances,
     remaining_path,
     shifted_plan,
     speed_over_ground,
@@ -219,18 +222,92 @@ def test_the_tail_speed_is_the_true_speed_over_ground_now() -> None:
         Oracle(OracleSettings(tail_speed="predicted"))
 
 
+def test_the_approach_residual_is_the_course_error_to_a_look_ahead_guidance() -> None:
+    """χ̃_N + atan(e_N/Δ) from the last control period's displacement, to the active leg
+    (x north, y east; leg 0 north from the origin, Δ = 2 m): 1 m east of it (e = +1,
+    starboard) moving north: atan(1/2); arriving there on the look-ahead course
+    −atan(1/2): 0; with leg 0's latch set, to leg 1 (east from (100, 0)): 3 m south of it
+    (e = +3) moving east: atan(3/2)."""
+    model = load_scenario("nominal").model
+    n_legs = 2
+    approach = _approach_function(model, n_legs, 2.0)
+    legs = np.array([0.0, 0.0, 1.0, 0.0, 100.0, 100.0, 0.0, 0.0, 1.0, 100.0])
+    ix, iy = model.state_index("x"), model.state_index("y")
+
+    def state(x: float, y: float, done: float) -> np.ndarray:
+        xa = np.zeros(model.n_states + n_legs - 1)
+        xa[ix], xa[iy], xa[-1] = x, y, done
+        return xa
+
+    def value(before: np.ndarray, after: np.ndarray) -> float:
+        return float(approach(before, after, legs))
+
+    assert value(state(10.0, 1.0, 0.0), state(11.0, 1.0, 0.0)) == pytest.approx(math.atan(0.5))
+    course = -math.atan(0.5)
+    before = state(11.0 - math.cos(course), 1.0 - math.sin(course), 0.0)
+    assert value(before, state(11.0, 1.0, 0.0)) == pytest.approx(0.0, abs=1e-12)
+    assert value(state(97.0, 5.0, 1.0), state(97.0, 6.0, 1.0)) == pytest.approx(math.atan(1.5))
+
+
+def test_the_tail_weighs_the_approach_or_the_terminal_stage() -> None:
+    """``approach`` (revision 5): the approach residual w_ψ·N_tail, the terminal stage cost
+    its own; ``stage`` (revisions 2–4): the terminal |e|/L and w_ψ|ψ̃| (1 + N_tail) times."""
+    ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
+    weights = (ctx.reward.heading_weight, ctx.reward.rudder_weight, ctx.reward.rudder_rate_weight)
+    for terms in TAIL_TERMS:
+        settings = OracleSettings(tail_terms=terms)
+        solver = OracleSolver(
+            ctx.nominal_model,
+            oracle_grid(ctx, settings),
+            settings,
+            ctx.control_period,
+            ctx.rudder_limit,
+            weights,
+            ctx.ship_length,
+        )
+        base = solver.weight.copy()
+        solver.set_tail(50.0)
+        changed = np.flatnonzero(solver.weight != base)
+        if terms == "approach":
+            assert changed.tolist() == [solver.n_z - 1]
+            assert solver.weight[-1] == pytest.approx(weights[0] * 50.0)
+        else:
+            assert changed.tolist() == solver._terminal.tolist()
+            assert np.allclose(solver.weight[changed], 51.0 * base[changed])
+    with pytest.raises(ValueError, match="tail_terms must be one of"):
+        Oracle(OracleSettings(tail_terms="offset"))
+
+
+def test_the_prediction_holds_the_disturbances_now_and_the_waves_at_their_mean() -> None:
+    """``mean`` (revision 5): the disturbances acting now over the applied interval, after
+    it the current and the yaw bias as they act now and the wave load at 0; ``held``
+    (revision 4): those acting now throughout, the wave load too."""
+    now, waves = np.array([0.1, 0.2, 3e-4]), np.array([0.0, 0.0, 2e-4])
+    truth = PlantTruth(0.0, np.zeros(3), None, now, waves)  # type: ignore[arg-type]
+    rows = predicted_disturbances(OracleSettings(), truth, 4)
+    assert np.array_equal(rows[0], now)
+    assert np.allclose(rows[1:], np.tile([0.1, 0.2, 1e-4], (3, 1)), rtol=0, atol=1e-15)
+    held = predicted_disturbances(OracleSettings(wave_forecast="held"), truth, 4)
+    assert np.array_equal(held, np.tile(now, (4, 1)))
+    calm = dataclasses.replace(truth, wave_now=None)
+    assert np.array_equal(predicted_disturbances(OracleSettings(), calm, 4), np.tile(now, (4, 1)))
+    with pytest.raises(ValueError, match="wave_forecast must be one of"):
+        Oracle(OracleSettings(wave_forecast="forecast"))
+
+
 #: the oracle of revision 3 (main a27de38), cost on catalogue trials without a current, seed 0
 REVISION_3_COSTS = {"maneuverability_change": 36.49362870705069, "rudder_aging": 22.295715849395073}
 
 
 @pytest.mark.parametrize("scenario", sorted(REVISION_3_COSTS))
 def test_the_causal_oracle_equals_revision_3_without_a_current(scenario: str) -> None:
-    """Revision 4 differs from 3 in two things: the disturbances held over the horizon
-    instead of the scheduled current ahead (the same on a trial without a current) and the
-    tail's speed (``tail_speed = "cruise"`` is revision 3's).  With revision 3's tail it
+    """Revisions 4 and 5 differ from 3 in the disturbances predicted (the current acting
+    now instead of the scheduled current ahead: the same on a trial without a current or
+    waves) and in the tail (its speed, ``tail_speed = "cruise"`` is revision 3's; its
+    terms, ``tail_terms = "stage"`` is revisions 2–4's).  With revision 3's tail it
     reproduces revision 3's cost to 1e-9."""
     sc = load_scenario(scenario)
-    settings = OracleSettings(tail_speed="cruise")
+    settings = OracleSettings(tail_speed="cruise", tail_terms="stage")
     result = run_episode(Oracle(settings), sc, seed=0, privileged=True)
     assert result.metrics["cost"] == pytest.approx(REVISION_3_COSTS[scenario], rel=1e-9)
 

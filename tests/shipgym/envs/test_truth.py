@@ -48,6 +48,7 @@ def test_the_truth_is_causal_it_holds_the_current_now_never_the_switch_ahead() -
         "state",
         "params",
         "disturbance_now",
+        "wave_now",
     ]
     assert np.allclose(truth.disturbance_now, dist.constant_row())
     _run_to(env, 149.0)
@@ -55,3 +56,21 @@ def test_the_truth_is_causal_it_holds_the_current_now_never_the_switch_ahead() -
     _run_to(env, 200.0)
     late = env.unwrapped.plant_truth()
     assert np.hypot(*late.disturbance_now[:2]) == pytest.approx(0.5)
+
+
+def test_the_truth_separates_the_wave_load_now() -> None:
+    """On a sea with waves (mariner_track, no current) the yaw disturbance acting now is
+    the wave load: ``wave_now`` is all of it, and nothing is left without the waves; on a
+    calm sea ``wave_now`` is zero."""
+    env = gym.make("ShipPathFollow-v0", scenario="mariner_track")
+    env.reset(seed=0)
+    _run_to(env, 20.0)
+    truth = env.unwrapped.plant_truth()
+    yaw = env.unwrapped.model.disturbance_names.index("yaw_disturbance")
+    assert truth.disturbance_now[yaw] != 0.0
+    assert np.array_equal(truth.wave_now, truth.disturbance_now)
+    assert not np.any(truth.without_waves)
+    calm = gym.make("ShipPathFollow-v0", scenario="blanke_current_shift")
+    calm.reset(seed=0)
+    _run_to(calm, 20.0)
+    assert not np.any(calm.unwrapped.plant_truth().wave_now)
