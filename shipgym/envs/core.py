@@ -222,9 +222,7 @@ def observation_space(context_features: bool = False, history_steps: int = 0) ->
 
 def observation_names(context_features: bool = False, history_steps: int = 0) -> tuple[str, ...]:
     """The names of the observation's entries, in order."""
-    return (
-        OBS_NAMES + (CONTEXT_NAMES if context_features else ()) + history_names(history_steps)
-    )
+    return OBS_NAMES + (CONTEXT_NAMES if context_features else ()) + history_names(history_steps)
 
 
 def observation_size(context_features: bool = False, history_steps: int = 0) -> int:

@@ -157,9 +157,7 @@ class TrialRowsVectorEnv(VectorEnv):
         self.context_features = context_features
         #: K: the observation ends with the last K control steps (as the single env)
         self.history_steps = history_steps
-        self._history = (
-            core.ObservationHistory(num_envs, history_steps) if history_steps else None
-        )
+        self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
         self.render_mode = None
         self.single_observation_space = self._parts.observation_space
         self.single_action_space = self._parts.action_space

@@ -83,9 +83,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self.context_features = context_features
         #: K: then the last K control steps (as the single env)
         self.history_steps = history_steps
-        self._history = (
-            core.ObservationHistory(num_envs, history_steps) if history_steps else None
-        )
+        self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
         self.num_envs = num_envs
         self.scenario = sc
         self.action_mode = action_mode
