@@ -60,10 +60,16 @@ def is_pickled(value: Any) -> bool:
 
 
 def load_data_only(
-    path: Path, algorithm: type, action_mode: str, context_features: bool = False
+    path: Path,
+    algorithm: type,
+    action_mode: str,
+    context_features: bool = False,
+    history_steps: int = 0,
 ) -> Any:
     """The SB3 model of the zip ``path`` saved by ``algorithm`` (an SB3 / sb3-contrib
-    class), built without unpickling, on the CPU, for the env's spaces in ``action_mode``."""
+    class), built without unpickling, on the CPU, for the env's spaces in ``action_mode``
+    (the observation with the context features and ``history_steps`` steps of history as
+    the model was trained)."""
     import torch
 
     with zipfile.ZipFile(path) as archive:
@@ -83,7 +89,8 @@ def load_data_only(
     if not isinstance(kwargs, dict) or is_pickled(kwargs):
         raise refuse_unpickling(path, "its policy_kwargs hold pickled objects")
     kwargs = {k: v for k, v in kwargs.items() if k != "device"}
-    obs_space, act_space = observation_space(context_features), action_space(action_mode)
+    obs_space = observation_space(context_features, history_steps)
+    act_space = action_space(action_mode)
     for key, space in (("observation_space", obs_space), ("action_space", act_space)):
         _check_bounds(path, key, data.get(key), space)
     model = algorithm(alias, env=None, device="cpu", _init_setup_model=False)
