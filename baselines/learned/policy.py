@@ -18,7 +18,10 @@ folder ``results/agents/<name>/seed_<k>/`` alike): its name means all of them
 one training seed, the ``seed`` of its ``meta.json`` (None without one).
 
 The policy sees exactly what the env's observation holds (measurements, no plant
-parameters, no schedule) and acts deterministically.  Recurrent agents (RecurrentPPO) keep
+parameters, no schedule) and acts deterministically.  A model trained with the context
+features or with ``history_steps=K`` (its ``meta.json``'s ``history_steps``) gets them
+appended to the env's plain observation by the policy, the window kept per episode by the
+envs' own :class:`~shipgym.envs.core.ObservationHistory`.  Recurrent agents (RecurrentPPO) keep
 their LSTM state within an episode and start afresh at every ``reset``.
 
 **Batched and one-by-one actions are the same bits.**  The network always runs on a batch

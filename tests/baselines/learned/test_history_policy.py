@@ -207,3 +207,20 @@ def test_the_training_envs_observe_the_config_s_history() -> None:
         venv.close()
     evaluation = make_eval_env(_config().eval, "rudder", 0, history_steps=k)
     assert evaluation.observation_space.shape == (core.observation_size(False, k),)
+
+
+def test_a_window_of_more_than_1000_entries_loads(tmp_path: Path) -> None:
+    """SB3 records the bounds as numpy prints them, elided beyond 1000 entries: a model of
+    a long window still loads, as data, and acts."""
+    k = 150
+    env = gym.make(ENV_ID, history_steps=k)
+    model = sb3.PPO("MlpPolicy", env, policy_kwargs={"net_arch": [4]}, device="cpu", seed=0)
+    folder = tmp_path / "long"
+    folder.mkdir()
+    model.save(folder / "model.zip")
+    (folder / "meta.json").write_text(json.dumps({"history_steps": k}))
+    policy = LearnedPolicy(folder)
+    assert policy.observation_width == core.observation_size(False, k) > 1000
+    obs, _ = gym.make(ENV_ID).reset(seed=0)
+    policy.reset(env.unwrapped.controller_context)
+    assert policy.act(obs, {}).shape == (1,)
