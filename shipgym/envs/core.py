@@ -535,8 +535,14 @@ class ObservationHistory:
     def update(self, obs: np.ndarray, rows: Any = None) -> np.ndarray:
         """The windows after the marked events, given the rows' new observations ``obs``
         (one row each, of ``rows``: indices, None for all); returns those rows' windows."""
-        idx = np.arange(len(self.window)) if rows is None else np.asarray(rows, dtype=np.intp)
         base = np.asarray(obs)[:, : len(OBS_NAMES)]
+        if rows is None and self._stepped.all() and not self._restart.any():
+            # every row stepped (a training env's usual step): no gathers
+            self.window = history_window(self.window, self._last, base)
+            self._last = base.astype(np.float32, copy=True)
+            self._stepped[:] = False
+            return self.window
+        idx = np.arange(len(self.window)) if rows is None else np.asarray(rows, dtype=np.intp)
         start = self._restart[idx]
         step = self._stepped[idx] & ~start
         if step.any():
