@@ -13,7 +13,7 @@ import inspect
 import os
 from typing import Any, Literal
 
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, StrictInt, ValidationInfo, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
 from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
@@ -34,6 +34,9 @@ class AgentEnvConfig(StrictModel):
     normalize_reward: bool = True  # VecNormalize(norm_obs=False): the obs is already scaled
     #: append the controller-context features to the observation (core.CONTEXT_NAMES)
     context_features: bool = False
+    #: K: append the last K control steps of (measurements, applied rudder command) to the
+    #: observation (core.ObservationHistory; docs/observation.md); 0: none
+    history_steps: StrictInt = Field(0, ge=0)
     #: discount in physical time: γ = exp(−Ts/τ) per ship with τ = gamma_seconds [s]
     #: (PPO and RecurrentPPO on vec_env batched over a distribution); None: hyperparams.gamma
     gamma_seconds: float | None = Field(None, gt=0)
@@ -191,7 +194,12 @@ def algo_class(algo: str) -> type:
     return classes[algo]
 
 
-def _single_env_factory(source: dict[str, Any], action_mode: str, context_features: bool = False):
+def _single_env_factory(
+    source: dict[str, Any],
+    action_mode: str,
+    context_features: bool = False,
+    history_steps: int = 0,
+):
     def make() -> Any:
         import gymnasium as gym
 
@@ -203,12 +211,14 @@ def _single_env_factory(source: dict[str, Any], action_mode: str, context_featur
                 scenario=source["scenario"],
                 action_mode=action_mode,
                 context_features=context_features,
+                history_steps=history_steps,
             )
         return gym.make(
             shipgym.RANDOMIZED_ENV_ID,
             distribution=source["distribution"],
             action_mode=action_mode,
             context_features=context_features,
+            history_steps=history_steps,
         )
 
     return make
@@ -236,7 +246,12 @@ def make_ship_envs(config: AgentEnvConfig) -> list[Any]:
     counts = ship_env_counts(config.n_envs, len(dist.config.ships))
     return [
         ShipTrialsVectorEnv(
-            n, dist, k, config.action_mode, context_features=config.context_features
+            n,
+            dist,
+            k,
+            config.action_mode,
+            context_features=config.context_features,
+            history_steps=config.history_steps,
         )
         for k, n in enumerate(counts)
     ]
@@ -260,6 +275,7 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
                 config.scenario,
                 config.action_mode,
                 context_features=config.context_features,
+                history_steps=config.history_steps,
             )
         )
     else:
@@ -267,6 +283,7 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
             {"scenario": config.scenario, "distribution": config.distribution},
             config.action_mode,
             config.context_features,
+            config.history_steps,
         )
         cls = SubprocVecEnv if config.vec_env == "subproc" and config.n_envs > 1 else DummyVecEnv
         venv = cls([factory] * config.n_envs)
@@ -275,14 +292,18 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
 
 
 def make_eval_env(
-    config: EvalConfig, action_mode: str, seed: int, context_features: bool = False
+    config: EvalConfig,
+    action_mode: str,
+    seed: int,
+    context_features: bool = False,
+    history_steps: int = 0,
 ) -> Any:
     """One env cycling through the validation scenarios in order, seeded (reproducible
     model selection)."""
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     factory = _single_env_factory(
-        {"distribution": config.distribution}, action_mode, context_features
+        {"distribution": config.distribution}, action_mode, context_features, history_steps
     )
     venv = DummyVecEnv([factory])
     venv.seed(seed)

@@ -23,7 +23,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from shipgym.config import validate_model
-from shipgym.envs.core import observation_names
+from shipgym.envs.core import HISTORY_WIDTH, observation_names
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.trust import pickle_trusted, refuse_unpickling
 
@@ -59,10 +59,14 @@ class ObsNormalizer(BaseModel):
     @field_validator("mean", "var")
     @classmethod
     def _length(cls, value: list[float]) -> list[float]:
-        if len(value) not in OBSERVATION_SIZES:
+        if not any(
+            len(value) >= size and (len(value) - size) % HISTORY_WIDTH == 0
+            for size in OBSERVATION_SIZES
+        ):
             raise ValueError(
                 f"{len(value)} entries: the observation has {OBSERVATION_SIZES[0]}, "
-                f"or {OBSERVATION_SIZES[1]} with the context features"
+                f"or {OBSERVATION_SIZES[1]} with the context features, plus {HISTORY_WIDTH} "
+                "per step of history (history_steps)"
             )
         return value
 

@@ -18,7 +18,10 @@ folder ``results/agents/<name>/seed_<k>/`` alike): its name means all of them
 one training seed, the ``seed`` of its ``meta.json`` (None without one).
 
 The policy sees exactly what the env's observation holds (measurements, no plant
-parameters, no schedule) and acts deterministically.  Recurrent agents (RecurrentPPO) keep
+parameters, no schedule) and acts deterministically.  A model trained with the context
+features or with ``history_steps=K`` (its ``meta.json``'s ``history_steps``) gets them
+appended to the env's plain observation by the policy, the window kept per episode by the
+envs' own :class:`~shipgym.envs.core.ObservationHistory`.  Recurrent agents (RecurrentPPO) keep
 their LSTM state within an episode and start afresh at every ``reset``.
 
 **Batched and one-by-one actions are the same bits.**  The network always runs on a batch
@@ -45,11 +48,17 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, model_validator
 
 from shipgym.config import validate_model
 from shipgym.envs.context import ControllerContext
-from shipgym.envs.core import OBS_NAMES, observation_names
+from shipgym.envs.core import (
+    HISTORY_WIDTH,
+    OBS_NAMES,
+    ObservationHistory,
+    check_history_steps,
+    observation_size,
+)
 from shipgym_baselines.errors import ControllerError, UnsafeFileError
 from shipgym_baselines.learned.loading import load_data_only
 from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
@@ -130,7 +139,9 @@ class PolicyMeta(BaseModel):
 
     ``name``: the policy's name; ``algo``: one of :data:`ALGORITHMS` (must be the zip's);
     ``action_mode``: must be the zip's; ``env_steps`` and ``wall_time_s`` [s]: the training
-    cost, both or neither; ``seed``: the training seed.
+    cost, both or neither; ``seed``: the training seed; ``history_steps``: the K control
+    steps of history the model observes (the training env's ``history_steps``; absent: 0,
+    or the ``config.env.history_steps`` that ``shipgym train`` records).
     """
 
     model_config = ConfigDict(extra="allow", frozen=True)
@@ -141,6 +152,7 @@ class PolicyMeta(BaseModel):
     env_steps: int | None = Field(None, ge=0)
     wall_time_s: float | None = Field(None, ge=0)
     seed: int | None = Field(None, ge=0)
+    history_steps: StrictInt | None = Field(None, ge=0)
 
     @model_validator(mode="after")
     def _cost_complete(self) -> PolicyMeta:
@@ -159,6 +171,8 @@ class SavedModel:
     action_mode: str
     #: it observes the controller-context features too (trained with context_features)
     context_features: bool = False
+    #: K: it observes the last K control steps too (trained with history_steps)
+    history_steps: int = 0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -262,16 +276,16 @@ def _folder_label(path: Path) -> str:
     return f"{path.parent.name}/{path.name}" if SEED_FOLDER.fullmatch(path.name) else path.name
 
 
-def read_model(path: Path) -> SavedModel:
+def read_model(path: Path, history_steps: int = 0) -> SavedModel:
     """The algorithm and action mode of a model zip, read from its ``data`` entry; a
-    truncated or corrupt zip, or one that is not an SB3 model of this env, is a clear error
-    naming the file."""
+    truncated or corrupt zip, or one that is not an SB3 model of this env observing
+    ``history_steps`` steps of history (its meta's), is a clear error naming the file."""
     stat = path.stat()
-    return _read_model(path.resolve(), stat.st_mtime_ns, stat.st_size)
+    return _read_model(path.resolve(), stat.st_mtime_ns, stat.st_size, history_steps)
 
 
 @functools.lru_cache(maxsize=64)
-def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
+def _read_model(path: Path, _mtime_ns: int, _size: int, history_steps: int) -> SavedModel:
     try:
         with zipfile.ZipFile(path) as archive:
             names = archive.namelist()
@@ -295,12 +309,15 @@ def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
             f"{path}: corrupt model zip: its 'data' is not JSON ({exc})"
         ) from None
     observed = _box_shape(data.get("observation_space"))
-    sizes = {(len(observation_names(flag)),): flag for flag in (False, True)}
+    sizes = {(observation_size(flag, history_steps),): flag for flag in (False, True)}
     if observed not in sizes:
         raise ControllerError(
-            f"{path}: the model observes {_describe(data.get('observation_space'))}; the "
-            f"ShipPathFollow envs observe shape ({len(OBS_NAMES)},) ({', '.join(OBS_NAMES)}), "
-            f"or ({len(observation_names(True))},) with context_features"
+            f"{path}: the model observes {_describe(data.get('observation_space'))}; with "
+            f"history_steps {history_steps} (its {META_FILE}'s, 0 without one) the "
+            f"ShipPathFollow envs observe shape ({observation_size(False, history_steps)},) "
+            f"({', '.join(OBS_NAMES)}, then {HISTORY_WIDTH} per step of history), or "
+            f"({observation_size(True, history_steps)},) with context_features; a model "
+            f'trained with history_steps K needs "history_steps": K in its {META_FILE}'
         )
     shape = _box_shape(data.get("action_space"))
     mode = ACTION_MODE_OF_SIZE.get(shape[0]) if shape is not None and len(shape) == 1 else None
@@ -310,7 +327,11 @@ def _read_model(path: Path, _mtime_ns: int, _size: int) -> SavedModel:
             "a Box of shape (1,) (action_mode rudder) or (2,) (guidance)"
         )
     return SavedModel(
-        path=path, algo=detect_algorithm(data), action_mode=mode, context_features=sizes[observed]
+        path=path,
+        algo=detect_algorithm(data),
+        action_mode=mode,
+        context_features=sizes[observed],
+        history_steps=history_steps,
     )
 
 
@@ -372,9 +393,10 @@ def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> P
     ``seed_<k>`` folder's), the observation statistics.  ``training_seed``: which seed's files
     (None: the first; a single model's must be its meta's seed)."""
     folder, seed = _seed_folder(_source(name_or_path), training_seed)
-    saved = read_model(_folder_model(folder))
-    meta_file = _meta_file(saved.path)
+    model_file = _folder_model(folder)
+    meta_file = _meta_file(model_file)
     meta, checked = _read_meta(meta_file) if meta_file else ({}, PolicyMeta())
+    saved = read_model(model_file, _history_steps(meta, checked, meta_file))
     if seed is None:
         seed = checked.seed
         if training_seed is not None and training_seed != seed:
@@ -413,7 +435,35 @@ def read_policy(name_or_path: str | Path, training_seed: int | None = None) -> P
     )
 
 
-def load_model(path: Path, algo: str, action_mode: str, context_features: bool = False) -> Any:
+def _history_steps(meta: dict[str, Any], checked: PolicyMeta, meta_file: Path | None) -> int:
+    """The K control steps of history a model observes, from its ``meta.json``: the key
+    ``history_steps``, else the training config's ``config.env.history_steps``, else 0; the
+    two disagreeing is a clear error."""
+    config = meta.get("config")
+    env = config.get("env") if isinstance(config, dict) else None
+    recorded = env.get("history_steps") if isinstance(env, dict) else None
+    if recorded is not None:
+        try:
+            recorded = check_history_steps(recorded)
+        except ValueError as exc:
+            raise ControllerError(f"{meta_file}: key 'config.env.history_steps': {exc}") from None
+    if checked.history_steps is None:
+        return 0 if recorded is None else recorded
+    if recorded is not None and recorded != checked.history_steps:
+        raise ControllerError(
+            f"{meta_file}: key 'history_steps' is {checked.history_steps}, but its training "
+            f"config's env.history_steps is {recorded}"
+        )
+    return checked.history_steps
+
+
+def load_model(
+    path: Path,
+    algo: str,
+    action_mode: str,
+    context_features: bool = False,
+    history_steps: int = 0,
+) -> Any:
     """The SB3 model of a zip, on the CPU, read as data (:func:`load_data_only`); a zip
     that only unpickling can read is refused unless the command trusts pickles, then
     loaded by SB3; a zip that does not load is a clear error."""
@@ -427,7 +477,7 @@ def load_model(path: Path, algo: str, action_mode: str, context_features: bool =
             f"{path}: a {name} model needs {module} ({exc}): {install_hint('rl')}"
         ) from exc
     try:
-        return load_data_only(path, algorithm, action_mode, context_features)
+        return load_data_only(path, algorithm, action_mode, context_features, history_steps)
     except UnsafeFileError:
         if not pickle_trusted():
             raise
@@ -520,14 +570,27 @@ class LearnedPolicy:
 
     ``name``: its name (default: the meta's, else :func:`policy_label`);
     ``training_seed``: which of a multi-seed policy's seeds (None: the first), kept as the
-    attribute ``training_seed`` (a single model's: its meta's seed)."""
+    attribute ``training_seed`` (a single model's: its meta's seed); ``history_steps``: the
+    K the caller expects (None: the meta's, :class:`PolicyMeta`; another than the meta's is
+    a clear error)."""
 
     kind = "learned"
 
     def __init__(
-        self, path: str | Path, name: str | None = None, training_seed: int | None = None
+        self,
+        path: str | Path,
+        name: str | None = None,
+        training_seed: int | None = None,
+        history_steps: int | None = None,
     ) -> None:
         files = read_policy(path, training_seed)
+        if history_steps is not None:
+            history_steps = check_history_steps(history_steps)
+            if history_steps != files.model.history_steps:
+                raise ControllerError(
+                    f"{files.model.path}: asked for history_steps {history_steps}, but it was "
+                    f"trained with history_steps {files.model.history_steps} (its {META_FILE})"
+                )
         self.model_path = files.model.path
         self.algo = files.algo
         self.meta: dict[str, Any] = files.meta
@@ -542,12 +605,23 @@ class LearnedPolicy:
         #: policy appends them from the context at reset (shipgym.envs.core.CONTEXT_NAMES)
         self.context_features = files.model.context_features
         self._context_rows: list[np.ndarray] = []
-        self.model = load_model(self.model_path, self.algo, self.action_mode, self.context_features)
+        #: K: the model reads the last K control steps after them: the policy keeps the
+        #: window of each episode from the observations it is given (core.ObservationHistory)
+        self.history_steps = files.model.history_steps
+        self._history: ObservationHistory | None = None
+        self.model = load_model(
+            self.model_path,
+            self.algo,
+            self.action_mode,
+            self.context_features,
+            self.history_steps,
+        )
         _eval_mode_once(self.model.policy)
         self.obs_normalizer: ObsNormalizer | None = (
             load_normalizer(files.vecnormalize) if files.vecnormalize is not None else None
         )
-        width = len(observation_names(self.context_features))
+        #: the number of observation entries the model reads
+        self.observation_width = width = observation_size(self.context_features, self.history_steps)
         if self.obs_normalizer is not None and len(self.obs_normalizer.mean) != width:
             raise ControllerError(
                 f"{files.vecnormalize}: statistics of {len(self.obs_normalizer.mean)} "
@@ -564,9 +638,10 @@ class LearnedPolicy:
         check_action_mode(self, context)
         self._memory = _Memory()
         self._context_rows = [context.feature_row] if self.context_features else []
+        self._history = ObservationHistory(1, self.history_steps) if self.history_steps else None
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        rows = self._with_context(np.asarray(obs)[None], [0])
+        rows = self._model_rows(np.asarray(obs)[None], [0])
         return self._act_rows(rows, [self._memory])[0]
 
     def reset_batch(self, contexts: Sequence[ControllerContext]) -> None:
@@ -575,20 +650,41 @@ class LearnedPolicy:
             check_action_mode(self, context)
         self._batch = [_Memory() for _ in contexts]
         self._context_rows = [c.feature_row for c in contexts] if self.context_features else []
+        self._history = (
+            ObservationHistory(len(contexts), self.history_steps) if self.history_steps else None
+        )
 
     def act_batch(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
         """The actions (one row each) for the observations ``obs`` (one row each) of the
         episodes ``episodes`` (indices into :meth:`reset_batch`'s contexts); each is the
         action :meth:`act` would give in that episode alone, bit for bit."""
-        rows = self._with_context(np.asarray(obs), episodes)
+        rows = self._model_rows(np.asarray(obs), episodes)
         return self._act_rows(rows, [self._batch[i] for i in episodes])
 
-    def _with_context(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
-        """The env's observations, with the episodes' context features appended when the
-        model reads them (the env's own observation without them)."""
-        if not self.context_features or obs.shape[1] != len(OBS_NAMES):
+    def _model_rows(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
+        """The observations the model reads, one row per episode of ``episodes``: the env's
+        own when they have the model's width (an env made with its context_features and
+        history_steps); from the env's plain observation (its first entries, OBS_NAMES) the
+        episodes' context features appended, then their history windows, advanced by one
+        control step per call after the episode's first (each call is the next step)."""
+        width = obs.shape[1]
+        if width == self.observation_width:
             return obs
-        return np.concatenate([obs, np.stack([self._context_rows[i] for i in episodes])], axis=1)
+        if width not in (len(OBS_NAMES), observation_size(True)):
+            raise ControllerError(
+                f"{self.name}: observations of {width} entries; the model reads "
+                f"{self.observation_width} (context_features {self.context_features}, "
+                f"history_steps {self.history_steps}), or takes the env's plain "
+                f"{len(OBS_NAMES)} (or {observation_size(True)} with context features) and "
+                "appends the rest: an env made with another history_steps?"
+            )
+        parts = [obs[:, : len(OBS_NAMES)]]
+        if self.context_features:
+            parts.append(np.stack([self._context_rows[i] for i in episodes]))
+        if self._history is not None:
+            self._history.stepped(episodes)
+            parts.append(self._history.update(parts[0], episodes))
+        return np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]
 
     def _act_rows(self, obs: np.ndarray, memories: list[_Memory]) -> np.ndarray:
         if self.obs_normalizer is not None:

@@ -93,14 +93,23 @@ def reference_costs(
 
 
 def run_agent_episode(
-    model: Any, scenario_name: str, seed: int, action_mode: str, context_features: bool
+    model: Any,
+    scenario_name: str,
+    seed: int,
+    action_mode: str,
+    context_features: bool,
+    history_steps: int = 0,
 ) -> tuple[float, float]:
     """(episode return, episode cost C) of an SB3 model acting deterministically on one
-    trial (RecurrentPPO's memory carried through the episode)."""
+    trial (RecurrentPPO's memory carried through the episode); ``history_steps``: the
+    model's observation history (the env's argument)."""
     from shipgym.envs.path_follow import ShipPathFollowEnv
 
     env = ShipPathFollowEnv(
-        scenario_name, action_mode=action_mode, context_features=context_features
+        scenario_name,
+        action_mode=action_mode,
+        context_features=context_features,
+        history_steps=history_steps,
     )
     try:
         obs, _ = env.reset(seed=seed)
@@ -124,12 +133,15 @@ def evaluate_relative(
     references: Sequence[dict[str, Any]],
     action_mode: str,
     context_features: bool,
+    history_steps: int = 0,
 ) -> dict[str, Any]:
     """The agent on every trial: {"returns", "costs", "selection" (the geometric-mean cost
     ratio)}."""
     returns, costs = [], []
     for name, seed in trials:
-        ret, cost = run_agent_episode(model, name, seed, action_mode, context_features)
+        ret, cost = run_agent_episode(
+            model, name, seed, action_mode, context_features, history_steps
+        )
         returns.append(ret)
         costs.append(cost)
     ratio = geometric_mean_ratio(costs, [r["cost"] for r in references])

@@ -219,6 +219,7 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
         config.env.action_mode,
         seed=config.seed,
         context_features=config.env.context_features,
+        history_steps=config.env.history_steps,
     )
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
     evaluation = EvalCallback(
@@ -290,6 +291,7 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
                 references,
                 config.env.action_mode,
                 config.env.context_features,
+                config.env.history_steps,
             )
             self.steps.append(int(self.num_timesteps))
             self.returns.append(found["returns"])
@@ -477,6 +479,8 @@ def train(
         "name": config.name,
         "algo": config.algo,
         "action_mode": config.env.action_mode,
+        # the observation's history window: evaluation builds the same (policy.PolicyMeta)
+        "history_steps": config.env.history_steps,
         "env_steps": int(model.num_timesteps),
         "wall_time_s": progress_cb.wall(),
         "seed": config.seed,

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -78,6 +79,29 @@ CONTEXT_NAMES = (
 )
 CONTEXT_LOW = np.zeros(len(CONTEXT_NAMES), dtype=np.float32)
 CONTEXT_HIGH = np.full(len(CONTEXT_NAMES), 2.0, dtype=np.float32)
+
+#: the optional history window (``history_steps=K``), appended after the observation
+#: (and :data:`CONTEXT_NAMES`): per past control step, oldest first, these entries of the
+#: observation at that step's start (the ship's measured quantities; not
+#: ``last_rudder_command``, which the applied command repeats, nor the path geometry) …
+HISTORY_MEASUREMENTS = (
+    "cross_track",
+    "sin_heading_error",
+    "cos_heading_error",
+    "yaw_rate",
+    "rudder_angle",
+    "speed",
+)
+#: … then the rudder command applied during that step, δc/δmax: the
+#: ``last_rudder_command`` entry of the observation at the step's end
+HISTORY_ACTION = "rudder_command"
+HISTORY_STEP_NAMES = (*HISTORY_MEASUREMENTS, HISTORY_ACTION)
+#: entries per history step
+HISTORY_WIDTH = len(HISTORY_STEP_NAMES)
+_HISTORY_MEASURED = np.array([OBS_NAMES.index(name) for name in HISTORY_MEASUREMENTS])
+_APPLIED = OBS_NAMES.index("last_rudder_command")
+_HISTORY_LOW = np.append(OBS_LOW[_HISTORY_MEASURED], OBS_LOW[_APPLIED]).astype(np.float32)
+_HISTORY_HIGH = np.append(OBS_HIGH[_HISTORY_MEASURED], OBS_HIGH[_APPLIED]).astype(np.float32)
 
 #: guidance action: a0 scales the law's length scale (LOS R_LOS = nL, look-ahead / TVVF Δ,
 #: VF τ) by 2^a0 ∈ [½, 2]; a1 → course offset a1·30°.
@@ -140,24 +164,74 @@ class StepConstants:
         )
 
 
-def observation_bounds(context_features: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def check_history_steps(history_steps: Any) -> int:
+    """``history_steps`` (K, control steps of history in the observation) checked: an int
+    ≥ 0 (not a bool), else a ValueError naming it."""
+    if (
+        isinstance(history_steps, bool)
+        or not isinstance(history_steps, numbers.Integral)
+        or history_steps < 0
+    ):
+        raise ValueError(
+            f"history_steps must be an int ≥ 0 (control steps of history in the "
+            f"observation; 0: none), got {history_steps!r}"
+        )
+    return int(history_steps)
+
+
+def history_bounds(history_steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) of the history window of K = ``history_steps`` steps: per step the
+    bounds of :data:`HISTORY_MEASUREMENTS` and of the applied command, [-1, 1]."""
+    k = check_history_steps(history_steps)
+    return np.tile(_HISTORY_LOW, k), np.tile(_HISTORY_HIGH, k)
+
+
+def history_names(history_steps: int) -> tuple[str, ...]:
+    """The names of the history window's entries, oldest step first: ``<name>_lag<j>``
+    with j the steps back (j = 1: the control step that just ended)."""
+    k = check_history_steps(history_steps)
+    return tuple(f"{name}_lag{lag}" for lag in range(k, 0, -1) for name in HISTORY_STEP_NAMES)
+
+
+def observation_bounds(
+    context_features: bool = False, history_steps: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) of the observation: :data:`OBS_NAMES`, then :data:`CONTEXT_NAMES` when
-    ``context_features``."""
-    if not context_features:
+    ``context_features``, then the history window of ``history_steps`` steps."""
+    k = check_history_steps(history_steps)
+    if not context_features and k == 0:
         return OBS_LOW, OBS_HIGH
-    return np.concatenate([OBS_LOW, CONTEXT_LOW]), np.concatenate([OBS_HIGH, CONTEXT_HIGH])
+    lows, highs = [OBS_LOW], [OBS_HIGH]
+    if context_features:
+        lows.append(CONTEXT_LOW)
+        highs.append(CONTEXT_HIGH)
+    if k:
+        low, high = history_bounds(k)
+        lows.append(low)
+        highs.append(high)
+    return np.concatenate(lows), np.concatenate(highs)
 
 
-def observation_space(context_features: bool = False) -> spaces.Box:
-    """The envs' observation space: :data:`OBS_NAMES` (and :data:`CONTEXT_NAMES` when
-    ``context_features``), scaled to their bounds."""
-    low, high = observation_bounds(context_features)
+def observation_space(context_features: bool = False, history_steps: int = 0) -> spaces.Box:
+    """The envs' observation space: :data:`OBS_NAMES` (then :data:`CONTEXT_NAMES` when
+    ``context_features``, then the history window of ``history_steps`` steps), scaled to
+    their bounds."""
+    low, high = observation_bounds(context_features, history_steps)
     return spaces.Box(low, high, dtype=np.float32)
 
 
-def observation_names(context_features: bool = False) -> tuple[str, ...]:
+def observation_names(context_features: bool = False, history_steps: int = 0) -> tuple[str, ...]:
     """The names of the observation's entries, in order."""
-    return OBS_NAMES + (CONTEXT_NAMES if context_features else ())
+    return OBS_NAMES + (CONTEXT_NAMES if context_features else ()) + history_names(history_steps)
+
+
+def observation_size(context_features: bool = False, history_steps: int = 0) -> int:
+    """The number of entries of the observation."""
+    return (
+        len(OBS_NAMES)
+        + (len(CONTEXT_NAMES) if context_features else 0)
+        + HISTORY_WIDTH * check_history_steps(history_steps)
+    )
 
 
 def action_space(action_mode: str) -> spaces.Box:
@@ -181,6 +255,8 @@ class EnvParts:
     action_space: spaces.Box
     #: the controller-context features (CONTEXT_NAMES, scaled), or an empty array when off
     context_row: np.ndarray
+    #: K: control steps of history appended to the observation (0: none)
+    history_steps: int
     metric_settings: MetricSettings
     autopilot_gains: PIDGains | None  # guidance mode: the heading PID's gains
 
@@ -193,9 +269,11 @@ class EnvParts:
         batch: int | None = None,
         context_features: bool = False,
         threads: int = 2,
+        history_steps: int = 0,
     ) -> EnvParts:
         if action_mode not in ACTION_MODES:
             raise ValueError(f"action_mode must be 'rudder' or 'guidance', got {action_mode!r}")
+        history_steps = check_history_steps(history_steps)
         sc = scenario
         k = StepConstants.of(sc)
         model = sc.model
@@ -227,9 +305,10 @@ class EnvParts:
             integrator=integrator,
             disturbances=disturbances,
             tracker=tracker,
-            observation_space=observation_space(context_features),
+            observation_space=observation_space(context_features, history_steps),
             action_space=action_space(action_mode),
             context_row=scenario_context_row(sc) if context_features else _NO_CONTEXT,
+            history_steps=history_steps,
             metric_settings=metric_settings(sc),
             autopilot_gains=gains,
         )
@@ -411,6 +490,75 @@ def batch_observation(
     return np.concatenate(
         [obs, np.broadcast_to(context, (obs.shape[0], context.shape[-1]))], axis=1
     )
+
+
+def history_window(window: np.ndarray, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
+    """The history window (..., K·HISTORY_WIDTH), oldest step first, advanced by the control
+    step from the observation ``previous`` to ``current`` (..., ≥ 9; their first 9 entries
+    are read): the oldest step dropped, the new step appended as the newest, its
+    :data:`HISTORY_MEASUREMENTS` from ``previous`` (the step's start) and its applied
+    command from ``current``'s ``last_rudder_command``.  The one definition of the window's
+    layout (docs/observation.md)."""
+    step = np.concatenate(
+        [previous[..., _HISTORY_MEASURED], current[..., _APPLIED : _APPLIED + 1]], axis=-1
+    )
+    return np.concatenate([window[..., HISTORY_WIDTH:], step.astype(window.dtype)], axis=-1)
+
+
+class ObservationHistory:
+    """The history windows of N rows (episodes), float32 (N, K·HISTORY_WIDTH): what every
+    env with ``history_steps=K > 0`` and the learned-policy adapter keep.
+
+    A row marked by :meth:`restart` (its episode started) gets an all-zero window at its
+    next :meth:`update`; a row marked by :meth:`stepped` (it advanced one control period)
+    gets its window advanced by :func:`history_window` from its last seen observation to
+    the new one.  An unmarked row keeps its window, so an update is idempotent.
+    """
+
+    def __init__(self, n_rows: int, history_steps: int) -> None:
+        self.history_steps = check_history_steps(history_steps)
+        self.window = np.zeros((n_rows, HISTORY_WIDTH * self.history_steps), dtype=np.float32)
+        #: each row's observation at its last update (the start of its pending step)
+        self._last = np.zeros((n_rows, len(OBS_NAMES)), dtype=np.float32)
+        self._restart = np.ones(n_rows, dtype=bool)
+        self._stepped = np.zeros(n_rows, dtype=bool)
+
+    def restart(self, rows: Any = slice(None)) -> None:
+        """Rows (mask, indices or slice) whose episode starts: zeros at the next update."""
+        self._restart[rows] = True
+        self._stepped[rows] = False
+
+    def stepped(self, rows: Any = slice(None)) -> None:
+        """Rows (mask, indices or slice) that advanced one control period."""
+        self._stepped[rows] = True
+
+    def update(self, obs: np.ndarray, rows: Any = None) -> np.ndarray:
+        """The windows after the marked events, given the rows' new observations ``obs``
+        (one row each, of ``rows``: indices, None for all); returns those rows' windows."""
+        base = np.asarray(obs)[:, : len(OBS_NAMES)]
+        if rows is None and self._stepped.all() and not self._restart.any():
+            # every row stepped (a training env's usual step): no gathers
+            self.window = history_window(self.window, self._last, base)
+            self._last = base.astype(np.float32, copy=True)
+            self._stepped[:] = False
+            return self.window
+        idx = np.arange(len(self.window)) if rows is None else np.asarray(rows, dtype=np.intp)
+        start = self._restart[idx]
+        step = self._stepped[idx] & ~start
+        if step.any():
+            moved = idx[step]
+            self.window[moved] = history_window(self.window[moved], self._last[moved], base[step])
+        if start.any():
+            self.window[idx[start]] = 0.0
+        seen = start | step
+        self._last[idx[seen]] = base[seen]
+        self._restart[idx] = False
+        self._stepped[idx] = False
+        return self.window[idx]
+
+    def append(self, obs: np.ndarray, rows: Any = None) -> np.ndarray:
+        """``obs`` (one row each of ``rows``) with the rows' updated windows after it."""
+        return np.concatenate([obs, self.update(obs, rows)], axis=1)
 
 
 def context_columns(

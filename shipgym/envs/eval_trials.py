@@ -76,7 +76,9 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         compile: bool = True,
         samples: bool = True,
         row_infos: str = "all",
+        history_steps: int = 0,
     ) -> None:
+        history_steps = core.check_history_steps(history_steps)
         if row_infos not in ROW_INFOS:
             raise RowInfosError(f"row_infos must be one of {ROW_INFOS}, got {row_infos!r}")
         if row_infos == "end" and samples:
@@ -98,7 +100,9 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         problem = lockstep_problem(self.scenarios)
         if problem is not None:
             raise LockstepError(f"these trials cannot run in one env: {problem}")
-        super().__init__(len(self.seeds), self.scenarios[0], action_mode, compile, False)
+        super().__init__(
+            len(self.seeds), self.scenarios[0], action_mode, compile, False, history_steps
+        )
         n = self.num_envs
         #: rows whose episode has ended (they stay done)
         self.finished = np.ones(n, dtype=bool)

@@ -21,6 +21,10 @@ With ``context_features=True`` (a ``gym.make`` argument, default off) 7 entries 
 controller context a classical controller is designed from (the nominal model's first-order
 Nomoto K and T, L, U0, Ts, δmax; :func:`shipgym.envs.core.context_columns`, table in
 docs/observation.md), constant over an episode, never the true parameters or the schedule.
+With ``history_steps=K`` (default 0: none) 7·K entries follow last: the last K control
+steps, oldest first, each the measured entries 0–4 and 6 at the step's start and the
+rudder command applied during it, δc/δmax; zeros before the episode's start
+(:class:`shipgym.envs.core.ObservationHistory`, table in docs/observation.md).
 
 Reward, termination, observation and info are the step core of :mod:`shipgym.envs.core`
 (the same functions as the batched env); its docstring gives the reward.
@@ -186,6 +190,10 @@ class ShipPathFollowEnv(gym.Env):
     * ``render_mode``: None, ``"rgb_array"`` or ``"human"``.
     * ``compile``: compile the CasADi period function to C (cached per machine); False
       uses CasADi's VM (the same bits, slower).
+    * ``context_features``: append the 7 controller-context features (default False).
+    * ``history_steps``: K ≥ 0, append the last K control steps of (measurements, applied
+      rudder command), 7 entries each, oldest first, zeros before the episode's start
+      (default 0: the observation above, unchanged; docs/observation.md).
 
     ``gym.make_vec(ENV_ID, num_envs=N)`` returns the batched
     :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit).
@@ -213,7 +221,9 @@ class ShipPathFollowEnv(gym.Env):
         render_mode: str | None = None,
         compile: bool = True,
         context_features: bool = False,
+        history_steps: int = 0,
     ) -> None:
+        history_steps = core.check_history_steps(history_steps)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -221,11 +231,18 @@ class ShipPathFollowEnv(gym.Env):
             )
         self.scenario: Scenario = load_scenario(scenario)
         parts = core.EnvParts.build(
-            self.scenario, action_mode, compile, context_features=context_features
+            self.scenario,
+            action_mode,
+            compile,
+            context_features=context_features,
+            history_steps=history_steps,
         )
         self._parts = parts
         #: the observation ends with the controller-context features (core.CONTEXT_NAMES)
         self.context_features = context_features
+        #: K: the observation ends with the last K control steps (core.ObservationHistory)
+        self.history_steps = history_steps
+        self._history = core.ObservationHistory(1, history_steps) if history_steps else None
         self.action_mode = action_mode
         self.render_mode = render_mode
         self.model = self.scenario.model
@@ -276,6 +293,8 @@ class ShipPathFollowEnv(gym.Env):
         self._log: dict[str, list[float]] = {name: [] for name in LOG_FIELDS}
         self._w_log: list[np.ndarray] = []
         self._reached_goal = False
+        if self._history is not None:
+            self._history.restart()
         return self._observation(frame), self._info(frame)  # no period yet: no samples
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -306,6 +325,8 @@ class ShipPathFollowEnv(gym.Env):
         self._step_count += 1
         self._t = self._step_count * k.control_period
         self._delta_c = delta_c
+        if self._history is not None:
+            self._history.stepped()
         # NaN/inf propagate through RK4: checking the final state suffices
         if not all(map(math.isfinite, trajectory[-1].tolist())):
             return self._non_finite_step(frame, delta_c)
@@ -385,7 +406,9 @@ class ShipPathFollowEnv(gym.Env):
         )
         np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
         if self.context_features:
-            return np.concatenate([obs, self._parts.context_row])
+            obs = np.concatenate([obs, self._parts.context_row])
+        if self._history is not None:
+            obs = self._history.append(obs[None])[0]
         return obs
 
     def _info(self, frame: Any) -> dict[str, Any]:

@@ -18,6 +18,7 @@ from typing import Any, ClassVar
 import gymnasium as gym
 import numpy as np
 
+from shipgym.envs.core import check_history_steps
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import (
@@ -54,7 +55,8 @@ class ShipPathFollowRandomizedEnv(gym.Env):
     ``gym.make("ShipPathFollowRandomized-v0", distribution="train", action_mode="rudder",
     render_mode=None, compile=True)``; ``distribution``: a name in ``configs/distributions``
     or a :class:`~shipgym.scenarios.sampling.ScenarioDistribution`; on a test split
-    ``reset(options={"index": i})`` picks the i-th test scenario.
+    ``reset(options={"index": i})`` picks the i-th test scenario.  ``context_features`` and
+    ``history_steps`` as the single env's (each reset starts a new history window).
 
     .. rubric:: Version history
 
@@ -70,7 +72,10 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         render_mode: str | None = None,
         compile: bool = True,
         context_features: bool = False,
+        history_steps: int = 0,
     ) -> None:
+        #: K: the observation ends with the last K control steps (as the single env)
+        self.history_steps = check_history_steps(history_steps)
         self.distribution = (
             distribution
             if isinstance(distribution, ScenarioDistribution)
@@ -97,6 +102,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             render_mode=self.render_mode,
             compile=self._compile,
             context_features=self.context_features,
+            history_steps=self.history_steps,
         )
 
     def reset(

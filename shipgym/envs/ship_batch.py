@@ -78,9 +78,11 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         action_mode: str = "rudder",
         compile: bool = True,
         context_features: bool = False,
+        history_steps: int = 0,
     ) -> None:
         if not (isinstance(num_envs, int) and num_envs >= 1):
             raise ValueError(f"num_envs must be an int ≥ 1, got {num_envs!r}")
+        history_steps = core.check_history_steps(history_steps)
         dist = (
             distribution
             if isinstance(distribution, ScenarioDistribution)
@@ -95,7 +97,9 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         self.ship_index = ship_index_of(dist, ship)
         self.ship = dist.config.ships[self.ship_index].model
         self._first = build_scenario(self._draw(train_rng(0), "first"))
-        super().__init__(num_envs, self._first, action_mode, compile, context_features)
+        super().__init__(
+            num_envs, self._first, action_mode, compile, context_features, history_steps
+        )
         self.episode_metrics = False  # a training env: no per-episode metrics
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
         #: the config of each env's current trial (names ``<distribution>:train-<seed>``)

@@ -136,7 +136,9 @@ class TrialRowsVectorEnv(VectorEnv):
         action_mode: str,
         compile: bool,
         context_features: bool,
+        history_steps: int = 0,
     ) -> None:
+        history_steps = core.check_history_steps(history_steps)
         # the plant on the calling thread: the row envs run inside processes that already
         # fill the cores (leaderboard workers, training jobs side by side with one torch
         # thread each), where a second thread waits for a core (≈ 2.5 ms per call instead
@@ -148,10 +150,14 @@ class TrialRowsVectorEnv(VectorEnv):
             batch=num_envs,
             context_features=context_features,
             threads=1,
+            history_steps=history_steps,
         )
         self.num_envs = num_envs
         self.action_mode = action_mode
         self.context_features = context_features
+        #: K: the observation ends with the last K control steps (as the single env)
+        self.history_steps = history_steps
+        self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
         self.render_mode = None
         self.single_observation_space = self._parts.observation_space
         self.single_action_space = self._parts.action_space
@@ -217,6 +223,8 @@ class TrialRowsVectorEnv(VectorEnv):
         self._noisy[i] = not tr.sensor.ideal
         if self.context_features:
             self._context[i] = tr.context_row
+        if self._history is not None:
+            self._history.restart(i)
 
     def _advance(self, a: np.ndarray, live: np.ndarray) -> Period:
         """One control period of the ``live`` rows with actions ``a`` (n_envs, n_act),
@@ -270,6 +278,8 @@ class TrialRowsVectorEnv(VectorEnv):
         last = traj[:, -1]
         finite = np.isfinite(last).all(axis=1)
         moved = every and bool(finite.all())  # every row advances
+        if self._history is not None:
+            self._history.stepped(live)
         steps = self._steps + 1
         if every:
             self._t = steps * k.control_period
@@ -342,7 +352,7 @@ class TrialRowsVectorEnv(VectorEnv):
 
     def _observation(self, frame: TrackFrame | None = None) -> np.ndarray:
         k = self._k0
-        return core.batch_observation(
+        obs = core.batch_observation(
             self._tracks.frame if frame is None else frame,
             self._psi_m,
             self._r_m,
@@ -352,6 +362,7 @@ class TrialRowsVectorEnv(VectorEnv):
             k,
             self._context if self.context_features else None,
         )
+        return obs if self._history is None else self._history.append(obs)
 
     def close(self, **kwargs: Any) -> None:
         return None

@@ -58,7 +58,9 @@ class ShipPathFollowVectorEnv(VectorEnv):
         episode_metrics: bool = True,
         max_episode_steps: int | None = None,
         context_features: bool = False,
+        history_steps: int = 0,
     ) -> None:
+        history_steps = core.check_history_steps(history_steps)
         if num_envs < 1:
             raise ValueError(f"num_envs must be ≥ 1, got {num_envs}")
         if max_episode_steps is not None and not (
@@ -69,11 +71,19 @@ class ShipPathFollowVectorEnv(VectorEnv):
             raise ValueError("the batched env does not render; use a single env for that")
         sc = load_scenario(scenario)
         parts = core.EnvParts.build(
-            sc, action_mode, compile, batch=num_envs, context_features=context_features
+            sc,
+            action_mode,
+            compile,
+            batch=num_envs,
+            context_features=context_features,
+            history_steps=history_steps,
         )
         self._parts = parts
         #: the observation ends with the controller-context features (as the single env)
         self.context_features = context_features
+        #: K: then the last K control steps (as the single env)
+        self.history_steps = history_steps
+        self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
         self.num_envs = num_envs
         self.scenario = sc
         self.action_mode = action_mode
@@ -169,6 +179,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
         # states at t0 + h … t0 + Ts (the integrator's buffer, valid until the next step)
         traj = self._integrator.substep_states(self._state, delta_c, self._w_block, self._p_block)
         steps = np.where(live, self._steps + 1, self._steps)
+        if self._history is not None:
+            self._history.stepped(live)
         finite = np.all(np.isfinite(traj[:, -1]), axis=1)
         advance = live & finite
         self._steps = steps
@@ -246,6 +258,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._p_dirty[mask] = False
         self._speed[mask] = k.nominal_speed
         self._log[:, mask] = 0.0
+        if self._history is not None:
+            self._history.restart(mask)
         for i in np.flatnonzero(mask):
             sensor = self._sensors[i]
             self._disturbances.reset(i, self._rngs[i])  # before the sensor's draws
@@ -271,7 +285,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
 
     def _observation(self) -> np.ndarray:
         k = self._k
-        return core.batch_observation(
+        obs = core.batch_observation(
             self._tracker.frame,
             self._psi_m,
             self._r_m,
@@ -281,6 +295,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
             k,
             self._parts.context_row if self.context_features else None,
         )
+        return obs if self._history is None else self._history.append(obs)
 
     def _info(self) -> dict[str, Any]:
         k = self._k
