@@ -77,8 +77,8 @@ ROLLOUT_DIR = "rollouts"
 DATA_DIR = "data"
 STUDENT_DIR = "students"
 MODEL_FILE = "model.zip"
-#: what a DAgger run writes into its folder (``force`` clears these, and only these)
-#: (and the staged ``.<name>.part`` a kill may leave)
+#: what a DAgger run writes into its folder, a staged ``.<name>.part`` a kill may leave
+#: included (``force`` clears these, and only these)
 DAGGER_OUTPUTS = (
     SETTINGS_FILE,
     ROUNDS_FILE,
@@ -95,7 +95,12 @@ STEP_KEYS = ("obs", "label", "applied", "by_teacher", "reward")
 #: a round file's arrays: :data:`STEP_KEYS` and, per row, its round, its episode id
 #: (round × episodes_per_round + episode), the env seed and the step in the episode
 DATA_KEYS = (*STEP_KEYS, "round", "episode", "seed", "step")
-#: the keys of a round's record in ``rounds.json``
+#: the keys of a round's record in ``rounds.json``: its β, rollouts and labels (this round's;
+#: ``labels_total``: the aggregate's, the env steps so far), the share of steps the teacher's
+#: action was applied, the rollouts' mean return, the teacher's and the rollouts' CPU seconds
+#: and labels per CPU second of each, the rollouts read from the label cache, the previous
+#: student's MSE on this round's labels (None in round 0), the fitted student's MSE on the
+#: aggregate, its gradient steps and the training's CPU seconds
 ROUND_KEYS = (
     "round",
     "beta",
