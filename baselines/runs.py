@@ -175,11 +175,12 @@ def clear_outputs(
     folder: str | os.PathLike, outputs: Sequence[str], option: str = "--force"
 ) -> None:
     """Remove the earlier outputs (names or glob patterns of ``outputs``) from ``folder``;
-    a :class:`RunError`, before removing anything, when it holds anything else."""
+    a :class:`RunError`, before removing anything, when it holds anything else (a run's
+    lock file, :data:`LOCK_FILE`, is neither)."""
     path = Path(folder)
     if not path.is_dir():
         return
-    entries = sorted(path.iterdir())
+    entries = sorted(p for p in path.iterdir() if p.name != LOCK_FILE)  # not an output
     foreign = [p.name for p in entries if not any(fnmatch.fnmatch(p.name, o) for o in outputs)]
     if foreign:
         raise RunError(
