@@ -8,10 +8,16 @@ settings), the loop hands it the env's
 :meth:`~shipgym.envs.path_follow.ShipPathFollowEnv.plant_truth` through
 ``reset_privileged``.  A plug-in cannot take the names (a registered name is never
 re-registered) and nothing of the truth reaches ``info`` or the context.
+
+At training time a teacher may read it too (:func:`teacher_truth`): the DAgger teacher
+(:class:`shipgym_baselines.learned.teachers.OracleTeacher`) labels the states a student
+learns from with the oracle's action.  The student never receives it, and the evaluation
+loop never calls :func:`teacher_truth` (tested).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from shipgym_baselines.errors import ControllerError
@@ -44,3 +50,23 @@ def reset_with_truth(policy: Any, context: Any, env: Any, seed: int | None) -> N
     if type(policy) not in PRIVILEGED.values():
         raise ControllerError(f"only the built-in references read the true plant, not {policy!r}")
     policy.reset_privileged(context, env.plant_truth, seed=seed)
+
+
+def teacher_truth(env: Any) -> Callable[[], Any]:
+    """Training time only: the truth of ``env`` in the episode it is in, the
+    :meth:`~shipgym.envs.path_follow.ShipPathFollowEnv.plant_truth` callable (returns the
+    :class:`~shipgym.envs.truth.PlantTruth` now), for a teacher that labels a student's
+    training data.  ``env``: a ShipPathFollow env or the randomised training env (either
+    possibly wrapped), after its ``reset``: the randomised env's truth is its current
+    scenario's, so a teacher asks again after every reset.  Nothing evaluated calls it."""
+    base = getattr(env, "unwrapped", env)
+    try:
+        truth = base.plant_truth
+    except AttributeError:
+        truth = None
+    if not callable(truth):
+        raise ControllerError(
+            f"{type(base).__name__} has no plant truth: a teacher labels on a ShipPathFollow "
+            "env (or the randomised training env)"
+        )
+    return truth
