@@ -20,7 +20,7 @@ from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.learned.curves import PlateauRule
 
-ALGOS = ("ppo", "sac", "td3", "recurrent_ppo")
+ALGOS = ("ppo", "sac", "td3", "recurrent_ppo", "dagger")
 
 
 class AgentEnvConfig(StrictModel):
@@ -90,7 +90,9 @@ class EvalConfig(StrictModel):
 
 class AgentConfig(StrictModel):
     name: str
-    algo: Literal["ppo", "sac", "td3", "recurrent_ppo"]
+    #: ``dagger``: a student distilled from the oracle (shipgym_baselines.learned.dagger_agent;
+    #: ``hyperparams`` then holds the DAgger settings)
+    algo: Literal["ppo", "sac", "td3", "recurrent_ppo", "dagger"]
     policy: str = "MlpPolicy"
     n_timesteps: int = Field(ge=1)
     seed: int = Field(0, ge=0)
@@ -113,6 +115,10 @@ class AgentConfig(StrictModel):
         if self.plateau is not None and self.plateau.metric == "selection":
             if self.eval.select_on != "relative_cost":
                 raise ValueError("plateau.metric 'selection' needs eval.select_on: relative_cost")
+        if self.algo == "dagger":
+            from shipgym_baselines.learned.dagger_agent import check_config
+
+            check_config(self)
         return self
 
     @field_validator("hyperparams")
@@ -153,7 +159,12 @@ TRAINER_ARGUMENTS = {
 def hyperparameter_names(algo: str) -> list[str] | None:
     """The keyword arguments of the algorithm's SB3 constructor that ``hyperparams`` may set
     (its signature, less :data:`TRAINER_ARGUMENTS` and private ones), sorted; None when the
-    algorithm is unknown or stable-baselines3 is not installed."""
+    algorithm is unknown or stable-baselines3 is not installed; for ``dagger`` the DAgger
+    settings (:class:`~shipgym_baselines.learned.dagger_agent.DaggerHyperparams`)."""
+    if algo == "dagger":
+        from shipgym_baselines.learned.dagger_agent import hyperparameter_names as dagger_names
+
+        return dagger_names()
     try:
         cls = algo_class(algo)
     except (ImportError, ValueError):
@@ -181,14 +192,14 @@ def list_agent_configs() -> list[str]:
 
 
 def algo_class(algo: str) -> type:
-    """The SB3 / sb3-contrib class of an algorithm id."""
+    """The SB3 / sb3-contrib class of an algorithm id (``dagger``: PPO, its student's)."""
     if algo == "recurrent_ppo":
         from sb3_contrib import RecurrentPPO
 
         return RecurrentPPO
     import stable_baselines3 as sb3
 
-    classes = {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3}
+    classes = {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3, "dagger": sb3.PPO}
     if algo not in classes:
         raise ValueError(f"unknown algorithm {algo!r}; valid: {', '.join(ALGOS)}")
     return classes[algo]

@@ -21,6 +21,10 @@ checkpoints, replay buffers or logs) into a policy directory; :func:`ship_policy
 shipped layout
 ``baselines/learned/policies/<name>/seed_<k>/``.  So ``shipgym train all --seeds 0 1 2
 --ship --resume`` on finished runs only exports them.
+
+An ``algo: dagger`` config (a student distilled from the oracle) is trained by
+:func:`shipgym_baselines.learned.dagger_agent.train_dagger`: the same folder contract,
+rounds of DAgger instead of checkpoints.
 """
 
 from __future__ import annotations
@@ -60,6 +64,7 @@ TRAINING_OUTPUTS = (
     "tb",
     "learning_curve.json",
     "tuned_from.json",
+    "dagger",  # a dagger agent's DAgger run (shipgym_baselines.learned.dagger_agent)
 )
 #: the chosen settings a run was started with (``--settings tuned``; null: the config's)
 TUNED_FROM_FILE = "tuned_from.json"
@@ -366,6 +371,10 @@ def train(
     if updates:
         config = config.model_copy(update=updates)
     out = Path(out_dir or f"results/agents/{config.name}")
+    if config.algo == "dagger":  # a student distilled from the oracle
+        from shipgym_baselines.learned.dagger_agent import train_dagger
+
+        return train_dagger(config, out, resume, progress, force, tuned_from)
     if resume and (finished := finished_run(out, config.n_timesteps)) is not None:
         if int(finished.get("env_steps", 0)) < config.n_timesteps:
             sys.stderr.write(
@@ -628,8 +637,11 @@ def run_train_job(job: dict[str, Any]) -> dict[str, Any]:
     if resume and job.get("fresh_if_unstarted"):
         # a sweep re-run after a kill: a run that reached no checkpoint (and saved no
         # model) starts afresh; its partial logs are all it had
+        from shipgym_baselines.learned.dagger_agent import started
+
         out = Path(job["out_dir"])
-        if latest_checkpoint(out) is None and not (out / "model.zip").is_file():
+        unstarted = latest_checkpoint(out) is None and not started(out)
+        if unstarted and not (out / "model.zip").is_file():
             resume, force = False, True
     meta = train(
         config,
