@@ -341,8 +341,8 @@ def train_dagger(
     hyper, run_settings = hyperparams(config), settings(config)
     if resume and (done := finished(out, config)) is not None:
         return done
-    last_seed = run_settings.episode_seed(hyper.rounds, 0)
-    if last_seed > EVAL_SEED_OFFSET:
+    last_seed = run_settings.episode_seed(hyper.rounds - 1, hyper.episodes_per_round - 1)
+    if last_seed >= EVAL_SEED_OFFSET:
         raise RunError(
             f"training env seeds up to {last_seed} would reach the evaluation seeds "
             f"(≥ {EVAL_SEED_OFFSET}); use a smaller seed or fewer rounds × episodes"
