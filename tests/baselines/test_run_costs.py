@@ -76,9 +76,7 @@ DEFAULT_RUN_CPU_S = 1028.0
 FACTOR = 1.25
 
 
-def default_plan(
-    controllers: list | None = None, in_range: bool = True
-) -> tuple[list[Job], dict]:
+def default_plan(controllers: list | None = None, in_range: bool = True) -> tuple[list[Job], dict]:
     """The default suite's jobs and scenarios, planned as the leaderboard plans them;
     ``in_range`` False: without the in-range split (the suite of the recorded run)."""
     spec = load_suite("default")
