@@ -691,6 +691,7 @@ def plot_scenarios(
 SPLIT_TITLES = {
     "catalogue": "catalogue scenarios",
     "heldout": "held-out scenarios",
+    "inrange": "in-range scenarios",
     "yours": "your scenarios",
 }
 _RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"

@@ -137,16 +137,23 @@ YOURS = "yours"
 SPLIT_TITLES = {
     "catalogue": "Catalogue scenarios",
     "heldout": "Held-out scenarios",
+    "inrange": "In-range scenarios, drawn from the training ranges",
     YOURS: "Your scenarios",
 }
+#: the splits of the named test scenarios (``<split>:<index>``): jumps outside the learned
+#: agents' training ranges (extrapolation), and inside them (interpolation)
+TEST_SPLITS = ("heldout", "inrange")
+#: the splits of :func:`generalisation`, in its order
+GENERALISATION_SPLITS = ("catalogue", *TEST_SPLITS)
 
 
 def scenario_split(scenario: str, own: Collection[str] = ()) -> str:
-    """``heldout`` for named held-out test scenarios (``heldout:3``), :data:`YOURS` for the
-    suite's own scenarios (``own``: their table names; a YAML path, as older records name
-    them), else ``catalogue``."""
-    if scenario.startswith("heldout:"):
-        return "heldout"
+    """``heldout`` / ``inrange`` for named held-out / in-range test scenarios
+    (``heldout:3``, ``inrange:3``), :data:`YOURS` for the suite's own scenarios (``own``:
+    their table names; a YAML path, as older records name them), else ``catalogue``."""
+    for split in TEST_SPLITS:
+        if scenario.startswith(f"{split}:"):
+            return split
     return YOURS if scenario in own or is_path(scenario) else "catalogue"
 
 
@@ -1100,23 +1107,32 @@ def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     (out / "generalisation.json").write_text(dumps(generalisation(rows), indent=2))
 
 
+def _generalisation_splits(rows: Sequence[Mapping[str, Any]]) -> tuple[str, ...]:
+    """The splits of :func:`generalisation`: catalogue and held-out always, in-range when
+    the run has in-range rows."""
+    present = {r["split"] for r in rows}
+    return tuple(s for s in GENERALISATION_SPLITS if s != "inrange" or s in present)
+
+
 def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per controller: mean ACE/L, return and success on catalogue vs held-out scenarios.
+    """Per controller: mean ACE/L, return and success on catalogue vs held-out scenarios
+    (and in-range ones, ``inrange_*`` keys, when the run has them).
 
     Means are over the scenarios of each split on which *every* controller of the table
     ran (so that all controllers are compared on the same set; ``*_scenarios`` counts them).
     """
     controllers = list(dict.fromkeys(r["controller"] for r in rows))
     ran = {(r["scenario"], r["controller"]) for r in rows if r.get("applies", True)}
+    splits = _generalisation_splits(rows)
     common = {}
-    for split in ("catalogue", "heldout"):
+    for split in splits:
         scenarios = dict.fromkeys(r["scenario"] for r in rows if r["split"] == split)
         common[split] = [s for s in scenarios if all((s, c) in ran for c in controllers)]
     out = []
     for controller in controllers:
         mine = [r for r in rows if r["controller"] == controller]
         entry: dict[str, Any] = {"controller": controller, "kind": mine[0]["kind"]}
-        for split in ("catalogue", "heldout"):
+        for split in splits:
             group = [r for r in mine if r["scenario"] in common[split]]
             entry[f"{split}_scenarios"] = len(group)
             for key in ("ace_L", "return", "success"):
@@ -1127,24 +1143,28 @@ def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def generalisation_table(rows: list[dict[str, Any]]) -> str:
-    """Markdown of :func:`generalisation` (empty when the suite has no held-out scenarios)."""
-    if not any(r["split"] == "heldout" for r in rows):
+    """Markdown of :func:`generalisation` (empty when the suite has no held-out or in-range
+    scenarios)."""
+    if not any(r["split"] in TEST_SPLITS for r in rows):
         return ""
     gen = generalisation(rows)
+    splits = _generalisation_splits(rows)
+    label = {"catalogue": "catalogue", "heldout": "held-out", "inrange": "in-range"}
+    counts = ", ".join(f"{gen[0][f'{s}_scenarios']} {label[s]}" for s in splits)
+    header = ["controller", "kind"] + [
+        f"{what} {label[s]}" for what in ("ACE/L", "return", "success") for s in splits
+    ]
+    title = " vs ".join(label[s] for s in splits)
     lines = [
-        "\n## Generalisation: catalogue vs held-out scenarios\n\nMeans over the scenarios "
-        "of each split on which every controller ran "
-        f"({gen[0]['catalogue_scenarios']} catalogue, {gen[0]['heldout_scenarios']} held-out).\n",
-        "| controller | kind | ACE/L catalogue | ACE/L held-out | return catalogue | "
-        "return held-out | success catalogue | success held-out |",
-        "|---|---|---|---|---|---|---|---|",
+        f"\n## Generalisation: {title} scenarios\n\nMeans over the scenarios "
+        f"of each split on which every controller ran ({counts}).\n",
+        "| " + " | ".join(header) + " |",
+        "|" + "---|" * len(header),
     ]
     for g in gen:
         cells = [md_cell(g["controller"]), md_cell(g["kind"])]
         cells += [
-            _fmt(g[f"{split}_{key}"])
-            for key in ("ace_L", "return", "success")
-            for split in ("catalogue", "heldout")
+            _fmt(g[f"{split}_{key}"]) for key in ("ace_L", "return", "success") for split in splits
         ]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -75,6 +75,7 @@ SORT_DIGITS = 7
 SPLIT_TITLES = {
     "catalogue": "Catalogue scenarios",
     "heldout": "Held-out scenarios",
+    "inrange": "In-range scenarios, drawn from the training ranges",
     "yours": "Your scenarios",
 }
 #: the long table's metric columns: key → header (with units)

@@ -14,9 +14,9 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   (evaluation seed): C / C_oracle, 1 = as good as the oracle, lower is better
   (:func:`scored_episodes`).  An episode *fails* when it ends outside the corridor or with a
   non-finite state (``termination_reason``), or its cost is not finite.
-* **Aggregate ranking** per controller and split (catalogue / held-out), over the scenarios
-  of the split that have the oracle's episodes: the interquartile mean (IQM) and the
-  geometric mean of the cost ratios, the probability of improvement over ``pid_los``
+* **Aggregate ranking** per controller and split (catalogue / held-out / in-range / yours),
+  over the scenarios of the split that have the oracle's episodes: the interquartile mean
+  (IQM) and the geometric mean of the cost ratios, the probability of improvement over ``pid_los``
   P(ratio < pid_los's ratio on a scenario) + ½ P(equal) (rliable's probability of
   improvement of the negated ratios: lower cost is the improvement; None for ``pid_los``
   itself and where ``pid_los`` lacks a scenario of the row) and the failure rate,
@@ -569,8 +569,8 @@ def aggregate_ranking(
     not ``reference``) on the same scenarios (those with the oracle's episodes), ranked by
     the cost ratio's IQM, ascending; a competitor without ratios on some of them is ranked on
     its own in the split ``"<split>:partial"``.  ``splits``: scenario → "catalogue" |
-    "heldout"; ``kinds``: controller → kind (default: the episodes').  Empty without the
-    oracle's episodes."""
+    "heldout" | "inrange" | "yours"; ``kinds``: controller → kind (default: the episodes').
+    Empty without the oracle's episodes."""
     scored = scored_episodes(episodes)
     kind_of = controller_kinds(episodes, kinds)
     competitors = sorted(c for c, k in kind_of.items() if k != REFERENCE_KIND)

@@ -24,7 +24,7 @@ from shipgym.config import (
     resolve,
 )
 from shipgym.errors import ShipgymError
-from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_SEEDS
+from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_INRANGE_SCENARIOS, MAX_SEEDS
 from shipgym.scenarios import Scenario, list_scenarios, load_scenario
 from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
 from shipgym.scenarios.trials import TrialRandomization
@@ -48,7 +48,9 @@ class SuiteConfig(StrictModel):
 
     ``scenarios``: catalogue names, named test scenarios (``heldout:3``) or YAML paths (a
     relative path is read against the suite file's folder); ``heldout_scenarios`` N adds
-    ``heldout:0 … heldout:N-1``; ``controllers``: what ``shipgym evaluate`` accepts
+    ``heldout:0 … heldout:N-1`` (jumps outside the training ranges), ``inrange_scenarios``
+    M adds ``inrange:0 … inrange:M-1`` (drawn from the training ranges; each split ranked in
+    its own table); ``controllers``: what ``shipgym evaluate`` accepts
     (registered controllers, installed plug-ins, specs ``module.path:Attr`` /
     ``path/to/file.py:Attr``, shipped learned policies, trained agents' folders, SB3 model
     zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
@@ -65,6 +67,7 @@ class SuiteConfig(StrictModel):
     description: str = ""
     scenarios: list[str] = Field(default_factory=list)
     heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
+    inrange_scenarios: int = Field(0, ge=0, le=MAX_INRANGE_SCENARIOS)
     controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1, le=MAX_SEEDS)
     randomize: TrialRandomization | None = None
@@ -79,13 +82,20 @@ class SuiteConfig(StrictModel):
 
     @model_validator(mode="after")
     def _some_scenarios(self) -> SuiteConfig:
-        if not self.scenarios and not self.heldout_scenarios:
-            raise ValueError("a suite needs 'scenarios' or 'heldout_scenarios'")
+        if not self.scenarios and not self.heldout_scenarios and not self.inrange_scenarios:
+            raise ValueError(
+                "a suite needs 'scenarios' or 'heldout_scenarios' (or 'inrange_scenarios')"
+            )
         return self
 
     def all_scenarios(self) -> list[str]:
-        """The suite's scenarios followed by ``heldout:0 … heldout:N-1``."""
-        return [*self.scenarios, *(f"heldout:{i}" for i in range(self.heldout_scenarios))]
+        """The suite's scenarios followed by ``heldout:0 … heldout:N-1`` and
+        ``inrange:0 … inrange:M-1``."""
+        return [
+            *self.scenarios,
+            *(f"heldout:{i}" for i in range(self.heldout_scenarios)),
+            *(f"inrange:{i}" for i in range(self.inrange_scenarios)),
+        ]
 
 
 def list_suites() -> list[str]:
@@ -214,7 +224,7 @@ def scenario_names(
 # --- checking a suite file (``shipgym scenarios --validate``) --------------------------------
 
 #: top-level keys that make a YAML file a suite (a scenario file has none of them)
-SUITE_KEYS = ("controllers", "scenarios", "heldout_scenarios")
+SUITE_KEYS = ("controllers", "scenarios", "heldout_scenarios", "inrange_scenarios")
 
 
 def is_suite_file(name_or_path: str | os.PathLike) -> bool:

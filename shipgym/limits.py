@@ -14,6 +14,7 @@ cross-track error).  Each is refused early, in one line naming the key and the l
 * a config file (YAML): :data:`MAX_CONFIG_BYTES` bytes, refused before parsing;
 * evaluation seeds per scenario: :data:`MAX_SEEDS` (``--seeds``, a suite's ``seeds``);
 * held-out scenarios of a suite: :data:`MAX_HELDOUT_SCENARIOS` (``heldout_scenarios``);
+* in-range scenarios of a suite: :data:`MAX_INRANGE_SCENARIOS` (``inrange_scenarios``);
 * trial ranges of a suite's ``randomize:``: :data:`RANDOMIZE_BOUNDS` (``randomize.<key>``);
 * local worker processes: at least 1, at most the number of jobs (more are clamped to it,
   :func:`worker_count`; ``--workers``).
@@ -37,6 +38,8 @@ MAX_CONFIG_BYTES = 1_000_000
 MAX_SEEDS = 10_000
 #: held-out test scenarios a suite draws (``heldout_scenarios``); the default suite: 4
 MAX_HELDOUT_SCENARIOS = 1_000
+#: in-range test scenarios a suite draws (``inrange_scenarios``); the default suite: 16
+MAX_INRANGE_SCENARIOS = 1_000
 #: the interval each trial range of a suite's ``randomize:`` block must lie in
 RANDOMIZE_BOUNDS: dict[str, tuple[float, float]] = {
     "cross_track_offset_L": (-100.0, 100.0),  # ship lengths

@@ -4,11 +4,11 @@
 YAML line): one ``ok FILE`` line per good file, one ``FILE:LINE: key 'K': message`` line per
 problem of a bad one, in line order; exit code 2 when any file is bad.  An unknown key
 close to a valid one is followed by "did you mean 'K'?".  A file whose top level has
-``controllers``, ``scenarios`` or ``heldout_scenarios`` (or a packaged suite's name) is
-checked as a suite (:func:`shipgym_baselines.suite.check_suite_file`: its schema, every
-scenario it lists, every controller), any other as a scenario.  With ``--json``: a list of
-``{"file", "kind", "ok", "problems"}`` (``kind``: ``scenario`` or ``suite``; ``problems``:
-the lines without the file name).
+``controllers``, ``scenarios``, ``heldout_scenarios`` or ``inrange_scenarios`` (or a packaged
+suite's name) is checked as a suite (:func:`shipgym_baselines.suite.check_suite_file`: its
+schema, every scenario it lists, every controller), any other as a scenario.  With
+``--json``: a list of ``{"file", "kind", "ok", "problems"}`` (``kind``: ``scenario`` or
+``suite``; ``problems``: the lines without the file name).
 """
 
 from __future__ import annotations

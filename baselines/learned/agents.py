@@ -3,7 +3,7 @@
 A config names the algorithm, the policy, the number of env steps, the hyperparameters
 passed to the SB3 constructor, the training envs (a scenario distribution, or one fixed
 scenario for the batched env) and the periodic evaluation on held-out *validation*
-scenarios (never the ``heldout`` test set, which is kept for the leaderboard).
+scenarios (never the ``heldout`` or ``inrange`` test sets, kept for the leaderboard).
 """
 
 from __future__ import annotations
@@ -73,17 +73,28 @@ class AgentEnvConfig(StrictModel):
 class EvalConfig(StrictModel):
     distribution: str = "validation"
     freq: int = Field(20_000, ge=1)  # env steps between evaluations
-    n_episodes: int = Field(8, ge=1)
+    #: validation trials per evaluation, the distribution's first (default: all 32 of
+    #: ``validation``, :data:`shipgym_baselines.learned.selection.SELECTION_TRIALS`)
+    n_episodes: int = Field(32, ge=1)
     #: what picks the best model: the mean validation return, or the geometric mean of the
     #: per-trial cost over a reference's (shipgym_baselines.learned.selection)
     select_on: Literal["return", "relative_cost"] = "return"
 
     @model_validator(mode="after")
     def _not_the_test_set(self) -> EvalConfig:
-        if self.distribution == "heldout":
+        from shipgym.scenarios.sampling import DistributionError, load_distribution
+        from shipgym_baselines.tuning.validation import TEST_ONLY
+
+        test_only = self.distribution in TEST_ONLY
+        if not test_only:
+            try:
+                test_only = load_distribution(self.distribution).config.test_only
+            except DistributionError:
+                test_only = False  # an unknown distribution is named when training starts
+        if test_only:
             raise ValueError(
-                "eval.distribution: 'heldout' is the leaderboard's test set; select models "
-                "on 'validation'"
+                f"eval.distribution: {self.distribution!r} is a test split of the leaderboard "
+                "(test_only: the held-out or in-range scenarios); select models on 'validation'"
             )
         return self
 

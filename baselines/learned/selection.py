@@ -10,7 +10,10 @@ evaluation runs the agent on fixed validation trials (validation scenario i with
 with C the episode cost (:func:`shipgym.metrics.episode_cost`) and C_ref the ``oracle``'s
 cost on the same trial from the shipped reference table
 (:mod:`shipgym_baselines.references`) where present, else ``pid_los``'s, computed once per
-run (``eval/reference_costs.json`` in the run folder).  Both are never the held-out set.
+run (``eval/reference_costs.json`` in the run folder, with the oracle revision it was read
+at: a file of another revision is read again).  The trials are every validation trial by
+default (:data:`SELECTION_TRIALS`: ``validation:0`` … ``validation:31``, eight per ship);
+never a ``test_only`` split (the held-out and in-range ones the leaderboard ranks).
 """
 
 from __future__ import annotations
@@ -31,17 +34,24 @@ FALLBACK_REFERENCE = "pid_los"
 #: costs below this are floored in the ratio (a perfect episode costs > 0 anyway)
 COST_FLOOR = 1e-9
 REFERENCE_FILE = "reference_costs.json"
+#: the selection's trials by default (``eval.n_episodes``): all 32 validation trials (with
+#: 8, two per ship, the selection score was mostly noise)
+SELECTION_TRIALS = 32
 
 
-def validation_trials(distribution: str, n_episodes: int) -> list[tuple[str, int]]:
+def validation_trials(
+    distribution: str, n_episodes: int = SELECTION_TRIALS
+) -> list[tuple[str, int]]:
     """(scenario name, env seed) of the selection's trials: the first ``n_episodes``
-    scenarios of the (test-split) validation distribution, scenario i with seed
-    EVAL_SEED_OFFSET + i."""
+    scenarios of the validation distribution (a test split drawn from the training ranges,
+    never a ``test_only`` one), scenario i with seed EVAL_SEED_OFFSET + i."""
     from shipgym.scenarios.sampling import load_distribution
+    from shipgym_baselines.tuning.validation import check_validation_split
 
     dist = load_distribution(distribution)
     if dist.split != "test":
         raise RunError(f"eval.distribution {distribution!r} is not a test split")
+    check_validation_split(distribution)
     if n_episodes > len(dist):
         raise RunError(
             f"eval.n_episodes {n_episodes}: {distribution!r} has {len(dist)} scenarios; "
@@ -78,17 +88,22 @@ def reference_costs(
     trials: Sequence[tuple[str, int]], cache_dir: str | Path | None = None
 ) -> list[dict[str, Any]]:
     """The reference cost of every trial, read from / written to ``cache_dir`` (once per
-    run: a cache for other trials is recomputed)."""
+    run: a cache for other trials, or of another oracle revision or env revision, is
+    recomputed)."""
+    from shipgym_baselines.references import oracle_header
+
     cache = None if cache_dir is None else Path(cache_dir) / REFERENCE_FILE
     wanted = [[name, seed] for name, seed in trials]
+    header = oracle_header()
+    revision = {"env_revision": header["env_revision"], "oracle": header["oracle"]}
     if cache is not None and cache.is_file():
         data = json.loads(cache.read_text())
-        if data.get("trials") == wanted:
+        if data.get("trials") == wanted and all(data.get(k) == v for k, v in revision.items()):
             return data["references"]
     refs = [reference_cost(name, seed) for name, seed in trials]
     if cache is not None:
         cache.parent.mkdir(parents=True, exist_ok=True)
-        cache.write_text(json.dumps({"trials": wanted, "references": refs}, indent=1))
+        cache.write_text(json.dumps({"trials": wanted, "references": refs, **revision}, indent=1))
     return refs
 
 

@@ -4,8 +4,8 @@ A validation trial is a named scenario of a validation distribution (``validatio
 training ranges in the test seed space: ``configs/distributions/validation.yaml``) with one
 evaluation seed, :data:`~shipgym_baselines.evaluation.EVAL_SEED_OFFSET` + k.  Every
 scenario a study runs comes from :func:`validation_trials`, which refuses any distribution
-that is not the training ranges in the test seed space (so never the held-out split, never
-a catalogue scenario).
+that is not the training ranges in the test seed space and every ``test_only`` one (so never
+the held-out or in-range split, never a catalogue scenario).
 
 The denominator of the cost ratio is the ``oracle``'s cost on the same trial
 (:mod:`shipgym_baselines.references`): read from the shipped table (which holds every trial
@@ -44,15 +44,26 @@ class ValidationTrial:
     seed: int
 
 
+#: test splits only the leaderboard reads, whatever their files say (``test_only``)
+TEST_ONLY = ("heldout", "inrange")
+
+
 def check_validation_split(distribution: str) -> None:
     """Raise unless ``distribution`` is a validation split: a test split drawn from a train
-    split's ranges (``ranges_of``), never the held-out one."""
+    split's ranges (``ranges_of``), never a ``test_only`` one (the held-out and in-range
+    splits)."""
     dist = load_distribution(distribution)
-    if dist.split != "test" or dist.config.ranges_of is None or dist.name == "heldout":
+    if dist.config.test_only or dist.name in TEST_ONLY:
+        raise RunError(
+            f"validation distribution {distribution!r}: a test split only the leaderboard "
+            "reads (test_only); tuning and model selection score on a validation split "
+            "('validation')"
+        )
+    if dist.split != "test" or dist.config.ranges_of is None:
         raise RunError(
             f"validation distribution {distribution!r}: tuning scores on a validation split "
-            "only (a test split with 'ranges_of' a train split), never the held-out or "
-            "catalogue scenarios"
+            "only (a test split with 'ranges_of' a train split), never the held-out, in-range "
+            "or catalogue scenarios"
         )
 
 

@@ -25,8 +25,11 @@ had).  Training envs draw theirs from the env's own seeded generator through
 :func:`train_scenario_seed` and ``SeedSequence([TRAIN_SALT, seed])``, a seed space disjoint
 from the test one (tested).  The ``heldout`` distribution contains jump kinds and sizes
 outside the training ranges, on every ship (the leaderboard's generalisation rows);
-``validation`` (training ranges, test seed space) is what training evaluates on to keep its
-best model.
+``validation`` (training ranges, test seed space) is what tuning scores on and training
+evaluates on to keep its best model; ``inrange`` (training ranges, test seed space under
+its own name, so none of its scenarios is a validation one) is the leaderboard's in-range
+split.  ``heldout`` and ``inrange`` are ``test_only``: tuning and model selection refuse
+them.
 
 Units are those of scenario configs: lengths in ship lengths where a key ends in ``_L``,
 angles in degrees where it ends in ``_deg``, times in s, speeds in m/s, ship parameters in
@@ -179,6 +182,9 @@ class DistributionConfig(StrictModel):
     name: str
     description: str = ""
     split: Literal["train", "test"]
+    #: test splits the leaderboard ranks and nothing else reads: tuning and model selection
+    #: refuse them (``heldout``, ``inrange``)
+    test_only: bool = False
     #: test splits: number of named scenarios (one ship; else each ship's ``count``)
     size: int | None = Field(None, ge=1)
     #: test splits: the ships, path and sensors of this distribution (the training ranges
@@ -254,6 +260,8 @@ class DistributionConfig(StrictModel):
             if getattr(self, field) is not None and self.ranges_of is None:
                 raise ValueError(f"{field}: only with ranges_of (else each ship's jumps)")
         if self.split == "train":
+            if self.test_only:
+                raise ValueError("test_only: only a test split is kept for testing")
             for i, ship in enumerate(self.ships):
                 if ship.count is not None:
                     raise ValueError(f"ships.{i}.count: a train split draws ships by 'weight'")

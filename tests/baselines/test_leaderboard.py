@@ -627,3 +627,60 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
     assert terminal_summary(gap).startswith(text.split("\n\n")[1])
     html = (gap / "leaderboard.html").read_text()
     assert 'id="headroom"' in html and "2.500<i>3 trials</i>" in html
+
+
+def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
+    """A smoke-sized run (1 seed; pid_los, lqr and the oracle) on a catalogue, a
+    held-out and an in-range scenario: the in-range scenario is its own split in every
+    output, beside the other two; its oracle reference, which the shipped table lacks, is
+    computed and kept in the per-user cache as any missing reference."""
+    from shipgym_baselines.leaderboard import trials
+    from shipgym_baselines.references import ReferenceCache, shipped_table
+    from shipgym_baselines.suite import load_suite
+
+    randomize = load_suite("default").randomize.model_dump(mode="json")
+    suite = write_suite(
+        tmp_path,
+        scenarios=["rudder_aging"],
+        heldout_scenarios=1,
+        inrange_scenarios=1,
+        controllers=["pid_los", "lqr", "oracle"],
+        seeds=1,
+        randomize=randomize,
+    )
+    out = tmp_path / "out"
+    run(suite, out)
+    board = json.loads((out / "aggregate.json").read_text())
+    assert all(set(r) == AGGREGATE_KEYS for r in board)
+    assert {(r["split"], r["controller"]) for r in board} == {
+        (split, controller)
+        for split in ("catalogue", "heldout", "inrange")
+        for controller in ("pid_los", "lqr")
+    }
+    assert {r["scenarios"][0] for r in board if r["split"] == "inrange"} == {"inrange:0"}
+    rows = json.loads((out / "leaderboard.json").read_text())
+    assert {(r["scenario"], r["split"]) for r in rows} == {
+        ("rudder_aging", "catalogue"),
+        ("heldout:0", "heldout"),
+        ("inrange:0", "inrange"),
+    }
+    scores = json.loads((out / "scenario_scores.json").read_text())
+    assert {s["scenario"]: s["split"] for s in scores}["inrange:0"] == "inrange"
+    for entry in json.loads((out / "generalisation.json").read_text()):
+        assert entry["catalogue_scenarios"] == entry["heldout_scenarios"] == 1
+        assert entry["inrange_scenarios"] == 1 and "inrange_ace_L" in entry
+    text = (out / "leaderboard.md").read_text()
+    tables = [line for line in text.splitlines() if line.startswith("### ") and "(1," in line]
+    assert tables == [
+        "### Catalogue scenarios (1, the same for every controller)",
+        "### Held-out scenarios (1, the same for every controller)",
+        "### In-range scenarios, drawn from the training ranges (1, the same for every controller)",
+    ]
+    assert "## Generalisation: catalogue vs held-out vs in-range scenarios" in text
+    assert "(1 catalogue, 1 held-out, 1 in-range)" in text
+    assert (out / "ranking_inrange.png").is_file() and (out / "profile_inrange.png").is_file()
+    html = (out / "leaderboard.html").read_text()
+    assert 'id="ranking-inrange"' in html and "In-range scenarios, drawn from" in html
+    (trial,) = trials(Job("oracle", "inrange:0", (10_000,), None, randomize))
+    assert shipped_table().lookup(trial, 10_000) is None
+    assert ReferenceCache().lookup(trial, 10_000) is not None

@@ -53,6 +53,16 @@ def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
     assert default.seeds == 10
 
 
+def test_default_suite_ranks_the_in_range_split_after_the_held_out_one() -> None:
+    """The 16 in-range scenarios (inrange:0-15) follow the held-out ones."""
+    default = load_suite("default")
+    assert default.inrange_scenarios == 16
+    assert default.all_scenarios()[31:] == [
+        *(f"heldout:{i}" for i in range(16)),
+        *(f"inrange:{i}" for i in range(16)),
+    ]
+
+
 def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
     """quick: 3 seeds, the default suite's controllers and trials, 12 scenarios = 4 ships ×
     (rudder aging, current shift, manoeuvrability change)."""
@@ -110,6 +120,8 @@ def test_a_suite_without_scenarios_is_an_error(tmp_path: Path) -> None:
         load_suite(file)
     only_heldout = write(tmp_path, "name: s\nheldout_scenarios: 2\ncontrollers: [pid_los]\n")
     assert load_suite(only_heldout).all_scenarios() == ["heldout:0", "heldout:1"]
+    only_inrange = write(tmp_path, "name: s\ninrange_scenarios: 2\ncontrollers: [pid_los]\n")
+    assert load_suite(only_inrange).all_scenarios() == ["inrange:0", "inrange:1"]
 
 
 def test_bad_yaml_names_file_and_line(tmp_path: Path) -> None:
@@ -140,7 +152,13 @@ def test_unknown_suite_lists_the_suites() -> None:
 
 
 @pytest.mark.parametrize(
-    ("extra", "key"), [("seeds: 0\n", "seeds"), ("heldout_scenarios: -1\n", "heldout_scenarios")]
+    ("extra", "key"),
+    [
+        ("seeds: 0\n", "seeds"),
+        ("heldout_scenarios: -1\n", "heldout_scenarios"),
+        ("inrange_scenarios: -1\n", "inrange_scenarios"),
+        ("inrange_scenarios: 1001\n", "inrange_scenarios"),
+    ],
 )
 def test_counts_are_validated(tmp_path: Path, extra: str, key: str) -> None:
     file = write(tmp_path, f"name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\n{extra}")

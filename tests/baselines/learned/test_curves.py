@@ -104,3 +104,64 @@ def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
     assert plot_learning_curves(figures, {"sac": []}) == []
     ranking_html, scenario_html, legend_names = figure_sections(files)
     assert "learning curves" in ranking_html and scenario_html == "" and legend_names == []
+
+
+def test_selection_runs_on_all_32_validation_trials_by_default() -> None:
+    """Model selection and stopping (eval.n_episodes), the learned studies' objective and
+    the shipped agent configs: every validation trial, validation:0 … validation:31."""
+    from shipgym_baselines.learned.agents import EvalConfig, list_agent_configs, load_agent_config
+    from shipgym_baselines.learned.selection import SELECTION_TRIALS
+    from shipgym_baselines.tuning.space import list_tuning, load_tuning
+    from shipgym_baselines.tuning.validation import validation_trials as study_trials
+
+    every = [(f"validation:{i}", 10_000 + i) for i in range(32)]
+    assert SELECTION_TRIALS == 32 and EvalConfig().n_episodes == 32
+    assert validation_trials("validation") == every
+    for name in list_agent_configs():
+        agent = load_agent_config(name)
+        assert agent.eval.distribution == "validation", name
+        assert validation_trials(agent.eval.distribution, agent.eval.n_episodes) == every, name
+    learned = [load_tuning(n) for n in list_tuning() if load_tuning(n).kind == "learned"]
+    assert learned
+    for config in learned:
+        v = config.validation
+        trials = study_trials(v.distribution, None, v.per_ship, config.ships)
+        assert [(t.name, t.seed) for t in trials] == every, config.name
+
+
+def test_selection_never_names_the_leaderboards_test_splits() -> None:
+    """The held-out and in-range splits (test_only) are refused by the selection's trials and
+    by an agent config's eval block."""
+    from pydantic import ValidationError
+
+    from shipgym_baselines.learned.agents import EvalConfig
+
+    for split in ("heldout", "inrange"):
+        with pytest.raises(RunError, match="test_only"):
+            validation_trials(split, 4)
+        with pytest.raises(ValidationError, match="test_only"):
+            EvalConfig(distribution=split)
+
+
+def test_the_run_folders_references_are_read_again_for_another_oracle_revision(
+    tmp_path,
+) -> None:
+    """``eval/reference_costs.json`` records the oracle revision it was read at; a file of
+    another revision (or the same trials without one) is replaced by the current oracle's
+    costs (the shipped table holds every validation trial)."""
+    from shipgym_baselines.learned.selection import REFERENCE_FILE, reference_costs
+    from shipgym_baselines.references import oracle_header
+
+    trials = [("validation:0", 10_000), ("validation:1", 10_001)]
+    stale = {"oracle": {"revision": -1}, "env_revision": oracle_header()["env_revision"]}
+    fake = [{"cost": 123.0, "reference": "oracle"}] * 2
+    wanted = [list(t) for t in trials]
+    (tmp_path / REFERENCE_FILE).write_text(
+        json.dumps({"trials": wanted, "references": fake, **stale})
+    )
+    refs = reference_costs(trials, tmp_path)
+    assert [r["reference"] for r in refs] == ["oracle", "oracle"]
+    assert all(r["cost"] != 123.0 for r in refs)
+    data = json.loads((tmp_path / REFERENCE_FILE).read_text())
+    assert data["oracle"] == oracle_header()["oracle"] and data["references"] == refs
+    assert reference_costs(trials, tmp_path) == refs  # read back, the same revision

@@ -26,6 +26,8 @@ from shipgym_baselines.tuning.validation import (
     validation_trials,
 )
 
+#: the packaged distributions' folder
+DISTRIBUTIONS = Path(__file__).resolve().parents[3] / "configs" / "distributions"
 #: a tiny per-ship pid_los study: nomoto2's first validation trial, 3 trials
 TINY = {
     "name": "pid_los_tiny",
@@ -101,9 +103,22 @@ def test_tuning_reads_only_validation_trials(
     run_study(plan, n_trials=2)
     assert drawn and {name.split(":")[0] for name in drawn} == {"validation"}
     assert files == []
-    for bad in ("heldout", "train"):
+    for bad in ("heldout", "inrange", "train"):
         with pytest.raises(RunError, match="validation split"):
             check_validation_split(bad)
+
+
+def test_tuning_cannot_name_the_leaderboards_test_splits(tmp_path: Path) -> None:
+    """The held-out and in-range splits (test_only) are refused by every path to a study's
+    trials, also as a copy of their file under another name."""
+    for split in ("heldout", "inrange"):
+        with pytest.raises(RunError, match="test_only"):
+            validation_trials(split)
+    copy = tmp_path / "my_split.yaml"
+    copy.write_text((DISTRIBUTIONS / "inrange.yaml").read_text().replace("inrange", "my_split"))
+    with pytest.raises(RunError, match="test_only"):
+        validation_trials(str(copy))
+    assert len(validation_trials()) == 32  # the validation split itself: every trial
 
 
 def test_a_study_reports_resumes_and_refuses_to_overwrite(tiny: Path, tmp_path: Path) -> None:

@@ -14,7 +14,7 @@ import yaml
 
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
-from shipgym.scenarios import list_scenarios, load_scenario
+from shipgym.scenarios import ScenarioError, list_scenarios, load_scenario
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import (
     DistributionConfig,
@@ -388,3 +388,84 @@ def test_ranges_of_takes_a_train_splits_ranges_only(
     bad.write_text("name: bad\n" + text)
     with pytest.raises(DistributionError, match=message):
         load_distribution(bad)
+
+
+# --- the in-range test split ------------------------------------------------------------------
+
+
+def test_inrange_names_parse_and_generate_the_same_scenario_every_time() -> None:
+    """``inrange:0`` … ``inrange:15``: four per ship, interleaved as the validation split,
+    each name loading the same settings on every call; beyond 15 a clear error."""
+    from shipgym.scenarios.sampling import sampled_scenario_config
+
+    inrange = load_distribution("inrange")
+    assert inrange.split == "test" and len(inrange) == 16
+    assert inrange.test_names() == [f"inrange:{i}" for i in range(16)]
+    assert [inrange.test_scenario(i).ship.model for i in range(16)] == list(SHIPS) * 4
+    for name in ("inrange:0", "inrange:7", "inrange:15"):
+        first = sampled_scenario_config(name)
+        assert first.name == name
+        assert first == sampled_scenario_config(name)
+        assert load_scenario(name).config == first  # the env's loader reads the same
+    with pytest.raises(DistributionError, match=r"index 16 out of range; valid: 0 … 15"):
+        sampled_scenario_config("inrange:16")
+    with pytest.raises(ScenarioError, match=r"inrange: index 16 out of range"):
+        load_scenario("inrange:16")
+
+
+def test_inrange_covers_every_ship_and_family_inside_the_training_ranges() -> None:
+    """Every trial has its change, each size inside the training ranges (train.yaml); each
+    3-DOF ship shows each of its four families once, nomoto2 its three."""
+    inrange, train = load_distribution("inrange"), load_distribution("train").config
+    assert inrange.config.ranges_of == "train" and inrange.config.path == train.path
+    ranges = {ship.model: _training_ranges(ship) for ship in train.ships}
+    seen: dict[str, list[str]] = collections.defaultdict(list)
+    for config in (inrange.test_scenario(i) for i in range(len(inrange))):
+        families = _families(config)
+        assert len(families) == 1, (config.name, families)
+        for family, (lo, hi) in families.items():
+            low, high = ranges[config.ship.model][family]
+            factor = CURRENT_FACTOR if family == "current" else (1.0, 1.0)
+            assert low * factor[0] - 1e-9 <= lo and hi <= high * factor[1] + 1e-9
+            seen[config.ship.model].append(family)
+    assert sorted(set(seen["nomoto2"])) == ["aging", "d0_shift", "gain"]
+    for ship in SHIPS[1:]:
+        assert sorted(seen[ship]) == ["aging", "current", "gain", "loading"], ship
+
+
+def test_inrange_seeds_are_apart_from_validation_heldout_and_training() -> None:
+    """The in-range split's seed space: SeedSequence([TEST_SALT, crc32("inrange"), j],
+    spawn_key=(k,)), its own name key (apart from the validation and held-out splits'), the
+    test salt (apart from training's [TRAIN_SALT, s]); no in-range trial equals a
+    validation, held-out or catalogue one."""
+    import zlib
+
+    from shipgym.scenarios.sampling import TEST_SALT, TRAIN_SALT, test_rng
+
+    keys = {name: zlib.crc32(name.encode()) for name in ("inrange", "validation", "heldout")}
+    assert keys["inrange"] == 0xE4191536 and len(set(keys.values())) == 3
+    assert TEST_SALT != TRAIN_SALT
+    for j in range(4):
+        for k in range(4):
+            ours = test_rng("inrange", j, k).bit_generator.seed_seq
+            assert ours.entropy == [TEST_SALT, keys["inrange"], j]
+            assert ours.spawn_key == ((k,) if k else ())
+    assert train_rng(7).bit_generator.seed_seq.entropy == [TRAIN_SALT, 7]
+    inrange, validation = load_distribution("inrange"), load_distribution("validation")
+    heldout = load_distribution("heldout")
+    ours = {_content(inrange.test_scenario(i)) for i in range(len(inrange))}
+    theirs = {_content(validation.test_scenario(i)) for i in range(len(validation))}
+    theirs |= {_content(heldout.test_scenario(i)) for i in range(len(heldout))}
+    theirs |= {_content(load_scenario(name).config) for name in list_scenarios()}
+    assert len(ours) == 16 and not ours & theirs
+
+
+def test_the_leaderboards_splits_are_test_only_and_a_train_split_cannot_be() -> None:
+    """``test_only`` marks the splits tuning and model selection refuse (the held-out and
+    in-range ones); a train split with it is refused, naming the key."""
+    assert load_distribution("heldout").config.test_only
+    assert load_distribution("inrange").config.test_only
+    assert not load_distribution("validation").config.test_only
+    data = {**_raw("train"), "test_only": True}
+    with pytest.raises(ValueError, match="test_only: only a test split"):
+        DistributionConfig.model_validate(data)
