@@ -108,7 +108,7 @@ def test_unknown_name_names_kind_request_and_valid_names() -> None:
         resolve("distributions", "trian")
     msg = str(info.value)
     assert "unknown distribution 'trian'" in msg and "configs/distributions" in msg
-    assert "valid: heldout, train, validation" in msg
+    assert "valid: heldout, inrange, train, validation" in msg
 
 
 def test_missing_file_names_the_file(tmp_path: Path) -> None:
