@@ -63,6 +63,7 @@ from pydantic import Field
 from shipgym.config import StrictModel
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.learned.meta import training_meta
 
 #: the ``algo`` of an agent config trained by DAgger
 DAGGER_ALGO = "dagger"
@@ -322,10 +323,8 @@ def train_dagger(
     to ``out/meta.json`` (module doc).  Refusals as :func:`~shipgym_baselines.learned.
     train.train`'s: a folder that is not empty without ``resume`` / ``force``, a
     ``resume`` without a started run."""
-    import stable_baselines3
     import torch
 
-    import shipgym
     from shipgym_baselines.learned import dagger
     from shipgym_baselines.learned.selection import reference_costs, validation_trials
     from shipgym_baselines.learned.teachers import oracle_teacher
@@ -400,33 +399,22 @@ def train_dagger(
     newest = dagger._student_file(run_dir, int(done_rounds[-1]["round"]))
     shutil.copyfile(newest, out / "model.zip")
     summary = dagger.DaggerRun(run_dir, None, done_rounds).summary()
-    meta = {
-        "name": config.name,
+    labels = int(done_rounds[-1]["labels_total"])
+    meta = training_meta(
+        config,
         # the zip's algorithm (the student is a PPO policy: it loads, and fine-tunes, as PPO)
-        "algo": "ppo",
-        "trainer": DAGGER_ALGO,
-        "action_mode": config.env.action_mode,
-        "history_steps": config.env.history_steps,
-        "env_steps": int(done_rounds[-1]["labels_total"]),
-        "teacher_labels": int(done_rounds[-1]["labels_total"]),
-        "wall_time_s": wall(),
-        "seed": config.seed,
-        "training": config.env.distribution or config.env.scenario,
-        "config": config.model_dump(),
-        "selection": config.eval.select_on,
-        "plateau": None if config.plateau is None else config.plateau.model_dump(),
-        "stopped_on_plateau_at": scores.stopped_at,
-        "tuned_from": tuned_from,
-        "dagger": {
+        algo="ppo",
+        env_steps=labels,
+        wall_time_s=wall(),
+        stopped_at=scores.stopped_at,
+        tuned_from=tuned_from,
+        trainer=DAGGER_ALGO,
+        teacher_labels=labels,
+        dagger={
             **summary,
             "best_round": scores.best_round(),
             "validation_cpu_s": float(sum(scores.eval_cpu)),
         },
-        "versions": {
-            "shipgym": shipgym.__version__,
-            "stable_baselines3": stable_baselines3.__version__,
-            "torch": torch.__version__,
-        },
-    }
+    )
     (out / "meta.json").write_text(json.dumps(meta, indent=2))
     return meta

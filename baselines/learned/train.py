@@ -50,6 +50,7 @@ from shipgym_baselines.learned.agents import (
     make_eval_env,
     make_training_env,
 )
+from shipgym_baselines.learned.meta import training_meta
 from shipgym_baselines.runs import check_out_dir, clear_outputs
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
@@ -354,11 +355,8 @@ def train(
     unless ``force`` (its earlier outputs are removed first).  ``tuned_from``: the study
     settings applied to ``config`` (:func:`shipgym_baselines.tuning.tuned.tuned_agent`),
     recorded in the meta; a resumed run must be resumed with the settings it started with."""
-    import stable_baselines3
     import torch
     from stable_baselines3.common.vec_env import VecNormalize
-
-    import shipgym
 
     torch.set_num_threads(1)  # small networks: threads only contend with the env workers
     if not isinstance(config, AgentConfig):
@@ -484,27 +482,14 @@ def train(
             tb_log_name=config.name,
         )
     model.save(str(out / "model.zip"))
-    meta = {
-        "name": config.name,
-        "algo": config.algo,
-        "action_mode": config.env.action_mode,
-        # the observation's history window: evaluation builds the same (policy.PolicyMeta)
-        "history_steps": config.env.history_steps,
-        "env_steps": int(model.num_timesteps),
-        "wall_time_s": progress_cb.wall(),
-        "seed": config.seed,
-        "training": config.env.distribution or config.env.scenario,
-        "config": config.model_dump(),
-        "selection": config.eval.select_on,
-        "plateau": None if config.plateau is None else config.plateau.model_dump(),
-        "stopped_on_plateau_at": curves.stopped_at,
-        "tuned_from": tuned_from,
-        "versions": {
-            "shipgym": shipgym.__version__,
-            "stable_baselines3": stable_baselines3.__version__,
-            "torch": torch.__version__,
-        },
-    }
+    meta = training_meta(
+        config,
+        algo=config.algo,
+        env_steps=model.num_timesteps,
+        wall_time_s=progress_cb.wall(),
+        stopped_at=curves.stopped_at,
+        tuned_from=tuned_from,
+    )
     (out / "meta.json").write_text(json.dumps(meta, indent=2))
     save_obs_statistics(venv, out)
     venv.close()
