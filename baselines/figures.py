@@ -101,7 +101,7 @@ PAGE_GREYS = 9
 #: controller families, the order of the columns
 FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
 REFERENCES = ("zero_rudder", "random", ORACLE, ORACLE_FROZEN)
-_LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3")
+_LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3", "ppo_history", "dagger", "bc")
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
 #: the oracle's episode, drawn in every column as the reference
 _ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}

@@ -368,8 +368,9 @@ def suite_record(
     seed_list: list[int],
     seeds_of: Mapping[str, list[int | None]],
 ) -> dict[str, Any]:
-    """The resolved suite as ``run.json`` keeps it: evaluation seeds, the trial
-    randomisation, controllers (table name, how the suite names it, kind, training seeds),
+    """The resolved suite as ``run.json`` keeps it: evaluation seeds (``scenario_seeds``:
+    the scenarios run on fewer, :meth:`~shipgym_baselines.suite.SuiteConfig.scenario_seeds`),
+    the trial randomisation, controllers (table name, how the suite names it, kind, training seeds),
     each scenario's settings (by table name), the pairs that do not apply and, when the
     suite has its own scenarios, ``scenario_files`` (table name → the YAML file read)."""
     ships = {s: sc.model.name for s, sc in scenarios.items()}
@@ -386,9 +387,11 @@ def suite_record(
         )
     files = scenario_names(spec.all_scenarios(), suite_scenario).files
     own = {"scenario_files": {n: f for n, f in files.items() if n in scenarios}}
+    fewer = {s: v for s, v in spec.scenario_seeds(seed_list).items() if s in scenarios}
     return {
         "name": spec.name,
         "seeds": seed_list,
+        **({"scenario_seeds": fewer} if fewer else {}),  # absent without: older records resume
         "randomize": None if spec.randomize is None else spec.randomize.model_dump(mode="json"),
         "controllers": controllers,
         "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
@@ -410,30 +413,31 @@ def plan_jobs(
     randomize: dict[str, Any] | None,
     skip: set[tuple[str, str]],
     references: str = "table",
+    scenario_seeds: Mapping[str, list[int]] | None = None,
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job of all seeds
     per training seed (a learned agent's) or of all seeds (a classical controller's: they
     run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
     reference table is looked up trial by trial).  ``scenarios``: names, or name →
-    recorded settings (the jobs run those)."""
+    recorded settings (the jobs run those); ``scenario_seeds``: the scenarios run on other
+    seeds than ``seed_list``, with theirs."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
+        seeds = list((scenario_seeds or {}).get(scenario, seed_list))
         for c in names:
             label = controller_label(c)
             if (scenario, label) in skip:
                 continue
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
-                    jobs.append(Job(c, scenario, tuple(seed_list), k, randomize, settings))
+                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings))
                 elif not grants_truth(c):
-                    jobs.append(
-                        Job(c, scenario, tuple(seed_list), k, randomize, settings, references)
-                    )
+                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings, references))
                 else:
                     jobs += [
                         Job(c, scenario, (seed,), k, randomize, settings, references)
-                        for seed in seed_list
+                        for seed in seeds
                     ]
     return jobs
 
@@ -523,7 +527,14 @@ def run_leaderboard(
     skip = {tuple(pair) for pair in record["does_not_apply"]}
     references = "recompute" if recompute_references else "table"
     jobs = plan_jobs(
-        names, record["scenarios"], seed_list, seeds_of, record["randomize"], skip, references
+        names,
+        record["scenarios"],
+        seed_list,
+        seeds_of,
+        record["randomize"],
+        skip,
+        references,
+        record.get("scenario_seeds"),
     )
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
     n_episodes = sum(len(job.seeds) for job in jobs)
@@ -642,7 +653,7 @@ def write_results(
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     episodes = episode_rows(results)
     splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
-    ranked = rankable(episodes)
+    ranked = rankable(episodes, suite.get("scenario_seeds"))
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
     drawn = figures.episodes_to_draw(results)
@@ -836,12 +847,16 @@ def _metric_cells(
 # --- the ranking -----------------------------------------------------------------------------
 
 
-def rankable(episodes: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def rankable(
+    episodes: list[dict[str, Any]], scenario_seeds: Mapping[str, Collection[int]] | None = None
+) -> list[dict[str, Any]]:
     """The episodes the ranking is computed from: those of the scenarios on which every
     controller that ran there has all its runs (each of its training seeds × every
-    evaluation seed of the record).  A complete run keeps them all; an interrupted or
-    merged record leaves out the scenarios it holds only in part."""
-    seeds = {int(e["seed"]) for e in episodes}
+    evaluation seed of the record; ``scenario_seeds``: the scenarios run on fewer, with
+    theirs).  A complete run keeps them all; an interrupted or merged record leaves out the
+    scenarios it holds only in part."""
+    every = {int(e["seed"]) for e in episodes}
+    fewer = scenario_seeds or {}
     trained: dict[str, set[Any]] = defaultdict(set)
     cells: dict[tuple[str, str], set[tuple[Any, int]]] = defaultdict(set)
     for e in episodes:
@@ -850,7 +865,7 @@ def rankable(episodes: list[dict[str, Any]]) -> list[dict[str, Any]]:
     partial = {
         scenario
         for (scenario, controller), runs in cells.items()
-        if len(runs) != len(trained[controller]) * len(seeds)
+        if len(runs) != len(trained[controller]) * len(fewer.get(scenario, every))
     }
     return [e for e in episodes if e["scenario"] not in partial]
 

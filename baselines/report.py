@@ -50,7 +50,8 @@ def merge_runs(
     folders: Sequence[str | os.PathLike],
 ) -> tuple[dict[str, Any], list[EpisodeResult], list[dict[str, Any]]]:
     """(suite, episodes, sources) of run folders merged: scenarios and controllers in order
-    of first appearance, seeds and "does not apply" pairs united; ``sources`` describes each
+    of first appearance, seeds (each scenario's too: ``scenario_seeds``, when some ran on
+    fewer) and "does not apply" pairs united; ``sources`` describes each
     run (folder, command, status, times, episodes of jobs)."""
     suite: dict[str, Any] = {
         "name": None,
@@ -61,6 +62,7 @@ def merge_runs(
         "does_not_apply": [],
     }
     first_with: dict[str, str] = {}
+    ran_on: dict[str, set[int]] = {}  # scenario → the seeds any run ran it on
     episode_in: dict[Key, str] = {}
     cost_of: dict[Key, Any] = {}
     results = []
@@ -95,6 +97,9 @@ def merge_runs(
             pair for pair in run_suite["does_not_apply"] if pair not in suite["does_not_apply"]
         ]
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
+        fewer = run_suite.get("scenario_seeds", {})
+        for name in run_suite["scenarios"]:
+            ran_on.setdefault(name, set()).update(fewer.get(name, run_suite["seeds"]))
         suite["name"] = suite["name"] or run_suite.get("name")
         episodes = read_episodes(folder, suite=run_suite)
         kinds = {c["name"]: c["kind"] for c in run_suite["controllers"]}
@@ -122,6 +127,9 @@ def merge_runs(
                 "jobs": record.get("jobs"),
             }
         )
+    fewer = {n: sorted(s) for n, s in ran_on.items() if s != set(suite["seeds"])}
+    if fewer:
+        suite["scenario_seeds"] = fewer
     return suite, results, sources
 
 

@@ -132,7 +132,8 @@ def profile_suite(
     per_ship: dict[str, dict[str, float]] = defaultdict(_entry)
     per_pair: dict[str, dict[str, dict[str, float]]] = defaultdict(lambda: defaultdict(_entry))
     for (label, scenario), cell in cells.items():
-        runs = spec.seeds * len(seeds_of[label])
+        suite_seeds = len(spec.scenario_seeds(range(spec.seeds)).get(scenario, range(spec.seeds)))
+        runs = suite_seeds * len(seeds_of[label])
         cell["suite_cpu_s"] = cell["cpu_s"] / max(cell["episodes"], 1) * runs
         for target in (
             per_controller[label],

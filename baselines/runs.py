@@ -472,11 +472,11 @@ def _lines(file: Path) -> list[tuple[int, str]]:
 
 class _SuiteKeys(NamedTuple):
     """What a resolved suite (``run.json``'s) runs: scenarios, the (scenario, controller)
-    pairs that apply, the evaluation seeds, each controller's training seeds."""
+    pairs that apply, each scenario's evaluation seeds, each controller's training seeds."""
 
     scenarios: set[str]
     pairs: set[tuple[str, str]]
-    seeds: set[int]
+    seeds: dict[str, set[int]]  # scenario → its evaluation seeds
     trained: dict[str, set[int | None]]
 
 
@@ -484,7 +484,9 @@ def _suite_keys(suite: Mapping[str, Any]) -> _SuiteKeys:
     skip = {tuple(pair) for pair in suite["does_not_apply"]}
     trained = {c["name"]: set(c["training_seeds"]) for c in suite["controllers"]}
     pairs = {(s, c) for s in suite["scenarios"] for c in trained if (s, c) not in skip}
-    return _SuiteKeys(set(suite["scenarios"]), pairs, set(suite["seeds"]), trained)
+    fewer = suite.get("scenario_seeds", {})
+    seeds = {s: set(fewer.get(s, suite["seeds"])) for s in suite["scenarios"]}
+    return _SuiteKeys(set(suite["scenarios"]), pairs, seeds, trained)
 
 
 def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
@@ -497,8 +499,8 @@ def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
         return f"scenario {scenario!r} is not in the run's suite"
     if (scenario, controller) not in pairs:
         return f"{controller!r} does not apply to {scenario!r} in the run's suite"
-    if seed not in seeds:
-        return f"seed {seed} is not one of the run's seeds"
+    if seed not in seeds[scenario]:
+        return f"seed {seed} is not one of the run's seeds of {scenario!r}"
     if training_seed not in trained[controller]:
         return f"training seed {training_seed} is not one of {controller!r}'s in the run"
     return None

@@ -50,7 +50,8 @@ class SuiteConfig(StrictModel):
     relative path is read against the suite file's folder); ``heldout_scenarios`` N adds
     ``heldout:0 … heldout:N-1`` (jumps outside the training ranges), ``inrange_scenarios``
     M adds ``inrange:0 … inrange:M-1`` (drawn from the training ranges; each split ranked in
-    its own table); ``controllers``: what ``shipgym evaluate`` accepts
+    its own table) on the first ``inrange_seeds`` evaluation seeds (None: all ``seeds``);
+    ``controllers``: what ``shipgym evaluate`` accepts
     (registered controllers, installed plug-ins, specs ``module.path:Attr`` /
     ``path/to/file.py:Attr``, shipped learned policies, trained agents' folders, SB3 model
     zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
@@ -68,6 +69,7 @@ class SuiteConfig(StrictModel):
     scenarios: list[str] = Field(default_factory=list)
     heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
     inrange_scenarios: int = Field(0, ge=0, le=MAX_INRANGE_SCENARIOS)
+    inrange_seeds: int | None = Field(None, ge=1, le=MAX_SEEDS)
     controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1, le=MAX_SEEDS)
     randomize: TrialRandomization | None = None
@@ -96,6 +98,14 @@ class SuiteConfig(StrictModel):
             *(f"heldout:{i}" for i in range(self.heldout_scenarios)),
             *(f"inrange:{i}" for i in range(self.inrange_scenarios)),
         ]
+
+    def scenario_seeds(self, seeds: Sequence[int]) -> dict[str, list[int]]:
+        """The scenarios that run on fewer evaluation seeds than ``seeds`` (the run's), with
+        theirs: each in-range scenario on the first ``inrange_seeds``; empty when none do."""
+        if self.inrange_seeds is None or self.inrange_seeds >= len(seeds):
+            return {}
+        fewer = list(seeds[: self.inrange_seeds])
+        return {f"inrange:{i}": fewer for i in range(self.inrange_scenarios)}
 
 
 def list_suites() -> list[str]:

@@ -3,8 +3,9 @@
 The tables (:mod:`shipgym_baselines.references`, one per reference: ``oracle`` and
 ``oracle_frozen``) ship with the package; the leaderboard reads them and runs a reference
 only for a trial its table lacks.  This command runs each reference of ``--reference``
-(default: both) on every trial of the given suites (scenarios × the suite's seeds, drawn with
-its ``randomize`` ranges) and, with ``--validation``, the ``oracle`` on the validation split
+(default: both) on every trial of the given suites (scenarios × the suite's seeds, the
+in-range ones × its ``inrange_seeds``, drawn with its ``randomize`` ranges) and, with
+``--validation``, the ``oracle`` on the validation split
 that ``shipgym tune`` scores on (:func:`~shipgym_baselines.tuning.validation.validation_trials`;
 tuning needs no other reference), that its table does not hold yet.  It writes a table after
 every episode, so an interrupted fill resumes where it stopped.  ``--table PATH`` writes
@@ -91,9 +92,11 @@ def run(args: argparse.Namespace) -> int:
         n = int(args.seeds if args.seeds is not None else spec.seeds)
         check_seeds(n, "--seeds")
         randomize = None if spec.randomize is None else spec.randomize.model_dump(mode="json")
+        seeds = [EVAL_SEED_OFFSET + i for i in range(n)]
+        fewer = spec.scenario_seeds(seeds)
         for scenario in spec.all_scenarios():
             suite_scenario(scenario)  # a bad name fails here, before any work
-            for seed in (EVAL_SEED_OFFSET + i for i in range(n)):
+            for seed in fewer.get(scenario, seeds):
                 for ref in chosen:
                     job = Job(ref, scenario, (seed,), None, randomize, references="recompute")
                     (trial,) = trials(job)

@@ -630,12 +630,13 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
 
 
 def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
-    """A smoke-sized run (1 seed; pid_los, lqr and the oracle) on a catalogue, a
-    held-out and an in-range scenario: the in-range scenario is its own split in every
-    output, beside the other two; its oracle reference, which the shipped table lacks, is
-    computed and kept in the per-user cache as any missing reference."""
+    """A smoke-sized run (2 seeds, the in-range scenario on the first only; pid_los, lqr
+    and the oracle) on a catalogue, a held-out and an in-range scenario: the in-range
+    scenario is its own split in every output, beside the other two, run on its own seeds
+    (``run.json``'s ``scenario_seeds``); its oracle reference is read from the shipped
+    table, which holds the default suite's in-range trials."""
     from shipgym_baselines.leaderboard import trials
-    from shipgym_baselines.references import ReferenceCache, shipped_table
+    from shipgym_baselines.references import shipped_table
     from shipgym_baselines.suite import load_suite
 
     randomize = load_suite("default").randomize.model_dump(mode="json")
@@ -644,12 +645,29 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
         scenarios=["rudder_aging"],
         heldout_scenarios=1,
         inrange_scenarios=1,
+        inrange_seeds=1,
         controllers=["pid_los", "lqr", "oracle"],
-        seeds=1,
+        seeds=2,
         randomize=randomize,
     )
     out = tmp_path / "out"
     run(suite, out)
+    assert read_run(out)["suite"]["scenario_seeds"] == {"inrange:0": [10_000]}
+    episodes = [(e["scenario"], e["seed"]) for e in read_episodes(out)]
+    assert sorted(set(episodes)) == [
+        ("heldout:0", 10_000),
+        ("heldout:0", 10_001),
+        ("inrange:0", 10_000),
+        ("rudder_aging", 10_000),
+        ("rudder_aging", 10_001),
+    ]
+    beyond = tmp_path / "beyond"  # an in-range episode on a seed of the others only
+    shutil.copytree(out, beyond)
+    first = next(e for e in read_episodes(out) if e["scenario"] == "inrange:0")
+    with open(beyond / "episodes.jsonl", "a") as fh:
+        fh.write(json.dumps({**first, "seed": 10_001}) + "\n")
+    with pytest.raises(RunError, match="seed 10001 is not one of the run's seeds of 'inrange:0'"):
+        read_episodes(beyond, suite=read_run(beyond)["suite"])
     board = json.loads((out / "aggregate.json").read_text())
     assert all(set(r) == AGGREGATE_KEYS for r in board)
     assert {(r["split"], r["controller"]) for r in board} == {
@@ -682,5 +700,4 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     html = (out / "leaderboard.html").read_text()
     assert 'id="ranking-inrange"' in html and "In-range scenarios, drawn from" in html
     (trial,) = trials(Job("oracle", "inrange:0", (10_000,), None, randomize))
-    assert shipped_table().lookup(trial, 10_000) is None
-    assert ReferenceCache().lookup(trial, 10_000) is not None
+    assert shipped_table().lookup(trial, 10_000) is not None  # the default suite's trial

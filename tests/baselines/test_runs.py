@@ -435,7 +435,7 @@ def test_finding2_a_duplicated_line_counts_once_on_resume_and_report(
         ),
         ({"controller": "pid_vf"}, "controller 'pid_vf' is not in the run's suite"),
         ({"scenario": "current_shift"}, "scenario 'current_shift' is not in the run's suite"),
-        ({"seed": 77}, "seed 77 is not one of the run's seeds"),
+        ({"seed": 77}, "seed 77 is not one of the run's seeds of 'nominal'"),
         ({"training_seed": 3}, "training seed 3 is not one of 'pid_los''s in the run"),
     ],
 )

@@ -8,6 +8,7 @@ from shipgym_baselines.style import controller_style
 
 def test_built_in_controllers_have_distinct_fixed_styles() -> None:
     names = [*CONTROLLERS, "ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3"]
+    names += ["ppo_history", "dagger", "bc"]
     looks = {(controller_style(n).color, controller_style(n).linestyle) for n in names}
     assert len(looks) == len(set(names))
 

@@ -54,16 +54,19 @@ def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
 
 
 def test_the_in_range_split_follows_the_held_out_one() -> None:
-    """The default suite leaves the in-range split out (over its time budget with it); a
-    suite that adds 16 in-range scenarios (inrange:0-15) ranks them after the held-out ones."""
+    """The default suite ranks 16 in-range scenarios (inrange:0-15) after the held-out ones,
+    each on the suite's first two evaluation seeds (the others on all ten)."""
     default = load_suite("default")
-    assert default.inrange_scenarios == 0
-    assert default.all_scenarios()[31:] == [f"heldout:{i}" for i in range(16)]
-    with_split = default.model_copy(update={"inrange_scenarios": 16})
-    assert with_split.all_scenarios()[31:] == [
+    assert default.inrange_scenarios == 16 and default.inrange_seeds == 2
+    assert default.all_scenarios()[31:] == [
         *(f"heldout:{i}" for i in range(16)),
         *(f"inrange:{i}" for i in range(16)),
     ]
+    seeds = list(range(10_000, 10_010))
+    fewer = default.scenario_seeds(seeds)
+    assert fewer == {f"inrange:{i}": [10_000, 10_001] for i in range(16)}
+    assert default.scenario_seeds(seeds[:2]) == {}  # --seeds 2: every scenario on both
+    assert default.model_copy(update={"inrange_seeds": None}).scenario_seeds(seeds) == {}
 
 
 def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
@@ -161,6 +164,7 @@ def test_unknown_suite_lists_the_suites() -> None:
         ("heldout_scenarios: -1\n", "heldout_scenarios"),
         ("inrange_scenarios: -1\n", "inrange_scenarios"),
         ("inrange_scenarios: 1001\n", "inrange_scenarios"),
+        ("inrange_seeds: 0\n", "inrange_seeds"),
     ],
 )
 def test_counts_are_validated(tmp_path: Path, extra: str, key: str) -> None:

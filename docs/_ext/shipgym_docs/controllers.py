@@ -254,14 +254,53 @@ def _settings_section(record: ControllerRecord) -> str:
     )
 
 
+def seed_rows(metas: list[Path]) -> list[tuple[Any, ...]]:
+    """Per training seed: env steps, teacher labels, wall time, the best validation cost
+    ratio of its learning curve and where the run stopped (from the shipped files)."""
+    rows = []
+    for file in metas:
+        meta = json.loads(file.read_text())
+        curve_file = file.with_name("learning_curve.json")
+        curve = json.loads(curve_file.read_text()) if curve_file.is_file() else {}
+        scores = curve.get("selection") or []
+        best = min(range(len(scores)), key=scores.__getitem__) if scores else None
+        at = "–" if best is None else f"{curve['env_steps'][best]:,}"
+        rows.append(
+            (
+                file.parent.name,
+                f"{meta.get('env_steps', 0):,}",
+                f"{meta.get('teacher_labels', 0):,}" if "teacher_labels" in meta else "–",
+                f"{meta.get('wall_time_s', 0.0):.0f}",
+                "–" if best is None else f"{scores[best]:.2f}",
+                at,
+                f"{len(scores)}",
+            )
+        )
+    return rows
+
+
+SEED_HEADER = [
+    "training seed",
+    "env steps",
+    "teacher labels",
+    "wall time [s]",
+    "best validation cost ratio",
+    "at env step",
+    "validations",
+]
+
+
 def learned_page(name: str) -> str:
     folder = POLICY_DIR / name
     metas = sorted(folder.glob("seed_*/meta.json")) or sorted(folder.glob("meta.json"))
     meta = json.loads(metas[0].read_text())
     config = meta.get("config", {})
+    trainer = meta.get("trainer")
     rows = [
         ("kind", "learned"),
         ("algorithm", f"`{meta.get('algo')}` (stable-baselines3 / sb3-contrib)"),
+        *([("trained by", f"`{trainer}` (a student of the `oracle`)")] if trainer else []),
+        ("history window", f"{meta.get('history_steps', 0)} control steps"),
         ("action mode", f"`{meta.get('action_mode')}`"),
         ("reads", "the observation only (deterministic policy)"),
         ("applies to", ", ".join(f"`{s}`" for s in MODELS)),
@@ -291,6 +330,11 @@ def learned_page(name: str) -> str:
             table(["name", "value"], [(f"`{k}`", cell(v)) for k, v in hyper.items()]),
             "\n## Policy\n",
             f"`{config.get('policy')}`, `policy_kwargs` = `{config.get('policy_kwargs')}`\n",
+            "\n## Training seeds\n",
+            "Each seed's run, from its shipped `meta.json` and `learning_curve.json` (the "
+            "validation cost ratio: the geometric mean over the validation trials of the "
+            "cost over the oracle's; the shipped model is the best one).\n",
+            table(SEED_HEADER, seed_rows(metas)),
             *tuned,
         ]
     )
