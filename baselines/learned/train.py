@@ -461,6 +461,10 @@ def train(
             verbose=0,
             **build_hyperparams(config, venv.action_space.shape[0]),
         )
+    if model.tensorboard_log is None:  # else SB3 makes an empty SB3-<time> folder in /tmp
+        from stable_baselines3.common.logger import Logger
+
+        model.set_logger(Logger(folder=None, output_formats=[]))
     if config.env.gamma_seconds is not None:
         # the rollout buffer's GAE broadcasts an (n_envs,) γ: each env its ship's
         # exp(−Ts/τ); SB3's time-limit bootstrap keeps the scalar hyperparams γ

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import tempfile
 from pathlib import Path
 
 import gymnasium as gym
@@ -163,9 +164,16 @@ def _policy_params(directory: Path) -> list[np.ndarray]:
     return [p.detach().numpy().copy() for p in policy.model.policy.parameters()]
 
 
-def test_ppo_trains_saves_reloads_and_evaluates_like_the_leaderboard(tmp_path: Path) -> None:
+def test_ppo_trains_saves_reloads_and_evaluates_like_the_leaderboard(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     out = tmp_path / "run"
+    temp = tmp_path / "temp"  # the temp dir SB3's default logger would write into
+    temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))
+    monkeypatch.delenv("SB3_LOGDIR", raising=False)
     meta = train(_tiny_config(), out_dir=out, progress=False, tensorboard=False)
+    assert not list(temp.glob("SB3-*"))  # without TensorBoard, no SB3-<time> folder there
     assert meta["env_steps"] == 256 and meta["algo"] == "ppo"
     for name in ("model.zip", "best_model.zip", "meta.json"):
         assert (out / name).is_file(), name
