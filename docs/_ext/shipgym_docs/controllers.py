@@ -21,6 +21,8 @@ from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical import lqr, nmpc, pid
 from shipgym_baselines.classical.adaptive.settings import L1BacksteppingSettings
 from shipgym_baselines.classical.l1_backstepping import L1Backstepping
+from shipgym_baselines.figures import plot_learning_curves
+from shipgym_baselines.learned.curves import agent_curves
 from shipgym_baselines.learned.policy import POLICY_DIR, shipped_policies
 from shipgym_baselines.registry import CONTROLLERS, ControllerRecord
 from shipgym_baselines.tuning.chosen import ALL_SHIPS, read_chosen
@@ -312,6 +314,7 @@ def learned_page(name: str) -> str:
     hyper = config.get("hyperparams", {})
     document = read_chosen(name)
     chosen = chosen_for(document, ALL_SHIPS)
+    curves = curves_section(name)
     tuned = (
         [
             "\n## Chosen settings\n",
@@ -335,9 +338,27 @@ def learned_page(name: str) -> str:
             "validation cost ratio: the geometric mean over the validation trials of the "
             "cost over the oracle's; the shipped model is the best one).\n",
             table(SEED_HEADER, seed_rows(metas)),
+            *curves,
             *tuned,
         ]
     )
+
+
+def curves_section(name: str) -> list[str]:
+    """The learning-curve section of a learned agent's page ([] when it ships no curve)."""
+    if not agent_curves(name):
+        return []
+    return [
+        "\n## Learning curves\n",
+        "Each seed's validation evaluations over its training (`learning_curve.json`): "
+        "the validation cost ratio on a log axis where the run selects on it, the oracle "
+        "= 1 dashed (the gap to the oracle is the height above the line), each seed's "
+        "shipped model ringed; else the validation mean return.  The scores are the ones "
+        "recorded while the seed trained, against the oracle and validation trials of that "
+        "time (`config.eval.n_episodes` in its `meta.json`): curves of agents trained under "
+        "another oracle revision or on fewer trials do not compare.\n",
+        f"![learning curves of {name}](img/{name}_curves.png)\n",
+    ]
 
 
 def index(names: list[str], learned: list[str]) -> str:
@@ -364,4 +385,6 @@ def write(root: Path) -> list[Path]:
     out = [write_text(folder / "index.md", index(names, learned))]
     out += [write_text(folder / f"{n}.md", page(CONTROLLERS[n])) for n in names]
     out += [write_text(folder / f"{n}.md", learned_page(n)) for n in learned]
+    for n in learned:
+        out += plot_learning_curves(folder / "img", {n: agent_curves(n)}, stem=f"{n}_curves")
     return out

@@ -165,3 +165,32 @@ def test_the_run_folders_references_are_read_again_for_another_oracle_revision(
     data = json.loads((tmp_path / REFERENCE_FILE).read_text())
     assert data["oracle"] == oracle_header()["oracle"] and data["references"] == refs
     assert reference_costs(trials, tmp_path) == refs  # read back, the same revision
+
+
+def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
+    tmp_path, monkeypatch
+) -> None:
+    """A run that selects on the validation cost ratio is drawn on it (log axis, the oracle
+    at 1, each seed's best point ringed); one without it on its return."""
+    from shipgym_baselines import figures
+
+    drawn = {}
+
+    def keep(fig, out_dir, stem, **_):
+        drawn[stem] = fig
+        return []
+
+    monkeypatch.setattr(figures, "save_figure", keep)
+    ratio = {"env_steps": [10, 20, 30], "mean_return": [-3.0, -2.0, -2.5], "std_return": [1.0] * 3}
+    curves = {
+        "dagger": [{**ratio, "selection": [5.0, 2.0, 2.5], "seed": 0}],
+        "ppo": [{**ratio, "seed": 0}],
+    }
+    figures.plot_learning_curves(tmp_path, curves, stem="mine")
+    by_cost, by_return = drawn["mine"].axes[:2]
+    assert by_cost.get_yscale() == "log" and by_return.get_yscale() == "linear"
+    assert by_cost.get_ylabel() == "validation cost / oracle's"
+    lines = {line.get_label(): line for line in by_cost.get_lines()}
+    assert list(lines["oracle = 1"].get_ydata()) == [1.0, 1.0]
+    rings = [ln for ln in by_cost.get_lines() if ln.get_marker() == "o"]
+    assert [(float(r.get_xdata()[0]), float(r.get_ydata()[0])) for r in rings] == [(20.0, 2.0)]
