@@ -18,10 +18,11 @@ The content hash is the SHA-256 of the resolved scenario's settings as canonical
 (:func:`scenario_key`), so an edited scenario never meets a stale entry.  ``trace`` holds
 the figure's columns (:data:`TRACE_KEYS`) thinned to at most :data:`TRACE_POINTS` points.
 The leaderboard reads an entry for each reference episode and runs the reference only for a
-trial missing from its table (``--recompute-references``: for every trial); ``shipgym
-references`` fills the tables (resumable: it writes after every episode).  A table of another
+trial missing from its table (``--recompute-references``: for every trial); a table of another
 env revision, oracle revision or other oracle settings is ignored as a whole (every trial is
-then computed).
+then computed).  ``shipgym references`` fills a table (resumable: it writes after every
+episode); :func:`fill_tables` refuses to fill a file of another header (:func:`foreign`)
+unless asked to replace it, and then keeps the old file beside it (:func:`backup_path`).
 
 A trial the shipped table lacks (an own scenario, a suite's extra seeds) is computed once per
 user: :class:`ReferenceCache` keeps its entry in a table of the same format at
@@ -152,6 +153,11 @@ class ReferenceTable:
         """Record the reference's episode ``result`` of ``scenario`` (a trial)."""
         self.entries[entry_key(scenario, result.seed)] = table_entry(result)
 
+    def store(self, scenario: Scenario, result: EpisodeResult) -> None:
+        """:meth:`add` the episode, then :meth:`save` the table to its file."""
+        self.add(scenario, result)
+        self.save()
+
     def save(self, path: str | os.PathLike | None = None) -> Path:
         """Write the table atomically (sorted keys: the same entries give the same bytes)."""
         file = Path(path) if path is not None else (self.path or table_path(self.reference))
@@ -175,6 +181,83 @@ def table_entry(result: EpisodeResult) -> dict[str, Any]:
         "metrics": _plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
         "trace": thin_trace(result.trajectory),
     }
+
+
+def foreign(path: str | os.PathLike, reference: str = ORACLE) -> str | None:
+    """What keeps the file at ``path`` from being filled as ``reference``'s table, in words
+    (``a table of another revision or settings (env_revision 3, not 4)``); None when there
+    is no file or it holds such a table under the current header (:func:`oracle_header`)."""
+    file = Path(path)
+    if not file.exists():
+        return None
+    try:
+        with gzip.open(file, "rt", encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, EOFError, ValueError) as exc:
+        return f"no reference table ({exc})"
+    if not isinstance(data, dict):
+        return "no reference table (no JSON object)"
+    wanted, differences = oracle_header(reference), []
+    for key, want in wanted.items():
+        have = data.get(key, "missing")
+        if key == "oracle" and isinstance(have, dict):
+            differences += [
+                f"oracle {k} {have.get(k, 'missing')}, not {want.get(k, 'none')}"
+                for k in sorted(set(have) | set(want))
+                if have.get(k) != want.get(k)
+            ]
+        elif have != want:
+            differences.append(f"{key} {have}, not {want}")
+    return (
+        f"a table of another revision or settings ({'; '.join(differences)})"
+        if differences
+        else None
+    )
+
+
+def backup_path(path: str | os.PathLike) -> Path:
+    """Where :func:`fill_tables` keeps a replaced table: ``<file>.bak`` beside it."""
+    file = Path(path)
+    return file.with_name(f"{file.name}.bak")
+
+
+def fill_tables(
+    files: Mapping[str, str | os.PathLike], replace: bool = False
+) -> dict[str, ReferenceTable]:
+    """The :class:`ReferenceTable` of each reference in ``files`` (reference -> file) to fill:
+    its entries when the file holds its table under the current header (none: empty).  A
+    file of another format, env revision, reference, oracle revision or oracle settings, or
+    no table at all (:func:`foreign`), is refused (:class:`RunError` naming the file and what
+    differs) unless ``replace``: then its bytes are kept as :func:`backup_path` (refused when
+    that file exists with other bytes: it is never overwritten) and the file starts afresh.
+    Every refusal comes before any file is written."""
+    tables: dict[str, ReferenceTable] = {}
+    replaced = []
+    for ref, path in files.items():
+        why = foreign(path, ref)
+        if why is None:
+            tables[ref] = ReferenceTable.load(path, ref)
+            continue
+        file, bak = Path(path), backup_path(path)
+        if not file.is_file():
+            raise RunError(f"{file} is no file: a table is a file (*.json.gz)")
+        if not replace:
+            raise RunError(
+                f"{file} holds {why}: --replace replaces it (keeping the old file as {bak})"
+            )
+        if bak.exists() and (not bak.is_file() or bak.read_bytes() != file.read_bytes()):
+            raise RunError(
+                f"--replace keeps {file} as {bak}, which exists: move that file away first"
+            )
+        replaced.append(ref)
+    for ref in replaced:
+        file, bak = Path(files[ref]), backup_path(files[ref])
+        if not bak.exists():  # else it holds these bytes already (an interrupted --replace)
+            with open(bak, "xb") as kept:
+                kept.write(file.read_bytes())
+        tables[ref] = ReferenceTable({}, file, ref)
+        tables[ref].save()  # the current header: a resumed fill needs no --replace
+    return {ref: tables[ref] for ref in files}
 
 
 @functools.cache
@@ -293,7 +376,7 @@ def lookup(
 
 #: the oracle's CPU seconds per control step of a trial at its full length (time limit over
 #: control period), by ship: the validation split's 8 episodes per ship (``shipgym references
-#: --validation --workers 1``, a cold compilation cache), the oracle's CPU and its C
+#: --packaged --validation --workers 1``, a cold compilation cache), the oracle's CPU and its C
 #: compilations' (each trial's solver is compiled anew) over the full-length steps; episodes
 #: that reach the goal early cost less
 ORACLE_CPU_S_PER_STEP: dict[str, float] = {

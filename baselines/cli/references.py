@@ -1,17 +1,30 @@
 """``shipgym references``: fill the privileged references' tables for suites' trials.
 
 The tables (:mod:`shipgym_baselines.references`, one per reference: ``oracle`` and
-``oracle_frozen``) ship with the package; the leaderboard reads them and runs a reference
-only for a trial its table lacks.  This command runs each reference of ``--reference``
-(default: both) on every trial of the given suites (scenarios × the suite's seeds, the
-in-range ones × its ``inrange_seeds``, drawn with its ``randomize`` ranges) and, with
-``--validation``, the ``oracle`` on the validation split
-that ``shipgym tune`` scores on (:func:`~shipgym_baselines.tuning.validation.validation_trials`;
-tuning needs no other reference), that its table does not hold yet.  It writes a table after
-every episode, so an interrupted fill resumes where it stopped.  ``--table PATH`` writes
-another file (one reference, the ``oracle`` unless ``--reference`` names another; default: the
-shipped tables, inside the installed package).
-Without ``--suite`` and ``--validation`` it fills the default suite's trials.
+``oracle_frozen``) ship with the package; the leaderboard reads them, then the per-user
+cache, and runs a reference only for a trial neither holds.  This command runs each
+reference of ``--reference`` (default: both) on every trial of the given suites (scenarios ×
+the suite's seeds, the in-range ones × its ``inrange_seeds``, drawn with its ``randomize``
+ranges) and, with ``--validation``, the ``oracle`` on the validation split that ``shipgym
+tune`` scores on (:func:`~shipgym_baselines.tuning.validation.validation_trials`; tuning
+needs no other reference), that its target does not hold yet.  It writes after every
+episode, so an interrupted fill resumes where it stopped.  Without ``--suite`` and
+``--validation`` it fills the default suite's trials.
+
+Where the episodes go:
+
+- by default, the per-user cache (:func:`~shipgym_baselines.references.user_cache_path`),
+  which every later leaderboard and study reads; a trial the shipped table holds is not
+  computed again;
+- ``--packaged``: the shipped tables inside the installed package (what every leaderboard
+  then reads first);
+- ``--table FILE``: that file (one reference, the ``oracle`` unless ``--reference`` names
+  another).
+
+A ``--packaged`` or ``--table`` file of another env revision, reference, oracle revision or
+oracle settings is refused in one line unless ``--replace``, which keeps the old file as
+``FILE.bak`` (never overwriting another one) and starts it afresh
+(:func:`~shipgym_baselines.references.fill_tables`).
 """
 
 from __future__ import annotations
@@ -20,6 +33,7 @@ import argparse
 import sys
 import time
 from contextlib import closing
+from typing import Any
 
 from shipgym_baselines.cli.options import add_json_option, emit
 from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
@@ -49,8 +63,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="the references to fill (default: all; with --table: oracle)",
     )
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--packaged",
+        action="store_true",
+        help="write the shipped tables inside the installed package (what every leaderboard "
+        "then reads); default: the per-user cache",
+    )
+    where.add_argument(
+        "--table",
+        default=None,
+        help="write this table file, one --reference only (default: the per-user cache)",
+    )
     p.add_argument(
-        "--table", default=None, help="the table file, one --reference only (default: shipped)"
+        "--replace",
+        action="store_true",
+        help="replace a --packaged or --table file of another revision or settings, keeping "
+        "the old one as FILE.bak",
     )
     add_json_option(
         p, "print {computed, held, wall_s, table, tables} as JSON (table: the first reference's)"
@@ -59,12 +88,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import functools
     import os
 
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
-    from shipgym_baselines.references import ReferenceTable, announce
+    from shipgym_baselines.references import (
+        ReferenceCache,
+        ReferenceTable,
+        announce,
+        fill_tables,
+        lookup,
+        table_path,
+    )
     from shipgym_baselines.suite import load_suite
 
     if args.reference is None:
@@ -73,19 +110,7 @@ def run(args: argparse.Namespace) -> int:
         chosen = list(dict.fromkeys(args.reference))
     if args.table is not None and len(chosen) != 1:
         raise RunError(f"--table names one file: give one --reference, not {chosen}")
-    tables = {ref: ReferenceTable.load(args.table, ref) for ref in chosen}
-    jobs, trial_of, held = [], {}, 0
-    todo: dict[str, list] = {ref: [] for ref in chosen}
-
-    def add(reference: str, job: Job, name: str, seed: int, trial) -> None:
-        nonlocal held
-        if tables[reference].lookup(trial, seed) is not None:
-            held += 1
-        elif (reference, name, seed) not in trial_of:
-            trial_of[(reference, name, seed)] = trial
-            todo[reference].append(trial)
-            jobs.append(job)
-
+    candidates: list[tuple[str, Job, str, int, Any]] = []  # reference, job, name, seed, trial
     suites = args.suite if args.suite is not None else ([] if args.validation else ["default"])
     for name in suites:
         spec = load_suite(name)
@@ -100,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
                 for ref in chosen:
                     job = Job(ref, scenario, (seed,), None, randomize, references="recompute")
                     (trial,) = trials(job)
-                    add(ref, job, scenario, seed, trial)
+                    candidates.append((ref, job, scenario, seed, trial))
     if args.validation and ORACLE in chosen:
         from shipgym_baselines.tuning.validation import validation_trials
 
@@ -108,9 +133,31 @@ def run(args: argparse.Namespace) -> int:
             # the trial as resolved settings: the job runs exactly this scenario
             settings = v.scenario.config.model_dump(mode="json")
             job = Job(ORACLE, v.name, (v.seed,), None, None, settings, references="recompute")
-            add(ORACLE, job, v.name, v.seed, v.scenario)
+            candidates.append((ORACLE, job, v.name, v.seed, v.scenario))
     if args.validation and ORACLE not in chosen:
         sys.stderr.write("references: --validation fills the oracle's table only: ignored\n")
+    tables: dict[str, ReferenceTable | ReferenceCache]
+    if args.table is not None or args.packaged:
+        files = {ref: args.table if args.table is not None else table_path(ref) for ref in chosen}
+        tables = dict(fill_tables(files, args.replace))
+        holds = {ref: tables[ref].lookup for ref in chosen}
+    else:
+        tables = {ref: ReferenceCache(reference=ref) for ref in chosen}
+        holds = {ref: functools.partial(lookup, cache=tables[ref], reference=ref) for ref in chosen}
+        if args.replace:
+            sys.stderr.write(
+                "references: --replace: a per-user cache of another revision is replaced "
+                "anyway (it holds only computed references): ignored\n"
+            )
+    jobs, trial_of, held = [], {}, 0
+    todo: dict[str, list] = {ref: [] for ref in chosen}
+    for ref, job, name, seed, trial in candidates:
+        if holds[ref](trial, seed) is not None:
+            held += 1
+        elif (ref, name, seed) not in trial_of:
+            trial_of[(ref, name, seed)] = trial
+            todo[ref].append(trial)
+            jobs.append(job)
     for ref in chosen:
         announce(todo[ref], f"written to {tables[ref].path} after each", ref)
     start = time.perf_counter()
@@ -119,16 +166,12 @@ def run(args: argparse.Namespace) -> int:
         for batch in results:
             for result in batch:
                 ref = result.controller
-                tables[ref].add(trial_of[(ref, result.scenario, result.seed)], result)
-                tables[ref].save(args.table)
+                tables[ref].store(trial_of[(ref, result.scenario, result.seed)], result)
                 done += 1
                 sys.stderr.write(
                     f"references: {done}/{len(jobs)} {ref} {result.scenario} seed "
                     f"{result.seed}: cost {result.metrics.get('cost')}\n"
                 )
-    for ref in chosen:
-        if not todo[ref]:
-            tables[ref].save(args.table)  # written once: a table of another revision is replaced
     wall = time.perf_counter() - start
     paths = {ref: str(tables[ref].path) for ref in chosen}
     summary = {

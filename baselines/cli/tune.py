@@ -4,8 +4,9 @@ The search space, budget and validation trials are ``configs/tuning/NAME.yaml``;
 protocol is ``docs/tuning.md`` (:mod:`shipgym_baselines.tuning`).  One study per ship for a
 per-ship config (``--ship`` picks one), in ``--out`` (default ``results/tuning/NAME``, a
 folder per ship) with its SQLite storage there unless ``--storage URL``; an existing study
-is continued only with ``--resume``.  Each study writes ``tuning_report.json`` into its folder
-and its chosen settings into ``<out>/chosen/<controller>.yaml``.  ``--promote`` writes them
+is continued only with ``--resume``, and only under the config it started with.  Each study
+writes ``tuning_report.json`` into its folder and its chosen settings into
+``<out>/chosen/<controller>.yaml``.  ``--promote`` writes them
 into the packaged ``configs/tuning/chosen`` instead (``--chosen-dir``: another folder),
 saying what they replace; settings that score better on the same validation trials are
 kept unless ``--force`` (the command then exits 1).
@@ -24,7 +25,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("tune", help="tune a controller's settings on the validation split (Optuna)")
     p.add_argument("name", help="tuning config in configs/tuning (pid_los, ppo, …) or a YAML path")
     p.add_argument("--trials", type=int, default=None, help="trials per study (default: budget)")
-    p.add_argument("--resume", action="store_true", help="continue the existing study")
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the existing study (refused if its config changed since it started)",
+    )
     p.add_argument("--storage", default=None, help="Optuna storage URL (default: SQLite in --out)")
     p.add_argument("--backend", choices=("local", "ray"), default="local")
     p.add_argument("--workers", type=int, default=1, help="Ray tasks at once (--backend ray)")

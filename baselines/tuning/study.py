@@ -5,7 +5,11 @@ A study is one (tuning config, ship) pair — ``<name>:<ship>`` for a per-ship c
 ``sqlite:///<folder>/study.db`` unless ``--storage`` names another.  An existing study is
 continued only with ``resume=True`` (else refused: nothing is overwritten silently), and a
 resumed study runs until it holds ``n_trials`` finished trials (complete, pruned or failed;
-a trial left running by a killed process is marked failed).  The sampler's seed is the
+a trial left running by a killed process is marked failed).  A study keeps what determines
+its scores (:func:`study_record`: the resolved config but its name, words, budget and final
+training; its ship and validation trials; the env and oracle revisions) and its SHA-256 in
+its user attributes; resuming it under a record that differs is refused, naming the keys
+that changed, and so is resuming a study that has no record.  The sampler's seed is the
 config's ``sampler_seed`` plus the number of trials already finished, so a resumed study
 draws new points and the same history gives the same suggestions.
 
@@ -13,8 +17,9 @@ Before its first trial a study scores the *default* settings (the config's ``def
 the registry's construction before tuning — for a classical controller its paper-literal
 design, ``preset: paper``; for a learned agent its agent config unchanged) and keeps the
 ratios in the study, so the report can compare best and default on the same trials.  When the study
-ends, its ``tuning_report.json`` is (re)written and the chosen settings — the best trial's,
-or none (the default kept) when the best is not below the default — go into
+ends, its ``tuning_report.json`` is (re)written and the chosen settings — the best trial's
+as it was scored (its ``settings`` user attribute: the fixed ones and its parameters), or none
+(the default kept) when the best is not below the default — go into
 ``<out>/chosen/<controller>.yaml`` (:mod:`~shipgym_baselines.tuning.chosen`): the packaged
 ``configs/tuning/chosen`` only with ``promote`` (or another folder with ``chosen_dir``).
 Settings already in the target section are replaced only when the winner is not worse on
@@ -27,6 +32,7 @@ study from the shared storage.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import os
 import time
@@ -49,6 +55,11 @@ CHOSEN_FOLDER = "chosen"
 BACKENDS = ("local", "ray")
 #: Optuna's states of a finished trial
 FINISHED = ("COMPLETE", "PRUNED", "FAIL")
+#: a tuning config's keys that do not change a study's scores: its name and words, its budget
+#: (``--trials`` with ``--resume`` extends a study) and a learned study's final training
+UNSCORED = frozenset({"name", "description", "budget", "final"})
+#: the study's user attributes that keep :func:`study_record` and its SHA-256
+RECORD_ATTR, DIGEST_ATTR = "record", "record_sha256"
 
 Progress = Callable[[str], object]
 
@@ -147,6 +158,61 @@ def plan_trials(plan: StudyPlan) -> list[ValidationTrial]:
     return validation_trials(v.distribution, plan.ship, v.per_ship, plan.config.ships)
 
 
+def study_record(plan: StudyPlan) -> dict[str, Any]:
+    """What determines a study's scores: its config resolved (but :data:`UNSCORED`), its
+    ship, its validation trials (name, env seed and scenario content hash each) and the env
+    and oracle revisions."""
+    from shipgym_baselines.references import scenario_key
+
+    trials = [f"{t.name}:{t.seed}:{scenario_key(t.scenario)}" for t in plan_trials(plan)]
+    return {
+        **plan.config.model_dump(mode="json", exclude=set(UNSCORED)),
+        "ship": plan.ship,
+        "validation_trials": trials,
+        **promotion.revisions(),
+    }
+
+
+def record_digest(record: dict[str, Any]) -> str:
+    """The SHA-256 of a :func:`study_record` as canonical JSON."""
+    text = json.dumps(record, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def changed_keys(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
+    """The keys whose values differ between two records, a mapping's keys named inside it
+    (``params.los_radius_L``, ``fixed.tuning``)."""
+    changed = []
+    for key in sorted(set(old) | set(new)):
+        a, b = old.get(key), new.get(key)
+        if a == b:
+            continue
+        if isinstance(a, dict) and isinstance(b, dict):
+            changed += [f"{key}.{k}" for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+        else:
+            changed.append(key)
+    return changed
+
+
+def check_record(plan: StudyPlan, study: Any) -> None:
+    """Refuse to continue ``study`` unless it was started with the plan's
+    :func:`study_record` (:class:`RunError` naming the keys that changed)."""
+    held = study.user_attrs.get(DIGEST_ATTR)
+    advice = "start a new study with another --out or --storage"
+    if held is None:
+        raise RunError(
+            f"--resume: study {plan.study_name!r} in {plan.storage} has no record of the config "
+            f"it started with (it began before studies kept one): {advice}"
+        )
+    record = study_record(plan)
+    if held != record_digest(record):
+        changed = changed_keys(dict(study.user_attrs.get(RECORD_ATTR) or {}), record)
+        raise RunError(
+            f"--resume: the config differs from the one study {plan.study_name!r} started "
+            f"with: {', '.join(changed) or 'its record'} (restore it, or {advice})"
+        )
+
+
 class Scorer:
     """Scores settings on a study's validation trials: ``score(overrides, report)`` ->
     per-trial cost ratios (classical: evaluated a chunk at a time; learned: trained, then
@@ -192,15 +258,18 @@ class Scorer:
                 trial.set_user_attr("cpu_s", time.process_time() - start)
                 raise optuna.TrialPruned()
 
-        ratios = self.score({**self.plan.config.fixed, **params}, report)
+        settings = {**self.plan.config.fixed, **params}
+        trial.set_user_attr("settings", settings)  # what its value is the objective of
+        ratios = self.score(settings, report)
         trial.set_user_attr("ratios", ratios)
         trial.set_user_attr("cpu_s", time.process_time() - start)
         return geometric_mean(ratios)
 
 
 def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool = True) -> Any:
-    """The plan's Optuna study: created (refused if it exists and not ``resume``) or
-    loaded (``resume``: refused if there is none).  ``driver``: the process that runs the
+    """The plan's Optuna study: created with its :func:`study_record` (refused if it exists
+    and not ``resume``) or loaded (``resume``: refused if there is none, or if it started
+    with another record: :func:`check_record`).  ``driver``: the process that runs the
     study marks the trials a killed process left running as failed; a Ray task (False) must
     not, or it would fail another task's trial that is running now."""
     import optuna
@@ -218,6 +287,7 @@ def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool 
     finished = 0
     if exists:
         study = optuna.load_study(study_name=plan.study_name, storage=plan.storage)
+        check_record(plan, study)
         if driver:
             _fail_stale(study)
         finished = sum(t.state.name in FINISHED for t in study.trials)
@@ -227,13 +297,17 @@ def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool 
     )
     pruner = optuna.pruners.MedianPruner(n_startup_trials=plan.config.startup_trials)
     if not exists and create:
-        return optuna.create_study(
+        record = study_record(plan)
+        study = optuna.create_study(
             study_name=plan.study_name,
             storage=plan.storage,
             sampler=sampler,
             pruner=pruner,
             direction="minimize",
         )
+        study.set_user_attr(RECORD_ATTR, record)
+        study.set_user_attr(DIGEST_ATTR, record_digest(record))
+        return study
     return optuna.load_study(
         study_name=plan.study_name, storage=plan.storage, sampler=sampler, pruner=pruner
     )
@@ -359,11 +433,11 @@ def write_report(
     if best is not None:
         report["best_vs_default"] = best_vs_default(best.user_attrs["ratios"], default, names)
         improved = best.value < report["default_value"]
-        # the settings the winner was scored with: the best trial's (under the fixed ones),
-        # or the default's (a learned study's default names its env and rollout settings,
-        # the same as every trial's; a classical default, the paper's preset, is the
-        # controller's construction without chosen settings)
-        winner = {**config.fixed, **best.params} if improved else dict(config.default)
+        # the settings the winner was scored with: the best trial's as stored with it (the
+        # fixed ones and its parameters), or the default's (a learned study's default names
+        # its env and rollout settings, the same as every trial's; a classical default, the
+        # paper's preset, is the controller's construction without chosen settings)
+        winner = dict(best.user_attrs["settings"]) if improved else dict(config.default)
         settings = {k: v for k, v in winner.items() if k != "preset"}
         ratios = list(best.user_attrs["ratios"]) if improved else default
         values = f"{best.value:.4g}, default {report['default_value']:.4g}"

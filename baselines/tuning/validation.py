@@ -9,7 +9,7 @@ the held-out or in-range split, never a catalogue scenario).
 
 The denominator of the cost ratio is the ``oracle``'s cost on the same trial
 (:mod:`shipgym_baselines.references`): read from the shipped table (which holds every trial
-of the ``validation`` split: ``shipgym references --validation``), else from the per-user
+of the ``validation`` split: ``shipgym references --packaged --validation``), else from the per-user
 cache of computed references (:func:`~shipgym_baselines.references.user_cache_path`), else
 run once with the privileged oracle (the built-in channel,
 :mod:`shipgym_baselines.privileged`; the tuned controller never sees the truth) and stored

@@ -216,3 +216,138 @@ def test_the_estimate_is_steps_times_the_ships_measured_rate() -> None:
     (trial,) = trials(Job("oracle", "mariner_track", (0,)))
     steps = trial.config.time_limit / trial.control_period
     assert estimate_cpu_s([trial]) == pytest.approx(steps * ORACLE_CPU_S_PER_STEP["mariner"])
+
+
+# --- shipgym references: where it writes, and never over a table of another revision -------
+
+
+def _tiny_suite(folder: Path) -> Path:
+    """A suite of one trial: ``nominal`` on one seed."""
+    import yaml
+
+    suite = folder / "tiny.yaml"
+    suite.write_text(
+        yaml.safe_dump(
+            {"name": "tiny", "scenarios": ["nominal"], "controllers": ["oracle"], "seeds": 1}
+        )
+    )
+    return suite
+
+
+def _foreign_table(file: Path, entries: int) -> bytes:
+    """A table of ``entries`` entries under env revision -1 at ``file``; returns its bytes."""
+    scenario = load_scenario("nominal")
+    table = ReferenceTable(
+        {entry_key(scenario, s): {"metrics": {"cost": 9.0}} for s in range(entries)}
+    )
+    table.save(file)
+    with gzip.open(file, "rt") as f:
+        data = json.load(f)
+    data["env_revision"] = -1
+    with gzip.open(file, "wt") as f:
+        json.dump(data, f)
+    return file.read_bytes()
+
+
+def test_a_table_of_another_revision_is_refused_unless_replace(
+    oracle: CountingOracle, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Refused in one line naming the file and what differs, the file byte-identical and no
+    ``.bak``; ``--replace`` keeps the old bytes as ``FILE.bak`` and fills the file afresh; a
+    second ``--replace`` on the now current table touches no ``.bak``; an existing ``.bak``
+    of other bytes is never overwritten."""
+    from shipgym.envs.core import ENV_REVISION
+    from shipgym_baselines.cli import main
+
+    table = tmp_path / "mine.json.gz"
+    old = _foreign_table(table, 5)
+    argv = ["references", "--suite", str(_tiny_suite(tmp_path)), "--table", str(table)]
+    argv += ["--workers", "1"]
+    assert main(argv) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert str(table) in line and f"env_revision -1, not {ENV_REVISION}" in line
+    assert "--replace" in line
+    assert table.read_bytes() == old and not references.backup_path(table).exists()
+    assert oracle.runs == []  # refused before any work
+    assert main([*argv, "--replace"]) == 0
+    assert references.backup_path(table) == tmp_path / "mine.json.gz.bak"
+    assert references.backup_path(table).read_bytes() == old
+    assert references.foreign(table) is None
+    assert list(ReferenceTable.load(table).entries) == [entry_key(load_scenario("nominal"), 10000)]
+    assert main([*argv, "--replace"]) == 0 and len(oracle.runs) == 1  # held now
+    assert references.backup_path(table).read_bytes() == old
+    other = tmp_path / "other.json.gz"
+    old = _foreign_table(other, 2)
+    references.backup_path(other).write_bytes(b"an older backup")
+    argv[argv.index(str(table))] = str(other)
+    capsys.readouterr()
+    assert main([*argv, "--replace"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"{other}.bak, which exists" in line
+    assert other.read_bytes() == old
+    assert references.backup_path(other).read_bytes() == b"an older backup"
+
+
+def test_a_file_that_is_no_table_is_refused_naming_it(tmp_path: Path) -> None:
+    """Not gzip, or a table of the other reference: refused unless replaced."""
+    notes = tmp_path / "notes.json.gz"
+    notes.write_text("my notes")
+    assert (references.foreign(notes) or "").startswith("no reference table (")
+    with pytest.raises(RunError, match=r"notes\.json\.gz holds no reference table \("):
+        references.fill_tables({"oracle": notes})
+    assert notes.read_text() == "my notes"
+    frozen = tmp_path / "frozen.json.gz"
+    ReferenceTable({}, frozen, "oracle_frozen").save()
+    assert "reference oracle_frozen, not oracle" in (references.foreign(frozen) or "")
+    assert references.foreign(tmp_path / "absent.json.gz") is None
+
+
+def _digest(file: Path) -> str:
+    import hashlib
+
+    return hashlib.sha256(file.read_bytes()).hexdigest()
+
+
+def test_the_references_command_writes_the_packaged_tables_only_with_packaged(
+    oracle: CountingOracle,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """By default the episodes go to the per-user cache (which the leaderboard reads) and the
+    shipped tables stay byte-identical; ``--packaged`` writes the shipped table (here moved
+    to a temporary file); ``--packaged`` and ``--table`` exclude each other."""
+    from shipgym_baselines.cli import main
+
+    shipped = {ref: references.table_path(ref) for ref in references.REFERENCES}
+    before = {ref: _digest(file) for ref, file in shipped.items()}
+    argv = ["references", "--suite", str(_tiny_suite(tmp_path)), "--reference", "oracle"]
+    argv += ["--workers", "1", "--json"]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["tables"] == {"oracle": str(user_cache_path())} and summary["computed"] == 1
+    assert list(ReferenceTable.load(user_cache_path()).entries) == [
+        entry_key(load_scenario("nominal"), 10000)
+    ]
+    assert {ref: _digest(file) for ref, file in shipped.items()} == before
+    packaged = tmp_path / "packaged" / "oracle.json.gz"
+    monkeypatch.setattr(references, "table_path", lambda reference="oracle": packaged)
+    assert main([*argv, "--packaged"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["tables"] == {"oracle": str(packaged)} and summary["computed"] == 1
+    assert len(ReferenceTable.load(packaged).entries) == 1
+    with pytest.raises(SystemExit) as exit_:  # argparse: mutually exclusive
+        main([*argv, "--packaged", "--table", str(tmp_path / "t.json.gz")])
+    assert exit_.value.code == 2 and "--table" in capsys.readouterr().err
+
+
+def test_the_default_counts_what_the_shipped_table_holds(
+    capsys: pytest.CaptureFixture[str], user_cache: Path
+) -> None:
+    """The validation split is in the shipped table: nothing computed, no cache written."""
+    from shipgym_baselines.cli import main
+
+    assert main(["references", "--validation", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert (summary["computed"], summary["held"]) == (0, 32)
+    assert summary["table"] == str(user_cache_path()) and not user_cache_path().exists()

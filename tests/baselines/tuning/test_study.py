@@ -506,3 +506,87 @@ def test_a_missing_extra_is_one_line_naming_the_install(
     assert main(["tune", "pid_los", "--out", str(tmp_path / "out")]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert 'pip install -e ".[tune]"' in line and "optuna" in line
+
+
+# --- a study is continued only under the record it started with ----------------------------
+
+
+def test_a_resumed_study_with_an_edited_config_is_refused(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Another fixed block or narrower ranges: refused in one line naming the keys, the
+    study, its report and its chosen settings untouched; another budget alone resumes."""
+    out, folder = tmp_path / "out", tmp_path / "chosen"
+    where = ["--out", str(out), "--chosen-dir", str(folder)]
+    assert main(["tune", str(tiny), *where, "--trials", "1"]) == 0
+    report = (out / "nomoto2" / "tuning_report.json").read_bytes()
+    written = _digests(folder)
+    capsys.readouterr()
+    edited = tmp_path / "edited.yaml"
+    narrower = {**TINY["params"], "los_radius_L": {"low": 2.0, "high": 3.0}}
+    for edit, keys in [
+        ({"fixed": {"preset": "paper", "tuning": "vyshnegradsky"}}, "fixed.tuning"),
+        ({"params": narrower}, "params.los_radius_L"),
+        ({"fixed": {"preset": "paper"}, "params": narrower}, "fixed.tuning, params.los_radius_L"),
+    ]:
+        edited.write_text(yaml.safe_dump({**TINY, **edit}))
+        assert main(["tune", str(edited), *where, "--resume", "--trials", "2"]) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        said = "the config differs from the one study 'pid_los_tiny:nomoto2' started with: "
+        assert f"{said}{keys} (restore it, or start a new study" in line, line
+    assert (out / "nomoto2" / "tuning_report.json").read_bytes() == report
+    assert _digests(folder) == written
+    (plan,) = plan_studies(str(tiny), out=out)
+    assert len(optuna.load_study(study_name=plan.study_name, storage=plan.storage).trials) == 1
+    edited.write_text(yaml.safe_dump({**TINY, "budget": 9, "description": "more trials"}))
+    assert main(["tune", str(edited), *where, "--resume", "--trials", "1"]) == 0
+
+
+def test_a_study_keeps_its_record_and_one_without_is_not_resumed(tmp_path: Path) -> None:
+    """A new study holds its record and the record's digest; a study made without one (by
+    an older shipgym) is refused with advice rather than continued unchecked."""
+    from shipgym_baselines.tuning.study import StudyPlan, record_digest, study_record
+
+    config = TuningConfig.model_validate(TINY)
+    plan = StudyPlan("toy", config, "nomoto2", tmp_path, f"sqlite:///{tmp_path}/a.db", "a")
+    attrs = open_study(plan, resume=False).user_attrs
+    record = study_record(plan)
+    assert attrs["record"] == record and attrs["record_sha256"] == record_digest(record)
+    assert record["fixed"] == TINY["fixed"] and record["ship"] == "nomoto2"
+    assert record["validation_trials"][0].startswith("validation:0:10000:")
+    assert "budget" not in record and "name" not in record
+    old = StudyPlan("toy", config, "nomoto2", tmp_path, f"sqlite:///{tmp_path}/b.db", "b")
+    optuna.create_study(study_name="b", storage=old.storage)  # no record
+    with pytest.raises(RunError, match=r"has no record of the config it started with.*--out"):
+        open_study(old, resume=True)
+
+
+def test_the_chosen_settings_score_what_their_record_says(tmp_path: Path) -> None:
+    """A trial wins (the default is poor): the chosen section is the best trial's settings as
+    stored with it, and exactly those settings (over the paper preset they were scored from)
+    score the recorded objective now.  A plan whose fixed block differs from the study's
+    still writes the trial's own settings, never a mix of the two."""
+    import dataclasses
+
+    from shipgym_baselines.tuning.promotion import incumbent_settings
+    from shipgym_baselines.tuning.study import Scorer, write_report
+
+    file = tmp_path / "pid_los_tiny.yaml"
+    file.write_text(
+        yaml.safe_dump({**TINY, "default": {"preset": "paper", "natural_frequency_T": 0.5}})
+    )
+    (plan,) = plan_studies(str(file), out=tmp_path / "out", chosen_dir=tmp_path / "chosen")
+    report = run_study(plan, n_trials=2)
+    assert report["chosen"]["kept_default"] is False and report["chosen"]["written"]
+    settings, summary = chosen.section_record("pid_los", "nomoto2", tmp_path / "chosen")
+    assert settings == {"tuning": "pole_placement", **report["best_params"]}
+    trials = validation_trials("validation", "nomoto2", 1)
+    oracle = report["validation"]["oracle_costs"]
+    ratios = controller_ratios("pid_los", incumbent_settings(plan.config, settings), trials, oracle)
+    assert geometric_mean(ratios) == pytest.approx(summary["value"], rel=1e-12)
+    assert summary["best_value"] == summary["value"] == report["best_value"]
+    other = plan.config.model_copy(update={"fixed": {"preset": "paper", "tuning": "vyshnegradsky"}})
+    edited = dataclasses.replace(plan, config=other, chosen_dir=tmp_path / "again")
+    study = optuna.load_study(study_name=plan.study_name, storage=plan.storage)
+    again = write_report(edited, study, Scorer(edited))
+    assert again["chosen"]["settings"] == settings
