@@ -8,12 +8,14 @@ trains ``training.n_timesteps`` env steps in ``training.evaluations`` equal part
 part ends at a checkpoint, and the next resumes from it); after each part the current model
 is scored on the study's validation trials — the cost ratio to the oracle, their geometric
 mean reported to the pruner — so a poor configuration stops early.  The value of the trial
-is the last part's.  Runs live in ``<study folder>/runs/trial_<n>`` (the default in
-``runs/default``).
+is the last part's.  An ``algo: dagger`` agent's env steps are its teacher labels: each part
+runs its rounds until the part's labels are reached (:func:`dagger_part`).  Runs live in
+``<study folder>/runs/trial_<n>`` (the default in ``runs/default``).
 """
 
 from __future__ import annotations
 
+import functools
 import shutil
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -55,6 +57,14 @@ def apply_overrides(agent: Any, overrides: dict[str, Any]) -> Any:
     )
 
 
+def dagger_part(agent: Any, labels: int) -> Any:
+    """The ``algo: dagger`` config ``agent`` trained to the end of a part: its rounds until
+    ``labels`` teacher labels (env steps) are reached, after the round that reaches them (a
+    DAgger run continues to a higher cap); no plateau rule (the study's pruner stops a poor
+    trial)."""
+    return agent.model_copy(update={"n_timesteps": labels, "plateau": None})
+
+
 def train_and_score(
     config: TuningConfig,
     overrides: dict[str, Any],
@@ -74,15 +84,22 @@ def train_and_score(
     part = max(1, spec.n_timesteps // spec.evaluations)
     # checkpoints at the parts' ends; no periodic evaluation of its own (scored here)
     quiet = agent.eval.model_copy(update={"freq": 10 * spec.n_timesteps})
-    agent = agent.model_copy(update={"checkpoint_freq": part, "eval": quiet})
+    agent = agent.model_copy(
+        update={"checkpoint_freq": part, "eval": quiet, "n_timesteps": spec.n_timesteps}
+    )
     if folder.exists():
         shutil.rmtree(folder)  # a re-run trial (failed before) starts afresh
+    fit = functools.partial(train, progress=False, tensorboard=False)
     ratios: list[float] = []
     for k in range(1, spec.evaluations + 1):
         steps = part * k if k < spec.evaluations else spec.n_timesteps
-        latest = latest_checkpoint(folder) if k > 1 else None
-        if latest is None or latest[1] < steps:  # a part a long rollout already covered: skip
-            train(agent, folder, n_timesteps=steps, resume=k > 1, progress=False, tensorboard=False)
+        if agent.algo == "dagger":
+            meta = fit(dagger_part(agent, steps), folder, resume=k > 1)
+            steps = int(meta["env_steps"])
+        else:
+            latest = latest_checkpoint(folder) if k > 1 else None
+            if latest is None or latest[1] < steps:  # a part a long rollout covered: skip
+                fit(agent, folder, n_timesteps=steps, resume=k > 1)
         ratios = controller_ratios(str(folder / "model.zip"), {}, trials, oracle)
         if report is not None:
             report(geometric_mean(ratios), steps)

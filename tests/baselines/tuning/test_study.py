@@ -308,6 +308,47 @@ def test_a_learned_study_trains_scores_and_prunes_through_the_same_command(
     assert report["chosen"]["settings"] == winner
 
 
+def test_a_dagger_study_trains_its_rounds_in_parts(tmp_path: Path) -> None:
+    """A learned study of an ``algo: dagger`` agent: each part continues the DAgger run
+    until its labels are reached (parts of 50 labels, a round of one rollout ≈ 85: one round
+    a part), reports the labels so far, and the value is the newest student's cost ratio."""
+    agent = {
+        "name": "dagger_tiny",
+        "algo": "dagger",
+        "n_timesteps": 100_000,
+        "env": {"distribution": None, "scenario": "rudder_aging", "history_steps": 2},
+        "hyperparams": {"rounds": 5, "episodes_per_round": 1, "epochs": 1, "batch_size": 64},
+        "policy_kwargs": {"net_arch": [8]},
+        "eval": {"distribution": "validation", "n_episodes": 1, "select_on": "relative_cost"},
+    }
+    agent_file = tmp_path / "dagger_tiny.yaml"
+    agent_file.write_text(yaml.safe_dump(agent))
+    config = {
+        "name": "dagger_tiny",
+        "controller": "dagger",
+        "kind": "learned",
+        "per_ship": False,
+        "ships": ["nomoto2"],
+        "budget": 1,
+        "validation": {"distribution": "validation", "per_ship": 1},
+        "startup_trials": 1,
+        "training": {"agent": str(agent_file), "n_timesteps": 100, "evaluations": 2},
+        "params": {"env.history_steps": {"choices": [2, 4]}},
+    }
+    file = tmp_path / "dagger_tiny_study.yaml"
+    file.write_text(yaml.safe_dump(config))
+    (plan,) = plan_studies(str(file), out=tmp_path / "out", chosen_dir=tmp_path / "chosen")
+    report = run_study(plan)
+    (trial,) = report["trials"]
+    run = tmp_path / "out" / "runs" / f"trial_{trial['number']}"
+    rounds = json.loads((run / "dagger" / "rounds.json").read_text())
+    assert [r["round"] for r in rounds] == [0, 1]
+    assert list(trial["intermediate"]) == [str(r["labels_total"]) for r in rounds]
+    meta = json.loads((run / "meta.json").read_text())
+    assert meta["history_steps"] == trial["params"]["env.history_steps"]
+    assert trial["value"] == pytest.approx(trial["intermediate"][str(rounds[-1]["labels_total"])])
+
+
 def test_every_packaged_tuning_config_loads() -> None:
     from shipgym_baselines.tuning.space import list_tuning
 
