@@ -30,6 +30,7 @@ from shipgym_baselines.runs import (
     read_episodes,
     read_run,
 )
+from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 #: 2 scenarios × 2 controllers × 2 seeds: 8 quick episodes
@@ -548,3 +549,54 @@ def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_r
         on_episode=ran.append,
     )
     assert len(ran) == 7 and len(read_episodes(tmp_path / "out")) == 8
+
+
+@pytest.mark.parametrize(
+    "name", ["leaderboard.md", "aggregate.json", ".run.json.tmp", ".manifest.txt.tmp"]
+)
+def test_resume_refuses_a_link_planted_as_an_output_and_leaves_its_target(
+    tmp_path: Path, smoke_run: Path, capsys, name: str
+) -> None:
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    out = copy_folder(smoke_run, tmp_path / "out")
+    (out / name).unlink(missing_ok=True)
+    (out / name).symlink_to(notes)
+    argv = ["leaderboard", "--suite", "smoke", "--seeds", "1", "--out", str(out), "--resume"]
+    assert main([*argv, "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"shipgym leaderboard: error: {out / name} is a symbolic link to {notes}: a run "
+        "writes no file through it; remove it or choose another --out\n"
+    )
+    assert notes.read_text() == "my notes\n" and read_run(out)["status"] == "complete"
+
+
+def test_a_link_planted_while_the_tables_are_written_is_refused(
+    tmp_path: Path, smoke_run: Path, monkeypatch
+) -> None:
+    """A link that appears during the run, as a table the run is about to write: that
+    write is refused (the run fails in one line) and the link's target is unchanged."""
+    from shipgym_baselines import figures
+
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    out = copy_folder(smoke_run, tmp_path / "out")
+    draw = figures.plot_scenarios
+
+    def plant_then_draw(folder: Path, *args: object, **kwargs: object) -> list[Path]:
+        (folder / "aggregate.json").unlink(missing_ok=True)
+        (folder / "aggregate.json").symlink_to(notes)
+        return draw(folder, *args, **kwargs)
+
+    monkeypatch.setattr(figures, "plot_scenarios", plant_then_draw)
+    with pytest.raises(RunError, match=r"aggregate\.json is a symbolic link"):
+        run_leaderboard(
+            "smoke",
+            seeds=1,
+            out_dir=out,
+            controllers=SMOKE_CONTROLLERS,
+            show_progress=False,
+            resume=True,
+        )
+    assert notes.read_text() == "my notes\n" and read_run(out)["status"] == "failed"
