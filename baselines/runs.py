@@ -33,7 +33,9 @@ aggregated from ``episodes.jsonl`` (so a resumed run's tables equal a clean run'
 
 Strict JSON has no infinity or NaN: in ``episodes.jsonl`` a metric of ±inf (t_c = inf, "never
 converged") is the string ``"inf"`` / ``"-inf"`` and NaN is ``null`` (metrics ignore NaN), so
-a record reads back to the same numbers (:func:`read_episodes`).
+a record reads back to the same numbers (:func:`read_episodes`).  Read back, each value is
+checked by type: a metric is a finite number, null, ``"inf"`` or ``"-inf"``; only
+:data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text.
 """
 
 from __future__ import annotations
@@ -414,8 +416,37 @@ def episode_key(record: Mapping[str, Any]) -> Key:
     )
 
 
-#: metrics whose value is text (every other metric is a number, null, "inf" or "-inf")
+#: metrics whose value is text or null (every other metric is a number, null, "inf" or "-inf")
 TEXT_METRICS = ("termination_reason",)
+#: metrics whose value is a boolean (true / false, or null)
+BOOL_METRICS = ("success",)
+
+
+class _Constant(ValueError):
+    """A ``NaN`` / ``Infinity`` token: JSON's extension that strict JSON has not."""
+
+
+def _no_constant(token: str) -> Any:
+    raise _Constant(token)
+
+
+def _metric_problem(key: str, value: Any) -> str | None:
+    """Why ``value`` cannot be the metric ``key`` of an episode record, or None."""
+    if key in TEXT_METRICS:
+        return None if value is None or isinstance(value, str) else "not text"
+    if key in BOOL_METRICS:
+        return None if value is None or isinstance(value, bool) else "not true or false"
+    if value is None or value in ("inf", "-inf"):
+        return None
+    if isinstance(value, bool):
+        return f"not a number (only {', '.join(BOOL_METRICS)} is true or false)"
+    if isinstance(value, int | float):
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # an integer beyond any float
+            finite = False
+        return None if finite else "not a finite number"
+    return "not a number"
 
 
 def _bad_line(file: Path, number: int, problem: str) -> RunError:
@@ -440,10 +471,11 @@ def _check_episode(record: Any, file: Path, number: int) -> dict[str, Any]:
         ):
             raise _bad_line(file, number, f"{key} {_short(value)} is not an integer")
     for key, value in record.items():
-        if key in EPISODE_KEYS or key in TEXT_METRICS:
+        if key in EPISODE_KEYS:
             continue
-        if isinstance(value, str) and value not in ("inf", "-inf"):
-            raise _bad_line(file, number, f"metric {key} is {_short(value)}, not a number")
+        problem = _metric_problem(key, value)
+        if problem is not None:
+            raise _bad_line(file, number, f"metric {key} is {_short(value)}, {problem}")
     return record
 
 
@@ -504,9 +536,10 @@ def read_episodes(
     """The finished episodes of a run folder, numbers restored (±inf), as a set keyed by
     the episode key: a line repeating an earlier one is dropped; a last line cut short by
     a kill is left out.  A :class:`RunError` naming the file and line for a line that is
-    not an episode record (not UTF-8, not JSON, not an object, a key missing, a metric
-    that is text), repeats a key with other content, or (given ``suite``, as ``run.json``
-    records it) holds an episode that is not the suite's."""
+    not an episode record (not UTF-8, not JSON, a ``NaN`` / ``Infinity`` token, not an
+    object, a key missing, a value of the wrong type: :func:`_metric_problem`), repeats a
+    key with other content, or (given ``suite``, as ``run.json`` records it) holds an
+    episode that is not the suite's."""
     file = Path(folder) / EPISODES_FILE
     if not file.is_file():
         return []
@@ -515,7 +548,10 @@ def read_episodes(
     first: dict[Key, int] = {}
     for number, line in _lines(file):
         try:
-            parsed = json.loads(line)
+            parsed = json.loads(line, parse_constant=_no_constant)
+        except _Constant as exc:
+            strict = f'{exc} is not strict JSON (write null or "inf")'
+            raise _bad_line(file, number, strict) from None
         except ValueError:
             raise _bad_line(file, number, "not JSON") from None
         record = _check_episode(parsed, file, number)
