@@ -60,8 +60,8 @@ import numpy as np
 
 from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
+from shipgym_baselines.outfiles import write_bytes
 from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
-from shipgym_baselines.runs import write_bytes
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns

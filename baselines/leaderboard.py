@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import functools
+import io
 import json
 import math
 import os
@@ -58,6 +59,7 @@ from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
 from shipgym_baselines.figures import median_ace_episode
 from shipgym_baselines.jsonout import dumps, dumps_rows
+from shipgym_baselines.outfiles import carried, write_bytes, write_text
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
@@ -574,7 +576,7 @@ def run_leaderboard(
             bar.close()
         for row in rows:  # rows completed by a run that stopped before pruning them
             keep_drawn(log, rows, row)
-        with log.manifest.claiming():  # the tables and figures: listed for --force
+        with log.manifest.recording():  # the tables and figures: listed as written
             results = load_results(log.folder)
             return write_results(
                 log.folder, log.record["suite"], results, workers, vector_figures, show_progress
@@ -667,7 +669,7 @@ def write_results(
         ]
         plots = {
             scenario: pool.submit(
-                figures.plot_scenarios,
+                carried(figures.plot_scenarios),
                 out,
                 {key: ep for key, ep in drawn.items() if key[0] == scenario},
                 suite["scenarios"],
@@ -682,7 +684,7 @@ def write_results(
         )
         ranking_plots = [
             pool.submit(
-                figures.plot_ranking,
+                carried(figures.plot_ranking),
                 out,
                 [r for r in board if r["split"].removesuffix(PARTIAL) == split],
                 ranked,
@@ -701,8 +703,8 @@ def write_results(
             splits=splits,
         )
         scores = score_table(ranked, splits, kinds)
-        (out / AGGREGATE_FILE).write_text(dumps(board, indent=2) + "\n")
-        (out / SCENARIO_SCORES_FILE).write_text(dumps_rows(scores))  # one scenario a line
+        write_text(out / AGGREGATE_FILE, dumps(board, indent=2) + "\n")
+        write_text(out / SCENARIO_SCORES_FILE, dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         note = comparison_note(suite, out)
         headroom = headroom_table(ranked, scenario_ships(suite["scenarios"]), splits)
@@ -1109,17 +1111,19 @@ def _fmt(value: Any, std: Any = None) -> str:
 def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
     before the rows (the ranking)."""
-    (out / "leaderboard.json").write_text(dumps_rows(rows))  # one row a line
+    write_text(out / "leaderboard.json", dumps_rows(rows))  # one row a line
     keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
-    with open(out / "leaderboard.csv", "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=keys, restval="")
-        writer.writeheader()
-        writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
+    table = io.StringIO(newline="")
+    writer = csv.DictWriter(table, fieldnames=keys, restval="")
+    writer.writeheader()
+    writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
+    write_text(out / "leaderboard.csv", table.getvalue())
     rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
-    (out / "leaderboard.md").write_text(
-        (head + "\n" if head else "") + rows_part + generalisation_table(rows)
+    write_text(
+        out / "leaderboard.md",
+        (head + "\n" if head else "") + rows_part + generalisation_table(rows),
     )
-    (out / "generalisation.json").write_text(dumps(generalisation(rows), indent=2))
+    write_text(out / "generalisation.json", dumps(generalisation(rows), indent=2))
 
 
 def _generalisation_splits(rows: Sequence[Mapping[str, Any]]) -> tuple[str, ...]:
@@ -1254,17 +1258,19 @@ def plot_results(
     out: Path,
     scenarios: Mapping[str, Any] | None = None,
     randomize: Mapping[str, Any] | None = None,
-) -> None:
+) -> list[Path]:
     """Per scenario: tracks over the path, e(t) and δ(t) of the first evaluation seed (of
-    the first training seed) of each controller whose trajectory was kept.  ``scenarios``:
-    name → settings (as ``run.json`` records them; default: each scenario loaded by name);
-    ``randomize``: the trial randomisation (the jump time drawn is that seed's)."""
+    the first training seed) of each controller whose trajectory was kept; returns the
+    files written (:func:`plot_file`).  ``scenarios``: name → settings (as ``run.json``
+    records them; default: each scenario loaded by name); ``randomize``: the trial
+    randomisation (the jump time drawn is that seed's)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     randomization = None if randomize is None else TrialRandomization(**randomize)
+    written = []
     for scenario in sorted({r.scenario for r in results if r.trajectory}):
         first: dict[str, EpisodeResult] = {}
         for r in sorted(results, key=_order):
@@ -1291,5 +1297,9 @@ def plot_results(
         axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
         axes[0].legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(out / plot_file(scenario), dpi=FIGURE_DPI)
+        image = io.BytesIO()
+        fig.savefig(image, format="png", dpi=FIGURE_DPI)
         plt.close(fig)
+        written.append(out / plot_file(scenario))
+        write_bytes(written[-1], image.getvalue())
+    return written

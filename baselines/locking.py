@@ -9,7 +9,10 @@ A stale lock cannot block anyone: the kernel releases a process's record locks w
 dies, however it dies (kill -9 included), and record locks are not inherited by forked
 workers.  A lock file left by a killed run is therefore free; the next run takes it and
 writes its own holder into it.  The file is not a run's output: the "not empty" check and
-``--force`` ignore it, and a run that ends removes it.
+``--force`` ignore it, and a run that ends removes it.  It is opened without following a
+link (:func:`shipgym_baselines.outfiles.open_regular`): a link, a folder or a hard link in
+its place is refused in one line, and whatever it points to is left as it was (the "not
+empty" check and ``--force`` see it, too).
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.outfiles import open_regular
 
 #: the lock file a run keeps in its ``--out`` while it runs
 LOCK_FILE = ".shipgym.lock"
@@ -36,9 +40,13 @@ _HELD: set[Path] = set()
 def _holder(file: Path) -> str:
     """Who holds the lock, from the lock file (pid and start time)."""
     try:
-        holder = json.loads(file.read_text())
+        fd = open_regular(file, os.O_RDONLY)
+        try:
+            holder = json.loads(os.pread(fd, 4096, 0))
+        finally:
+            os.close(fd)
         return f"process {holder['pid']}, started {holder['start_time']}"
-    except (OSError, ValueError, KeyError, TypeError):
+    except (OSError, RunError, ValueError, KeyError, TypeError):
         return "a process that has not yet written its name"
 
 
@@ -52,10 +60,11 @@ def in_use(folder: Path, holder: str) -> RunError:
 
 def _acquire(folder: Path, start_time: str) -> int:
     """The descriptor of the locked lock file of ``folder``; a :class:`RunError` naming
-    the holder when another process holds it."""
+    the holder when another process holds it, or naming the lock file when it is a link
+    or no regular file of its own (:func:`~shipgym_baselines.outfiles.open_regular`)."""
     file = folder / LOCK_FILE
     while True:
-        fd = os.open(file, os.O_RDWR | os.O_CREAT, 0o644)
+        fd = open_regular(file, os.O_RDWR | os.O_CREAT)
         try:
             fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
@@ -84,8 +93,8 @@ def lock_holder(folder: str | os.PathLike) -> str | None:
     if path.resolve() in _HELD or not file.is_file():
         return None
     try:
-        fd = os.open(file, os.O_RDONLY)
-    except OSError:
+        fd = open_regular(file, os.O_RDONLY)
+    except (OSError, RunError):  # not a lock: the run refuses it when it takes the lock
         return None
     try:  # a shared lock conflicts with the holder's exclusive one; closing releases ours
         fcntl.lockf(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)

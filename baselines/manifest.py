@@ -1,24 +1,29 @@
 """What a run wrote into its folder: the manifest that ``--force`` deletes by.
 
-Every ``leaderboard`` / ``evaluate`` / ``report`` run lists each path it writes in
+Every ``leaderboard`` / ``evaluate`` / ``report`` / ``run`` lists each path it writes in
 :data:`MANIFEST_FILE` (one folder-relative path a line, appended *before* the file is
-written, so a run killed while writing a file still lists it; the tables and figures,
-whose names the drawing code chooses, are listed as they appear).  ``--force`` deletes
-exactly the listed paths and refuses, before deleting anything, a folder that holds
-anything else: a user's file, a directory of their own, a file of an earlier shipgym
-version that kept no manifest.  The lock file (:mod:`shipgym_baselines.locking`) is never listed
-and never deleted.
+written, so a run killed while writing a file still lists it).  A run lists what it
+writes itself, never what it finds: each file goes through
+:func:`shipgym_baselines.outfiles.write_bytes`, which announces it (and its temporary) to
+the manifest that is :meth:`Manifest.recording` (in a pool worker too:
+:func:`~shipgym_baselines.outfiles.carried`), so a user's file that appears meanwhile is
+not the run's.  ``--force`` deletes exactly the listed paths and refuses, before deleting
+anything, a folder that holds anything else: a user's file, a directory of their own, a
+link (never written by a run, whatever its name), a file of an earlier shipgym version
+that kept no manifest.  The lock file (:mod:`shipgym_baselines.locking`) is never listed
+and never deleted; only a regular file of that name is the lock.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.locking import LOCK_FILE
+from shipgym_baselines.outfiles import open_regular, recording, write_text
 
 #: the list of paths the runs in a folder wrote
 MANIFEST_FILE = "manifest.txt"
@@ -26,83 +31,100 @@ MANIFEST_FILE = "manifest.txt"
 
 def snapshot(folder: str | os.PathLike) -> set[str]:
     """Every path below ``folder`` (files, links and directories, relative, ``/``-separated;
-    symbolic links are not followed), the lock file aside."""
+    symbolic links are not followed), the lock file aside (a regular file of that name:
+    a link in its place is listed)."""
     root = Path(folder)
     found: set[str] = set()
     for top, dirs, files in os.walk(root):
         for name in [*dirs, *files]:
-            rel = (Path(top) / name).relative_to(root).as_posix()
-            if rel != LOCK_FILE:
+            path = Path(top) / name
+            rel = path.relative_to(root).as_posix()
+            if rel != LOCK_FILE or path.is_symlink() or not path.is_file():
                 found.add(rel)
     return found
+
+
+def _links(folder: Path, paths: Iterable[str]) -> set[str]:
+    """Those of ``paths`` (relative to ``folder``) that are symbolic links."""
+    return {p for p in paths if (folder / p).is_symlink()}
 
 
 def read_manifest(folder: str | os.PathLike) -> set[str]:
     """The paths ``folder``'s manifest lists (empty without one); the manifest itself
     included once it exists."""
     file = Path(folder) / MANIFEST_FILE
-    if not file.is_file():
+    if file.is_symlink() or not file.is_file():  # a link is nobody's manifest
         return set()
     listed = {line for line in file.read_text(errors="replace").splitlines() if line}
     return listed | {MANIFEST_FILE}
 
 
 class Manifest:
-    """The manifest of an open run folder: :meth:`claim` a path before writing it,
-    :meth:`claiming` around code that writes files it names itself."""
+    """The manifest of an open run folder: :meth:`claim` a path before writing it, or
+    write inside :meth:`recording` (each file written through
+    :mod:`shipgym_baselines.outfiles` is claimed as it is written)."""
 
     def __init__(self, folder: str | os.PathLike):
         self.folder = Path(folder)
         self.listed = read_manifest(self.folder)
 
     def claim(self, *paths: str) -> None:
-        """List ``paths`` (relative to the folder) unless listed; flushed at once."""
+        """List ``paths`` (relative to the folder) unless listed; on disk at once, in one
+        appending write (pool workers claim into the same file)."""
         new = [p for p in dict.fromkeys(paths) if p not in self.listed]
         if not new:
             return
-        with open(self.folder / MANIFEST_FILE, "a", encoding="utf-8") as fh:
-            fh.write("".join(f"{p}\n" for p in new))
+        data = "".join(f"{p}\n" for p in new).encode("utf-8")
+        fd = open_regular(self.folder / MANIFEST_FILE, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+        try:
+            done = 0
+            while done < len(data):
+                done += os.write(fd, data[done:])
+        finally:
+            os.close(fd)
         self.listed |= {*new, MANIFEST_FILE}
 
+    def record(self, paths: Sequence[Path]) -> None:
+        """Claim those of ``paths`` (absolute) that lie inside the folder: the recorder of
+        :meth:`recording`."""
+        root = Path(os.path.abspath(self.folder))
+        inside = [p.relative_to(root).as_posix() for p in paths if p.is_relative_to(root)]
+        self.claim(*[p for p in inside if p != "."])
+
     @contextlib.contextmanager
-    def claiming(self) -> Iterator[None]:
-        """List every path that appears in the folder during the ``with`` body (also when
-        it ends with an error)."""
-        before = snapshot(self.folder)
-        try:
+    def recording(self) -> Iterator[None]:
+        """Claim every file and folder written in this folder through
+        :mod:`shipgym_baselines.outfiles` during the ``with`` body, before it is written
+        (files that appear otherwise, a user's, are not claimed)."""
+        with recording(self.record):
             yield
-        finally:
-            self.claim(*sorted(snapshot(self.folder) - before))
 
     def compact(self, keep: Iterable[str] = ()) -> None:
         """Rewrite the manifest, when a run finishes, to list only the listed paths that
         exist and ``keep`` (what a later run in the folder may write again, e.g. the run
-        record and its temporary): a run that wrote and removed thousands of trajectory
+        record): a run that wrote and removed thousands of trajectory
         files and their temporaries lists only those it kept (issue 20).  Never lists
         anything unlisted, so ``--force`` still deletes only what runs wrote.  Atomic
         (a listed temporary renamed over the manifest); on a full disk left as it was."""
-        file = self.folder / MANIFEST_FILE
-        tmp = f".{MANIFEST_FILE}.tmp"
-        self.claim(tmp)  # a kill while it is written leaves it listed
-        kept = sorted((self.listed & snapshot(self.folder)) | {*keep, tmp} - {MANIFEST_FILE})
-        try:
-            (self.folder / tmp).write_text("".join(f"{p}\n" for p in kept), encoding="utf-8")
-            os.replace(self.folder / tmp, file)
-        except OSError:
-            (self.folder / tmp).unlink(missing_ok=True)
-            return
+        self.listed |= read_manifest(self.folder)  # pool workers' claims too
+        kept = sorted(((self.listed & snapshot(self.folder)) | set(keep)) - {MANIFEST_FILE})
+        with recording(self.record):  # its temporary is listed while it exists
+            try:
+                write_text(self.folder / MANIFEST_FILE, "".join(f"{p}\n" for p in kept))
+            except OSError:
+                return
         self.listed = {*kept, MANIFEST_FILE}
 
 
-def clear_listed(folder: str | os.PathLike, option: str = "--force") -> None:
-    """Delete what the manifest of ``folder`` lists; a :class:`RunError`, before deleting
-    anything, when the folder holds anything the manifest does not list."""
+def check_listed(folder: str | os.PathLike, option: str = "--force") -> set[str]:
+    """The paths below ``folder`` (:func:`snapshot`), all listed in its manifest; a
+    :class:`RunError` naming those that are not (or are links) otherwise."""
     path = Path(folder)
     if not path.is_dir():
-        return
+        return set()
     listed = read_manifest(path)
     present = snapshot(path)
-    foreign = sorted(present - listed)
+    foreign = sorted((present - listed) | _links(path, present))  # a run writes no link
     if foreign:
         more = f", … ({len(foreign)} in all)" if len(foreign) > 5 else ""
         shown = ", ".join(foreign[:5]) + more
@@ -111,6 +133,15 @@ def clear_listed(folder: str | os.PathLike, option: str = "--force") -> None:
             f"{option}: {path} holds files no run wrote{why}: {shown}; move them away or "
             "choose another folder"
         )
+    return present
+
+
+def clear_listed(folder: str | os.PathLike, option: str = "--force") -> None:
+    """Delete what the manifest of ``folder`` lists; a :class:`RunError`, before deleting
+    anything, when the folder holds anything the manifest does not list
+    (:func:`check_listed`)."""
+    path = Path(folder)
+    present = check_listed(path, option)
     for rel in sorted(present, key=lambda p: p.count("/"), reverse=True):  # deepest first
         entry = path / rel
         if entry.is_dir() and not entry.is_symlink():
@@ -119,4 +150,11 @@ def clear_listed(folder: str | os.PathLike, option: str = "--force") -> None:
             entry.unlink()
 
 
-__all__ = ["MANIFEST_FILE", "Manifest", "clear_listed", "read_manifest", "snapshot"]
+__all__ = [
+    "MANIFEST_FILE",
+    "Manifest",
+    "check_listed",
+    "clear_listed",
+    "read_manifest",
+    "snapshot",
+]

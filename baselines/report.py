@@ -35,7 +35,6 @@ from shipgym_baselines.runs import (
     outside_problem,
     read_episodes,
     read_run,
-    temporary_file,
     versions,
     write_json,
 )
@@ -184,19 +183,18 @@ def _write(
     from shipgym_baselines.leaderboard import write_results
 
     manifest = Manifest(target)
-    with manifest.claiming():
+    with manifest.recording():  # each file listed as it is written
         rows = write_results(target, suite, results, vector_figures=vector_figures)
-    manifest.claim(REPORT_FILE, temporary_file(target / REPORT_FILE).name)
-    document = {
-        "command": list(command),
-        "time": now(),
-        "versions": versions(),
-        "git_commit": git_commit(),
-        "runs": sources,
-        "suite": suite,
-    }
-    write_json(target / REPORT_FILE, document)
-    manifest.compact(keep=(REPORT_FILE, temporary_file(target / REPORT_FILE).name))
+        document = {
+            "command": list(command),
+            "time": now(),
+            "versions": versions(),
+            "git_commit": git_commit(),
+            "runs": sources,
+            "suite": suite,
+        }
+        write_json(target / REPORT_FILE, document)
+    manifest.compact(keep=(REPORT_FILE,))
     return rows
 
 

@@ -22,17 +22,20 @@
                      draws is kept (:meth:`RunLog.drop_trajectories`)
 
 A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.locking`) and lists every path
-it writes in ``manifest.txt`` (:mod:`shipgym_baselines.manifest`).  A folder that is not empty is
-refused before any work unless ``resume`` (run the episodes missing from ``episodes.jsonl``;
-the resolved suite must equal ``run.json``'s) or ``force`` (delete what the manifest lists
-first; a folder holding anything else is refused).  ``episodes.jsonl`` is read as a set
-keyed by the episode key (:func:`read_episodes`).  Tables are always aggregated from
-``episodes.jsonl`` (so a resumed run's tables equal a clean run's, and ``shipgym report``
-rebuilds them from the folder).
+it writes in ``manifest.txt`` (:mod:`shipgym_baselines.manifest`), each written through no link
+(:mod:`shipgym_baselines.outfiles`; a folder holding a link is refused).  A folder that is not
+empty is refused before any work unless ``resume`` (run the episodes missing from
+``episodes.jsonl``; the resolved suite must equal ``run.json``'s) or ``force`` (delete what the
+manifest lists first; a folder holding anything else is refused).  ``episodes.jsonl`` is
+read as a set keyed by the episode key (:func:`read_episodes`).  Tables are always
+aggregated from ``episodes.jsonl`` (so a resumed run's tables equal a clean run's, and
+``shipgym report`` rebuilds them from the folder).
 
 Strict JSON has no infinity or NaN: in ``episodes.jsonl`` a metric of ±inf (t_c = inf, "never
 converged") is the string ``"inf"`` / ``"-inf"`` and NaN is ``null`` (metrics ignore NaN), so
-a record reads back to the same numbers (:func:`read_episodes`).
+a record reads back to the same numbers (:func:`read_episodes`).  Read back, each value is
+checked by type: a metric is a finite number, null, ``"inf"`` or ``"-inf"``; only
+:data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text.
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ import datetime
 import errno
 import fnmatch
 import hashlib
+import io
 import json
 import math
 import os
@@ -68,6 +72,7 @@ from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
+from shipgym_baselines.outfiles import check_no_links, make_dir, open_regular, write_bytes
 from shipgym_baselines.signals import signal_number
 
 if TYPE_CHECKING:
@@ -140,13 +145,16 @@ def check_out_dir(
 ) -> Path:
     """``out`` as a Path once it can hold this run; a :class:`RunError` before any work when
     it cannot: unusable (:func:`check_out_usable`), in use by another run (its lock:
-    :mod:`shipgym_baselines.locking`), or not empty without ``resume`` / ``force`` (``note`` is
-    added to that message, e.g. where a default folder came from)."""
+    :mod:`shipgym_baselines.locking`), holding a link or a special file
+    (:func:`~shipgym_baselines.outfiles.check_no_links`: a run writes through none), or
+    not empty without ``resume`` / ``force`` (``note`` is added to that message, e.g.
+    where a default folder came from; a lock file left by a killed run does not count)."""
     path = check_out_usable(out, resume=resume, force=force)
     holder = lock_holder(path)
     if holder is not None:
         raise in_use(path, holder)
-    entries = sorted(p.name for p in path.iterdir() if p.name != LOCK_FILE) if path.is_dir() else []
+    check_no_links(path)
+    entries = sorted(p.name for p in path.iterdir() if not _is_lock(p)) if path.is_dir() else []
     if resume and RUN_FILE not in entries:
         raise RunError(f"--resume: {path} holds no run to resume (no {RUN_FILE})")
     if entries and not (resume or force):
@@ -155,6 +163,11 @@ def check_out_dir(
             "finish that run, --force to replace it, or another --out"
         )
     return path
+
+
+def _is_lock(entry: Path) -> bool:
+    """Whether ``entry`` is a lock file (:data:`LOCK_FILE`, a regular file, not a link)."""
+    return entry.name == LOCK_FILE and entry.is_file() and not entry.is_symlink()
 
 
 def _describe(path: Path, entries: list[str]) -> str:
@@ -180,7 +193,7 @@ def clear_outputs(
     path = Path(folder)
     if not path.is_dir():
         return
-    entries = sorted(p for p in path.iterdir() if p.name != LOCK_FILE)  # not an output
+    entries = sorted(p for p in path.iterdir() if not _is_lock(p))  # not an output
     foreign = [p.name for p in entries if not any(fnmatch.fnmatch(p.name, o) for o in outputs)]
     if foreign:
         raise RunError(
@@ -291,29 +304,10 @@ def _read_json(file: Path) -> Any:
 
 
 def write_json(file: Path, document: Any) -> None:
-    """Write atomically (a temporary file renamed over ``file``)."""
+    """Write atomically, through no link (:func:`~shipgym_baselines.outfiles.write_bytes`)."""
     from shipgym_baselines.jsonout import dumps
 
     write_bytes(file, (dumps(document, indent=2) + "\n").encode())
-
-
-def write_bytes(file: Path, data: bytes) -> None:
-    """Write ``data`` atomically (a temporary file renamed over ``file``): a full disk leaves
-    neither a half-written ``file`` nor its temporary, and its error names ``file``."""
-    tmp = temporary_file(file)
-    try:
-        tmp.write_bytes(data)
-        os.replace(tmp, file)
-    except BaseException as exc:  # no half-written temporary left behind (a full disk)
-        tmp.unlink(missing_ok=True)
-        if isinstance(exc, OSError) and exc.filename is None:
-            exc.filename = str(file)  # the one-line message names it
-        raise
-
-
-def temporary_file(file: Path) -> Path:
-    """Where :func:`write_json` writes ``file`` before renaming it over ``file``."""
-    return file.with_name(f".{file.name}.tmp")
 
 
 def as_json(document: Any) -> Any:
@@ -422,8 +416,37 @@ def episode_key(record: Mapping[str, Any]) -> Key:
     )
 
 
-#: metrics whose value is text (every other metric is a number, null, "inf" or "-inf")
+#: metrics whose value is text or null (every other metric is a number, null, "inf" or "-inf")
 TEXT_METRICS = ("termination_reason",)
+#: metrics whose value is a boolean (true / false, or null)
+BOOL_METRICS = ("success",)
+
+
+class _Constant(ValueError):
+    """A ``NaN`` / ``Infinity`` token: JSON's extension that strict JSON has not."""
+
+
+def _no_constant(token: str) -> Any:
+    raise _Constant(token)
+
+
+def _metric_problem(key: str, value: Any) -> str | None:
+    """Why ``value`` cannot be the metric ``key`` of an episode record, or None."""
+    if key in TEXT_METRICS:
+        return None if value is None or isinstance(value, str) else "not text"
+    if key in BOOL_METRICS:
+        return None if value is None or isinstance(value, bool) else "not true or false"
+    if value is None or value in ("inf", "-inf"):
+        return None
+    if isinstance(value, bool):
+        return f"not a number (only {', '.join(BOOL_METRICS)} is true or false)"
+    if isinstance(value, int | float):
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # an integer beyond any float
+            finite = False
+        return None if finite else "not a finite number"
+    return "not a number"
 
 
 def _bad_line(file: Path, number: int, problem: str) -> RunError:
@@ -448,10 +471,11 @@ def _check_episode(record: Any, file: Path, number: int) -> dict[str, Any]:
         ):
             raise _bad_line(file, number, f"{key} {_short(value)} is not an integer")
     for key, value in record.items():
-        if key in EPISODE_KEYS or key in TEXT_METRICS:
+        if key in EPISODE_KEYS:
             continue
-        if isinstance(value, str) and value not in ("inf", "-inf"):
-            raise _bad_line(file, number, f"metric {key} is {_short(value)}, not a number")
+        problem = _metric_problem(key, value)
+        if problem is not None:
+            raise _bad_line(file, number, f"metric {key} is {_short(value)}, {problem}")
     return record
 
 
@@ -512,9 +536,10 @@ def read_episodes(
     """The finished episodes of a run folder, numbers restored (±inf), as a set keyed by
     the episode key: a line repeating an earlier one is dropped; a last line cut short by
     a kill is left out.  A :class:`RunError` naming the file and line for a line that is
-    not an episode record (not UTF-8, not JSON, not an object, a key missing, a metric
-    that is text), repeats a key with other content, or (given ``suite``, as ``run.json``
-    records it) holds an episode that is not the suite's."""
+    not an episode record (not UTF-8, not JSON, a ``NaN`` / ``Infinity`` token, not an
+    object, a key missing, a value of the wrong type: :func:`_metric_problem`), repeats a
+    key with other content, or (given ``suite``, as ``run.json`` records it) holds an
+    episode that is not the suite's."""
     file = Path(folder) / EPISODES_FILE
     if not file.is_file():
         return []
@@ -523,7 +548,10 @@ def read_episodes(
     first: dict[Key, int] = {}
     for number, line in _lines(file):
         try:
-            parsed = json.loads(line)
+            parsed = json.loads(line, parse_constant=_no_constant)
+        except _Constant as exc:
+            strict = f'{exc} is not strict JSON (write null or "inf")'
+            raise _bad_line(file, number, strict) from None
         except ValueError:
             raise _bad_line(file, number, "not JSON") from None
         record = _check_episode(parsed, file, number)
@@ -559,7 +587,11 @@ def _repair(file: Path) -> None:
         return
     data = file.read_bytes()
     if data and not data.endswith(b"\n"):
-        file.write_bytes(data[: data.rfind(b"\n") + 1])
+        fd = open_regular(file, os.O_WRONLY)
+        try:
+            os.ftruncate(fd, data.rfind(b"\n") + 1)
+        finally:
+            os.close(fd)
 
 
 def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
@@ -736,11 +768,11 @@ class RunLog:
                 "episodes": 0,
             }
         manifest = Manifest(folder)
-        run_file = folder / RUN_FILE
-        manifest.claim(RUN_FILE, temporary_file(run_file).name, EPISODES_FILE)
+        manifest.claim(RUN_FILE, EPISODES_FILE)
         log = cls(folder, record, episodes, manifest)
         log._write_record()
-        log._file = open(log.episodes_file, "ab", buffering=0)  # closed by finish
+        appending = open_regular(log.episodes_file, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+        log._file = open(appending, "ab", buffering=0)  # closed by finish
         return log
 
     def append(self, result: EpisodeResult, keep_trajectory: bool = False) -> None:
@@ -750,18 +782,11 @@ class RunLog:
         record = episode_record(result)
         key = episode_key(record)
         if keep_trajectory and result.trajectory:
-            name = trajectory_file(key)
-            tmp = f"{name}.tmp.npz"
-            self.manifest.claim(TRAJECTORY_DIR, name, tmp)
-            (self.folder / TRAJECTORY_DIR).mkdir(exist_ok=True)
-            try:
-                np.savez_compressed(self.folder / tmp, **light_trajectory(result.trajectory))
-                os.replace(self.folder / tmp, self.folder / name)
-            except BaseException as exc:  # no half-written file left behind (a full disk)
-                (self.folder / tmp).unlink(missing_ok=True)
-                if isinstance(exc, OSError) and exc.filename is None:
-                    exc.filename = str(self.folder / tmp)  # the message names it
-                raise
+            data = io.BytesIO()
+            np.savez_compressed(data, **light_trajectory(result.trajectory))
+            with self.manifest.recording():  # listed before it is written
+                make_dir(self.folder / TRAJECTORY_DIR)
+                write_bytes(self.folder / trajectory_file(key), data.getvalue())
         assert self._file is not None, "append after finish"
         line = json.dumps(record, allow_nan=False, separators=COMPACT)  # no spaces
         self._write_line((line + "\n").encode())
@@ -815,8 +840,7 @@ class RunLog:
             cpu_s=self._earlier[1] + cpu,
         )
         self._write_record(in_place=status != "complete")
-        run_tmp = temporary_file(self.folder / RUN_FILE).name
-        self.manifest.compact(keep=(RUN_FILE, run_tmp, EPISODES_FILE))
+        self.manifest.compact(keep=(RUN_FILE, EPISODES_FILE))
 
     def elapsed(self) -> tuple[float, float]:
         """Wall-clock and CPU seconds of this invocation so far (:func:`cpu_seconds`)."""
@@ -867,7 +891,8 @@ class RunLog:
         a full disk), else left as it was."""
         file = self.folder / RUN_FILE
         try:
-            write_json(file, self.record)
+            with self.manifest.recording():  # listed before it is written
+                write_json(file, self.record)
         except OSError as exc:
             if not (in_place and exc.errno in NO_ROOM and file.is_file()):
                 raise
@@ -875,7 +900,7 @@ class RunLog:
 
             data = (dumps(self.record) + "\n").encode()
             if len(data) <= file.stat().st_size:
-                with contextlib.suppress(OSError), open(file, "r+b") as fh:
+                with contextlib.suppress(OSError), open(open_regular(file, os.O_RDWR), "r+b") as fh:
                     fh.write(data)
                     fh.truncate()
 

@@ -14,11 +14,14 @@ from pydantic import Discriminator, Field, Tag, ValidationError, field_validator
 
 from shipgym.config import (
     ConfigFile,
+    Name,
     StrictModel,
+    compose_yaml,
     error_message,
     is_path,
     list_names,
     load_yaml_model,
+    parse_yaml,
     read_config_text,
     read_yaml,
     resolve,
@@ -64,7 +67,7 @@ class SuiteConfig(StrictModel):
     written.
     """
 
-    name: str
+    name: Name
     description: str = ""
     scenarios: list[str] = Field(default_factory=list)
     heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
@@ -263,13 +266,13 @@ def check_suite_file(name_or_path: str | os.PathLike) -> list[Problem]:
     except ConfigError as exc:
         return [Problem("", str(exc))]
     try:
-        root = yaml.compose(text)
+        root = compose_yaml(text)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]
     except yaml.YAMLError as exc:
         return [Problem("", f"malformed YAML: {exc}")]
-    data = yaml.safe_load(text)
+    data = parse_yaml(text)
     if not isinstance(data, Mapping):
         return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
     problems: list[Problem] = []

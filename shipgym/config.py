@@ -28,10 +28,11 @@ from pathlib import Path
 from typing import Annotated, Any, Self, TypeVar, Union, get_args, get_origin
 
 import yaml
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import AfterValidator, BaseModel, ConfigDict, ValidationError
+from yaml.composer import ComposerError
 
 from shipgym.errors import ShipgymError
-from shipgym.limits import MAX_CONFIG_BYTES
+from shipgym.limits import MAX_CONFIG_BYTES, MAX_CONFIG_DEPTH, MAX_CONFIG_NODES, name_problem
 
 #: kind (folder of configs/) -> what one file of it is called in messages
 KINDS: dict[str, str] = {
@@ -51,6 +52,19 @@ M = TypeVar("M", bound=BaseModel)
 
 class ConfigError(ShipgymError, ValueError):
     """A config file cannot be found or is malformed; the message names the file and key."""
+
+
+def check_name(value: str) -> str:
+    """``value`` if it can name a scenario or suite (:func:`shipgym.limits.name_problem`:
+    length, control characters), else a ValueError saying why."""
+    problem = name_problem(value)
+    if problem is not None:
+        raise ValueError(f"the name {problem}")
+    return value
+
+
+#: a scenario's or suite's ``name`` (figures and tables are files named after it)
+Name = Annotated[str, AfterValidator(check_name)]
 
 
 class StrictModel(BaseModel):
@@ -235,11 +249,70 @@ def read_config_text(file: ConfigFile, error: type[Exception] = ConfigError) -> 
         raise error(f"{file}: cannot read: not UTF-8 text ({exc.reason})") from None
 
 
+class BoundedLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, bounded: a node tree nested deeper than
+    :data:`~shipgym.limits.MAX_CONFIG_DEPTH` (PyYAML composes it recursively: a deep file
+    ends in a RecursionError) or of more than :data:`~shipgym.limits.MAX_CONFIG_NODES`
+    values with its aliases expanded (a few lines of nested aliases make billions) is a
+    :class:`yaml.composer.ComposerError` at its line, as malformed YAML is."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0  # mappings and lists open
+        self._total = 0  # values composed so far, aliases expanded
+        self._expanded: dict[int, int] = {}  # id(node) -> its values, aliases expanded
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:
+        if self.check_event(yaml.AliasEvent):
+            mark = self.peek_event().start_mark
+            node = super().compose_node(parent, index)
+            self._count(self._expanded.get(id(node), 1), mark)
+            return node
+        self._depth += 1
+        if self._depth > MAX_CONFIG_DEPTH:
+            raise ComposerError(
+                None,
+                None,
+                f"nested deeper than the limit of {MAX_CONFIG_DEPTH} levels",
+                self.peek_event().start_mark,
+            )
+        before = self._total
+        try:
+            node = super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+        self._count(1, node.start_mark)
+        self._expanded[id(node)] = self._total - before
+        return node
+
+    def _count(self, values: int, mark: Any) -> None:
+        self._total += values
+        if self._total > MAX_CONFIG_NODES:
+            raise ComposerError(
+                None,
+                None,
+                f"more than the limit of {MAX_CONFIG_NODES} values (aliases expanded)",
+                mark,
+            )
+
+
+def parse_yaml(text: str) -> Any:
+    """``text`` parsed as YAML by :class:`BoundedLoader` (a :class:`yaml.YAMLError` when it
+    is malformed or beyond the limits)."""
+    return yaml.load(text, Loader=BoundedLoader)  # a SafeLoader: plain data only
+
+
+def compose_yaml(text: str) -> yaml.Node | None:
+    """``text``'s YAML node tree (where each key is written), bounded as :func:`parse_yaml`."""
+    return yaml.compose(text, Loader=BoundedLoader)
+
+
 def read_yaml(file: ConfigFile, error: type[Exception] = ConfigError) -> Any:
-    """The parsed YAML of ``file``; malformed YAML fails naming the file and the line."""
+    """The parsed YAML of ``file`` (:func:`parse_yaml`); malformed YAML, or YAML beyond the
+    limits, fails naming the file and the line."""
     text = read_config_text(file, error)
     try:
-        return yaml.safe_load(text)
+        return parse_yaml(text)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f", line {mark.line + 1}, column {mark.column + 1}" if mark else ""

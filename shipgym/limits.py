@@ -11,7 +11,11 @@ cross-track error).  Each is refused early, in one line naming the key and the l
 * waypoints of a path: :data:`MAX_WAYPOINTS` (``path.waypoints``);
 * a position [m], start or waypoint: ±:data:`MAX_POSITION_M` (``initial_state.x`` / ``y``,
   ``path.waypoints``);
-* a config file (YAML): :data:`MAX_CONFIG_BYTES` bytes, refused before parsing;
+* a config file (YAML): :data:`MAX_CONFIG_BYTES` bytes, refused before parsing; nested at
+  most :data:`MAX_CONFIG_DEPTH` levels deep and at most :data:`MAX_CONFIG_NODES` values
+  with its aliases expanded, refused while parsing;
+* a scenario's or suite's ``name``: :data:`MAX_NAME_CHARS` characters, :data:`MAX_NAME_BYTES`
+  bytes of UTF-8, no control character (:func:`name_problem`; file names are made of it);
 * evaluation seeds per scenario: :data:`MAX_SEEDS` (``--seeds``, a suite's ``seeds``);
 * held-out scenarios of a suite: :data:`MAX_HELDOUT_SCENARIOS` (``heldout_scenarios``);
 * in-range scenarios of a suite: :data:`MAX_INRANGE_SCENARIOS` (``inrange_scenarios``);
@@ -21,6 +25,8 @@ cross-track error).  Each is refused early, in one line naming the key and the l
 """
 
 from __future__ import annotations
+
+import unicodedata
 
 from shipgym.errors import ShipgymError
 
@@ -34,6 +40,16 @@ MAX_WAYPOINTS = 10_000
 MAX_POSITION_M = 1.0e6
 #: size of a scenario or suite YAML file [bytes] (10,000 waypoints take ≈ 300 kB)
 MAX_CONFIG_BYTES = 1_000_000
+#: levels of nested mappings and lists in a YAML file; the catalogue's deepest: 10
+MAX_CONFIG_DEPTH = 50
+#: values (scalars, mappings, lists) of a YAML file with its aliases expanded; a file within
+#: MAX_CONFIG_BYTES holds at most ≈ 500,000 without aliases
+MAX_CONFIG_NODES = 1_000_000
+#: characters of a scenario's or suite's name (a figure's file name is made of it)
+MAX_NAME_CHARS = 100
+#: bytes of a name in UTF-8: with a figure's prefix and suffix and a temporary's, the file
+#: name stays within the 255 bytes file systems allow
+MAX_NAME_BYTES = 200
 #: evaluation seeds per scenario of a run
 MAX_SEEDS = 10_000
 #: held-out test scenarios a suite draws (``heldout_scenarios``); the default suite: 4
@@ -52,6 +68,29 @@ RANDOMIZE_BOUNDS: dict[str, tuple[float, float]] = {
 
 class LimitError(ShipgymError, ValueError):
     """A value beyond a documented limit (inside a config validator, the key is named)."""
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name a scenario or suite, or None: longer than
+    :data:`MAX_NAME_CHARS` characters or :data:`MAX_NAME_BYTES` bytes (figures and their
+    temporaries are files named after it), empty, or holding a control character, line
+    break or lone surrogate (neither a file name nor a one-line message can carry it).
+    Other characters are drawn as typed and become ``_`` in a file name."""
+    if not name.strip():
+        return "is empty"
+    if len(name) > MAX_NAME_CHARS:
+        return f"has {len(name)} characters, beyond the limit of {MAX_NAME_CHARS}"
+    bad = next((c for c in name if unicodedata.category(c) in _UNPRINTABLE), None)
+    if bad is not None:
+        return f"holds the character U+{ord(bad):04X}, which no file name or line can carry"
+    size = len(name.encode("utf-8"))
+    if size > MAX_NAME_BYTES:
+        return f"takes {size} bytes in UTF-8, beyond the limit of {MAX_NAME_BYTES}"
+    return None
+
+
+#: Unicode categories a name may not hold: control, surrogate, line and paragraph separator
+_UNPRINTABLE = ("Cc", "Cs", "Zl", "Zp")
 
 
 def check_at_most(value: float, limit: float, what: str) -> None:

@@ -2,7 +2,9 @@
 
 Writes ``metrics.json`` (the episode's row: scenario, controller, kind, seed and every
 metric, as ``--json`` prints it) and the leaderboard's figure of the episode (path and
-track, cross-track error, rudder angle) into ``--out``.  The episode is the trial that
+track, cross-track error, rudder angle) into ``--out``, as a leaderboard writes its folder:
+locked while written, each file listed in ``manifest.txt`` and written through no link
+(``--force`` deletes only what the manifest lists).  The episode is the trial that
 ``--seed`` draws with ``--suite``'s randomisation (default suite ``default``), so it equals
 that suite's leaderboard episode of the scenario and seed; the default seed is the
 leaderboard's first evaluation seed.  A learned agent runs the policy of
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +34,6 @@ from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 #: the default ``--out`` is ``RUN_ROOT/<scenario>_<controller>_<seed>``
 RUN_ROOT = Path("results/run")
 METRICS_FILE = "metrics.json"
-#: what a run writes (``--force`` removes these and nothing else)
-OUTPUTS = (METRICS_FILE, "*.png")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -108,8 +109,9 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
+    from shipgym_baselines.manifest import check_listed
     from shipgym_baselines.registry import applies_to, training_seeds
-    from shipgym_baselines.runs import check_out_dir, clear_outputs
+    from shipgym_baselines.runs import check_out_dir
     from shipgym_baselines.suite import load_suite
 
     suite = load_suite(args.suite)
@@ -126,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
     name = Path(args.scenario).stem if is_path(args.scenario) else args.scenario
     out = check_out_dir(args.out or default_out(name, label, args.seed), force=args.force)
     if args.force:
-        clear_outputs(out, OUTPUTS)
+        check_listed(out)  # a user's file refused before the episode, not after
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
     settings = {} if training_seed is None else {"training_seed": training_seed}
@@ -140,11 +142,13 @@ def run(args: argparse.Namespace) -> int:
     items = list(row.items())
     row = dict([*items[:at], ("training_seed", training_seed), ("training_seeds", trained)])
     row |= dict(items[at:])
-    out.mkdir(parents=True, exist_ok=True)
-    (out / METRICS_FILE).write_text(dumps(row, indent=2) + "\n")
     randomize = None if suite.randomize is None else suite.randomize.model_dump(mode="json")
-    plot_results([result], out, {table_name: scenario}, randomize)
-    plots = sorted(p.name for p in out.glob("*.png"))
+    plots = _write(
+        out,
+        args.force,
+        dumps(row, indent=2) + "\n",
+        lambda: plot_results([result], out, {table_name: scenario}, randomize),
+    )
     if video is not None:
         trained_with = "" if training_seed is None else f", training seed {training_seed}"
         _write_video(video, result, trial, f"{name}: {label}, seed {args.seed}{trained_with}")
@@ -156,6 +160,27 @@ def run(args: argparse.Namespace) -> int:
         f"suite {suite.name!r}{policy})\n"
     )
     return 0
+
+
+def _write(out: Path, force: bool, metrics: str, draw: Callable[[], list[Path]]) -> list[str]:
+    """``metrics.json`` (the text ``metrics``) and the figures (``draw`` writes them and
+    returns their paths) into ``out``, locked, each file listed in its manifest as it is
+    written (``force``: what the manifest lists deleted first); the figures' names."""
+    from shipgym_baselines.locking import out_lock
+    from shipgym_baselines.manifest import Manifest, clear_listed
+    from shipgym_baselines.outfiles import write_text
+    from shipgym_baselines.runs import check_out_dir, now
+
+    with out_lock(out, now()):
+        check_out_dir(out, force=force)  # again, now that no other run can start there
+        if force:
+            clear_listed(out)
+        manifest = Manifest(out)
+        with manifest.recording():
+            write_text(out / METRICS_FILE, metrics)
+            plots = draw()
+        manifest.compact()
+    return sorted(p.name for p in plots)
 
 
 def _training_seed(label: str, trained: list[int], chosen: int | None) -> int | None:

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 from typing import Any
+
+from shipgym_baselines.outfiles import write_bytes
 
 
 def pyplot() -> Any:
@@ -17,6 +20,9 @@ def pyplot() -> Any:
 
 
 def save(fig: Any, path: Path, dpi: int = 90) -> None:
-    """Write ``fig`` to ``path`` (PNG, ``dpi`` dots per inch) and close it."""
-    fig.savefig(path, dpi=dpi)
+    """Write ``fig`` to ``path`` (PNG, ``dpi`` dots per inch; through no link:
+    :func:`~shipgym_baselines.outfiles.write_bytes`) and close it."""
+    image = io.BytesIO()
+    fig.savefig(image, format="png", dpi=dpi)
     pyplot().close(fig)
+    write_bytes(path, image.getvalue())

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.jsonout import dumps
+from shipgym_baselines.outfiles import write_text
 
 #: the rows of SPEC §9b: ``{case, controller, metric, ours, paper, …}``
 Rows = list[dict[str, Any]]
@@ -64,8 +65,8 @@ class Reproduction:
         out.mkdir(parents=True, exist_ok=True)
         documents = {f"{self.name}.json": outcome.rows, **outcome.documents}
         for file_name, document in documents.items():
-            (out / file_name).write_text(dumps(document, indent=2))
-        (out / f"{self.name}.md").write_text(self.report(outcome.rows))
+            write_text(out / file_name, dumps(document, indent=2))
+        write_text(out / f"{self.name}.md", self.report(outcome.rows))
         if plot:
             self.plots(outcome, out)
         return outcome.rows

@@ -15,6 +15,7 @@ from pydantic import ValidationError
 from shipgym.config import (
     ConfigError,
     catalogue,
+    compose_yaml,
     error_message,
     is_path,
     list_names,
@@ -274,7 +275,7 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     except ScenarioError as exc:
         return [Problem("", str(exc))]
     try:
-        root = yaml.compose(text)  # the node tree: where each key is written
+        root = compose_yaml(text)  # the node tree: where each key is written
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]

@@ -17,7 +17,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, Field, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
-from shipgym.config import StrictModel
+from shipgym.config import Name, StrictModel
 from shipgym.disturbance_config import (
     ConstantCurrent,
     CurrentConfig,
@@ -177,7 +177,7 @@ class RewardConfig(StrictModel):
 
 
 class ScenarioConfig(StrictModel):
-    name: str
+    name: Name  # figures and tables are files named after it (shipgym.limits.name_problem)
     description: str = ""
     source: str = ""
     ship: ShipConfig = ShipConfig()

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -18,3 +20,26 @@ def scratch_registry() -> Iterator[None]:
     registry._RECORDS.update(records)
     registry._RESOLVED.clear()
     registry._RESOLVED.update(resolved)
+
+
+#: the smoke suite's controllers a quick run keeps (one classical, one reference)
+SMOKE_CONTROLLERS = ["pid_los", "zero_rudder"]
+
+
+@pytest.fixture(scope="session")
+def smoke_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The smoke suite run once (one seed, :data:`SMOKE_CONTROLLERS`), complete: copy it
+    (:func:`copy_folder`) before changing it."""
+    from shipgym_baselines.leaderboard import run_leaderboard
+
+    out = tmp_path_factory.mktemp("smoke") / "out"
+    run_leaderboard(
+        "smoke", seeds=1, out_dir=out, controllers=SMOKE_CONTROLLERS, workers=1, show_progress=False
+    )
+    return out
+
+
+def copy_folder(source: Path, target: Path) -> Path:
+    """A copy of a run folder, every file of it (its manifest included)."""
+    shutil.copytree(source, target)
+    return target

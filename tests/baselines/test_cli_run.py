@@ -48,7 +48,11 @@ def test_json_is_the_episode_of_the_evaluation_loop(
             assert doc[key] == (value if finite else None), key
     assert doc["termination_reason"] == reference.metrics["termination_reason"]
     assert json.loads((out / "metrics.json").read_text()) == doc
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "rudder_aging.png"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "manifest.txt",
+        "metrics.json",
+        "rudder_aging.png",
+    ]
     assert (out / "rudder_aging.png").stat().st_size > 10_000
 
 
@@ -175,3 +179,36 @@ def test_an_untrained_controller_records_no_training_seed(
 ) -> None:
     doc = run_json(capsys, "nominal", "zero_rudder", "--out", str(tmp_path / "out"))
     assert (doc["training_seed"], doc["training_seeds"]) == (None, [])
+
+
+def test_force_keeps_a_users_file_and_folder_and_deletes_only_what_a_run_wrote(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``run --force`` follows the leaderboard's manifest rule: beside a user's file and
+    folder it is refused before the episode (naming them) and deletes nothing; without
+    them it replaces what the earlier run listed in ``manifest.txt``."""
+    out = tmp_path / "r"
+    argv = ["rudder_aging", "pid_los", "--suite", "smoke", "--out", str(out)]
+    run_json(capsys, *argv)
+    assert (out / "manifest.txt").read_text().split() == ["metrics.json", "rudder_aging.png"]
+    (out / "holiday.png").write_text("x\n")
+    (out / "my_plots.png").mkdir()
+    (out / "my_plots.png" / "a.png").write_text("mine")
+    assert main(["run", *argv, "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "--force: " in err and "holds files no run wrote: holiday.png, my_plots.png, " in err
+    assert (out / "holiday.png").read_text() == "x\n"
+    assert (out / "my_plots.png" / "a.png").read_text() == "mine"
+    (out / "holiday.png").unlink()
+    (out / "my_plots.png" / "a.png").unlink()
+    (out / "my_plots.png").rmdir()
+    (out / "nominal.png").write_text("an earlier run's figure")  # as if listed by a run
+    with open(out / "manifest.txt", "a") as manifest:
+        manifest.write("nominal.png\n")
+    run_json(capsys, *argv, "--force")
+    assert sorted(p.name for p in out.iterdir()) == [
+        "manifest.txt",
+        "metrics.json",
+        "rudder_aging.png",
+    ]

@@ -10,7 +10,14 @@ import pytest
 import yaml
 
 import shipgym_baselines.leaderboard
-from shipgym.limits import MAX_SEEDS, LimitError
+from shipgym.limits import (
+    MAX_CONFIG_BYTES,
+    MAX_CONFIG_DEPTH,
+    MAX_NAME_CHARS,
+    MAX_SEEDS,
+    LimitError,
+)
+from shipgym.scenarios.loader import catalogue_dir
 from shipgym_baselines.cli import main
 from shipgym_baselines.learned.train import train_sweep
 
@@ -87,3 +94,46 @@ def test_finding8_heldout_scenarios_beyond_the_limit_are_refused(tmp_path: Path,
     suite = _suite(tmp_path, heldout_scenarios=10**9)
     err = _refused(capsys, ["leaderboard", "--suite", suite, "--out", str(tmp_path / "o")])
     assert "heldout_scenarios" in err and "less than or equal to 1000" in err
+
+
+def test_a_240_character_scenario_name_is_refused_by_validate(tmp_path: Path, capsys) -> None:
+    """Its figure's file name would be too long (ENAMETOOLONG after every episode): the
+    name is refused up front, by ``--validate`` and by a leaderboard, in one line each."""
+    scenario = yaml.safe_load(catalogue_dir().joinpath("nominal.yaml").read_text())
+    file = tmp_path / "long.yaml"
+    file.write_text(yaml.safe_dump({**scenario, "name": "s" * 240}))
+    limit = f"the name has 240 characters, beyond the limit of {MAX_NAME_CHARS}"
+    assert main(["scenarios", "--validate", str(file)]) == 2
+    out, err = capsys.readouterr()
+    problem = [line for line in (out + err).splitlines() if line.startswith(f"{file}:")]
+    assert len(problem) == 1 and problem[0].endswith(f": key 'name': Value error, {limit}")
+    assert "Traceback" not in out + err
+    suite = _suite(tmp_path, scenarios=[str(file)])
+    err = _refused(capsys, ["leaderboard", "--suite", suite, "--out", str(tmp_path / "o")])
+    assert limit in err and not (tmp_path / "o").exists()
+    suite = _suite(tmp_path, name="n" * 240)
+    for argv in (["scenarios", "--validate", suite], ["leaderboard", "--suite", suite]):
+        assert main([*argv, "--out", str(tmp_path / "o")] if "leaderboard" in argv else argv)
+        shown = "".join(capsys.readouterr())
+        assert "key 'name'" in shown and "the name has 240 characters" in shown
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("[" * 5000 + "]" * 5000, f"nested deeper than the limit of {MAX_CONFIG_DEPTH} levels"),
+        ("#" * (MAX_CONFIG_BYTES + 1), f"larger than the limit of {MAX_CONFIG_BYTES} bytes"),
+    ],
+)
+def test_a_deep_or_oversized_yaml_is_refused_in_one_line(
+    tmp_path: Path, capsys, text: str, problem: str
+) -> None:
+    """A scenario or suite file of 5,000 nested lists or over the size limit: one line
+    naming the file and the limit, never a RecursionError's traceback."""
+    file = tmp_path / "deep.yaml"
+    file.write_text(f"name: deep\nscenarios: {text}\n")
+    assert main(["scenarios", "--validate", str(file)]) == 2
+    out, err = capsys.readouterr()
+    assert problem in out + err and "Traceback" not in out + err
+    err = _refused(capsys, ["leaderboard", "--suite", str(file), "--out", str(tmp_path / "o")])
+    assert str(file) in err and problem in err

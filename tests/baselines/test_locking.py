@@ -15,6 +15,7 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard import run_leaderboard
 from shipgym_baselines.locking import LOCK_FILE, out_lock
 from shipgym_baselines.runs import read_episodes, read_run
+from tests.baselines.conftest import copy_folder
 from tests.baselines.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -110,3 +111,37 @@ def test_finding1_the_lock_file_names_its_holder(tmp_path: Path) -> None:
         holder = json.loads((tmp_path / LOCK_FILE).read_text())
         assert holder["pid"] == os.getpid() and holder["start_time"].startswith("2026-01-02")
     assert not (tmp_path / LOCK_FILE).exists() and tmp_path.is_dir()
+
+
+def test_a_symlinked_lock_is_refused_and_its_target_unchanged(
+    tmp_path: Path, smoke_run: Path, capsys
+) -> None:
+    """A link planted as ``.shipgym.lock`` (to a user's file outside ``--out``) is refused
+    in one line naming it, by a new leaderboard, ``--force``, ``--resume`` and ``report
+    --out``; the file it points to is left as it was, and so is the folder."""
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    fresh, run = tmp_path / "fresh", copy_folder(smoke_run, tmp_path / "run")
+    fresh.mkdir()
+    leaderboard = ["leaderboard", "--suite", "smoke", "--seeds", "1", "--no-progress"]
+    tries = [
+        (fresh, [*leaderboard, "--out", str(fresh)]),
+        (run, [*leaderboard, "--out", str(run), "--force"]),
+        (run, [*leaderboard, "--out", str(run), "--resume"]),
+        (fresh, ["report", str(smoke_run), "--out", str(fresh)]),
+        (fresh, ["report", str(smoke_run), "--out", str(fresh), "--force"]),
+    ]
+    for folder, argv in tries:
+        (folder / LOCK_FILE).unlink(missing_ok=True)
+        (folder / LOCK_FILE).symlink_to(notes)
+        before = {p: p.lstat().st_mtime_ns for p in folder.rglob("*")}
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err
+        assert f"{folder / LOCK_FILE} is a symbolic link to {notes}" in err
+        assert notes.read_text() == "my notes\n"
+        assert {p: p.lstat().st_mtime_ns for p in folder.rglob("*")} == before
+    with pytest.raises(RunError, match="is a symbolic link"):  # the lock itself refuses it
+        with out_lock(fresh, "now"):
+            pass
+    assert notes.read_text() == "my notes\n"

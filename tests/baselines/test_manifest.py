@@ -15,6 +15,8 @@ from shipgym_baselines.manifest import (
     read_manifest,
     snapshot,
 )
+from shipgym_baselines.outfiles import make_dir, write_text
+from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
 
 
 def test_finding4_claimed_paths_are_listed_once_before_they_exist(tmp_path: Path) -> None:
@@ -26,11 +28,14 @@ def test_finding4_claimed_paths_are_listed_once_before_they_exist(tmp_path: Path
         "trajectories",
         "trajectories/a.npz",
     ]
-    with manifest.claiming():
-        (tmp_path / "figure.png").write_text("drawn")
-        (tmp_path / "sub").mkdir()
-        (tmp_path / "sub" / "page.svg").write_text("drawn")
-    assert read_manifest(tmp_path) >= {"figure.png", "sub", "sub/page.svg", MANIFEST_FILE}
+    with manifest.recording():
+        write_text(tmp_path / "figure.png", "drawn")
+        make_dir(tmp_path / "sub")
+        write_text(tmp_path / "sub" / "page.svg", "drawn")
+        (tmp_path / "users.txt").write_text("a user's, written meanwhile")
+    listed = read_manifest(tmp_path)
+    assert listed >= {"figure.png", "sub", "sub/page.svg", MANIFEST_FILE}
+    assert "users.txt" not in listed  # only what the run wrote itself
 
 
 def test_finding4_force_deletes_the_listed_and_refuses_anything_else(tmp_path: Path) -> None:
@@ -96,3 +101,51 @@ def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -
     (out / "mine.txt").unlink()
     clear_listed(out)
     assert snapshot(out) == set()  # the lock is released when the run ends
+
+
+def test_a_file_added_during_the_figures_stage_is_not_the_runs(
+    tmp_path: Path, smoke_run: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A user's file that appears while the tables and figures are drawn is not listed in
+    the manifest, and the next ``--force`` refuses to delete it (naming it)."""
+    from shipgym_baselines import figures
+    from shipgym_baselines.leaderboard import run_leaderboard
+
+    out = copy_folder(smoke_run, tmp_path / "out")
+    draw = figures.plot_scenarios
+
+    def draw_while_the_user_saves(folder: Path, *args: object, **kwargs: object) -> list[Path]:
+        (folder / "holiday.png").write_text("a user's")  # saved meanwhile, e.g. by a viewer
+        return draw(folder, *args, **kwargs)
+
+    monkeypatch.setattr(figures, "plot_scenarios", draw_while_the_user_saves)
+    settings = {"seeds": 1, "controllers": SMOKE_CONTROLLERS, "show_progress": False}
+    run_leaderboard("smoke", out_dir=out, resume=True, **settings)  # the tables again
+    listed = read_manifest(out)
+    assert "holiday.png" not in listed
+    assert {"leaderboard.md", "scenario_rudder_aging.png", "run.json"} <= listed
+    monkeypatch.undo()
+    with pytest.raises(RunError, match=r"--force: .* holds files no run wrote: holiday\.png;"):
+        run_leaderboard("smoke", out_dir=out, force=True, **settings)
+    assert (out / "holiday.png").read_text() == "a user's"
+
+
+def test_pool_workers_list_the_figures_they_write(
+    tmp_path: Path, smoke_run: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Figures drawn in a process pool are listed by the workers as they write them."""
+    import shipgym_baselines.leaderboard as leaderboard
+    from shipgym_baselines.runs import read_run
+
+    monkeypatch.setattr(leaderboard, "POOLED_FIGURES", 1)  # a pool for three figures
+    out = tmp_path / "out"
+    out.mkdir()
+    manifest = Manifest(out)
+    with manifest.recording():
+        leaderboard.write_results(
+            out, read_run(smoke_run)["suite"], leaderboard.load_results(smoke_run), workers=2
+        )
+    manifest.compact()
+    written = snapshot(out) - {MANIFEST_FILE}
+    assert {"scenario_heldout_0.png", "scenario_mariner_track.png"} <= written
+    assert read_manifest(out) - {MANIFEST_FILE} == written  # listed: all of them, only them

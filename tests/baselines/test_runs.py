@@ -30,6 +30,7 @@ from shipgym_baselines.runs import (
     read_episodes,
     read_run,
 )
+from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 #: 2 scenarios × 2 controllers × 2 seeds: 8 quick episodes
@@ -548,3 +549,100 @@ def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_r
         on_episode=ran.append,
     )
     assert len(ran) == 7 and len(read_episodes(tmp_path / "out")) == 8
+
+
+@pytest.mark.parametrize(
+    "name", ["leaderboard.md", "aggregate.json", ".run.json.tmp", ".manifest.txt.tmp"]
+)
+def test_resume_refuses_a_link_planted_as_an_output_and_leaves_its_target(
+    tmp_path: Path, smoke_run: Path, capsys, name: str
+) -> None:
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    out = copy_folder(smoke_run, tmp_path / "out")
+    (out / name).unlink(missing_ok=True)
+    (out / name).symlink_to(notes)
+    argv = ["leaderboard", "--suite", "smoke", "--seeds", "1", "--out", str(out), "--resume"]
+    assert main([*argv, "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"shipgym leaderboard: error: {out / name} is a symbolic link to {notes}: a run "
+        "writes no file through it; remove it or choose another --out\n"
+    )
+    assert notes.read_text() == "my notes\n" and read_run(out)["status"] == "complete"
+
+
+def test_a_link_planted_while_the_tables_are_written_is_refused(
+    tmp_path: Path, smoke_run: Path, monkeypatch
+) -> None:
+    """A link that appears during the run, as a table the run is about to write: that
+    write is refused (the run fails in one line) and the link's target is unchanged."""
+    from shipgym_baselines import figures
+
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    out = copy_folder(smoke_run, tmp_path / "out")
+    draw = figures.plot_scenarios
+
+    def plant_then_draw(folder: Path, *args: object, **kwargs: object) -> list[Path]:
+        (folder / "aggregate.json").unlink(missing_ok=True)
+        (folder / "aggregate.json").symlink_to(notes)
+        return draw(folder, *args, **kwargs)
+
+    monkeypatch.setattr(figures, "plot_scenarios", plant_then_draw)
+    with pytest.raises(RunError, match=r"aggregate\.json is a symbolic link"):
+        run_leaderboard(
+            "smoke",
+            seeds=1,
+            out_dir=out,
+            controllers=SMOKE_CONTROLLERS,
+            show_progress=False,
+            resume=True,
+        )
+    assert notes.read_text() == "my notes\n" and read_run(out)["status"] == "failed"
+
+
+@pytest.mark.parametrize(
+    ("value", "problem"),
+    [
+        ("NaN", 'NaN is not strict JSON (write null or "inf")'),
+        ("-Infinity", '-Infinity is not strict JSON (write null or "inf")'),
+        ("1e309", "metric ace is Infinity, not a finite number"),
+        ("true", "metric ace is true, not a number (only success is true or false)"),
+        ("[1, 2]", "metric ace is [1, 2], not a number"),
+        ('{"m": 1}', 'metric ace is {"m": 1}, not a number'),
+    ],
+)
+def test_episode_values_are_read_back_by_type(
+    tmp_path: Path, smoke_run: Path, capsys, value: str, problem: str
+) -> None:
+    """A metric is a finite number, null, "inf" or "-inf" (``success`` a boolean): any
+    other value is refused in one line naming the file and line, by ``report`` and by
+    ``--resume``, and the complete run stays complete."""
+    out = copy_folder(smoke_run, tmp_path / "out")
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    record = json.loads(lines[1])
+    text = json.dumps({**record, "ace": 0.5}).replace('"ace": 0.5', f'"ace": {value}')
+    lines[1] = text
+    (out / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    expected = f"{out / 'episodes.jsonl'}: line 2: {problem}"
+    assert main(["report", str(out), "--out", str(tmp_path / "report")]) == 2
+    assert capsys.readouterr().err == f"shipgym report: error: {expected}\n"
+    settings = {"seeds": 1, "controllers": SMOKE_CONTROLLERS, "show_progress": False}
+    with pytest.raises(RunError) as refused:
+        run_leaderboard("smoke", out_dir=out, resume=True, **settings)
+    assert str(refused.value) == expected
+    assert read_run(out)["status"] == "complete"
+
+
+def test_success_may_be_a_boolean_and_other_metrics_may_not(
+    tmp_path: Path, smoke_run: Path
+) -> None:
+    out = copy_folder(smoke_run, tmp_path / "out")
+    records = read_episodes(out)
+    assert all(isinstance(r["success"], bool) for r in records)
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    lines[0] = json.dumps({**json.loads(lines[0]), "success": 1.0})
+    (out / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    with pytest.raises(RunError, match=r"line 1: metric success is 1\.0, not true or false"):
+        read_episodes(out)

@@ -3,6 +3,7 @@ line naming the key and the limit (the audit's probes: 7 GB, hangs, ``std::bad_a
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -11,9 +12,14 @@ import pytest
 import yaml
 
 import shipgym  # noqa: F401  (registers the envs)
+from shipgym.config import ConfigError, read_yaml
 from shipgym.limits import (
     MAX_CONFIG_BYTES,
+    MAX_CONFIG_DEPTH,
+    MAX_CONFIG_NODES,
     MAX_EPISODE_STEPS,
+    MAX_NAME_BYTES,
+    MAX_NAME_CHARS,
     MAX_SUBSTEPS,
     MAX_WAYPOINTS,
     LimitError,
@@ -93,3 +99,58 @@ def test_finding8_workers_are_clamped_to_the_jobs_and_at_least_one() -> None:
     for bad in (-5, 0, 2.5, True):
         with pytest.raises(LimitError, match=r"--workers must be a whole number ≥ 1"):
             worker_count(bad, jobs=12)
+
+
+@pytest.mark.parametrize(
+    ("name", "problem"),
+    [
+        ("s" * 240, f"the name has 240 characters, beyond the limit of {MAX_NAME_CHARS}"),
+        ("船" * 70, f"the name takes 210 bytes in UTF-8, beyond the limit of {MAX_NAME_BYTES}"),
+        ("two\nlines", "the name holds the character U+000A"),
+        ("  ", "the name is empty"),
+    ],
+)
+def test_a_scenario_name_no_file_name_can_carry_is_refused(
+    tmp_path: Path, name: str, problem: str
+) -> None:
+    """A figure's file is named after its scenario: a name too long for a file name (255
+    bytes with the figure's prefix and a temporary's suffix) or with a control character
+    is refused when the file is read and by the validator, naming the key."""
+    file = _nominal(tmp_path, name=name)
+    (found,) = check_scenario_file(file)
+    assert found.key == "name" and problem in found.message
+    with pytest.raises(ScenarioError, match=f"key 'name': .*{re.escape(problem)}"):
+        load_scenario(str(file))
+    assert load_scenario(str(_nominal(tmp_path, name="a" * MAX_NAME_CHARS))).name == "a" * 100
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("bad: " + "[" * 5000 + "]" * 5000, f"nested deeper than the limit of {MAX_CONFIG_DEPTH}"),
+        (
+            'a: &a ["x", "x", "x", "x", "x", "x", "x", "x", "x"]\n'
+            + "".join(
+                f"{b}: &{b} [{', '.join([f'*{a}'] * 9)}]\n"
+                for a, b in zip("abcdefgh", "bcdefghi", strict=True)
+            ),
+            f"more than the limit of {MAX_CONFIG_NODES} values (aliases expanded)",
+        ),
+    ],
+)
+def test_a_deep_or_exploding_yaml_is_refused_in_one_line(
+    tmp_path: Path, text: str, problem: str
+) -> None:
+    """5,000 nested lists (PyYAML composes them recursively: a RecursionError of 3,000
+    lines) and nested aliases (a few lines that expand to 10⁹ values) are refused while
+    parsing, in one line naming the file, the line and the limit."""
+    file = tmp_path / "deep.yaml"
+    file.write_text("name: deep\n" + text + "\n")
+    start = time.perf_counter()
+    with pytest.raises(ConfigError) as refused:
+        read_yaml(file)
+    message = str(refused.value)
+    assert "\n" not in message and message.startswith(f"{file}, line ") and problem in message
+    (found,) = check_scenario_file(file)
+    assert found.line is not None and problem in found.message
+    assert time.perf_counter() - start < 5
