@@ -216,8 +216,9 @@ def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     verdict = (
         "`pid_los` is the only ranked controller on the 2 catalogue scenarios, with a "
         "cost-ratio IQM of 1.250 [1.250, 1.250] (1 = the oracle's cost, lower is better); no "
-        "learned agent is ranked. The failure rate (episodes ending outside the corridor or "
-        "non-finite) of `pid_los` is 0 %: none of its episodes failed."
+        "learned agent is ranked. The failure rate (episodes ending outside the corridor, "
+        "non-finite or by a controller error or timeout) of `pid_los` is 0 %: none of its "
+        "episodes failed."
     )
     assert (ranked / "leaderboard.md").read_text().startswith(f"# Leaderboard\n\n{verdict}\n\n")
     assert terminal_summary(ranked).startswith(f"{verdict}\n\n## Ranking")
