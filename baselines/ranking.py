@@ -369,16 +369,14 @@ def interval_estimate(
 
 
 def _tasks(scored: Sequence[Mapping[str, Any]], controller: str, scenarios: set[str]) -> list[str]:
-    """The scenarios of ``scenarios`` on which ``controller`` has cost ratios."""
-    return sorted(
-        {
-            ep["scenario"]
-            for ep in scored
-            if ep["controller"] == controller
-            and ep["scenario"] in scenarios
-            and ep.get("cost_ratio") is not None
-        }
-    )
+    """The scenarios of ``scenarios`` on which every episode of ``controller`` has a cost
+    ratio (one whose cost, or its oracle's, is not finite has none: its scenario is left
+    out of the controller's main table, so every ranked row keeps all its runs)."""
+    rated, unrated = set(), set()
+    for ep in scored:
+        if ep["controller"] == controller and ep["scenario"] in scenarios:
+            (rated if ep.get("cost_ratio") is not None else unrated).add(ep["scenario"])
+    return sorted(rated - unrated)
 
 
 def controller_kinds(
