@@ -53,10 +53,11 @@ class ActGuard:
 
     With a guard the loop ends an episode whose controller's ``reset`` or ``act`` raises,
     or gives an action that is not numbers of the action's shape or holds NaN or inf
-    (``termination_reason`` ``"controller_error"``), or whose call took longer than
-    ``timeout`` [s] of wall time (``"controller_timeout"``); the env's ``abandon`` charges
-    it as leaving the corridor at that step, and the metric ``error`` says why in one
-    line.  Without a guard (None) such an error propagates, as a debugger wants it.
+    (``termination_reason`` ``"controller_error"``), or whose ``act`` took longer than
+    ``timeout`` [s] of wall time (``"controller_timeout"``; ``reset`` has no limit: it may
+    build a solver, compiled to C once per machine); the env's ``abandon`` charges it as
+    leaving the corridor at that step, and the metric ``error`` says why in one line.
+    Without a guard (None) such an error propagates, as a debugger wants it.
 
     The time limit is checked when the call returns, not by stopping it: a Python call
     cannot be stopped safely from outside in its own process (an exception sent by a
@@ -90,9 +91,12 @@ def error_line(exc: BaseException) -> str:
     return text if len(text) <= ERROR_CHARS else text[: ERROR_CHARS - 1] + "…"
 
 
-def _call(guard: ActGuard | None, call: Callable[[], Any]) -> tuple[Any, float, _Failure | None]:
+def _call(
+    guard: ActGuard | None, call: Callable[[], Any], timed: bool = True
+) -> tuple[Any, float, _Failure | None]:
     """``call()`` (a controller's), its time on the act clock [s] and, with a guard, why
-    the controller failed (None: it did not; :class:`ActGuard`)."""
+    the controller failed (None: it did not; :class:`ActGuard`); ``timed``: held to the
+    guard's time limit (an act, not a reset)."""
     start = _clock()
     if guard is None:
         value = call()
@@ -103,7 +107,7 @@ def _call(guard: ActGuard | None, call: Callable[[], Any]) -> tuple[Any, float, 
     except Exception as exc:  # the controller's, whatever it is: the episode's result
         return None, _clock() - start, _Failure(CONTROLLER_ERROR, error_line(exc))
     took, wall = _clock() - start, time.perf_counter() - wall
-    if wall > guard.timeout:
+    if timed and wall > guard.timeout:
         slow = f"the call took {wall:.3g} s, over the limit of {guard.timeout:g} s"
         return value, took, _Failure(CONTROLLER_TIMEOUT, slow)
     return value, took, None
@@ -288,7 +292,7 @@ def run_episode(
             reset = functools.partial(reset_with_truth, policy, context, base, seed)
         else:
             reset = functools.partial(policy.reset, context, seed=seed)
-        _, _, failure = _call(guard, reset)
+        _, _, failure = _call(guard, reset, timed=False)
         took: float | None = None  # no act call yet
         while failure is None and not episode.done:
             action, took, failure = _act(
@@ -553,11 +557,11 @@ def _run_lockstep(
     try:
         contexts = episodes.contexts()
         if batch:
-            _, _, failure = _call(guard, lambda: policy.reset_batch(contexts))
+            _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), timed=False)
             failures = [failure] * n
         else:
             failures = [
-                _call(guard, functools.partial(p.reset, context, seed=seed))[2]
+                _call(guard, functools.partial(p.reset, context, seed=seed), timed=False)[2]
                 for p, context, seed in zip(policy, contexts, episodes.seeds, strict=True)
             ]
         for i, failure in enumerate(failures):

@@ -178,8 +178,8 @@ class Job(NamedTuple):
     #: the oracle's episodes: "table" (the shipped reference table, running only a trial it
     #: lacks) or "recompute" (run every trial)
     references: str = "table"
-    #: the limit [s] on one controller call: a slower call, or one that fails, ends its
-    #: episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
+    #: the limit [s] on one ``act`` call: a slower call, or a controller that fails, ends
+    #: its episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
     act_timeout: float = ACT_TIMEOUT_S
 
 
@@ -522,7 +522,7 @@ def run_leaderboard(
     :class:`~shipgym_baselines.runs.RunInterrupted`.
 
     A controller that fails (raises, gives a malformed or non-finite action, or takes
-    longer than ``act_timeout`` [s] for one call) ends that episode, recorded with
+    longer than ``act_timeout`` [s] for one ``act`` call) ends that episode, recorded with
     ``termination_reason`` ``controller_error`` / ``controller_timeout`` and its
     ``error``, and the run goes on (:class:`~shipgym_baselines.evaluation.ActGuard`);
     ``resume`` keeps such episodes unless ``retry_failed``, which runs them again.

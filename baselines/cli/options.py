@@ -55,17 +55,17 @@ def add_backend_option(parser: argparse.ArgumentParser) -> None:
 
 
 def add_act_timeout_option(parser: argparse.ArgumentParser) -> None:
-    """``--act-timeout``: the limit on one controller call; a slower call, or one that
-    fails, ends its episode as failed and the run goes on
+    """``--act-timeout``: the limit on one ``act`` call of a controller; a slower call, or
+    one that fails, ends its episode as failed and the run goes on
     (:class:`~shipgym_baselines.evaluation.ActGuard`)."""
     parser.add_argument(
         "--act-timeout",
         type=float,
         default=ACT_TIMEOUT_S,
         metavar="SECONDS",
-        help=f"wall time one controller call may take (default {ACT_TIMEOUT_S:g} s); a "
-        "slower call ends its episode as controller_timeout, as a call that raises or gives "
-        "a malformed or non-finite action ends it as controller_error; the run goes on",
+        help=f"wall time one act call of a controller may take (default {ACT_TIMEOUT_S:g} s); "
+        "a slower call ends its episode as controller_timeout, as a call that raises or "
+        "gives a malformed or non-finite action ends it as controller_error; the run goes on",
     )
 
 

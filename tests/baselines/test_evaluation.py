@@ -303,6 +303,19 @@ def test_a_call_over_the_limit_ends_its_episode_as_controller_timeout() -> None:
     assert m["compute_ms_max"] >= 200.0  # the slow call is timed
 
 
+def test_a_slow_reset_is_no_timeout() -> None:
+    """``reset`` may build (and compile) a solver: only ``act`` calls have the limit."""
+
+    class SlowReset(GoesWrong):
+        def reset(self, context: Any, seed: int | None = None) -> None:
+            time.sleep(0.1)
+            super().reset(context, seed=seed)
+
+    slow = SlowReset(_raise, on=set())
+    result = run_episode(slow, "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05))
+    assert result.metrics["termination_reason"] == "goal" and "error" not in result.metrics
+
+
 def test_a_failing_reset_ends_the_episode_before_any_act() -> None:
     class BadReset(PIDLOS):
         def reset(self, context: Any, seed: int | None = None) -> None:
