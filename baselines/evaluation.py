@@ -2,29 +2,34 @@
 
 :func:`run_episode` runs one episode; :func:`evaluate_batch` runs several in lockstep, as
 the rows of one :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (a learned
-policy with one network forward per step for all), with the same bits.
+policy with one network forward per step for all), with the same bits.  Given an
+:class:`ActGuard` (the leaderboard, ``evaluate`` and ``run`` give one), a controller that
+fails ends its episode as a result, not the run.
 """
 
 from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
+import math
 import os
 import time
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.envs.core import TRAJECTORY_KEYS
+from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
-from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
+from shipgym_baselines.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
 from shipgym_baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"
@@ -34,6 +39,98 @@ EVAL_SEED_OFFSET = 10_000
 #: the clock [s] that times each ``act`` call (``compute_ms``): wall time, unless
 #: :func:`act_clock` swaps it (the run-cost profile reads CPU time)
 _clock: Callable[[], float] = time.perf_counter
+
+
+#: the default limit [s] on the wall time of one controller call (``--act-timeout``)
+ACT_TIMEOUT_S = 10.0
+#: the most characters of an episode's ``error`` (the one-line message of its failure)
+ERROR_CHARS = 300
+
+
+@dataclasses.dataclass(frozen=True)
+class ActGuard:
+    """A failing controller ends its episode, not the run.
+
+    With a guard the loop ends an episode whose controller's ``reset`` or ``act`` raises,
+    or gives an action that is not numbers of the action's shape or holds NaN or inf
+    (``termination_reason`` ``"controller_error"``), or whose ``act`` took longer than
+    ``timeout`` [s] of wall time (``"controller_timeout"``; ``reset`` has no limit: it may
+    build a solver, compiled to C once per machine); the env's ``abandon`` charges it as
+    leaving the corridor at that step, and the metric ``error`` says why in one line.
+    Without a guard (None) such an error propagates, as a debugger wants it.
+
+    The time limit is checked when the call returns, not by stopping it: a Python call
+    cannot be stopped safely from outside in its own process (an exception sent by a
+    signal lands in whatever code runs, perhaps a library holding a lock, and does not
+    interrupt C code), and a worker process per controller would cost a round trip and
+    a pickled observation per step, and would leave a controller's state out of reach.
+    So a slow controller holds a run for at most one slow call per episode; a call that
+    never returns holds it until the run is stopped (Ctrl-C; ``--resume`` runs that
+    episode again).  A batch policy's ``act_batch`` acts for all live episodes: the
+    whole call counts against the limit.
+    """
+
+    timeout: float = ACT_TIMEOUT_S
+
+    def __post_init__(self) -> None:
+        if not self.timeout > 0.0:  # NaN too
+            raise RunError(f"--act-timeout must be a positive time in s, got {self.timeout}")
+
+
+class _Failure(NamedTuple):
+    """Why a controller's episode ended early: the termination reason and one line."""
+
+    reason: str
+    error: str
+
+
+def error_line(exc: BaseException) -> str:
+    """``Type: message`` of ``exc`` as one printable line of at most :data:`ERROR_CHARS`."""
+    text = "".join(c if c.isprintable() else " " for c in f"{type(exc).__name__}: {exc}")
+    text = " ".join(text.split())
+    return text if len(text) <= ERROR_CHARS else text[: ERROR_CHARS - 1] + "…"
+
+
+def _call(
+    guard: ActGuard | None, call: Callable[[], Any], timed: bool = True
+) -> tuple[Any, float, _Failure | None]:
+    """``call()`` (a controller's), its time on the act clock [s] and, with a guard, why
+    the controller failed (None: it did not; :class:`ActGuard`); ``timed``: held to the
+    guard's time limit (an act, not a reset)."""
+    start = _clock()
+    if guard is None:
+        value = call()
+        return value, _clock() - start, None
+    wall = time.perf_counter()
+    try:
+        value = call()
+    except Exception as exc:  # the controller's, whatever it is: the episode's result
+        return None, _clock() - start, _Failure(CONTROLLER_ERROR, error_line(exc))
+    took, wall = _clock() - start, time.perf_counter() - wall
+    if timed and wall > guard.timeout:
+        slow = f"the call took {wall:.3g} s, over the limit of {guard.timeout:g} s"
+        return value, took, _Failure(CONTROLLER_TIMEOUT, slow)
+    return value, took, None
+
+
+def _checked(action: Any, shape: tuple[int, ...]) -> tuple[Any, _Failure | None]:
+    """``action`` as :func:`~shipgym.envs.core.check_action` gives it, or the failure of
+    a controller that gave it (not numbers of ``shape``, or NaN or inf)."""
+    try:
+        return check_action(action, shape), None
+    except ValueError as exc:
+        return None, _Failure(CONTROLLER_ERROR, error_line(exc))
+
+
+def _act(
+    guard: ActGuard | None, act: Callable[[], Any], shape: tuple[int, ...]
+) -> tuple[Any, float, _Failure | None]:
+    """:func:`_call` of a controller's ``act``, its action checked when guarded
+    (:func:`_checked`)."""
+    action, took, failure = _call(guard, act)
+    if guard is not None and failure is None:
+        action, failure = _checked(action, shape)
+    return action, took, failure
 
 
 @contextlib.contextmanager
@@ -84,10 +181,14 @@ class _Record:
         self.info = info
         self.rows: list[tuple[float, ...]] | None = [_traj_row(info)] if rows else None
         self.act_times: list[float] = []
+        #: why the controller failed, if it did (:class:`ActGuard`)
+        self.failure: _Failure | None = None
 
-    def add(self, info: dict[str, Any] | None, act_time: float) -> None:
-        """The info (None: none this step) of a step whose action took ``act_time`` [s]."""
-        self.act_times.append(act_time)
+    def add(self, info: dict[str, Any] | None, act_time: float | None) -> None:
+        """The info (None: none this step) of a step whose action took ``act_time`` [s]
+        (None: no ``act`` call, its ``reset`` failed)."""
+        if act_time is not None:
+            self.act_times.append(act_time)
         if info is not None:
             self.info = info
             if self.rows is not None:
@@ -99,10 +200,16 @@ class _Record:
         """The episode's result; ``trajectory``: a record without rows (the env's)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
+        if self.failure is not None:
+            metrics["error"] = self.failure.error
         metrics.update(compute_time_metrics(self.act_times))
         stats = getattr(policy, "episode_stats", None)
         if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
-            metrics.update(stats())
+            try:
+                metrics.update(stats())
+            except Exception:
+                if self.failure is None:
+                    raise  # a failed controller's figures may fail too: left out
         if trajectory is None:
             traj = np.array(self.rows)
             trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
@@ -143,6 +250,12 @@ class _Episode:
         self.record.add(info, act_time)
         self.done = terminated or truncated
 
+    def abandon(self, failure: _Failure, act_time: float | None) -> None:
+        """End the episode now: its controller failed (in a call of ``act_time`` [s])."""
+        self.record.add(self.base.abandon(failure.reason), act_time)
+        self.record.failure = failure
+        self.done = True
+
     def result(self, policy: Policy) -> EpisodeResult:
         return self.record.result(policy)
 
@@ -155,6 +268,7 @@ def run_episode(
     env_id: str = ENV_ID,
     after_episode: Callable[[Any], None] | None = None,
     privileged: bool = False,
+    guard: ActGuard | None = None,
 ) -> EpisodeResult:
     """Run one episode; the policy sees only obs, info and the controller context.
 
@@ -165,20 +279,29 @@ def run_episode(
     ``compute_ms`` [ms] is its mean per step and ``compute_ms_max`` [ms] its maximum.
     ``privileged``: set by :func:`evaluate` / :func:`evaluate_batch` for the built-in
     references ``oracle`` and ``oracle_frozen`` only (:mod:`shipgym_baselines.privileged`):
-    they then read the true plant.
+    they then read the true plant.  ``guard``: a failing controller ends the episode
+    (:class:`ActGuard`); None: its error propagates.
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
     episode = _Episode(env_id, scenario, seed, action_mode)
     try:
+        base, shape = episode.base, episode.env.action_space.shape
+        context = base.controller_context
         if privileged:
-            reset_with_truth(policy, episode.base.controller_context, episode.base, seed)
+            reset = functools.partial(reset_with_truth, policy, context, base, seed)
         else:
-            policy.reset(episode.base.controller_context, seed=seed)
-        while not episode.done:
-            start = _clock()
-            action = policy.act(episode.obs, episode.info)
-            episode.step(action, _clock() - start)
+            reset = functools.partial(policy.reset, context, seed=seed)
+        _, _, failure = _call(guard, reset, timed=False)
+        took: float | None = None  # no act call yet
+        while failure is None and not episode.done:
+            action, took, failure = _act(
+                guard, lambda: policy.act(episode.obs, episode.info), shape
+            )
+            if failure is None:
+                episode.step(action, took)
+        if failure is not None:
+            episode.abandon(failure, took)
         result = episode.result(policy)
         if after_episode is not None:
             after_episode(episode.base)
@@ -206,6 +329,7 @@ def evaluate_batch(
     training_seed: int | None = None,
     action_mode: str | None = None,
     env_id: str = ENV_ID,
+    guard: ActGuard | None = None,
 ) -> list[EpisodeResult]:
     """The episodes of ``seeds``, the i-th on ``scenarios[i]`` (a list, one scenario per
     seed: e.g. each seed's trial variant) or all on one scenario; equal, bit for bit, to
@@ -227,7 +351,8 @@ def evaluate_batch(
 
     One by one (:func:`run_episode`) run the privileged references (they read their env's
     truth) and a non-batch Policy *instance* (one instance cannot act for several
-    episodes at once).
+    episodes at once).  ``guard``: a failing controller ends its episodes
+    (:class:`ActGuard`); None: its error propagates.
     """
     seeds = list(seeds)
     per_seed = list(scenarios) if isinstance(scenarios, list | tuple) else [scenarios] * len(seeds)
@@ -246,18 +371,21 @@ def evaluate_batch(
     mode = action_mode or mode or getattr(policy, "action_mode", "rudder")
     if isinstance(policy, BatchPolicy):
         # a batch policy acts on the observations alone: its rows skip the per-step infos
-        return _run_lockstep(policy, _episodes(per_seed, seeds, mode, env_id, lean=True))
+        episodes = _episodes(per_seed, seeds, mode, env_id, lean=True)
+        return _run_lockstep(policy, episodes, guard)
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
             make_controller(controller, training_seed=training_seed)[0] for _ in seeds[1:]
         ]
-        return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id))
+        return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id), guard)
     results = []
     for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
         if made and i > 0:
             policy, _ = make_controller(controller, training_seed=training_seed)
-        results.append(run_episode(policy, scenario, seed, mode, env_id, privileged=privileged))
+        results.append(
+            run_episode(policy, scenario, seed, mode, env_id, privileged=privileged, guard=guard)
+        )
     return results
 
 
@@ -267,6 +395,8 @@ class _Episodes(Protocol):
     seeds: list[int]
     obs: Sequence[np.ndarray]
     done: list[bool]
+    #: one episode's action shape
+    shape: tuple[int, ...]
 
     def info(self, i: int) -> dict[str, Any]: ...
 
@@ -277,6 +407,8 @@ class _Episodes(Protocol):
     def step(
         self, live: list[int], actions: Sequence[np.ndarray] | np.ndarray, times: list[float]
     ) -> None: ...
+
+    def abandon(self, i: int, failure: _Failure, act_time: float | None) -> None: ...
 
     def result(self, i: int, policy: Policy) -> EpisodeResult: ...
 
@@ -308,6 +440,7 @@ class _VectorEpisodes:
         ]
         self.done = [False] * len(seeds)
         self._actions = np.zeros(self.env.action_space.shape)
+        self.shape = self.env.single_action_space.shape
 
     def info(self, i: int) -> dict[str, Any]:
         return self.records[i].info
@@ -335,6 +468,12 @@ class _VectorEpisodes:
             self.records[i].add(rows[i], act_time)  # lean: an info at the last step only
         self.done = self.env.finished.tolist()
 
+    def abandon(self, i: int, failure: _Failure, act_time: float | None) -> None:
+        """End episode i now: its controller failed (in a call of ``act_time`` [s])."""
+        self.records[i].add(self.env.abandon(i, failure.reason), act_time)
+        self.records[i].failure = failure
+        self.done[i] = True
+
     def result(self, i: int, policy: Policy) -> EpisodeResult:
         return self.records[i].result(policy, self.env.trajectory(i))
 
@@ -356,6 +495,7 @@ class _SingleEpisodes:
             raise
         self.obs = [e.obs for e in self.episodes]
         self.done = [e.done for e in self.episodes]
+        self.shape = self.episodes[0].env.action_space.shape if self.episodes else ()
 
     def info(self, i: int) -> dict[str, Any]:
         return self.episodes[i].info
@@ -373,6 +513,11 @@ class _SingleEpisodes:
             episode = self.episodes[i]
             episode.step(action, act_time)
             self.obs[i], self.done[i] = episode.obs, episode.done
+
+    def abandon(self, i: int, failure: _Failure, act_time: float | None) -> None:
+        """End episode i now: its controller failed (in a call of ``act_time`` [s])."""
+        self.episodes[i].abandon(failure, act_time)
+        self.done[i] = True
 
     def result(self, i: int, policy: Policy) -> EpisodeResult:
         return self.episodes[i].result(policy)
@@ -401,35 +546,79 @@ def _episodes(
     return _SingleEpisodes(scenarios, seeds, action_mode, env_id)
 
 
-def _run_lockstep(policy: BatchPolicy | list[Policy], episodes: _Episodes) -> list[EpisodeResult]:
+def _run_lockstep(
+    policy: BatchPolicy | list[Policy], episodes: _Episodes, guard: ActGuard | None = None
+) -> list[EpisodeResult]:
     """:func:`evaluate_batch`'s loop: every episode steps in lockstep, acted on by one
-    :class:`BatchPolicy` or by its own policy of a list."""
+    :class:`BatchPolicy` or by its own policy of a list; ``guard``: a failing controller
+    ends its episodes (:class:`ActGuard`)."""
     n = len(episodes.obs)
     batch = not isinstance(policy, list)
     try:
+        contexts = episodes.contexts()
         if batch:
-            policy.reset_batch(episodes.contexts())
+            _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), timed=False)
+            failures = [failure] * n
         else:
-            for p, context, seed in zip(policy, episodes.contexts(), episodes.seeds, strict=True):
-                p.reset(context, seed=seed)
+            failures = [
+                _call(guard, functools.partial(p.reset, context, seed=seed), timed=False)[2]
+                for p, context, seed in zip(policy, contexts, episodes.seeds, strict=True)
+            ]
+        for i, failure in enumerate(failures):
+            if failure is not None:
+                episodes.abandon(i, failure, None)
         live = [i for i in range(n) if not episodes.done[i]]
         while live:
             if batch:
-                obs = episodes.stacked_obs(live)
-                start = _clock()
-                actions = np.asarray(policy.act_batch(obs, live))
-                times = [(_clock() - start) / len(live)] * len(live)
+                stepped, actions, times = _act_batch(policy, episodes, live, guard)
             else:
-                actions, times = [], []
+                stepped, actions, times = [], [], []
                 for i in live:
-                    start = _clock()
-                    actions.append(policy[i].act(episodes.obs[i], episodes.info(i)))
-                    times.append(_clock() - start)
-            episodes.step(live, actions, times)
+                    act = functools.partial(policy[i].act, episodes.obs[i], episodes.info(i))
+                    action, took, failure = _act(guard, act, episodes.shape)
+                    if failure is not None:
+                        episodes.abandon(i, failure, took)
+                        continue
+                    stepped.append(i)
+                    actions.append(action)
+                    times.append(took)
+            if stepped:
+                episodes.step(stepped, actions, times)
             live = [i for i in live if not episodes.done[i]]
         return [episodes.result(i, policy if batch else policy[i]) for i in range(n)]
     finally:
         episodes.close()
+
+
+def _act_batch(
+    policy: BatchPolicy, episodes: _Episodes, live: list[int], guard: ActGuard | None
+) -> tuple[list[int], Any, list[float]]:
+    """One ``act_batch`` for the ``live`` episodes: the episodes to step, their actions
+    and each one's share of the call's time [s].  With a guard, the episodes whose action
+    failed are abandoned: all of them when the call failed or its array has the wrong
+    shape, else those whose row holds NaN or inf."""
+    obs = episodes.stacked_obs(live)
+    raw, took, failure = _call(guard, lambda: policy.act_batch(obs, live))
+    share = took / len(live)
+    if guard is None:
+        return live, np.asarray(raw), [share] * len(live)
+    shape = (len(live), *episodes.shape)
+    if failure is None:
+        actions, failure = _checked(raw, shape)
+        if failure is None:
+            return live, actions, [share] * len(live)
+        if tuple(getattr(raw, "shape", ())) == shape:  # the rows with NaN or inf fail
+            rows = [_checked(row, episodes.shape) for row in np.asarray(raw)]
+            stepped = []
+            for i, (row, row_failure) in zip(live, rows, strict=True):
+                if row_failure is None:
+                    stepped.append((i, row))
+                else:
+                    episodes.abandon(i, row_failure, share)
+            return [i for i, _ in stepped], [row for _, row in stepped], [share] * len(stepped)
+    for i in live:
+        episodes.abandon(i, failure, share)
+    return [], [], []
 
 
 def training_seed(policy: Policy) -> int | None:
@@ -443,7 +632,10 @@ def training_seed(policy: Policy) -> int | None:
 
 
 def compute_time_metrics(act_times: list[float]) -> dict[str, float]:
-    """``compute_ms`` (mean) and ``compute_ms_max`` [ms] of the ``act`` durations [s]."""
+    """``compute_ms`` (mean) and ``compute_ms_max`` [ms] of the ``act`` durations [s] (NaN
+    without any: a controller whose ``reset`` failed)."""
+    if not act_times:
+        return {"compute_ms": math.nan, "compute_ms_max": math.nan}
     return {
         "compute_ms": 1e3 * float(np.mean(act_times)),
         "compute_ms_max": 1e3 * float(np.max(act_times)),
@@ -491,6 +683,7 @@ def evaluate(
     seeds: list[int],
     *,
     suite: str | os.PathLike | None = None,
+    guard: ActGuard | None = None,
     **settings: Any,
 ) -> list[EpisodeResult]:
     """Evaluate a controller on a scenario over seeds.
@@ -500,7 +693,8 @@ def evaluate(
     give its ``action_mode``; default: the policy's own).  ``suite``: a suite name or file;
     each seed then runs its trial of the scenario as that suite's leaderboard draws it
     (:func:`suite_trials`: start, jump time and current from the seed; seed 10000 + i is
-    the leaderboard's i-th); None: every seed runs the scenario as written.
+    the leaderboard's i-th); None: every seed runs the scenario as written.  ``guard``: a
+    failing controller ends its episode (:class:`ActGuard`); None: its error propagates.
     """
     trials = [scenario] * len(seeds) if suite is None else suite_trials(scenario, seeds, suite)
     results = []
@@ -512,5 +706,5 @@ def evaluate(
             privileged = plain and grants_truth(controller)
         else:
             policy, mode = controller, settings.get("action_mode")
-        results.append(run_episode(policy, trial, seed, mode, privileged=privileged))
+        results.append(run_episode(policy, trial, seed, mode, privileged=privileged, guard=guard))
     return results

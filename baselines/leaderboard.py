@@ -56,7 +56,7 @@ from shipgym_baselines.comparison import (
 )
 from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
-from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult
+from shipgym_baselines.evaluation import ACT_TIMEOUT_S, EVAL_SEED_OFFSET, EpisodeResult
 from shipgym_baselines.figures import median_ace_episode
 from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.outfiles import carried, write_bytes, write_text
@@ -70,6 +70,7 @@ from shipgym_baselines.ranking import (
     PARTIAL,
     SCORE_EXPLAINED,
     aggregate_ranking,
+    controller_failed,
     headroom_grid,
     headroom_table,
     is_partial,
@@ -179,6 +180,9 @@ class Job(NamedTuple):
     #: the oracle's episodes: "table" (the shipped reference table, running only a trial it
     #: lacks) or "recompute" (run every trial)
     references: str = "table"
+    #: the limit [s] on one ``act`` call: a slower call, or a controller that fails, ends
+    #: its episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
+    act_timeout: float = ACT_TIMEOUT_S
 
 
 @functools.lru_cache(maxsize=128)
@@ -244,15 +248,26 @@ def run_job(job: tuple) -> EpisodeResult:
     one = Job(job[0], job[1], (int(job[2]),), *job[3:])
     (trial,) = trials(one)
     seeds = list(one.seeds)
-    result = evaluation.evaluate(one.controller, trial, seeds, training_seed=one.training_seed)
+    result = evaluation.evaluate(
+        one.controller, trial, seeds, training_seed=one.training_seed, guard=_guard(one)
+    )
     return _named(result, one)[0]
+
+
+def _guard(job: Job) -> evaluation.ActGuard:
+    """How the job's episodes end when their controller fails."""
+    return evaluation.ActGuard(job.act_timeout)
 
 
 def run_batch(job: Job) -> list[EpisodeResult]:
     """The job's episodes, all seeds at once (:func:`shipgym_baselines.evaluation.evaluate_batch`),
     in the order of ``job.seeds``."""
     results = evaluation.evaluate_batch(
-        job.controller, trials(job), list(job.seeds), training_seed=job.training_seed
+        job.controller,
+        trials(job),
+        list(job.seeds),
+        training_seed=job.training_seed,
+        guard=_guard(job),
     )
     return _named(list(results), job)
 
@@ -269,8 +284,11 @@ def reference_work(job: Job) -> list[EpisodeResult]:
         if entry is not None:
             out.append(result_from_entry(entry, job.scenario, seed, reference))
         else:
-            (result,) = _named(evaluation.evaluate(job.controller, trial, [seed]), job)
-            cache.store(trial, result)
+            (result,) = _named(
+                evaluation.evaluate(job.controller, trial, [seed], guard=_guard(job)), job
+            )
+            if not controller_failed(result.metrics):  # a reference that failed: not kept
+                cache.store(trial, result)
             out.append(result)
     return out
 
@@ -482,6 +500,8 @@ def run_leaderboard(
     recompute_references: bool = False,
     vector_figures: bool = False,
     add_references: bool = False,
+    act_timeout: float = ACT_TIMEOUT_S,
+    retry_failed: bool = False,
 ) -> list[dict[str, Any]]:
     """Run the suite, write its tables, ranking and figures (:func:`write_results`); return
     the rows.
@@ -502,10 +522,17 @@ def run_leaderboard(
     episodes, workers and the time estimated from the recorded costs
     (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
     :class:`~shipgym_baselines.runs.RunInterrupted`.
+
+    A controller that fails (raises, gives a malformed or non-finite action, or takes
+    longer than ``act_timeout`` [s] for one ``act`` call) ends that episode, recorded with
+    ``termination_reason`` ``controller_error`` / ``controller_timeout`` and its
+    ``error``, and the run goes on (:class:`~shipgym_baselines.evaluation.ActGuard`);
+    ``resume`` keeps such episodes unless ``retry_failed``, which runs them again.
     """
     if out_dir is None:
         out_dir = suite_folder(suite)
-    check_out_usable(out_dir, resume=resume, force=force)  # before any work
+    check_failure_options(act_timeout, retry_failed, resume)  # before any work
+    check_out_usable(out_dir, resume=resume, force=force)
     if backend not in BACKENDS:
         raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
     spec = load_suite(suite)  # a bad suite is named before the state of out_dir
@@ -538,6 +565,7 @@ def run_leaderboard(
         references,
         record.get("scenario_seeds"),
     )
+    jobs = [job._replace(act_timeout=act_timeout) for job in jobs]
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
     n_episodes = sum(len(job.seeds) for job in jobs)
     log = RunLog.open(
@@ -549,11 +577,14 @@ def run_leaderboard(
         force=force,
     )
     with log.recording():  # holds out_dir's lock to the end
+        if retry_failed:
+            log.retry([key for key, ep in log.episodes.items() if controller_failed(ep)])
         todo = longest_first(missing(jobs, log.done), scenarios)
         announce_references(todo)
         rows = row_keys(jobs)
         if show_progress:  # the bar's first line, before any job ends
             sys.stderr.write(eta_line(todo, scenarios, workers, n_episodes) + "\n")
+        failed: set[str] = set()  # the controllers whose failure was announced
         bar = tqdm(
             total=n_episodes,
             initial=n_episodes - sum(len(job.seeds) for job in todo),
@@ -569,6 +600,7 @@ def run_leaderboard(
                             continue  # recorded before (a resumed job)
                         log.append(result, keep_trajectory=True)
                         keep_drawn(log, rows, (result.scenario, result.controller))
+                        announce_failure(result, failed)
                         bar.update(1)
                         if on_episode is not None:
                             on_episode(result)
@@ -581,6 +613,27 @@ def run_leaderboard(
             return write_results(
                 log.folder, log.record["suite"], results, workers, vector_figures, show_progress
             )
+
+
+def check_failure_options(act_timeout: float, retry_failed: bool, resume: bool) -> None:
+    """A :class:`RunError` for a limit that is not a positive time [s] and for
+    ``--retry-failed`` without ``--resume``."""
+    evaluation.ActGuard(act_timeout)
+    if retry_failed and not resume:
+        raise RunError("--retry-failed runs the failed episodes of a resumed run: add --resume")
+
+
+def announce_failure(result: EpisodeResult, announced: set[str]) -> None:
+    """One line on stderr at the first episode of a controller ended by its failure (its
+    error; the run goes on); ``announced``: the controllers already named, updated."""
+    if not controller_failed(result.metrics) or result.controller in announced:
+        return
+    announced.add(result.controller)
+    notice(
+        f"shipgym: {result.controller} failed on {result.scenario} seed {result.seed} "
+        f"({result.metrics['termination_reason']}: {result.metrics.get('error')}); its "
+        "episode counts as failed and the run goes on (episodes.jsonl has each failure)"
+    )
 
 
 def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:

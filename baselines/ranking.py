@@ -12,8 +12,9 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   any corridor penalty, the return without the goal bonus) over the cost of the reference
   controller ``oracle`` (a privileged NMPC on the true plant) on the same scenario and trial
   (evaluation seed): C / C_oracle, 1 = as good as the oracle, lower is better
-  (:func:`scored_episodes`).  An episode *fails* when it ends outside the corridor or with a
-  non-finite state (``termination_reason``), or its cost is not finite.
+  (:func:`scored_episodes`).  An episode *fails* when it ends outside the corridor, with a
+  non-finite state or by its controller's error or timeout (``termination_reason``,
+  :data:`FAILURE_REASONS`), or its cost is not finite.
 * **Aggregate ranking** per controller and split (catalogue / held-out / in-range / yours),
   over the scenarios of the split that have the oracle's episodes: the interquartile mean
   (IQM) and the geometric mean of the cost ratios, the probability of improvement over ``pid_los``
@@ -67,8 +68,20 @@ ORACLE_FROZEN = "oracle_frozen"
 BASELINE = "pid_los"
 #: the kind of the controllers shown on every scenario but never ranked
 REFERENCE_KIND = "reference"
+#: the ``termination_reason`` of an episode its controller ended: ``reset`` or ``act``
+#: raised, or gave an action that is malformed or not finite
+#: (:class:`~shipgym_baselines.evaluation.ActGuard`)
+CONTROLLER_ERROR = "controller_error"
+#: ... or a call took longer than the limit (``--act-timeout``)
+CONTROLLER_TIMEOUT = "controller_timeout"
+#: the ``termination_reason`` values of an episode its controller ended
+CONTROLLER_FAILURES = (CONTROLLER_ERROR, CONTROLLER_TIMEOUT)
 #: the ``termination_reason`` values of a failed episode
-FAILURE_REASONS = ("corridor", "non_finite_state")
+FAILURE_REASONS = ("corridor", "non_finite_state", *CONTROLLER_FAILURES)
+#: what a failed episode is, in the words of the tables and the verdict
+FAILED_EPISODES = (
+    "episodes ending outside the corridor, non-finite or by a controller error or timeout"
+)
 #: the split label's suffix of the table of controllers ranked on fewer scenarios
 PARTIAL = ":partial"
 #: 95 % intervals
@@ -130,7 +143,7 @@ SCORE_EXPLAINED = (
     "the oracle's cost and lower is better. Per controller and split: the interquartile "
     "mean (IQM) and the geometric mean of the ratios over runs (training seeds × "
     f"evaluation seeds) and scenarios, P(its ratio is below {BASELINE}'s on a scenario) and "
-    "the rate of episodes ending outside the corridor or non-finite, each with a 95 % "
+    f"the failure rate ({FAILED_EPISODES}), each with a 95 % "
     "stratified-bootstrap interval (rliable; Agarwal et al. 2021), ranked by IQM, lowest "
     "first."
 )
@@ -237,10 +250,17 @@ def _number(value: Any) -> float:
 
 # ---------------------------------------------------------------------------------- scores
 def is_failure(episode: Mapping[str, Any]) -> bool:
-    """The episode ended outside the corridor or non-finite (or its cost is not finite)."""
+    """The episode ended outside the corridor, non-finite or by its controller's error or
+    timeout (:data:`FAILURE_REASONS`), or its cost is not finite."""
     return episode.get("termination_reason") in FAILURE_REASONS or not math.isfinite(
         _number(episode.get("cost"))
     )
+
+
+def controller_failed(episode: Mapping[str, Any]) -> bool:
+    """The episode was ended by its controller's error or timeout
+    (:data:`CONTROLLER_FAILURES`)."""
+    return episode.get("termination_reason") in CONTROLLER_FAILURES
 
 
 def scored_episodes(
@@ -349,16 +369,14 @@ def interval_estimate(
 
 
 def _tasks(scored: Sequence[Mapping[str, Any]], controller: str, scenarios: set[str]) -> list[str]:
-    """The scenarios of ``scenarios`` on which ``controller`` has cost ratios."""
-    return sorted(
-        {
-            ep["scenario"]
-            for ep in scored
-            if ep["controller"] == controller
-            and ep["scenario"] in scenarios
-            and ep.get("cost_ratio") is not None
-        }
-    )
+    """The scenarios of ``scenarios`` on which every episode of ``controller`` has a cost
+    ratio (one whose cost, or its oracle's, is not finite has none: its scenario is left
+    out of the controller's main table, so every ranked row keeps all its runs)."""
+    rated, unrated = set(), set()
+    for ep in scored:
+        if ep["controller"] == controller and ep["scenario"] in scenarios:
+            (rated if ep.get("cost_ratio") is not None else unrated).add(ep["scenario"])
+    return sorted(rated - unrated)
 
 
 def controller_kinds(

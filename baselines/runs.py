@@ -73,6 +73,7 @@ from shipgym_baselines.jsonout import COMPACT
 from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.manifest import Manifest, clear_listed
 from shipgym_baselines.outfiles import check_no_links, make_dir, open_regular, write_bytes
+from shipgym_baselines.ranking import controller_failed
 from shipgym_baselines.signals import signal_number
 
 if TYPE_CHECKING:
@@ -416,8 +417,9 @@ def episode_key(record: Mapping[str, Any]) -> Key:
     )
 
 
-#: metrics whose value is text or null (every other metric is a number, null, "inf" or "-inf")
-TEXT_METRICS = ("termination_reason",)
+#: metrics whose value is text or null (every other metric is a number, null, "inf" or
+#: "-inf"): ``error`` is the one-line message of an episode its controller ended
+TEXT_METRICS = ("termination_reason", "error")
 #: metrics whose value is a boolean (true / false, or null)
 BOOL_METRICS = ("success",)
 
@@ -539,7 +541,9 @@ def read_episodes(
     not an episode record (not UTF-8, not JSON, a ``NaN`` / ``Infinity`` token, not an
     object, a key missing, a value of the wrong type: :func:`_metric_problem`), repeats a
     key with other content, or (given ``suite``, as ``run.json`` records it) holds an
-    episode that is not the suite's."""
+    episode that is not the suite's.  An episode its controller ended
+    (``controller_error`` / ``controller_timeout``) may be recorded again: the later line
+    is the episode (``--retry-failed`` runs it again, :meth:`RunLog.retry`)."""
     file = Path(folder) / EPISODES_FILE
     if not file.is_file():
         return []
@@ -559,7 +563,7 @@ def read_episodes(
         if keys is not None and (why := _foreign(key, keys)) is not None:
             raise _bad_line(file, number, why)
         record = {k: _number(v) for k, v in record.items()}
-        if key in records:
+        if key in records and not controller_failed(records[key]):
             if _same(records[key], record):
                 continue  # the same episode written twice: one episode
             raise _bad_line(
@@ -796,6 +800,12 @@ class RunLog:
         self.episodes[key] = record
         self.done.add(key)
         self._count += 1
+
+    def retry(self, keys: Iterable[Key]) -> None:
+        """Run these recorded episodes again (those their controller ended): they leave
+        :attr:`done`, and the line appended for each replaces the earlier one
+        (:func:`read_episodes`)."""
+        self.done -= set(keys)
 
     def _write_line(self, data: bytes) -> None:
         """Append one line to ``episodes.jsonl`` (unbuffered: on disk when this returns);

@@ -9,7 +9,7 @@
    the learned agents stand: the best one's rank and its IQM over the best classical
    controller's.
 2. **What the failures are**: the median failure rate of the table's controllers
-   (episodes ending outside the corridor or non-finite), and the scenarios the failed
+   (:data:`~shipgym_baselines.ranking.FAILED_EPISODES`), and the scenarios the failed
    episodes come from: those on which most controllers (more than half) fail most of their
    episodes (more than half), with their share of all failed episodes; when there are none,
    the scenario with the most failed episodes.
@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.ranking import (
+    FAILED_EPISODES,
     GAP_HEADROOM,
     ORACLE,
     ORACLE_FROZEN,
@@ -182,7 +183,7 @@ def failure_sentence(
 ) -> str:
     """Sentence 2: the median failure rate of ``table``'s rows and the scenarios the failed
     episodes of its controllers (on its scenarios, from ``episodes``) come from."""
-    what = "(episodes ending outside the corridor or non-finite)"
+    what = f"({FAILED_EPISODES})"
     if len(table) == 1:
         rate = f"The failure rate {what} of {code(table[0]['controller'])} is "
         rate += _percent(table[0]["failure_rate"])

@@ -191,7 +191,10 @@ def run(args: argparse.Namespace) -> int:
     elif out is None:
         out = suite_folder(args.suite)
         note = f" (the leaderboard's folder for --suite {args.suite}; give --out for another)"
-    # before any work: an unusable --out, then a bad suite, then --out in use or not empty
+    from shipgym_baselines.leaderboard import check_failure_options
+
+    # before any work: bad options, an unusable --out, a bad suite, --out in use or not empty
+    check_failure_options(args.act_timeout, args.retry_failed, args.resume)
     check_out_usable(out, resume=args.resume, force=args.force)
     spec = load_suite(args.suite)
     explicit = controllers is not None
@@ -214,6 +217,8 @@ def run(args: argparse.Namespace) -> int:
         recompute_references=getattr(args, "recompute_references", False),
         vector_figures=args.vector_figures,
         add_references=not args.no_references and (explicit or not lists_oracle(spec)),
+        act_timeout=args.act_timeout,
+        retry_failed=args.retry_failed,
     )
     if not args.json:
         from shipgym_baselines.runs import read_run

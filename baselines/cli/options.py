@@ -6,6 +6,7 @@ import argparse
 import sys
 from typing import Any
 
+from shipgym_baselines.evaluation import ACT_TIMEOUT_S
 from shipgym_baselines.jsonout import dumps
 from shipgym_baselines.runs import BACKENDS
 
@@ -53,6 +54,21 @@ def add_backend_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_act_timeout_option(parser: argparse.ArgumentParser) -> None:
+    """``--act-timeout``: the limit on one ``act`` call of a controller; a slower call, or
+    one that fails, ends its episode as failed and the run goes on
+    (:class:`~shipgym_baselines.evaluation.ActGuard`)."""
+    parser.add_argument(
+        "--act-timeout",
+        type=float,
+        default=ACT_TIMEOUT_S,
+        metavar="SECONDS",
+        help=f"wall time one act call of a controller may take (default {ACT_TIMEOUT_S:g} s); "
+        "a slower call ends its episode as controller_timeout, as a call that raises or "
+        "gives a malformed or non-finite action ends it as controller_error; the run goes on",
+    )
+
+
 def add_out_options(
     parser: argparse.ArgumentParser,
     out: str | None,
@@ -78,8 +94,8 @@ def add_run_options(
     out_help: str = "output directory (refused if not empty: see --resume, --force)",
 ) -> None:
     """The options of a suite run (``leaderboard``, ``evaluate``): --suite, --seeds, --out
-    (default ``out``) with --resume / --force, --backend, --workers, --trust-pickle,
-    --no-progress, --vector-figures, --json."""
+    (default ``out``) with --resume / --force, --retry-failed, --act-timeout, --backend,
+    --workers, --trust-pickle, --no-progress, --vector-figures, --json."""
     parser.add_argument(
         "--suite", default="default", help="suite name in configs/suites or a YAML path"
     )
@@ -87,6 +103,13 @@ def add_run_options(
         "--seeds", type=int, default=None, help="seeds per scenario (default: suite's)"
     )
     add_out_options(parser, out, out_help)
+    parser.add_argument(
+        "--retry-failed",
+        action="store_true",
+        help="with --resume: run again the episodes its controller ended (controller_error, "
+        "controller_timeout), which --resume alone keeps",
+    )
+    add_act_timeout_option(parser)
     add_backend_option(parser)
     parser.add_argument(
         "--workers", type=int, default=None, help="local processes (default: cores)"

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.cli.options import (
+    add_act_timeout_option,
     add_json_option,
     add_out_options,
     add_trust_pickle_option,
@@ -84,6 +85,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="also write an animation of the episode: FILE.gif (Pillow) or FILE.mp4 (needs "
         "ffmpeg: pip install 'shipgym[video]')",
     )
+    add_act_timeout_option(p)
     add_trust_pickle_option(p)
     add_json_option(p, "print the episode's metrics as one JSON object")
     p.set_defaults(func=run)
@@ -106,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym.config import is_path
     from shipgym.scenarios import load_scenario
     from shipgym.scenarios.trials import trial_scenario
-    from shipgym_baselines.evaluation import evaluate
+    from shipgym_baselines.evaluation import ActGuard, evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.manifest import check_listed
@@ -114,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.runs import check_out_dir
     from shipgym_baselines.suite import load_suite
 
+    guard = ActGuard(args.act_timeout)
     suite = load_suite(args.suite)
     scenario = load_scenario(_suite_file(args.scenario, suite))
     video = None if args.video is None else check_video_file(args.video)
@@ -132,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
     settings = {} if training_seed is None else {"training_seed": training_seed}
-    result = evaluate(args.controller, trial, [args.seed], **settings)[0]
+    result = evaluate(args.controller, trial, [args.seed], guard=guard, **settings)[0]
     # as the leaderboard names them: a scenario file under its name:
     table_name = scenario.name if is_path(args.scenario) else args.scenario
     result.controller, result.scenario = label, table_name

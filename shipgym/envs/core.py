@@ -656,6 +656,20 @@ def metric_settings(scenario: Scenario) -> MetricSettings:
     return MetricSettings(convergence_threshold=scenario.config.convergence_threshold)
 
 
+def check_action(action: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """One env's action as a float64 array of ``shape``, not clipped; ValueError naming
+    what is wrong if it is not numbers of that shape or holds NaN or inf."""
+    try:
+        if action is None:  # numpy reads None as NaN
+            raise TypeError("None is no number")
+        values = np.asarray(action, dtype=np.float64).reshape(shape)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"action must be an array of shape {shape}, got {action!r}") from exc
+    if not np.isfinite(values).all():
+        raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
+    return values
+
+
 def batch_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
     """A batched env's actions (n_envs, n_act) as float64, clipped to [-1, 1]; NaN or inf
     in any env's row is an error naming those envs (before anything steps)."""

@@ -26,6 +26,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from shipgym.angles import wrap_angle
 from shipgym.envs import core
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.row_tracking import RouteGroups
@@ -182,6 +183,31 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
             truncated,
             {"rows": infos},
         )
+
+    def abandon(self, i: int, reason: str) -> dict[str, Any]:
+        """End row i's episode now, for a cause outside the plant (e.g. its controller gave
+        no usable action): the single env's ``abandon`` (one more control step logged with
+        the plant not moved and the last rudder command, charged the corridor penalty from
+        this step on).  Returns that step's row ``info`` with ``termination_reason`` =
+        ``reason`` and ``episode_metrics``; the row is then finished."""
+        if not self._started:
+            raise RuntimeError("call reset() before abandon()")
+        if self.finished[i]:
+            raise ValueError(f"row {i} has finished: it cannot be abandoned")
+        k = self._k0
+        self._steps[i] += 1
+        step = int(self._steps[i])
+        self._t[i] = step * k.control_period
+        frame = self._tracks.frame
+        heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
+        reward = np.zeros(self.num_envs)
+        reward[i] = core.diverged_reward(step, self._trials[i].constants)
+        self._write_columns(np.array([i]), step, frame.cross_track, heading_error, reward)
+        self.finished[i] = True
+        info = self._row_info(i)
+        info["termination_reason"] = reason
+        info["episode_metrics"] = self.episode_metrics(i)
+        return info
 
     def _write_columns(
         self,

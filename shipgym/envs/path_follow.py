@@ -379,14 +379,7 @@ class ShipPathFollowEnv(gym.Env):
     # ------------------------------------------------------------------ pieces
     def _check_action(self, action: Any) -> list[float]:
         """The action as floats clipped to [-1, 1]; ValueError (state untouched) if malformed."""
-        try:
-            values = np.asarray(action, dtype=np.float64).reshape(self.action_space.shape).tolist()
-        except (TypeError, ValueError) as exc:
-            raise ValueError(
-                f"action must be an array of shape {self.action_space.shape}, got {action!r}"
-            ) from exc
-        if not all(map(math.isfinite, values)):
-            raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
+        values = core.check_action(action, self.action_space.shape).tolist()
         return [min(1.0, max(-1.0, v)) for v in values]
 
     def _observation(self, frame: Any) -> np.ndarray:
@@ -423,7 +416,7 @@ class ShipPathFollowEnv(gym.Env):
             (float(x[k.ix]), float(x[k.iy])),
         )
 
-    def _non_finite_step(self, frame: Any, delta_c: float):
+    def _non_finite_step(self, frame: Any, delta_c: float, reason: str = "non_finite_state"):
         """The plant produced NaN/inf: keep the last finite state and terminate with a reason.
 
         The penalty is that of leaving the corridor; the step is logged like any other, so
@@ -435,9 +428,24 @@ class ShipPathFollowEnv(gym.Env):
         heading_error = wrap_angle(float(x[k.ipsi]) - frame.path_angle)
         self._record(frame.cross_track, heading_error, float(x[k.idelta]), delta_c, reward)
         info = self._info(frame)
-        info["termination_reason"] = "non_finite_state"
+        info["termination_reason"] = reason
         info["episode_metrics"] = self.episode_metrics()
         return self._observation(frame), float(reward), True, False, info
+
+    def abandon(self, reason: str) -> dict[str, Any]:
+        """End the episode now, for a cause outside the plant (e.g. its controller gave no
+        usable action): one more control step is logged with the plant not moved and the
+        last rudder command, charged as a non-finite state is (the corridor penalty
+        counted from this step on).  Returns that step's ``info``: ``termination_reason``
+        = ``reason`` and ``episode_metrics``, no ``samples``.  Reset before stepping again.
+        """
+        if self._state is None:
+            raise RuntimeError("call reset() before abandon()")
+        self._step_count += 1
+        self._t = self._step_count * self._k.control_period
+        if self._history is not None:
+            self._history.stepped()
+        return self._non_finite_step(self._tracker.frame, self._delta_c, reason)[4]
 
     def _record(
         self, e: float, heading_error: float, delta: float, delta_c: float, reward: float

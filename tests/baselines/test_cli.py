@@ -403,3 +403,24 @@ def test_every_number_of_the_manoeuvre_output_has_its_unit(
         assert document["units"]["advance"] == "m" and document["advance"] > 600.0
     else:
         assert document["units"]["overshoot_1"] == "deg"
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--act-timeout", "0"], "--act-timeout must be a positive time in s, got 0.0"),
+        (["--act-timeout", "nan"], "--act-timeout must be a positive time in s, got nan"),
+        (
+            ["--retry-failed"],
+            "--retry-failed runs the failed episodes of a resumed run: add --resume",
+        ),
+    ],
+)
+@pytest.mark.parametrize("command", [["leaderboard"], ["evaluate", "pid_los"]])
+def test_failure_options_that_cannot_work_are_one_line_before_any_work(
+    command: list[str], extra: list[str], message: str, tmp_path: Path, capsys
+) -> None:
+    out = tmp_path / "out"
+    assert main([*command, "--suite", "smoke", "--out", str(out), *extra]) == 2
+    assert _error_line(capsys, command[0]) == message
+    assert not out.exists()

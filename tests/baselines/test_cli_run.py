@@ -212,3 +212,38 @@ def test_force_keeps_a_users_file_and_folder_and_deletes_only_what_a_run_wrote(
         "metrics.json",
         "rudder_aging.png",
     ]
+
+
+#: a controller whose second act is too slow for a tiny --act-timeout
+SLOW_PLUGIN = """
+import time
+
+import numpy as np
+
+
+class Slow:
+    name = "slow"
+    kind = "classical"
+
+    def reset(self, context, seed=None):
+        self.calls = 0
+
+    def act(self, obs, info):
+        self.calls += 1
+        if self.calls == 2:
+            time.sleep(0.2)
+        return np.zeros(1)
+"""
+
+
+def test_a_controller_too_slow_for_act_timeout_ends_the_episode(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plugin = tmp_path / "slow.py"
+    plugin.write_text(SLOW_PLUGIN)
+    out = tmp_path / "out"
+    argv = ["rudder_aging", f"{plugin}:Slow", "--act-timeout", "0.05", "--out", str(out)]
+    doc = run_json(capsys, *argv)
+    assert (doc["termination_reason"], doc["steps"]) == ("controller_timeout", 2)
+    assert doc["error"].startswith("the call took 0.2")
+    assert json.loads((out / "metrics.json").read_text()) == doc

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import time
 from typing import Any
 
@@ -13,16 +14,19 @@ from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.classical.reference import ZeroRudder
-from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.evaluation import (
+    ERROR_CHARS,
     EVAL_SEED_OFFSET,
+    ActGuard,
     EpisodeResult,
     compute_time_metrics,
+    error_line,
     evaluate,
     evaluate_batch,
     run_episode,
 )
-from shipgym_baselines.registry import make_controller, training_seeds
+from shipgym_baselines.registry import make_controller, register_controller, training_seeds
 
 SLEEP_S = 0.002
 
@@ -229,3 +233,181 @@ def test_batched_compute_time_divides_each_forward_among_the_live_envs() -> None
     assert a.metrics["compute_ms_max"] == 1000.0
     expected = (500.0 * n_short + 1000.0 * (n_long - n_short)) / n_long
     assert a.metrics["compute_ms"] == pytest.approx(expected, rel=1e-12)
+
+
+# --- a failing controller ends its episode (ActGuard) ----------------------------------------
+
+#: the act call at which a failing test controller goes wrong
+FAIL_AT = 3
+
+
+class GoesWrong(PIDLOS):
+    """pid_los until its ``FAIL_AT``-th act of an episode, which ``wrong`` replaces; only on
+    the seeds of ``on`` (None: every seed)."""
+
+    name = "goes_wrong"
+
+    def __init__(self, wrong: Any, on: set[int] | None = None) -> None:
+        super().__init__()
+        self.wrong, self.on = wrong, on
+
+    def reset(self, context: Any, seed: int | None = None) -> None:
+        super().reset(context, seed=seed)
+        self.calls, self.failing = 0, self.on is None or seed in self.on
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> Any:
+        self.calls += 1
+        action = super().act(obs, info)
+        return self.wrong() if self.failing and self.calls == FAIL_AT else action
+
+
+def _raise() -> None:
+    raise ValueError("the gain table\nhas no entry")
+
+
+#: a bad act → the start of the episode's one-line ``error``
+WRONG = {
+    "raises": (_raise, "ValueError: the gain table has no entry"),
+    "nan": (lambda: np.array([np.nan]), "ValueError: action contains NaN or inf"),
+    "none": (lambda: None, "ValueError: action must be an array of shape (1,), got None"),
+    "shape": (lambda: np.zeros(3), "ValueError: action must be an array of shape (1,), got"),
+    "text": (lambda: "hard to port", "ValueError: action must be an array of shape (1,)"),
+}
+
+
+def test_without_a_guard_a_failing_act_raises() -> None:
+    with pytest.raises(ValueError, match="the gain table"):
+        run_episode(GoesWrong(_raise), "rudder_aging", seed=EVAL_SEED_OFFSET)
+
+
+@pytest.mark.parametrize("kind", list(WRONG))
+def test_a_guarded_failing_act_ends_its_episode_as_controller_error(kind: str) -> None:
+    wrong, message = WRONG[kind]
+    result = run_episode(GoesWrong(wrong), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
+    m = result.metrics
+    assert m["termination_reason"] == "controller_error"
+    assert m["error"].startswith(message) and "\n" not in m["error"]
+    assert m["steps"] == FAIL_AT  # two steps acted, then the abandoned one
+    assert result.trajectory["t"].size == FAIL_AT + 1  # and the reset
+    assert math.isfinite(m["cost"]) and not m["success"]
+
+
+def test_a_call_over_the_limit_ends_its_episode_as_controller_timeout() -> None:
+    slow = GoesWrong(lambda: time.sleep(0.2) or np.zeros(1))
+    start = time.perf_counter()
+    result = run_episode(slow, "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05))
+    assert time.perf_counter() - start < 5.0  # one slow call, not a whole slow episode
+    m = result.metrics
+    assert m["termination_reason"] == "controller_timeout" and m["steps"] == FAIL_AT
+    assert re.fullmatch(r"the call took 0\.2\d* s, over the limit of 0\.05 s", m["error"])
+    assert m["compute_ms_max"] >= 200.0  # the slow call is timed
+
+
+def test_a_slow_reset_is_no_timeout() -> None:
+    """``reset`` may build (and compile) a solver: only ``act`` calls have the limit."""
+
+    class SlowReset(GoesWrong):
+        def reset(self, context: Any, seed: int | None = None) -> None:
+            time.sleep(0.1)
+            super().reset(context, seed=seed)
+
+    slow = SlowReset(_raise, on=set())
+    result = run_episode(slow, "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05))
+    assert result.metrics["termination_reason"] == "goal" and "error" not in result.metrics
+
+
+def test_a_failing_reset_ends_the_episode_before_any_act() -> None:
+    class BadReset(PIDLOS):
+        def reset(self, context: Any, seed: int | None = None) -> None:
+            raise RuntimeError("no model file")
+
+    result = run_episode(BadReset(), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
+    m = result.metrics
+    assert (m["termination_reason"], m["error"]) == (
+        "controller_error",
+        "RuntimeError: no model file",
+    )
+    assert m["steps"] == 1 and math.isnan(m["compute_ms"])  # no act was timed
+
+
+def test_a_failed_controllers_episode_stats_that_fail_are_left_out() -> None:
+    class NoStats(GoesWrong):
+        def episode_stats(self) -> dict[str, Any]:
+            raise RuntimeError("the stats need the last step")
+
+    result = run_episode(NoStats(_raise), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
+    assert result.metrics["termination_reason"] == "controller_error"
+    with pytest.raises(RuntimeError, match="the stats"):  # a controller that did not fail
+        run_episode(NoStats(_raise, on=set()), "rudder_aging", 0, guard=ActGuard())
+
+
+def test_in_lockstep_only_the_failing_seeds_episode_ends(scratch_registry: None) -> None:
+    """A controller made by name fails on one of three seeds: that episode ends as
+    controller_error, the others are the episodes one by one (lockstep rows)."""
+    register_controller("test_goes_wrong", lambda: GoesWrong(_raise, on={EVAL_SEED_OFFSET + 1}))
+    seeds = [EVAL_SEED_OFFSET + i for i in range(3)]
+    results = evaluate_batch("test_goes_wrong", "rudder_aging", seeds, guard=ActGuard())
+    reasons = [r.metrics["termination_reason"] for r in results]
+    assert reasons[1] == "controller_error" and results[1].metrics["steps"] == FAIL_AT
+    for i in (0, 2):
+        alone = run_episode(GoesWrong(_raise, on=set()), "rudder_aging", seeds[i])
+        assert "error" not in results[i].metrics
+        for key, value in alone.metrics.items():
+            if not key.startswith("compute_ms"):
+                assert _same(results[i].metrics[key], value), (i, key)
+
+
+class Batch(ZeroRudder):
+    """A batch policy whose ``act_batch`` gives ``rows(n)`` for n live episodes."""
+
+    name = "batch"
+
+    def __init__(self, rows: Any) -> None:
+        self.rows = rows
+
+    def reset_batch(self, contexts: Any) -> None:
+        self.steps = 0
+
+    def act_batch(self, obs: np.ndarray, episodes: Any) -> Any:
+        self.steps += 1
+        return self.rows(len(episodes)) if self.steps == FAIL_AT else np.zeros((len(obs), 1))
+
+
+def _nan_in_row_1(n: int) -> np.ndarray:
+    actions = np.zeros((n, 1))
+    actions[1] = np.nan
+    return actions
+
+
+@pytest.mark.parametrize(
+    ("rows", "failed", "message"),
+    [
+        (_nan_in_row_1, [False, True, False], "ValueError: action contains NaN or inf"),
+        (lambda n: np.zeros((n, 2)), [True] * 3, "ValueError: action must be an array of"),
+        (lambda n: _raise(), [True] * 3, "ValueError: the gain table has no entry"),
+    ],
+)
+def test_a_batch_policy_fails_the_rows_its_call_failed(
+    rows: Any, failed: list[bool], message: str
+) -> None:
+    seeds = [EVAL_SEED_OFFSET + i for i in range(3)]
+    results = evaluate_batch(Batch(rows), "rudder_aging", seeds, guard=ActGuard())
+    assert [r.metrics["termination_reason"] == "controller_error" for r in results] == failed
+    for result, fails in zip(results, failed, strict=True):
+        if fails:
+            assert result.metrics["error"].startswith(message)
+            assert result.metrics["steps"] == FAIL_AT
+        else:
+            assert result.metrics["steps"] > FAIL_AT
+
+
+def test_the_error_line_is_one_printable_bounded_line() -> None:
+    line = error_line(ValueError("a\nb\x1b[31m\t" + "x" * 1000))
+    assert line.startswith("ValueError: a b [31m xxx") and line.isprintable()
+    assert len(line) == ERROR_CHARS and line.endswith("…")
+
+
+@pytest.mark.parametrize("timeout", [0.0, -1.0, math.nan])
+def test_a_limit_that_is_no_positive_time_is_refused(timeout: float) -> None:
+    with pytest.raises(RunError, match="--act-timeout must be a positive time in s"):
+        ActGuard(timeout)

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import io
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -216,8 +218,9 @@ def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     verdict = (
         "`pid_los` is the only ranked controller on the 2 catalogue scenarios, with a "
         "cost-ratio IQM of 1.250 [1.250, 1.250] (1 = the oracle's cost, lower is better); no "
-        "learned agent is ranked. The failure rate (episodes ending outside the corridor or "
-        "non-finite) of `pid_los` is 0 %: none of its episodes failed."
+        "learned agent is ranked. The failure rate (episodes ending outside the corridor, "
+        "non-finite or by a controller error or timeout) of `pid_los` is 0 %: none of its "
+        "episodes failed."
     )
     assert (ranked / "leaderboard.md").read_text().startswith(f"# Leaderboard\n\n{verdict}\n\n")
     assert terminal_summary(ranked).startswith(f"{verdict}\n\n## Ranking")
@@ -701,3 +704,172 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     assert 'id="ranking-inrange"' in html and "In-range scenarios, drawn from" in html
     (trial,) = trials(Job("oracle", "inrange:0", (10_000,), None, randomize))
     assert shipped_table().lookup(trial, 10_000) is not None  # the default suite's trial
+
+
+# --- a failing controller is a result ---------------------------------------------------------
+
+#: controllers that fail at their third act of an episode (``Raises`` on seed 10001 only),
+#: unless the environment variable ``FIXED`` is set; ``ResetRaises`` fails in ``reset``
+BAD_PLUGINS = """
+import os
+import time
+
+import numpy as np
+
+
+class _Steer:
+    kind = "classical"
+
+    def reset(self, context, seed=None):
+        self.calls, self.seed = 0, seed
+
+    def act(self, obs, info):
+        self.calls += 1
+        rudder = np.clip(np.array([-2.0 * (obs[0] + obs[1]) - 4.0 * obs[3]]), -1.0, 1.0)
+        if self.calls == 3 and not os.environ.get("FIXED"):
+            return self.wrong(rudder)
+        return rudder
+
+
+class Raises(_Steer):
+    name = "raises"
+
+    def wrong(self, rudder):
+        if self.seed != 10001:
+            return rudder
+        raise ValueError("the gain table\\nhas no entry")
+
+
+class Nan(_Steer):
+    name = "nan"
+
+    def wrong(self, rudder):
+        return np.array([np.nan])
+
+
+class NoneAction(_Steer):
+    name = "none"
+
+    def wrong(self, rudder):
+        return None
+
+
+class Shape(_Steer):
+    name = "shape"
+
+    def wrong(self, rudder):
+        return np.zeros(3)
+
+
+class Slow(_Steer):
+    name = "slow"
+
+    def wrong(self, rudder):
+        time.sleep(0.2)
+        return rudder
+
+
+class ResetRaises(_Steer):
+    name = "reset_raises"
+
+    def reset(self, context, seed=None):
+        if not os.environ.get("FIXED"):
+            raise RuntimeError("no model file")
+        super().reset(context, seed)
+"""
+#: table name → (its failure rate, the start of its episodes' ``error``)
+BROKEN = {
+    "raises": (0.5, "ValueError: the gain table has no entry"),
+    "nan": (1.0, "ValueError: action contains NaN or inf: array([nan])"),
+    "none": (1.0, "ValueError: action must be an array of shape (1,), got None"),
+    "shape": (1.0, "ValueError: action must be an array of shape (1,), got array([0., 0., 0.])"),
+    "slow": (1.0, "the call took 0.2"),
+    "reset_raises": (1.0, "RuntimeError: no model file"),
+}
+
+
+def _broken_argv(plugins: Path, out: Path, *extra: str) -> list[str]:
+    classes = ["Raises", "Nan", "NoneAction", "Shape", "Slow", "ResetRaises"]
+    return [
+        "leaderboard",
+        "--suite",
+        "smoke",
+        "--controllers",
+        *(f"{plugins}:{c}" for c in classes),
+        "--act-timeout",
+        "0.05",
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--no-progress",
+        *extra,
+    ]
+
+
+@pytest.fixture(scope="module")
+def broken_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, str]:
+    """The smoke suite with a controller of each way to fail (and the references): (the
+    plug-in file, the run folder, what stderr said)."""
+    from shipgym_baselines.cli import main
+
+    root = tmp_path_factory.mktemp("broken")
+    plugins = root / "bad.py"
+    plugins.write_text(BAD_PLUGINS)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SHIPGYM_QUIET", raising=False)  # the failure notices
+        mp.delenv("FIXED", raising=False)
+        stderr = io.StringIO()
+        mp.setattr(sys, "stderr", stderr)
+        assert main(_broken_argv(plugins, root / "out")) == 0
+    return plugins, root / "out", stderr.getvalue()
+
+
+def _failed(folder: Path) -> list[dict]:
+    return [e for e in read_episodes(folder) if e["termination_reason"].startswith("controller")]
+
+
+def test_a_leaderboard_of_broken_controllers_finishes_and_ranks_each(
+    broken_run: tuple[Path, Path, str],
+) -> None:
+    _, out, stderr = broken_run
+    assert read_run(out)["status"] == "complete"
+    board = json.loads((out / "aggregate.json").read_text())
+    for split in ("catalogue", "heldout"):
+        rows = {r["controller"]: r for r in board if r["split"] == split}
+        assert set(rows) == set(BROKEN)
+        for name, (rate, _) in BROKEN.items():
+            assert rows[name]["failure_rate"] == rate, (split, name)
+    failed = _failed(out)
+    assert len(failed) == 6 * 5 + 3  # every episode of five, one seed a scenario of raises
+    for episode in failed:
+        rate, message = BROKEN[episode["controller"]]
+        reason = "controller_timeout" if episode["controller"] == "slow" else "controller_error"
+        assert episode["termination_reason"] == reason
+        assert episode["error"].startswith(message) and "\n" not in episode["error"]
+    assert "`raises`" in (out / "leaderboard.md").read_text()
+    assert "raises" in (out / "leaderboard.html").read_text()
+    for name in BROKEN:  # the first failure of each, named on stderr
+        assert f"shipgym: {name} failed on " in stderr
+
+
+def test_resume_keeps_the_failed_episodes_and_retry_failed_runs_them_again(
+    broken_run: tuple[Path, Path, str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from shipgym_baselines.cli import main
+
+    plugins, source, _ = broken_run
+    out = tmp_path / "out"
+    shutil.copytree(source, out)
+    lines = (out / "episodes.jsonl").read_text()
+    monkeypatch.setenv("FIXED", "1")  # the controllers work now
+    assert main(_broken_argv(plugins, out, "--resume")) == 0
+    assert (out / "episodes.jsonl").read_text() == lines  # nothing run again
+    assert len(_failed(out)) == len(_failed(source))
+    assert main(_broken_argv(plugins, out, "--resume", "--retry-failed")) == 0
+    assert len((out / "episodes.jsonl").read_text().splitlines()) == len(lines.splitlines()) + len(
+        _failed(source)
+    )
+    assert _failed(out) == [] and read_run(out)["status"] == "complete"
+    board = json.loads((out / "aggregate.json").read_text())
+    assert {r["controller"]: r["failure_rate"] for r in board} == dict.fromkeys(BROKEN, 0.0)

@@ -231,6 +231,40 @@ def test_a_controller_without_some_scenarios_is_ranked_in_the_partial_table() ->
     assert rows[1]["prob_improvement_over_pid_los"] == 1.0  # against pid_los on its scenarios
 
 
+@pytest.mark.parametrize("reason", ["controller_error", "controller_timeout"])
+def test_an_episode_its_controller_ended_counts_in_the_failure_rate(reason: str) -> None:
+    eps = _episodes({"pid_los": [1.5] * 4, "broken": [9.0] * 4})
+    for e in eps:
+        if e["controller"] == "broken" and e["seed"] != 10_000:
+            e["termination_reason"] = reason
+    scored = scored_episodes(eps)
+    assert {e["failure"] for e in scored if e["controller"] == "broken" and e["seed"] > 10_000} == {
+        1.0
+    }
+    rows = aggregate_ranking(eps, {"a": "catalogue", "b": "catalogue"}, reps=100)
+    broken = next(r for r in rows if r["controller"] == "broken")
+    assert broken["split"] == "catalogue" and broken["failure_rate"] == pytest.approx(0.75)
+    assert broken["cost_ratio_iqm"] == pytest.approx(9.0)  # ranked, last
+
+
+@pytest.mark.parametrize("cost", [math.inf, math.nan, None])
+def test_an_episode_without_a_finite_cost_moves_its_scenario_to_the_partial_table(
+    cost: float | None,
+) -> None:
+    """No ratio for that episode: the row keeps every run of its other scenarios (no
+    unequal runs), and the scenario of the episode leaves its main table."""
+    eps = _episodes({"pid_los": [1.5] * 3, "broken": [2.0] * 3}, scenarios=("a", "b", "c"))
+    for e in eps:
+        if (e["controller"], e["scenario"], e["seed"]) == ("broken", "c", 10_001):
+            e["cost"] = cost
+    rows = aggregate_ranking(eps, {"a": "catalogue", "b": "catalogue", "c": "catalogue"}, reps=100)
+    assert [(r["split"], r["controller"], r["scenarios"], r["runs"]) for r in rows] == [
+        ("catalogue", "pid_los", ["a", "b", "c"], 3),
+        ("catalogue:partial", "broken", ["a", "b"], 3),
+    ]
+    assert performance_profiles(eps, {"a": "catalogue", "c": "catalogue"}, "catalogue", [1.0])
+
+
 def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     """pid_los not ranked: every row's probability of improvement over it is None, and
     leaderboard.md's and the page's tables drop the column."""

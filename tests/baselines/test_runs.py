@@ -27,6 +27,7 @@ from shipgym_baselines.runs import (
     RunInterrupted,
     check_out_dir,
     clear_outputs,
+    episode_key,
     read_episodes,
     read_run,
 )
@@ -425,6 +426,24 @@ def test_finding2_a_duplicated_line_counts_once_on_resume_and_report(
     assert len(ran) == 3 and all(r["episodes"] == 2 for r in rows)
     assert main(["report", str(out), "--out", str(tmp_path / "report"), "--json"]) == 0
     assert [r["episodes"] for r in json.loads(capsys.readouterr().out)] == [2, 2, 2, 2]
+
+
+def test_a_later_line_of_an_episode_its_controller_ended_replaces_it(
+    tmp_path: Path, clean_run: Path
+) -> None:
+    """A retried episode's line (--retry-failed) replaces its controller_error line; a
+    line after an episode that ended otherwise is still refused."""
+    out = copy_run(clean_run, tmp_path / "out")
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    first = json.loads(lines[0])
+    failed = {**first, "termination_reason": "controller_error", "error": "ValueError: x"}
+    (out / "episodes.jsonl").write_text("\n".join([json.dumps(failed), *lines]) + "\n")
+    (record,) = [r for r in read_episodes(out) if episode_key(r) == episode_key(first)]
+    assert record["termination_reason"] == first["termination_reason"] and "error" not in record
+    assert len(read_episodes(out)) == len(lines)
+    (out / "episodes.jsonl").write_text("\n".join([*lines, json.dumps(failed)]) + "\n")
+    with pytest.raises(RunError, match=f"line {len(lines) + 1}: episode .* again"):
+        read_episodes(out)
 
 
 @pytest.mark.parametrize(

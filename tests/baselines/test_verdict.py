@@ -125,8 +125,9 @@ def test_one_controller_no_learned_agents_no_failures() -> None:
     assert text == (
         "`pid_los` is the only ranked controller on the 4 catalogue scenarios, with a "
         "cost-ratio IQM of 1.250 [1.200, 1.300] (1 = the oracle's cost, lower is better); no "
-        "learned agent is ranked. The failure rate (episodes ending outside the corridor or "
-        "non-finite) of `pid_los` is 0 %: none of its episodes failed."
+        "learned agent is ranked. The failure rate (episodes ending outside the corridor, "
+        "non-finite or by a controller error or timeout) of `pid_los` is 0 %: none of its "
+        "episodes failed."
     )
     failing = {("nomoto2_a", "pid_los"): 3, ("blanke_d", "pid_los"): 1}
     board = [row("pid_los", 1.25, (1.2, 1.3), failure_rate=0.25)]

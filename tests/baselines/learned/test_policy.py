@@ -18,7 +18,7 @@ import pytest
 import shipgym  # noqa: F401  (registers the envs)
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import ControllerError
-from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, evaluate_batch
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, ActGuard, evaluate, evaluate_batch
 from shipgym_baselines.learned.policy import (
     ALGORITHMS,
     BATCH_ROWS,
@@ -401,3 +401,23 @@ def test_the_lean_forward_is_predict_bit_for_bit(name: str) -> None:
     obs = obs.astype(np.float32)
     expected, _ = policy.model.predict(obs, deterministic=True)
     np.testing.assert_array_equal(lean(obs), expected)
+
+
+def test_an_sb3_zip_with_nan_weights_fails_its_episodes_not_the_run(tmp_path: Path) -> None:
+    """Its actions are NaN: each episode ends as controller_error at its first step, in
+    lockstep as one by one, with the one-line message."""
+    import torch
+
+    model = sb3.PPO("MlpPolicy", _env(), device="cpu", policy_kwargs={"net_arch": [4]}, seed=0)
+    with torch.no_grad():
+        for weights in model.policy.parameters():
+            weights.fill_(float("nan"))
+    model.save(tmp_path / "broken")
+    path = str(tmp_path / "broken.zip")
+    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
+    lockstep = evaluate_batch(path, "rudder_aging", seeds, guard=ActGuard())
+    alone = evaluate(path, "rudder_aging", seeds[:1], guard=ActGuard())
+    for result in [*lockstep, *alone]:
+        m = result.metrics
+        assert (m["termination_reason"], m["steps"]) == ("controller_error", 1)
+        assert m["error"].startswith("ValueError: action contains NaN or inf: array([nan]")

@@ -239,3 +239,41 @@ def test_bad_row_infos_are_refused() -> None:
         EvaluationTrialsVectorEnv(trials, SEEDS, samples=False, row_infos="last")
     with pytest.raises(RowInfosError, match="no samples"):
         EvaluationTrialsVectorEnv(trials, SEEDS, row_infos="end")
+
+
+@pytest.mark.parametrize("mode", ["rudder", "guidance"])
+def test_an_abandoned_row_is_the_single_env_episode_abandoned(mode: str) -> None:
+    """Row 1 abandoned after 5 steps: its info, metrics and trajectory are the single env's
+    abandoned at that step, bit for bit; the other rows step on as without it."""
+    trials = _variants("heldout:8", NOISY)
+    rng = np.random.default_rng(5)
+    n_act = 1 if mode == "rudder" else 2
+    actions = rng.uniform(-1.0, 1.0, size=(8, len(SEEDS), n_act))
+    env = EvaluationTrialsVectorEnv(trials, SEEDS, mode)
+    plain = EvaluationTrialsVectorEnv(trials, SEEDS, mode)
+    env.reset()
+    plain.reset()
+    single = ShipPathFollowEnv(trials[1], action_mode=mode)
+    single.reset(seed=SEEDS[1])
+    for a in actions[:5]:
+        env.step(a)
+        plain.step(a)
+        single.step(a[1])
+    row = env.abandon(1, "controller_timeout")
+    alone = single.abandon("controller_timeout")
+    _assert_same(row, alone, "abandoned")
+    assert row["termination_reason"] == "controller_timeout" and env.finished.tolist() == [
+        False,
+        True,
+        False,
+    ]
+    trajectory = env.trajectory(1)
+    assert trajectory["t"][-1] == alone["t"] and trajectory["t"].size == 7  # reset + 6
+    with pytest.raises(ValueError, match="row 1 has finished"):
+        env.abandon(1, "controller_error")
+    for a in actions[5:]:
+        obs, *_ = env.step(a)
+        obs_plain, *_ = plain.step(a)
+        np.testing.assert_array_equal(obs[[0, 2]], obs_plain[[0, 2]])
+    for i in (0, 2):
+        _assert_same(env.episode_metrics(i), plain.episode_metrics(i), f"row {i}")

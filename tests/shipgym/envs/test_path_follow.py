@@ -14,6 +14,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 
 import shipgym  # registers the environments
+from shipgym.envs import core
 from shipgym.scenarios import load_scenario
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("ShipPathFollow"))
@@ -642,3 +643,37 @@ def test_bad_action_mode_raises_naming_it(env_id: str) -> None:
 def test_bad_render_mode_raises_naming_it(env_id: str) -> None:
     with pytest.raises(ValueError, match="hologram"):
         gym.make(env_id, render_mode="hologram")
+
+
+@pytest.mark.parametrize("case", CASES, ids=case_id)
+def test_a_none_action_is_refused_as_no_number(case: tuple) -> None:
+    env = make(*case)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"action must be an array of shape \(\d,\), got None"):
+        env.step(None)
+
+
+# --------------------------------------------------------------------------------------------
+# An episode abandoned (its controller failed)
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("steps", [0, 4])
+def test_abandon_ends_the_episode_with_the_reason_and_the_corridor_penalty(steps: int) -> None:
+    """One more step logged, the plant not moved, charged (e_max/L)·(steps left) as a
+    non-finite state is; the return is the steps' rewards and that penalty."""
+    env = make("ShipPathFollow-v0", "rudder", "rudder_aging")
+    env.reset(seed=3)
+    rewards = [env.step(np.array([0.2]))[1] for _ in range(steps)]
+    base = env.unwrapped
+    before = base.pose
+    info = base.abandon("controller_error")
+    k = core.StepConstants.of(base.scenario)
+    penalty = (k.max_cross_track / k.ship_length) * (k.max_steps - steps)
+    metrics = info["episode_metrics"]
+    assert info["termination_reason"] == "controller_error"
+    assert "samples" not in info and base.pose == before
+    assert metrics["steps"] == steps + 1 and info["t"] == (steps + 1) * k.control_period
+    assert metrics["return"] == pytest.approx(sum(rewards) - penalty, rel=1e-12)
+    assert metrics["cost"] == pytest.approx(penalty - sum(rewards), rel=1e-12)
+    assert not metrics["success"]
