@@ -281,6 +281,9 @@ def seed_rows(metas: list[Path]) -> list[tuple[Any, ...]]:
     return rows
 
 
+#: the oracle's student and its two arms, drawn side by side on the learned-agents page
+STUDENTS = ("dagger", "bc", "ppo_history")
+
 SEED_HEADER = [
     "training seed",
     "env steps",
@@ -387,4 +390,6 @@ def write(root: Path) -> list[Path]:
     out += [write_text(folder / f"{n}.md", learned_page(n)) for n in learned]
     for n in learned:
         out += plot_learning_curves(folder / "img", {n: agent_curves(n)}, stem=f"{n}_curves")
+    students = {n: agent_curves(n) for n in STUDENTS if n in learned}
+    out += plot_learning_curves(folder / "img", students, stem="students_curves")
     return out
