@@ -30,6 +30,7 @@ from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
 from shipgym_baselines.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"
@@ -142,29 +143,6 @@ def act_clock(clock: Callable[[], float]) -> Iterator[None]:
         yield
     finally:
         _clock = saved
-
-
-@dataclasses.dataclass
-class EpisodeResult:
-    """Metrics and trajectory of one (controller, scenario, seed) episode; ``training_seed``:
-    the seed a learned policy was trained with (None for the rest)."""
-
-    controller: str
-    kind: str
-    scenario: str
-    seed: int
-    metrics: dict[str, Any]
-    trajectory: dict[str, np.ndarray]
-    training_seed: int | None = None
-
-    def row(self) -> dict[str, Any]:
-        return {
-            "scenario": self.scenario,
-            "controller": self.controller,
-            "kind": self.kind,
-            "seed": self.seed,
-            **self.metrics,
-        }
 
 
 class _Record:

@@ -12,8 +12,8 @@ What a run hands in:
 
 * ``drawn``: (scenario, controller) → :class:`DrawnEpisode` (or a plain ``(seed,
   trajectory)`` / ``(seed, trajectory, training_seed)`` tuple) — the episode to draw, its
-  trajectory as :attr:`shipgym_baselines.evaluation.EpisodeResult.trajectory` keeps it (arrays ``t``
-  [s], ``x``, ``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad], …).
+  trajectory as :attr:`shipgym_baselines.records.episodes.EpisodeResult.trajectory` keeps it
+  (arrays ``t`` [s], ``x``, ``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad], …).
   :func:`median_ace_episode` names the episode to keep (the median-ACE seed, and its training
   seed), :func:`episodes_to_draw` picks them from episode results.
 * ``aggregate``: the ``aggregate.json`` rows (:func:`shipgym_baselines.ranking.aggregate_ranking`);
@@ -58,10 +58,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from shipgym_baselines.decimation import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.escaping import plain_text
-from shipgym_baselines.outfiles import write_bytes
 from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.records.outfiles import write_bytes
+from shipgym_baselines.records.trajectories import DRAWN_KEYS, thin_trajectory
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
@@ -299,8 +299,8 @@ def _seed_key(seed: int | None) -> tuple[bool, int]:
 
 def episodes_to_draw(results: Iterable[Any]) -> dict[tuple[str, str], DrawnEpisode]:
     """The median-ACE episode of each (scenario, controller) of ``results``
-    (:class:`~shipgym_baselines.evaluation.EpisodeResult`), for :func:`plot_scenarios`; a pair whose
-    median episode has no kept trajectory is left out."""
+    (:class:`~shipgym_baselines.records.episodes.EpisodeResult`), for :func:`plot_scenarios`; a
+    pair whose median episode has no kept trajectory is left out."""
     results = list(results)
     records = [
         {

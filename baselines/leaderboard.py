@@ -14,7 +14,7 @@ a learned agent's one training seed on one scenario for all of them, the oracle'
 network forward per step for a learned agent's, equal to the episodes one by one).
 ``local`` runs the jobs in a process pool; ``ray`` submits the same job function to a Ray
 cluster (``pip install shipgym[ray]``).
-The parent records each episode as it arrives (:mod:`shipgym_baselines.runs`: ``run.json``,
+The parent records each episode as it arrives (:mod:`shipgym_baselines.records.runs`: ``run.json``,
 ``episodes.jsonl``), and every table is aggregated from that record: the rows with
 ``*_ci95`` intervals, ``aggregate.json`` (the ranking of :mod:`shipgym_baselines.ranking`: cost over
 the oracle's), ``scenario_scores.json``, the figures.
@@ -56,10 +56,9 @@ from shipgym_baselines.comparison import (
 )
 from shipgym_baselines.errors import BackendError, RunError, check_seeds
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
-from shipgym_baselines.evaluation import ACT_TIMEOUT_S, EVAL_SEED_OFFSET, EpisodeResult
+from shipgym_baselines.evaluation import ACT_TIMEOUT_S, EVAL_SEED_OFFSET
 from shipgym_baselines.figures import median_ace_episode
 from shipgym_baselines.jsonout import dumps, dumps_rows
-from shipgym_baselines.outfiles import carried, write_bytes, write_text
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.ranking import (
@@ -80,10 +79,9 @@ from shipgym_baselines.ranking import (
     scenario_ships,
 )
 from shipgym_baselines.ranking import scenario_scores as score_table
-from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
-from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from shipgym_baselines.run_costs import eta_line, tables_line
-from shipgym_baselines.runs import (
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
+from shipgym_baselines.records.runs import (
     BACKENDS,
     RUN_FILE,
     RunLog,
@@ -93,6 +91,9 @@ from shipgym_baselines.runs import (
     read_episodes,
     read_run,
 )
+from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
+from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
+from shipgym_baselines.run_costs import eta_line, tables_line
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 from shipgym_baselines.suite import load_suite, scenario_names
@@ -521,7 +522,7 @@ def run_leaderboard(
     ``show_progress``: a progress bar on stderr, after one line before the first episode: the
     episodes, workers and the time estimated from the recorded costs
     (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
-    :class:`~shipgym_baselines.runs.RunInterrupted`.
+    :class:`~shipgym_baselines.records.runs.RunInterrupted`.
 
     A controller that fails (raises, gives a malformed or non-finite action, or takes
     longer than ``act_timeout`` [s] for one ``act`` call) ends that episode, recorded with

@@ -50,7 +50,6 @@ from shipgym_baselines.figures import (
     LEGEND_TOP_KEY,
     figure_stem,
 )
-from shipgym_baselines.outfiles import write_bytes
 from shipgym_baselines.ranking import (
     BASELINE,
     GAIN,
@@ -64,6 +63,7 @@ from shipgym_baselines.ranking import (
     no_ranking,
     resolution_lines,
 )
+from shipgym_baselines.records.outfiles import write_bytes
 from shipgym_baselines.style import controller_style
 
 #: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)

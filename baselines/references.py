@@ -48,7 +48,7 @@ import math
 import os
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -58,10 +58,8 @@ from shipgym.notices import duration, notice
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
-from shipgym_baselines.runs import _number, _plain
-
-if TYPE_CHECKING:
-    from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.runs import from_plain, plain
 
 #: the references with a table, in the order they are computed
 REFERENCES = (ORACLE, ORACLE_FROZEN)
@@ -178,7 +176,7 @@ def table_entry(result: EpisodeResult) -> dict[str, Any]:
     """The table's entry of a reference's episode ``result``."""
     return {
         "scenario": result.scenario,
-        "metrics": _plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
+        "metrics": plain(result.metrics),  # ±inf as "inf" (episodes.jsonl's rule)
         "trace": thin_trace(result.trajectory),
     }
 
@@ -270,9 +268,7 @@ def result_from_entry(
     entry: Mapping[str, Any], scenario: str, seed: int, reference: str = ORACLE
 ) -> EpisodeResult:
     """``reference``'s :class:`EpisodeResult` of a table entry (its trajectory: the trace)."""
-    from shipgym_baselines.evaluation import EpisodeResult
-
-    metrics = {k: _number(v) for k, v in entry["metrics"].items()}
+    metrics = {k: from_plain(v) for k, v in entry["metrics"].items()}
     return EpisodeResult(
         controller=reference,
         kind="reference",

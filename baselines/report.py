@@ -1,7 +1,7 @@
 """``shipgym report``: the tables and plots rebuilt from one or more run folders.
 
 Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.jsonl``,
-:mod:`shipgym_baselines.runs`); several merge into one table (separate ``evaluate`` runs of
+:mod:`shipgym_baselines.records.runs`); several merge into one table (separate ``evaluate`` runs of
 different
 policies on the same suite give the leaderboard of those policies).  Runs that give the same
 scenario name different settings, draw their trials differently (``randomize``), or hold the
@@ -18,12 +18,13 @@ import os
 from collections.abc import Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from shipgym_baselines.errors import RunError, RunFailed
-from shipgym_baselines.locking import out_lock
-from shipgym_baselines.manifest import Manifest, clear_listed
-from shipgym_baselines.runs import (
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.locking import out_lock
+from shipgym_baselines.records.manifest import Manifest, clear_listed
+from shipgym_baselines.records.runs import (
     Key,
     check_out_dir,
     check_out_usable,
@@ -38,9 +39,6 @@ from shipgym_baselines.runs import (
     versions,
     write_json,
 )
-
-if TYPE_CHECKING:
-    from shipgym_baselines.evaluation import EpisodeResult
 
 REPORT_FILE = "report.json"
 

@@ -204,8 +204,8 @@ def record_costs(
     import platform
 
     from shipgym_baselines.leaderboard import Job, suite_scenario, work
+    from shipgym_baselines.records.runs import git_commit
     from shipgym_baselines.registry import controller_kind, controller_label
-    from shipgym_baselines.runs import git_commit
     from shipgym_baselines.suite import load_suite
 
     spec = load_suite(suite)

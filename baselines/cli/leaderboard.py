@@ -1,7 +1,7 @@
 """``shipgym leaderboard`` (the suite's controllers) and ``shipgym evaluate`` (one policy).
 
 Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
-:mod:`shipgym_baselines.runs`); a folder that is not empty is refused before any work unless
+:mod:`shipgym_baselines.records.runs`); a folder that is not empty is refused before any work unless
 ``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for a suite's own
 controllers, ``results/evaluate/<suite>/<controllers>`` for the controllers given
 (``evaluate``'s policy, ``--controllers``: one folder per suite and set of controllers, outside
@@ -176,7 +176,7 @@ def named_controllers(
 def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
     the rows)."""
-    from shipgym_baselines.runs import check_out_dir, check_out_usable
+    from shipgym_baselines.records.runs import check_out_dir, check_out_usable
     from shipgym_baselines.suite import load_suite
 
     policy = getattr(args, "policy", None)
@@ -221,7 +221,7 @@ def run(args: argparse.Namespace) -> int:
         retry_failed=args.retry_failed,
     )
     if not args.json:
-        from shipgym_baselines.runs import read_run
+        from shipgym_baselines.records.runs import read_run
 
         record = read_run(out)
         sys.stderr.write(

@@ -111,9 +111,9 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.evaluation import ActGuard, evaluate
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
-    from shipgym_baselines.manifest import check_listed
+    from shipgym_baselines.records.manifest import check_listed
+    from shipgym_baselines.records.runs import check_out_dir
     from shipgym_baselines.registry import applies_to, training_seeds
-    from shipgym_baselines.runs import check_out_dir
     from shipgym_baselines.suite import load_suite
 
     guard = ActGuard(args.act_timeout)
@@ -169,10 +169,10 @@ def _write(out: Path, force: bool, metrics: str, draw: Callable[[], list[Path]])
     """``metrics.json`` (the text ``metrics``) and the figures (``draw`` writes them and
     returns their paths) into ``out``, locked, each file listed in its manifest as it is
     written (``force``: what the manifest lists deleted first); the figures' names."""
-    from shipgym_baselines.locking import out_lock
-    from shipgym_baselines.manifest import Manifest, clear_listed
-    from shipgym_baselines.outfiles import write_text
-    from shipgym_baselines.runs import check_out_dir, now
+    from shipgym_baselines.records.locking import out_lock
+    from shipgym_baselines.records.manifest import Manifest, clear_listed
+    from shipgym_baselines.records.outfiles import write_text
+    from shipgym_baselines.records.runs import check_out_dir, now
 
     with out_lock(out, now()):
         check_out_dir(out, force=force)  # again, now that no other run can start there

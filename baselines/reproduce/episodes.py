@@ -5,7 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, EpisodeResult, run_episode
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.reproduce.protocol import Progress
 
 

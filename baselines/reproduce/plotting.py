@@ -6,7 +6,7 @@ import io
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.outfiles import write_bytes
+from shipgym_baselines.records.outfiles import write_bytes
 
 
 def pyplot() -> Any:
@@ -21,7 +21,7 @@ def pyplot() -> Any:
 
 def save(fig: Any, path: Path, dpi: int = 90) -> None:
     """Write ``fig`` to ``path`` (PNG, ``dpi`` dots per inch; through no link:
-    :func:`~shipgym_baselines.outfiles.write_bytes`) and close it."""
+    :func:`~shipgym_baselines.records.outfiles.write_bytes`) and close it."""
     image = io.BytesIO()
     fig.savefig(image, format="png", dpi=dpi)
     pyplot().close(fig)

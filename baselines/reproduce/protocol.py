@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.jsonout import dumps
-from shipgym_baselines.outfiles import write_text
+from shipgym_baselines.records.outfiles import write_text
 
 #: the rows of SPEC §9b: ``{case, controller, metric, ours, paper, …}``
 Rows = list[dict[str, Any]]

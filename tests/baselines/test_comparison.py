@@ -22,7 +22,7 @@ from shipgym_baselines.comparison import (
     with_references,
 )
 from shipgym_baselines.ranking import NO_RANKING, NOTHING_TO_RANK
-from shipgym_baselines.runs import read_episodes, read_run
+from shipgym_baselines.records.runs import read_episodes, read_run
 from shipgym_baselines.suite import load_suite
 
 #: a user's controller, as docs/plugins.md enters one

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from shipgym_baselines.decimation import (
+from shipgym_baselines.records.runs import light_trajectory, read_trajectory
+from shipgym_baselines.records.trajectories import (
     DRAWN_KEYS,
     m4_indices,
     pack_trajectory,
     thin_trajectory,
     unpack_trajectory,
 )
-from shipgym_baselines.runs import light_trajectory, read_trajectory
 
 BUCKETS = 50
 

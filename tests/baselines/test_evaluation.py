@@ -19,13 +19,13 @@ from shipgym_baselines.evaluation import (
     ERROR_CHARS,
     EVAL_SEED_OFFSET,
     ActGuard,
-    EpisodeResult,
     compute_time_metrics,
     error_line,
     evaluate,
     evaluate_batch,
     run_episode,
 )
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.registry import make_controller, register_controller, training_seeds
 
 SLEEP_S = 0.002

@@ -20,7 +20,7 @@ from shipgym_baselines.leaderboard import (
     run_leaderboard,
 )
 from shipgym_baselines.learned.policy import model_zip
-from shipgym_baselines.runs import read_episodes, read_run
+from shipgym_baselines.records.runs import read_episodes, read_run
 from tests.baselines.test_runs import TIMING, untimed, write_suite
 
 RANDOMIZE = {

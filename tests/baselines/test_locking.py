@@ -13,15 +13,15 @@ import pytest
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard import run_leaderboard
-from shipgym_baselines.locking import LOCK_FILE, out_lock
-from shipgym_baselines.runs import read_episodes, read_run
+from shipgym_baselines.records.locking import LOCK_FILE, out_lock
+from shipgym_baselines.records.runs import read_episodes, read_run
 from tests.baselines.conftest import copy_folder
 from tests.baselines.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 HOLD = """
 import sys, time
-from shipgym_baselines.locking import out_lock
+from shipgym_baselines.records.locking import out_lock
 with out_lock(sys.argv[1], "2026-01-02T03:04:05+00:00"):
     print("locked", flush=True)
     time.sleep(600)

@@ -7,15 +7,15 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.locking import LOCK_FILE
-from shipgym_baselines.manifest import (
+from shipgym_baselines.records.locking import LOCK_FILE
+from shipgym_baselines.records.manifest import (
     MANIFEST_FILE,
     Manifest,
     clear_listed,
     read_manifest,
     snapshot,
 )
-from shipgym_baselines.outfiles import make_dir, write_text
+from shipgym_baselines.records.outfiles import make_dir, write_text
 from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
 
 
@@ -71,8 +71,8 @@ def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -
     temporary, and ``--force`` still clears the folder and refuses a user's file."""
     import numpy as np
 
-    from shipgym_baselines.evaluation import EpisodeResult
-    from shipgym_baselines.runs import RunLog, episode_key, episode_record, trajectory_file
+    from shipgym_baselines.records.episodes import EpisodeResult
+    from shipgym_baselines.records.runs import RunLog, episode_key, episode_record, trajectory_file
 
     out = tmp_path / "out"
     suite = {"scenarios": {"nominal": {}}, "controllers": [], "seeds": [0, 1, 2]}
@@ -135,7 +135,7 @@ def test_pool_workers_list_the_figures_they_write(
 ) -> None:
     """Figures drawn in a process pool are listed by the workers as they write them."""
     import shipgym_baselines.leaderboard as leaderboard
-    from shipgym_baselines.runs import read_run
+    from shipgym_baselines.records.runs import read_run
 
     monkeypatch.setattr(leaderboard, "POOLED_FIGURES", 1)  # a pool for three figures
     out = tmp_path / "out"

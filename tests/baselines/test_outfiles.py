@@ -1,4 +1,4 @@
-"""Files a run writes go through no link (:mod:`shipgym_baselines.outfiles`): a planted
+"""Files a run writes go through no link (:mod:`shipgym_baselines.records.outfiles`): a planted
 link is refused in one line naming it, and what it points to is left as it was."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.outfiles import (
+from shipgym_baselines.records.outfiles import (
     carried,
     check_no_links,
     make_dir,
@@ -105,7 +105,7 @@ def test_a_pool_task_announces_its_files_to_the_submitting_process_recorders(
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from shipgym_baselines.manifest import Manifest, read_manifest
+    from shipgym_baselines.records.manifest import Manifest, read_manifest
 
     manifest = Manifest(tmp_path)
     with manifest.recording():

@@ -22,8 +22,8 @@ from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.jsonout import dumps
 from shipgym_baselines.leaderboard import run_leaderboard
-from shipgym_baselines.manifest import snapshot
-from shipgym_baselines.runs import (
+from shipgym_baselines.records.manifest import snapshot
+from shipgym_baselines.records.runs import (
     RunInterrupted,
     check_out_dir,
     clear_outputs,
@@ -543,7 +543,7 @@ class _FillsUp(io.FileIO):
 def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_run: Path) -> None:
     """A full disk cuts an episode's line short: it is cut off again, so no partial line
     stays between whole ones once there is room again."""
-    from shipgym_baselines.runs import RunLog, episode_result
+    from shipgym_baselines.records.runs import RunLog, episode_result
 
     records = read_episodes(clean_run)
     log = RunLog.open(

@@ -12,7 +12,7 @@ import yaml
 
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.runs import EPISODES_FILE, episode_result
+from shipgym_baselines.records.runs import EPISODES_FILE, episode_result
 
 
 def test_finding7_a_records_trajectory_names_only_a_file_in_its_run_folder(

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from shipgym_baselines.runs import read_episodes, read_run
+from shipgym_baselines.records.runs import read_episodes, read_run
 from tests.baselines.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]

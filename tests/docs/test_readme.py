@@ -46,7 +46,7 @@ def test_the_evaluate_example_gives_the_leaderboards_episodes(
     controller with the default suite's trial ranges, gives the same episodes."""
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import run_leaderboard
-    from shipgym_baselines.runs import read_episodes
+    from shipgym_baselines.records.runs import read_episodes
     from shipgym_baselines.suite import load_suite
 
     blocks = re.findall(r"```python\n(.*?)```", README, flags=re.S)

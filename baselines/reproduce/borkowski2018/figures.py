@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.reproduce.borkowski2018.experiment import TRUTH
 from shipgym_baselines.reproduce.borkowski2018.quality_index import cumulative_J
 from shipgym_baselines.reproduce.plotting import pyplot, save

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.reproduce.liu2019.experiment import CASES
 from shipgym_baselines.reproduce.plotting import pyplot, save
 from shipgym_baselines.reproduce.protocol import Outcome

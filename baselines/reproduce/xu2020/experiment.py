@@ -8,7 +8,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipgym_baselines.errors import check_seeds
-from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.reproduce.episodes import seeded_episodes
 from shipgym_baselines.reproduce.protocol import Outcome, Progress
 from shipgym_baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS

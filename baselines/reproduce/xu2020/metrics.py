@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from shipgym.angles import wrap_angle
-from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
 
 #: per-episode figures: metric -> (quantity of PUBLISHED or None, statistic, unit)
 EPISODE_METRICS = {

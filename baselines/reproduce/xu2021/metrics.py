@@ -10,7 +10,7 @@ import numpy as np
 from shipgym.angles import wrap_angle
 from shipgym.tracking import PathTracker
 from shipgym_baselines.classical.l1_backstepping import high_frequency_power
-from shipgym_baselines.evaluation import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.reproduce.xu2021.controllers import Recorded
 from shipgym_baselines.reproduce.xu2021.scenario import switch_time
 

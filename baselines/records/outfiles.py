@@ -18,7 +18,7 @@ through this module:
 
 Every path :func:`write_bytes` and :func:`make_dir` write is first announced to the
 recorders of this process (:func:`recording`; the run's manifest lists it before it
-exists, :mod:`shipgym_baselines.manifest`); :func:`carried` takes them along into a pool
+exists, :mod:`shipgym_baselines.records.manifest`); :func:`carried` takes them along into a pool
 worker.  The folder ``--out`` itself may be a link (a results folder on another disk):
 only what is inside it is checked.
 """

@@ -21,15 +21,15 @@
                      row (scenario, controller) is complete only the episode its figure
                      draws is kept (:meth:`RunLog.drop_trajectories`)
 
-A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.locking`) and lists every path
-it writes in ``manifest.txt`` (:mod:`shipgym_baselines.manifest`), each written through no link
-(:mod:`shipgym_baselines.outfiles`; a folder holding a link is refused).  A folder that is not
-empty is refused before any work unless ``resume`` (run the episodes missing from
-``episodes.jsonl``; the resolved suite must equal ``run.json``'s) or ``force`` (delete what the
-manifest lists first; a folder holding anything else is refused).  ``episodes.jsonl`` is
-read as a set keyed by the episode key (:func:`read_episodes`).  Tables are always
-aggregated from ``episodes.jsonl`` (so a resumed run's tables equal a clean run's, and
-``shipgym report`` rebuilds them from the folder).
+A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.records.locking`) and
+lists every path it writes in ``manifest.txt`` (:mod:`shipgym_baselines.records.manifest`),
+each written through no link (:mod:`shipgym_baselines.records.outfiles`; a folder holding a
+link is refused).  A folder that is not empty is refused before any work unless ``resume``
+(run the episodes missing from ``episodes.jsonl``; the resolved suite must equal
+``run.json``'s) or ``force`` (delete what the manifest lists first; a folder holding anything
+else is refused).  ``episodes.jsonl`` is read as a set keyed by the episode key
+(:func:`read_episodes`).  Tables are always aggregated from ``episodes.jsonl`` (so a resumed
+run's tables equal a clean run's, and ``shipgym report`` rebuilds them from the folder).
 
 Strict JSON has no infinity or NaN: in ``episodes.jsonl`` a metric of ±inf (t_c = inf, "never
 converged") is the string ``"inf"`` / ``"-inf"`` and NaN is ``null`` (metrics ignore NaN), so
@@ -58,26 +58,24 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from importlib import metadata
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, NamedTuple
+from typing import IO, Any, NamedTuple
 
 import numpy as np
 
-from shipgym_baselines.decimation import (
+from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.jsonout import COMPACT
+from shipgym_baselines.ranking import controller_failed
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.locking import LOCK_FILE, in_use, lock_holder, out_lock
+from shipgym_baselines.records.manifest import Manifest, clear_listed
+from shipgym_baselines.records.outfiles import check_no_links, make_dir, open_regular, write_bytes
+from shipgym_baselines.records.trajectories import (
     DRAWN_KEYS,
     pack_trajectory,
     thin_trajectory,
     unpack_trajectory,
 )
-from shipgym_baselines.errors import RunError, RunFailed
-from shipgym_baselines.jsonout import COMPACT
-from shipgym_baselines.locking import LOCK_FILE, in_use, lock_holder, out_lock
-from shipgym_baselines.manifest import Manifest, clear_listed
-from shipgym_baselines.outfiles import check_no_links, make_dir, open_regular, write_bytes
-from shipgym_baselines.ranking import controller_failed
 from shipgym_baselines.signals import signal_number
-
-if TYPE_CHECKING:
-    from shipgym_baselines.evaluation import EpisodeResult
 
 RUN_FILE = "run.json"
 EPISODES_FILE = "episodes.jsonl"
@@ -146,8 +144,8 @@ def check_out_dir(
 ) -> Path:
     """``out`` as a Path once it can hold this run; a :class:`RunError` before any work when
     it cannot: unusable (:func:`check_out_usable`), in use by another run (its lock:
-    :mod:`shipgym_baselines.locking`), holding a link or a special file
-    (:func:`~shipgym_baselines.outfiles.check_no_links`: a run writes through none), or
+    :mod:`shipgym_baselines.records.locking`), holding a link or a special file
+    (:func:`~shipgym_baselines.records.outfiles.check_no_links`: a run writes through none), or
     not empty without ``resume`` / ``force`` (``note`` is added to that message, e.g.
     where a default folder came from; a lock file left by a killed run does not count)."""
     path = check_out_usable(out, resume=resume, force=force)
@@ -230,7 +228,7 @@ def versions() -> dict[str, str]:
 def git_commit() -> str | None:
     """``git rev-parse HEAD`` of the checkout the package runs from; None when it is not a
     git checkout (an installed wheel) or git is missing."""
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]  # baselines/records/runs.py -> the checkout
     if not (root / ".git").exists():
         return None
     try:
@@ -305,7 +303,8 @@ def _read_json(file: Path) -> Any:
 
 
 def write_json(file: Path, document: Any) -> None:
-    """Write atomically, through no link (:func:`~shipgym_baselines.outfiles.write_bytes`)."""
+    """Write atomically, through no link
+    (:func:`~shipgym_baselines.records.outfiles.write_bytes`)."""
     from shipgym_baselines.jsonout import dumps
 
     write_bytes(file, (dumps(document, indent=2) + "\n").encode())
@@ -366,7 +365,7 @@ def _short(value: Any, limit: int = 60) -> str:
 # --- episodes.jsonl --------------------------------------------------------------------------
 
 
-def _plain(value: Any) -> Any:
+def plain(value: Any) -> Any:
     """A metric as strict JSON: numpy scalars as Python ones, ±inf as "inf"/"-inf", NaN null."""
     if isinstance(value, bool | np.bool_):
         return bool(value)
@@ -378,14 +377,15 @@ def _plain(value: Any) -> Any:
             return None
         return value if math.isfinite(value) else ("inf" if value > 0 else "-inf")
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple | np.ndarray):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     return value
 
 
-def _number(value: Any) -> Any:
-    """The inverse of :func:`_plain` for one value."""
+def from_plain(value: Any) -> Any:
+    """One value as :func:`plain` wrote it, read back: "inf" / "-inf" as ±inf, the rest as
+    it is."""
     if value == "inf":
         return math.inf
     if value == "-inf":
@@ -402,7 +402,7 @@ def episode_record(result: EpisodeResult) -> dict[str, Any]:
         "seed": int(result.seed),
         "training_seed": result.training_seed,
     }
-    return _plain({**head, **result.metrics})
+    return plain({**head, **result.metrics})
 
 
 def episode_key(record: Mapping[str, Any]) -> Key:
@@ -562,7 +562,7 @@ def read_episodes(
         key = episode_key(record)
         if keys is not None and (why := _foreign(key, keys)) is not None:
             raise _bad_line(file, number, why)
-        record = {k: _number(v) for k, v in record.items()}
+        record = {k: from_plain(v) for k, v in record.items()}
         if key in records and not controller_failed(records[key]):
             if _same(records[key], record):
                 continue  # the same episode written twice: one episode
@@ -582,7 +582,7 @@ def _same(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
 
 
 def _canonical(record: Mapping[str, Any]) -> str:
-    return json.dumps(_plain(dict(record)), sort_keys=True)
+    return json.dumps(plain(dict(record)), sort_keys=True)
 
 
 def _repair(file: Path) -> None:
@@ -599,11 +599,11 @@ def _repair(file: Path) -> None:
 
 
 def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
-    """A trajectory as its file keeps it (issue 20: the run folder's weight): only the
-    arrays a figure draws (:data:`~shipgym_baselines.decimation.DRAWN_KEYS`), thinned to
+    """A trajectory as its file keeps it, compact so that a run folder stays small: only the
+    arrays a figure draws (:data:`~shipgym_baselines.records.trajectories.DRAWN_KEYS`), thinned to
     what a figure can show without aliasing (M4,
-    :func:`~shipgym_baselines.decimation.thin_trajectory`), packed as 16-bit codes over
-    each array's range (:func:`~shipgym_baselines.decimation.pack_trajectory`: within
+    :func:`~shipgym_baselines.records.trajectories.thin_trajectory`), packed as 16-bit codes over
+    each array's range (:func:`~shipgym_baselines.records.trajectories.pack_trajectory`: within
     range / 131068, far below a figure's pixel; the episode's metrics are computed
     before, at full precision); the file is deflated (``np.savez_compressed``).
     :func:`read_trajectory` reads it back."""
@@ -640,11 +640,9 @@ def _inside(folder: Path, name: Any) -> Path:
 
 
 def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> EpisodeResult:
-    """An :class:`~shipgym_baselines.evaluation.EpisodeResult` from a record of ``folder``'s
+    """An :class:`~shipgym_baselines.records.episodes.EpisodeResult` from a record of ``folder``'s
     ``episodes.jsonl`` (its trajectory read if it was kept, else empty; a record of an
     earlier version names its file as ``trajectory``)."""
-    from shipgym_baselines.evaluation import EpisodeResult
-
     trajectory: dict[str, np.ndarray] = {}
     name = record.get("trajectory") or trajectory_file(episode_key(record))
     if name:
@@ -667,8 +665,8 @@ def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> Epis
 
 class RunLog:
     """An open run folder: its ``run.json`` record, the ``episodes.jsonl`` it appends to,
-    its manifest (:mod:`shipgym_baselines.manifest`) and its lock
-    (:mod:`shipgym_baselines.locking`).
+    its manifest (:mod:`shipgym_baselines.records.manifest`) and its lock
+    (:mod:`shipgym_baselines.records.locking`).
 
     :meth:`open` locks the folder and starts (or resumes) the run, :meth:`append` records
     each finished episode, :meth:`recording` sets the final status and releases the lock.
@@ -947,7 +945,9 @@ __all__ = [
     "clear_outputs",
     "differences",
     "episode_result",
+    "from_plain",
     "outside_problem",
+    "plain",
     "read_episodes",
     "read_run",
     "versions",

@@ -1,4 +1,5 @@
-"""Thinning a trajectory to what a figure can show, without aliasing (issue 20).
+"""Thinning a trajectory to what a figure can show, without aliasing, so that a run folder
+stays small.
 
 :func:`m4_indices` is M4 (Jugel et al. 2014, "M4: a visualization-oriented time series data
 aggregation", PVLDB 7(10)): the time axis is cut into ``buckets`` equal spans (one per pixel
@@ -72,8 +73,8 @@ _NON_FINITE = 65535
 
 
 def pack_trajectory(arrays: Mapping[str, Any]) -> dict[str, np.ndarray]:
-    """Equal-length float arrays (a thinned trajectory) as a kept file holds them (issue
-    20: the run folder's weight): ``keys`` (their names), ``ranges`` (per array its finite
+    """Equal-length float arrays (a thinned trajectory) as a kept file holds them, compact
+    so that a run folder stays small: ``keys`` (their names), ``ranges`` (per array its finite
     [min, max], float64) and ``codes`` (per array 16-bit codes over that range, each the
     difference from the previous one, mod 2¹⁶: a smooth series has small steps, which
     deflate well).  :func:`unpack_trajectory` inverts it to within range / 131068."""

@@ -10,7 +10,7 @@ dies, however it dies (kill -9 included), and record locks are not inherited by 
 workers.  A lock file left by a killed run is therefore free; the next run takes it and
 writes its own holder into it.  The file is not a run's output: the "not empty" check and
 ``--force`` ignore it, and a run that ends removes it.  It is opened without following a
-link (:func:`shipgym_baselines.outfiles.open_regular`): a link, a folder or a hard link in
+link (:func:`shipgym_baselines.records.outfiles.open_regular`): a link, a folder or a hard link in
 its place is refused in one line, and whatever it points to is left as it was (the "not
 empty" check and ``--force`` see it, too).
 """
@@ -27,7 +27,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.outfiles import open_regular
+from shipgym_baselines.records.outfiles import open_regular
 
 #: the lock file a run keeps in its ``--out`` while it runs
 LOCK_FILE = ".shipgym.lock"
@@ -61,7 +61,7 @@ def in_use(folder: Path, holder: str) -> RunError:
 def _acquire(folder: Path, start_time: str) -> int:
     """The descriptor of the locked lock file of ``folder``; a :class:`RunError` naming
     the holder when another process holds it, or naming the lock file when it is a link
-    or no regular file of its own (:func:`~shipgym_baselines.outfiles.open_regular`)."""
+    or no regular file of its own (:func:`~shipgym_baselines.records.outfiles.open_regular`)."""
     file = folder / LOCK_FILE
     while True:
         fd = open_regular(file, os.O_RDWR | os.O_CREAT)

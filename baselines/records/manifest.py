@@ -4,13 +4,13 @@ Every ``leaderboard`` / ``evaluate`` / ``report`` / ``run`` lists each path it w
 :data:`MANIFEST_FILE` (one folder-relative path a line, appended *before* the file is
 written, so a run killed while writing a file still lists it).  A run lists what it
 writes itself, never what it finds: each file goes through
-:func:`shipgym_baselines.outfiles.write_bytes`, which announces it (and its temporary) to
+:func:`shipgym_baselines.records.outfiles.write_bytes`, which announces it (and its temporary) to
 the manifest that is :meth:`Manifest.recording` (in a pool worker too:
-:func:`~shipgym_baselines.outfiles.carried`), so a user's file that appears meanwhile is
+:func:`~shipgym_baselines.records.outfiles.carried`), so a user's file that appears meanwhile is
 not the run's.  ``--force`` deletes exactly the listed paths and refuses, before deleting
 anything, a folder that holds anything else: a user's file, a directory of their own, a
 link (never written by a run, whatever its name), a file of an earlier shipgym version
-that kept no manifest.  The lock file (:mod:`shipgym_baselines.locking`) is never listed
+that kept no manifest.  The lock file (:mod:`shipgym_baselines.records.locking`) is never listed
 and never deleted; only a regular file of that name is the lock.
 """
 
@@ -22,8 +22,8 @@ from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.locking import LOCK_FILE
-from shipgym_baselines.outfiles import open_regular, recording, write_text
+from shipgym_baselines.records.locking import LOCK_FILE
+from shipgym_baselines.records.outfiles import open_regular, recording, write_text
 
 #: the list of paths the runs in a folder wrote
 MANIFEST_FILE = "manifest.txt"
@@ -62,7 +62,7 @@ def read_manifest(folder: str | os.PathLike) -> set[str]:
 class Manifest:
     """The manifest of an open run folder: :meth:`claim` a path before writing it, or
     write inside :meth:`recording` (each file written through
-    :mod:`shipgym_baselines.outfiles` is claimed as it is written)."""
+    :mod:`shipgym_baselines.records.outfiles` is claimed as it is written)."""
 
     def __init__(self, folder: str | os.PathLike):
         self.folder = Path(folder)
@@ -94,7 +94,7 @@ class Manifest:
     @contextlib.contextmanager
     def recording(self) -> Iterator[None]:
         """Claim every file and folder written in this folder through
-        :mod:`shipgym_baselines.outfiles` during the ``with`` body, before it is written
+        :mod:`shipgym_baselines.records.outfiles` during the ``with`` body, before it is written
         (files that appear otherwise, a user's, are not claimed)."""
         with recording(self.record):
             yield
@@ -103,7 +103,7 @@ class Manifest:
         """Rewrite the manifest, when a run finishes, to list only the listed paths that
         exist and ``keep`` (what a later run in the folder may write again, e.g. the run
         record): a run that wrote and removed thousands of trajectory
-        files and their temporaries lists only those it kept (issue 20).  Never lists
+        files and their temporaries lists only those it kept.  Never lists
         anything unlisted, so ``--force`` still deletes only what runs wrote.  Atomic
         (a listed temporary renamed over the manifest); on a full disk left as it was."""
         self.listed |= read_manifest(self.folder)  # pool workers' claims too
