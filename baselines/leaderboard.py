@@ -93,8 +93,8 @@ from shipgym_baselines.records.runs import (
 )
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label, training_seeds
-from shipgym_baselines.run_costs import eta_line, tables_line
 from shipgym_baselines.signals import worker_init
+from shipgym_baselines.studies.run_costs import eta_line, tables_line
 from shipgym_baselines.style import FIGURE_DPI, controller_style
 from shipgym_baselines.suite import load_suite, scenario_names
 from shipgym_baselines.verdict import folder_verdict, plain_name, verdict
@@ -521,7 +521,7 @@ def run_leaderboard(
     ``results/<suite>`` (:func:`~shipgym_baselines.comparison.suite_folder`).
     ``show_progress``: a progress bar on stderr, after one line before the first episode: the
     episodes, workers and the time estimated from the recorded costs
-    (:func:`shipgym_baselines.run_costs.eta_line`).  Ctrl-C raises
+    (:func:`shipgym_baselines.studies.run_costs.eta_line`).  Ctrl-C raises
     :class:`~shipgym_baselines.records.runs.RunInterrupted`.
 
     A controller that fails (raises, gives a malformed or non-finite action, or takes

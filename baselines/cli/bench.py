@@ -6,9 +6,9 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
-from shipgym_baselines import benchmarks
 from shipgym_baselines.cli.options import add_json_option, emit
 from shipgym_baselines.errors import check_count
+from shipgym_baselines.studies import benchmarks
 
 #: bench target -> the benchmark run with the parsed options (``--repeats``)
 BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
@@ -21,7 +21,7 @@ BENCHES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
 
 
 def _profile(args: argparse.Namespace) -> dict[str, Any]:
-    from shipgym_baselines.run_costs import profile_suite
+    from shipgym_baselines.studies.run_costs import profile_suite
 
     return profile_suite(
         args.suite,

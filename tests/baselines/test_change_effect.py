@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from shipgym.scenarios import load_scenario
-from shipgym_baselines.change_effect import (
+from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
+from shipgym_baselines.registry import make_controller
+from shipgym_baselines.studies.change_effect import (
     MATTERS,
     change_effect,
     change_time,
@@ -16,8 +18,6 @@ from shipgym_baselines.change_effect import (
     step_costs,
     twin,
 )
-from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
-from shipgym_baselines.registry import make_controller
 
 
 def test_matrix_scenarios_are_the_three_ships_times_three_families_times_two_routes() -> None:

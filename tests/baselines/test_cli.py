@@ -219,7 +219,7 @@ def test_cli_bench_identification_json(capsys) -> None:
 
 def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
     """The nomoto2 figures, and per ship each family member's (here two, 40 steps: CI time)."""
-    from shipgym_baselines import benchmarks
+    from shipgym_baselines.studies import benchmarks
 
     monkeypatch.setattr(benchmarks, "NMPC_FAMILY", ("nmpc", "nmpc_lambda_lssvm_svf"))
     monkeypatch.setattr(benchmarks, "PER_SHIP_MAX_STEPS", 40)
@@ -293,7 +293,7 @@ def test_no_help_text_points_to_the_unshipped_spec(capsys) -> None:
 def test_bench_training_compares_equal_widths() -> None:
     """Each path's rate and CPU, and the ratios at the config's width and at the wide one
     (tiny runs: the figures' shape, not their speed)."""
-    from shipgym_baselines.benchmarks import bench_training
+    from shipgym_baselines.studies.benchmarks import bench_training
 
     figures = bench_training(n_envs=4, timesteps=64, kinds=("batched", "dummy"), wide_envs=8)
     for label in ("batched", "dummy", "batched_wide", "dummy_wide"):
@@ -325,7 +325,7 @@ def test_env_clock_counts_the_env_cpu_and_nothing_else() -> None:
     import numpy as np
     from stable_baselines3.common.vec_env import VecEnv
 
-    from shipgym_baselines.benchmarks import _env_clock
+    from shipgym_baselines.studies.benchmarks import _env_clock
 
     def burn(seconds: float) -> None:
         end = time.process_time() + seconds

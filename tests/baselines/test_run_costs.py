@@ -1,4 +1,4 @@
-"""Where a leaderboard run's CPU time goes (shipgym_baselines.run_costs)."""
+"""Where a leaderboard run's CPU time goes (shipgym_baselines.studies.run_costs)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from shipgym_baselines.leaderboard import (
     work,
 )
 from shipgym_baselines.registry import training_seeds
-from shipgym_baselines.run_costs import (
+from shipgym_baselines.studies.run_costs import (
     TABLES_CPU_S_PER_SCENARIO,
     estimate_cpu_s,
     eta_line,

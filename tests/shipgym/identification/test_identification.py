@@ -185,7 +185,7 @@ def test_degenerate_batch_data_raise_with_the_reason() -> None:
 
 # ----------------------------------------------------------------------------- online
 def rudder_aging_log(seed: int):
-    from shipgym_baselines.benchmarks import identification_log
+    from shipgym_baselines.studies.benchmarks import identification_log
 
     return identification_log("rudder_aging", seed=seed, excitation_deg=1.0)
 

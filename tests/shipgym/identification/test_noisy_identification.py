@@ -86,7 +86,7 @@ def test_online_svf_window_matches_the_batch_fit(log) -> None:
 def case3_log():
     """Case 3 (maneuverability_change, heading noise and outliers) under pid_los + 1° eq. (45)
     excitation, open loop for the identifiers."""
-    from shipgym_baselines.benchmarks import identification_log
+    from shipgym_baselines.studies.benchmarks import identification_log
 
     return identification_log("maneuverability_change", seed=0, excitation_deg=1.0)
 

@@ -1,5 +1,5 @@
 """Does a scenario's change matter?  A non-adaptive controller's cost after the change
-against its cost on the scenario's nominal twin (issue 18).
+against its cost on the scenario's nominal twin (docs/scenario-matrix.md).
 
 Cost of a step = −reward without the goal bonus (the corridor penalty included), so the
 episode cost C is the sum of the step costs and C / steps its cost per step.  For a
@@ -14,9 +14,9 @@ after-change cost is ≥ 1.3× the twin's over the same window (:data:`MATTERS`)
 with the twin rather than with the steps before t*, because what comes after t* on a route
 (its turns) differs from what comes before whatever the plant does.
 
-``python -m shipgym_baselines.change_effect [SCENARIO …] [--controller C] [--seeds N] [--json]``
-prints the table (default: every matrix scenario with a change, ``pid_los``, 3 seeds of the
-default suite's trials).
+``python -m shipgym_baselines.studies.change_effect`` (options: ``[SCENARIO …]
+[--controller C] [--seeds N] [--json]``) prints the table (default: every matrix scenario
+with a change, ``pid_los``, 3 seeds of the default suite's trials).
 """
 
 from __future__ import annotations
@@ -35,10 +35,10 @@ from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
 from shipgym_baselines.suite import load_suite
 
-#: the factor by which a change must raise the after-change cost per step (issue 18)
+#: the factor by which a change must raise the after-change cost per step
 MATTERS = 1.3
 #: the non-adaptive reference's construction: ``pid_los``'s paper design (pole placement on
-#: the nominal model's Nomoto fit, never re-tuned).  Issue 21's tuned settings were chosen
+#: the nominal model's Nomoto fit, never re-tuned).  The tuned settings (docs/tuning.md) were chosen
 #: on validation trials that include these change families, and on the Mariner and Esso
 #: Osaka manoeuvrability changes they no longer degrade by 1.3x: the measurement of whether
 #: a change matters keeps the design that was never tuned for it.

@@ -1,8 +1,8 @@
 """Evidence for the nomoto2 unit reading: pid_los on each scenario under each reading.
 
-``python -m shipgym_baselines.unit_readings [--json]`` prints ACE, t_c and how the episode ended for
-every catalogue nomoto2 scenario with ``ship.unit_reading`` set to each reading (README,
-"Units of the nomoto2 ship").
+``python -m shipgym_baselines.studies.unit_readings [--json]`` prints ACE, t_c and how the
+episode ended for every catalogue nomoto2 scenario with ``ship.unit_reading`` set to each
+reading (README, "Units of the nomoto2 ship").
 """
 
 from __future__ import annotations

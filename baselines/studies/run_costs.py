@@ -171,7 +171,7 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
 # --- recorded costs: the leaderboard's first estimate ----------------------------------------
 
 #: the recorded costs (:func:`record_costs`), shipped beside the references' tables
-COSTS_FILE = Path(__file__).parent / "reference_data" / "leaderboard_costs.json"
+COSTS_FILE = Path(__file__).parents[1] / "reference_data" / "leaderboard_costs.json"
 #: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
 LEARNED_SEEDS = 10
 #: evaluation seeds of the other controllers' measured jobs (in lockstep, as a run's)
@@ -193,7 +193,7 @@ def record_costs(
     suite: str = "quick", show_progress: bool = False, cache: Path | None = None
 ) -> dict[str, Any]:
     """Measure the costs :func:`estimate_cpu_s` reads (written to :data:`COSTS_FILE` by
-    ``python -m shipgym_baselines.run_costs``): per controller and ship, CPU seconds per
+    ``python -m shipgym_baselines.studies.run_costs``): per controller and ship, CPU seconds per
     control step of the scenario's time limit, from :func:`profile_suite` on ``suite``
     (classical controllers and references with :data:`OTHER_SEEDS` evaluation seeds, learned
     agents with :data:`LEARNED_SEEDS`, each job's seeds in lockstep as a run's; a learned
@@ -255,7 +255,7 @@ def record_costs(
     return {
         "about": "CPU seconds per control step of a scenario's time limit (time_limit / "
         "control_period), per controller and ship, as the leaderboard runs its jobs; "
-        "shipgym_baselines.run_costs.estimate_cpu_s reads it",
+        "shipgym_baselines.studies.run_costs.estimate_cpu_s reads it",
         "measured": {
             "suite": spec.name,
             "commit": git_commit(),
@@ -263,7 +263,7 @@ def record_costs(
             "cpu_s": time.process_time() - start,
             "profiles_cpu_s": [found["cpu_s"] for found in profiles],
             "load_average": [found["load_average"] for found in profiles],
-            "command": "python -m shipgym_baselines.run_costs",
+            "command": "python -m shipgym_baselines.studies.run_costs",
         },
         "cpu_s_per_limit_step": dict(sorted(per_step.items())),
         "oracle_computed": oracle_computed,

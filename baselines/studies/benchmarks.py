@@ -1,4 +1,5 @@
-"""Benchmarks of SPEC §10 (medians over repeats; machines are noisy)."""
+"""Benchmarks of the speed targets (docs/benchmarks.md; medians over repeats: machines are
+noisy)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.models import MODELS
 
-#: issue 11's speed floors on the 2-core machine (steps/s, env-steps/s at N = 1024, µs)
+#: the speed floors on the 2-core machine (steps/s, env-steps/s at N = 1024, µs)
 SINGLE_ENV_TARGET = 25_000
 BATCHED_ENV_TARGET = 350_000
 PCHIP_PROJECTION_TARGET_US = 20.0
@@ -267,7 +268,7 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
     return out
 
 
-#: the NMPC family (issue 17: the solve-time targets hold for each member on every ship)
+#: the NMPC family (the solve-time targets hold for each member on every ship)
 NMPC_FAMILY = (
     "nmpc",
     "nmpc_wlssvm",
@@ -346,7 +347,7 @@ def bench_nmpc(
     ``scenarios``, the paper's settings), and ``per_ship``: every ``family`` member on each
     ship, as the leaderboard runs it (its tuned settings)
     (:func:`solve_times_per_ship`) with ``family_median_ms`` / ``family_p99_ms``, the
-    largest over the members (targets ≤ 1 ms / ≤ 5 ms, issue 17), and the privileged
+    largest over the members (targets ≤ 1 ms / ≤ 5 ms), and the privileged
     ``oracle``'s ``oracle_median_ms`` / ``oracle_p99_ms`` (target median ≤ 20 ms, its
     episodes cut after ``max_steps`` or :data:`ORACLE_MAX_STEPS`); None: :data:`NMPC_FAMILY`,
     :data:`PER_SHIP_MAX_STEPS`."""
@@ -394,7 +395,7 @@ def bench_nmpc(
     }
 
 
-#: issue 21: PPO training on the distribution through the per-ship batched envs runs at
+#: PPO training on the distribution through the per-ship batched envs runs at
 #: least this many times as fast as through SB3's DummyVecEnv (env steps/s, learning included)
 BATCHED_OVER_DUMMY_TARGET = 2.0
 
