@@ -21,7 +21,7 @@ from shipgym_baselines.leaderboard import (
 )
 from shipgym_baselines.learned.policy import model_zip
 from shipgym_baselines.records.runs import read_episodes, read_run
-from tests.baselines.test_runs import TIMING, untimed, write_suite
+from tests.baselines.records.test_runs import TIMING, untimed, write_suite
 
 RANDOMIZE = {
     "cross_track_offset_L": [-1.0, 1.0],

@@ -12,7 +12,7 @@ from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.runs import read_run
 from shipgym_baselines.report import write_report
-from tests.baselines.test_runs import untimed, write_suite
+from tests.baselines.records.test_runs import untimed, write_suite
 
 
 @pytest.fixture(scope="module")

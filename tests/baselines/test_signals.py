@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.records.runs import read_episodes, read_run
-from tests.baselines.test_runs import write_suite
+from tests.baselines.records.test_runs import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 

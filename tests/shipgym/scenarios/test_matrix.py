@@ -2,7 +2,7 @@
 
 For esso_osaka, mariner and blanke: ``{ship}_nominal`` and, for each family (rudder aging,
 current shift, manoeuvrability change), ``{ship}_{family}`` and ``{ship}_{family}_curved``.
-Whether each change *matters* is tested in tests/baselines/test_change_effect.py.
+Whether each change *matters* is tested in tests/baselines/studies/test_change_effect.py.
 """
 
 from __future__ import annotations

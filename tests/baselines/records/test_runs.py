@@ -33,7 +33,7 @@ from shipgym_baselines.records.runs import (
 )
 from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 #: 2 scenarios × 2 controllers × 2 seeds: 8 quick episodes
 TINY = {
     "name": "tiny",

@@ -16,9 +16,9 @@ from shipgym_baselines.leaderboard import run_leaderboard
 from shipgym_baselines.records.locking import LOCK_FILE, out_lock
 from shipgym_baselines.records.runs import read_episodes, read_run
 from tests.baselines.conftest import copy_folder
-from tests.baselines.test_runs import write_suite
+from tests.baselines.records.test_runs import write_suite
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 HOLD = """
 import sys, time
 from shipgym_baselines.records.locking import out_lock
