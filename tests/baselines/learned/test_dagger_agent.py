@@ -188,15 +188,20 @@ def test_a_run_killed_while_scoring_resumes_without_relabelling(
 
 
 def test_the_packaged_configs() -> None:
-    """dagger and bc: the same student but the history; ppo_history: PPO with its window."""
+    """bc: the student dagger's study chose (``--settings tuned``) but the history;
+    ppo_history: PPO with a window."""
+    from shipgym_baselines.tuning.tuned import tuned_agent
+
     dagger, bc, ppo = (load_agent_config(n) for n in ("dagger", "bc", "ppo_history"))
     assert (dagger.algo, bc.algo, ppo.algo) == ("dagger", "dagger", "ppo")
     assert dagger.env.history_steps == ppo.env.history_steps > 0 == bc.env.history_steps
     assert dagger.env.context_features and bc.env.context_features and ppo.env.context_features
     assert dagger.env.distribution == bc.env.distribution == ppo.env.distribution == "train"
+    tuned, _ = tuned_agent(dagger)
+    assert tuned.env.history_steps > 0
     strip = {"name": None, "env": None}
-    assert dagger.model_copy(update=strip) == bc.model_copy(update=strip)
-    assert dagger.env.model_copy(update={"history_steps": 0}) == bc.env
+    assert tuned.model_copy(update=strip) == bc.model_copy(update=strip)
+    assert tuned.env.model_copy(update={"history_steps": 0}) == bc.env
     assert settings(dagger).net_arch == dagger.policy_kwargs["net_arch"]
 
 
