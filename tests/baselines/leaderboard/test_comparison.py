@@ -1,7 +1,7 @@
 """A run of chosen controllers is ranked against the references added to it
 (shipgym_baselines.leaderboard.comparison): a plug-in gets a cost ratio and a rank,
-``--no-references``
-none (and the message names how to get one), the oracle alone has nothing to rank."""
+``--no-references`` none (and the message names how to get one), the oracle alone has
+nothing to rank."""
 
 from __future__ import annotations
 
