@@ -26,10 +26,10 @@ from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError, RunError
+from shipgym_baselines.leaderboard.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
-from shipgym_baselines.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.registry import make_controller
 
@@ -642,7 +642,7 @@ def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) 
     leaderboard's own drawing (:func:`shipgym_baselines.leaderboard.trials`), so seed
     10000 + i is the leaderboard's trial i of the scenario."""
     from shipgym_baselines.leaderboard import Job, trials
-    from shipgym_baselines.suite import load_suite
+    from shipgym_baselines.leaderboard.suite import load_suite
 
     spec = load_suite(suite)
     randomize = None if spec.randomize is None else spec.randomize.model_dump(mode="json")

@@ -21,8 +21,8 @@ from collections.abc import Callable
 from typing import Any
 
 from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.plugins import ControllerEntry, as_entry
-from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.registry import CONTROLLERS
 
 #: the names that receive the truth

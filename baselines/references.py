@@ -57,7 +57,7 @@ from shipgym.envs.core import ENV_REVISION
 from shipgym.notices import duration, notice
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.records.runs import from_plain, plain
 

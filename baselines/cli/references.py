@@ -36,7 +36,7 @@ from contextlib import closing
 from typing import Any
 
 from shipgym_baselines.cli.options import add_json_option, emit
-from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 
 #: the references with a table (:data:`shipgym_baselines.references.REFERENCES`)
 REFERENCES = (ORACLE, ORACLE_FROZEN)
@@ -94,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
+    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.references import (
         ReferenceCache,
         ReferenceTable,
@@ -102,7 +103,6 @@ def run(args: argparse.Namespace) -> int:
         lookup,
         table_path,
     )
-    from shipgym_baselines.suite import load_suite
 
     if args.reference is None:
         chosen = [ORACLE] if args.table is not None else list(REFERENCES)

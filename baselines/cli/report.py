@@ -37,7 +37,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Merge the runs, write the report, print the table (or rows); say which runs were
     incomplete."""
-    from shipgym_baselines.report import write_report
+    from shipgym_baselines.leaderboard.report import write_report
 
     rows, sources = write_report(
         args.runs,

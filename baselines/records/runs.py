@@ -64,7 +64,7 @@ import numpy as np
 
 from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.jsonout import COMPACT
-from shipgym_baselines.ranking import controller_failed
+from shipgym_baselines.leaderboard.ranking import controller_failed
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.records.locking import LOCK_FILE, in_use, lock_holder, out_lock
 from shipgym_baselines.records.manifest import Manifest, clear_listed

@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-#: the arrays a scenario figure draws (:func:`shipgym_baselines.figures.plot_scenario`), the
-#: only ones a run folder keeps of a trajectory: time [s], position [m], cross-track error
+#: the arrays a scenario figure draws (:func:`shipgym_baselines.leaderboard.figures.plot_scenario`),
+#: the only ones a run folder keeps of a trajectory: time [s], position [m], cross-track error
 #: [m], rudder angle [rad]
 DRAWN_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")
 #: time buckets of a kept trajectory: the width [px] of a scenario figure's panel drawn at

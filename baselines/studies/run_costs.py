@@ -93,9 +93,9 @@ def profile_suite(
         suite_scenario,
         work,
     )
+    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.privileged import grants_truth
     from shipgym_baselines.registry import controller_label, training_seeds
-    from shipgym_baselines.suite import load_suite
 
     torch.set_num_threads(1)
     check_seeds(seeds, "--seeds")
@@ -204,9 +204,9 @@ def record_costs(
     import platform
 
     from shipgym_baselines.leaderboard import Job, suite_scenario, work
+    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.runs import git_commit
     from shipgym_baselines.registry import controller_kind, controller_label
-    from shipgym_baselines.suite import load_suite
 
     spec = load_suite(suite)
     labels = [controller_label(c) for c in spec.controllers]

@@ -123,7 +123,7 @@ def test_the_smoke_leaderboard_opens_with_its_verdict(smoke: tuple[Path, list[di
     """leaderboard.md, the terminal summary and the page open with the run's two sentences:
     the catalogue leader of aggregate.json with its IQM, the learned agent's rank."""
     from shipgym_baselines.leaderboard import terminal_summary
-    from shipgym_baselines.verdict import folder_verdict, plain_name
+    from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name
 
     out, _ = smoke
     board = [

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-import shipgym_baselines.leaderboard
+import shipgym_baselines.leaderboard.run
 from shipgym.limits import (
     MAX_CONFIG_BYTES,
     MAX_CONFIG_DEPTH,
@@ -67,13 +67,13 @@ def test_finding8_workers_below_one_are_refused(tmp_path: Path, capsys) -> None:
 
 def test_finding8_workers_beyond_the_jobs_are_clamped(tmp_path: Path, monkeypatch) -> None:
     started = []
-    real = shipgym_baselines.leaderboard.iter_results
+    real = shipgym_baselines.leaderboard.run.iter_results
 
     def spy(jobs, backend, workers):
         started.append(workers)
         return real(jobs, backend, workers)
 
-    monkeypatch.setattr(shipgym_baselines.leaderboard, "iter_results", spy)
+    monkeypatch.setattr(shipgym_baselines.leaderboard.run, "iter_results", spy)
     argv = [
         "leaderboard",
         "--suite",

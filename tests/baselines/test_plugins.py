@@ -24,6 +24,7 @@ from shipgym_baselines.cli import main
 from shipgym_baselines.errors import ConfigError, ControllerError, RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, run_episode
 from shipgym_baselines.leaderboard import check_controllers, run_job, run_leaderboard
+from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerEntry, anchored, entry_point_names, parse_spec
 from shipgym_baselines.registry import (
     CONTROLLERS,
@@ -33,7 +34,6 @@ from shipgym_baselines.registry import (
     make_controller,
     unknown_controller,
 )
-from shipgym_baselines.suite import load_suite
 
 #: the docs page of plug-ins, whose example blocks run as written
 PLUGINS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "plugins.md"

@@ -21,7 +21,7 @@ from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical import lqr, nmpc, pid
 from shipgym_baselines.classical.adaptive.settings import L1BacksteppingSettings
 from shipgym_baselines.classical.l1_backstepping import L1Backstepping
-from shipgym_baselines.figures import plot_learning_curves
+from shipgym_baselines.leaderboard.figures import plot_learning_curves
 from shipgym_baselines.learned.curves import agent_curves
 from shipgym_baselines.learned.policy import POLICY_DIR, shipped_policies
 from shipgym_baselines.registry import CONTROLLERS, ControllerRecord

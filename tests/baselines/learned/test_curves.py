@@ -86,9 +86,9 @@ def test_validation_trials_are_fixed_and_never_heldout() -> None:
 
 
 def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
-    from shipgym_baselines.figures import LEARNING_CURVES_STEM, plot_learning_curves
+    from shipgym_baselines.leaderboard.figures import LEARNING_CURVES_STEM, plot_learning_curves
+    from shipgym_baselines.leaderboard.page import figure_sections
     from shipgym_baselines.learned.curves import agent_curves
-    from shipgym_baselines.pages import figure_sections
 
     root = tmp_path / "policies"
     for seed in (1, 0):
@@ -172,7 +172,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
 ) -> None:
     """A run that selects on the validation cost ratio is drawn on it (log axis, the oracle
     at 1, each seed's best point ringed); one without it on its return."""
-    from shipgym_baselines import figures
+    from shipgym_baselines.leaderboard import figures
 
     drawn = {}
 

@@ -108,8 +108,7 @@ def test_a_file_added_during_the_figures_stage_is_not_the_runs(
 ) -> None:
     """A user's file that appears while the tables and figures are drawn is not listed in
     the manifest, and the next ``--force`` refuses to delete it (naming it)."""
-    from shipgym_baselines import figures
-    from shipgym_baselines.leaderboard import run_leaderboard
+    from shipgym_baselines.leaderboard import figures, run_leaderboard
 
     out = copy_folder(smoke_run, tmp_path / "out")
     draw = figures.plot_scenarios
@@ -134,16 +133,16 @@ def test_pool_workers_list_the_figures_they_write(
     tmp_path: Path, smoke_run: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Figures drawn in a process pool are listed by the workers as they write them."""
-    import shipgym_baselines.leaderboard as leaderboard
+    from shipgym_baselines.leaderboard import outputs
     from shipgym_baselines.records.runs import read_run
 
-    monkeypatch.setattr(leaderboard, "POOLED_FIGURES", 1)  # a pool for three figures
+    monkeypatch.setattr(outputs, "POOLED_FIGURES", 1)  # a pool for three figures
     out = tmp_path / "out"
     out.mkdir()
     manifest = Manifest(out)
     with manifest.recording():
-        leaderboard.write_results(
-            out, read_run(smoke_run)["suite"], leaderboard.load_results(smoke_run), workers=2
+        outputs.write_results(
+            out, read_run(smoke_run)["suite"], outputs.load_results(smoke_run), workers=2
         )
     manifest.compact()
     written = snapshot(out) - {MANIFEST_FILE}

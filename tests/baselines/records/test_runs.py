@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-import shipgym_baselines.leaderboard
+import shipgym_baselines.leaderboard.jobs
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError, RunFailed
 from shipgym_baselines.jsonout import dumps
@@ -292,7 +292,7 @@ def test_a_killed_run_keeps_its_episodes_and_resumes(tmp_path: Path, clean_run: 
 
 def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> None:
     calls: list[object] = []
-    real = shipgym_baselines.leaderboard.run_batch  # a controller's 2 seeds in lockstep
+    real = shipgym_baselines.leaderboard.jobs.run_batch  # a controller's 2 seeds in lockstep
 
     def third_is_interrupted(job: tuple) -> object:
         calls.append(job)
@@ -300,7 +300,7 @@ def test_cli_ctrl_c_says_what_was_kept(tmp_path: Path, monkeypatch, capsys) -> N
             raise KeyboardInterrupt
         return real(job)
 
-    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_batch", third_is_interrupted)
+    monkeypatch.setattr(shipgym_baselines.leaderboard.jobs, "run_batch", third_is_interrupted)
     out = tmp_path / "out"
     args = ["leaderboard", "--suite", write_suite(tmp_path), "--out", str(out), "--workers", "1"]
     args.append("--no-references")  # the suite's two controllers only
@@ -328,7 +328,7 @@ def test_plots_stay_in_the_run_folder(tmp_path: Path) -> None:
 
 def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> None:
     calls: list[object] = []
-    real = shipgym_baselines.leaderboard.run_batch  # a controller's 2 seeds in lockstep
+    real = shipgym_baselines.leaderboard.jobs.run_batch  # a controller's 2 seeds in lockstep
 
     def second_fails(job: tuple) -> object:
         calls.append(job)
@@ -336,7 +336,7 @@ def test_a_failing_run_is_recorded_as_failed(tmp_path: Path, monkeypatch) -> Non
             raise RuntimeError("a bug in a controller")
         return real(job)
 
-    monkeypatch.setattr(shipgym_baselines.leaderboard, "run_batch", second_fails)
+    monkeypatch.setattr(shipgym_baselines.leaderboard.jobs, "run_batch", second_fails)
     out = tmp_path / "out"
     with pytest.raises(RuntimeError, match="a bug"):  # a bug keeps its traceback
         run_leaderboard(write_suite(tmp_path), out_dir=out, workers=1, show_progress=False)
@@ -596,7 +596,7 @@ def test_a_link_planted_while_the_tables_are_written_is_refused(
 ) -> None:
     """A link that appears during the run, as a table the run is about to write: that
     write is refused (the run fails in one line) and the link's target is unchanged."""
-    from shipgym_baselines import figures
+    from shipgym_baselines.leaderboard import figures
 
     notes = tmp_path / "notes.txt"
     notes.write_text("my notes\n")

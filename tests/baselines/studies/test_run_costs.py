@@ -15,6 +15,7 @@ from shipgym_baselines.leaderboard import (
     suite_scenario,
     work,
 )
+from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import training_seeds
 from shipgym_baselines.studies.run_costs import (
     TABLES_CPU_S_PER_SCENARIO,
@@ -25,7 +26,6 @@ from shipgym_baselines.studies.run_costs import (
     recorded_costs,
     step_cost,
 )
-from shipgym_baselines.suite import load_suite
 
 
 @pytest.fixture(scope="module")

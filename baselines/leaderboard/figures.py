@@ -1,9 +1,9 @@
-"""The leaderboard's figures (issue 13): per-scenario small multiples and the rliable ranking.
+"""The leaderboard's figures: per-scenario small multiples and the rliable ranking.
 
-Every figure uses :func:`shipgym_baselines.style.controller_style` (one colour and line style per
-controller, the same in every figure), labels its axes with units, keeps legends outside the
-data and is written twice (:func:`save_figure`): drawn at
-:data:`~shipgym_baselines.style.FIGURE_DPI` (200 dpi), as a palette PNG of at most
+Every figure uses :func:`shipgym_baselines.leaderboard.style.controller_style` (one colour and line
+style per controller, the same in every figure), labels its axes with units, keeps legends
+outside the data and is written twice (:func:`save_figure`): drawn at
+:data:`~shipgym_baselines.leaderboard.style.FIGURE_DPI` (200 dpi), as a palette PNG of at most
 :data:`PAGE_WIDTH` pixels (the page's image), and as a vector copy beside it (SVG; the
 scenario figures, which hold the long trajectories, as gzip-compressed SVGZ).  Matplotlib runs
 on the Agg backend.
@@ -16,7 +16,8 @@ What a run hands in:
   (arrays ``t`` [s], ``x``, ``y`` [m], ``cross_track_error`` [m], ``rudder_angle`` [rad], …).
   :func:`median_ace_episode` names the episode to keep (the median-ACE seed, and its training
   seed), :func:`episodes_to_draw` picks them from episode results.
-* ``aggregate``: the ``aggregate.json`` rows (:func:`shipgym_baselines.ranking.aggregate_ranking`);
+* ``aggregate``: the ``aggregate.json`` rows
+  (:func:`shipgym_baselines.leaderboard.ranking.aggregate_ranking`);
   ``episodes``: the ``episodes.jsonl`` records; ``splits``: scenario → split.
 
 Functions (each returns the written files, PNG then SVG):
@@ -58,11 +59,11 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from shipgym_baselines.escaping import plain_text
-from shipgym_baselines.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.leaderboard.escaping import plain_text
+from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.records.outfiles import write_bytes
 from shipgym_baselines.records.trajectories import DRAWN_KEYS, thin_trajectory
-from shipgym_baselines.style import FIGURE_DPI, controller_style
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
@@ -83,7 +84,7 @@ LIGHT_FIGURES = {
 #: vector copy keeps every detail; fewer pixels barely lighten a line figure: its
 #: compressed bytes follow the lines' length in pixels, not the area)
 PAGE_WIDTH = 1400
-#: a scenario figure's PNG text chunks for the page (issue 20): its legends as JSON (a list
+#: a scenario figure's PNG text chunks for the page: its legends as JSON (a list
 #: of [column title, [[controller, label], …]]; the oracle's label ends ", the reference",
 #: the frozen optimum's ", never adapts")
 #: and where they start (the fraction of the height from the top); the page shows the
@@ -94,7 +95,7 @@ LEGEND_TOP_KEY = "shipgym:legend-top"
 #: most colours of a page PNG's palette: the figure's own colours (every line, marker, text
 #: and patch, an alpha one as it shows on white), each also half-way to white (the
 #: antialiasing of a thin line on the white axes), and a ramp of PAGE_GREYS greys (text,
-#: grid); every pixel takes its nearest (issue 20: a controller keeps its colour on the
+#: grid); every pixel takes its nearest (so a controller keeps its colour on the
 #: page; an adaptive 64-colour palette spent itself on near-whites and greyed the lines)
 PAGE_COLOURS = 256
 PAGE_GREYS = 9
@@ -160,7 +161,7 @@ def save_figure(
 ) -> list[Path]:
     """Write ``fig`` as ``<stem>.png`` (the page's image, :func:`write_page_png`) and, if
     asked, its vector copy ``<stem><vector>`` (``.svg``, or ``.svgz``: the SVG deflated, for
-    a figure of long trajectories; None: none, the default of a run, issue 20: the page
+    a figure of long trajectories; None: none, the default of a run: the page
     shows the PNG and the copy would double the figures' weight) into ``out_dir`` (made if
     missing), close it and return the paths.  ``tight``: crop to what is drawn (for a
     figure drawn outside its canvas, as rliable's interval plot is); a layout engine's
@@ -245,7 +246,7 @@ def write_page_png(
     colours: Iterable[tuple[float, float, float]] = (),
 ) -> None:
     """``rgb`` (a PIL RGB image of the figure drawn at :data:`FIGURE_DPI`) written as the
-    page shows it (issue 20: the page's weight): reduced by the smallest whole factor that
+    page shows it (kept light: the page embeds it): reduced by the smallest whole factor that
     makes it at most :data:`PAGE_WIDTH` pixels wide (each pixel the mean of its block; the
     dpi recorded accordingly), each pixel the nearest colour of :func:`page_palette` of
     the figure's ``colours`` (:func:`figure_colours`; no dithering), deflated at the
@@ -727,7 +728,7 @@ def plot_ranking(
     saying on how many scenarios) and ``profile_<split>`` (performance profiles of the cost
     ratio from ``episodes``, one panel per family); see the module doc; ``vector``: their
     SVG copies too.  Returns every written file."""
-    from shipgym_baselines.ranking import PARTIAL, trial_headroom
+    from shipgym_baselines.leaderboard.ranking import PARTIAL, trial_headroom
 
     files: list[Path] = []
     headroom = trial_headroom(episodes)
@@ -749,7 +750,7 @@ def _ranking_label(row: Mapping[str, Any], common: int) -> str:
 def frozen_marks(headroom: Sequence[float]) -> dict[str, float]:
     """Where the frozen optimum lies on the cost-ratio panels: the IQM and the geometric mean
     of its ratios C_frozen / C_oracle (``headroom``, one per trial); empty without any."""
-    from shipgym_baselines.ranking import geometric_mean, interquartile_mean
+    from shipgym_baselines.leaderboard.ranking import geometric_mean, interquartile_mean
 
     if not len(headroom):
         return {}
@@ -874,7 +875,7 @@ def _plot_profiles(
 ) -> list[Path]:
     from rliable import plot_utils
 
-    from shipgym_baselines.ranking import performance_profiles, scored_episodes
+    from shipgym_baselines.leaderboard.ranking import performance_profiles, scored_episodes
 
     plt = pyplot()
     in_split = {s for s, sp in splits.items() if sp == split}

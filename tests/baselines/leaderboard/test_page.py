@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from shipgym_baselines.figures import DrawnEpisode, plot_scenario
-from shipgym_baselines.pages import PAGE_FILE, page, unpacked_body, write_html
+from shipgym_baselines.leaderboard.figures import DrawnEpisode, plot_scenario
+from shipgym_baselines.leaderboard.page import PAGE_FILE, page, unpacked_body, write_html
 
 CONTROLLERS = [
     "pid_los",
@@ -371,8 +371,8 @@ def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
 
 
 def test_the_frozen_optimum_has_its_own_legend_swatch() -> None:
-    from shipgym_baselines.pages import _legend_html
-    from shipgym_baselines.style import controller_style
+    from shipgym_baselines.leaderboard.page import _legend_html
+    from shipgym_baselines.leaderboard.style import controller_style
 
     html = _legend_html([("PID", [("oracle", "o"), ("oracle_frozen", "f"), ("pid_los", "p")])])
     assert '<span class="kref"></span>o' in html and '<span class="kfrozen"></span>f' in html

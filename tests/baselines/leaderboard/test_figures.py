@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from shipgym_baselines import figures
-from shipgym_baselines.figures import (
+from shipgym_baselines.leaderboard import figures
+from shipgym_baselines.leaderboard.figures import (
     LEGEND_KEY,
     LEGEND_TOP_KEY,
     PAGE_COLOURS,
@@ -25,8 +25,8 @@ from shipgym_baselines.figures import (
     plot_ranking,
     plot_scenario,
 )
-from shipgym_baselines.ranking import aggregate_ranking
-from shipgym_baselines.style import FIGURE_DPI, controller_style
+from shipgym_baselines.leaderboard.ranking import aggregate_ranking
+from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 
 SVG = "{http://www.w3.org/2000/svg}"
 

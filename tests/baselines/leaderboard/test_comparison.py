@@ -1,6 +1,7 @@
 """A run of chosen controllers is ranked against the references added to it
-(shipgym_baselines.comparison): a plug-in gets a cost ratio and a rank, ``--no-references``
-none (and the message names how to get one), the oracle alone has nothing to rank."""
+(shipgym_baselines.leaderboard.comparison): a plug-in gets a cost ratio and a rank,
+``--no-references`` none (and the message names how to get one), the oracle alone has
+nothing to rank."""
 
 from __future__ import annotations
 
@@ -14,16 +15,16 @@ import pytest
 import yaml
 
 from shipgym_baselines.cli import main
-from shipgym_baselines.comparison import (
+from shipgym_baselines.leaderboard.comparison import (
     REFERENCES,
     comparison_note,
     references_record,
     suite_folder,
     with_references,
 )
-from shipgym_baselines.ranking import NO_RANKING, NOTHING_TO_RANK
+from shipgym_baselines.leaderboard.ranking import NO_RANKING, NOTHING_TO_RANK
+from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.records.runs import read_episodes, read_run
-from shipgym_baselines.suite import load_suite
 
 #: a user's controller, as docs/plugins.md enters one
 POLICY_FILE = """

@@ -1,6 +1,6 @@
-"""``leaderboard.html``: the leaderboard as one self-contained page (issue 13).
+"""``leaderboard.html``: the leaderboard as one self-contained page.
 
-It opens with the run's verdict in two sentences (:mod:`shipgym_baselines.verdict`).
+It opens with the run's verdict in two sentences (:mod:`shipgym_baselines.leaderboard.verdict`).
 No network: the style sheet and the script are inline and every figure is embedded as a
 data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
 
@@ -8,12 +8,12 @@ data URI (the SVG copy where there is one, else the PNG).  The page holds, in or
    ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
    rate, 95 % intervals; a split's partial table below it), the resolution of each split,
    the headroom per ship × change family (what knowing the change is worth: C_frozen /
-   C_oracle, :func:`shipgym_baselines.ranking.headroom_table`) and the figures
-   (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.figures`);
+   C_oracle, :func:`shipgym_baselines.leaderboard.ranking.headroom_table`) and the figures
+   (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.leaderboard.figures`);
 2. the **controller × scenario table**: the oracle's mean cost, then each controller's
    geometric-mean cost ratio with its interval (``scenario_scores.json``,
-   :func:`shipgym_baselines.ranking.scenario_scores`), shaded from 1 (the oracle, green) to ≥ 4
-   (red);
+   :func:`shipgym_baselines.leaderboard.ranking.scenario_scores`), shaded from 1 (the oracle, green)
+   to ≥ 4 (red);
 3. the **scenario figures** (``scenario_*``), one per scenario;
 4. the **long per-row table** (``leaderboard.json`` rows), collapsed.
 
@@ -44,13 +44,13 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from shipgym_baselines.figures import (
+from shipgym_baselines.leaderboard.figures import (
     LEARNING_CURVES_STEM,
     LEGEND_KEY,
     LEGEND_TOP_KEY,
     figure_stem,
 )
-from shipgym_baselines.ranking import (
+from shipgym_baselines.leaderboard.ranking import (
     BASELINE,
     GAIN,
     HEADROOM_EXPLAINED,
@@ -63,8 +63,8 @@ from shipgym_baselines.ranking import (
     no_ranking,
     resolution_lines,
 )
+from shipgym_baselines.leaderboard.style import controller_style
 from shipgym_baselines.records.outfiles import write_bytes
-from shipgym_baselines.style import controller_style
 
 #: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)
 PROB = f"prob_improvement_over_{BASELINE}"
@@ -525,8 +525,8 @@ def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
 
 
 def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
-    """The headroom table (:func:`shipgym_baselines.ranking.headroom_table` rows): one row per
-    ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
+    """The headroom table (:func:`shipgym_baselines.leaderboard.ranking.headroom_table` rows): one
+    row per ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
     over its trials (how many beside it); empty without rows."""
     if not headroom:
         return ""
@@ -583,14 +583,15 @@ def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
 
 # ------------------------------------------------------------------------------ figures
 def _anchor(name: str) -> str:
-    """The id of a scenario's figure (the stem :func:`shipgym_baselines.figures.plot_scenario` gives
+    """The id of a scenario's figure (the stem
+    :func:`shipgym_baselines.leaderboard.figures.plot_scenario` gives
     its files)."""
     return "scenario_" + figure_stem(name)
 
 
 class PageImage(NamedTuple):
     """A figure as the page embeds it: MIME type, bytes, and the legends it carries as text
-    (a scenario figure's :data:`~shipgym_baselines.figures.LEGEND_KEY`; None: in the
+    (a scenario figure's :data:`~shipgym_baselines.leaderboard.figures.LEGEND_KEY`; None: in the
     image)."""
 
     mime: str
@@ -603,8 +604,8 @@ def page_image(png: Path) -> PageImage:
     (a palette figure: ≈ 20 % smaller; every current browser shows WebP; effort 4 of 6:
     0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the PNG as it is.  A
     scenario figure whose PNG says where its legends start
-    (:data:`~shipgym_baselines.figures.LEGEND_TOP_KEY`) is cut above them and its legends
-    returned as text (the page writes them under the image, issue 20)."""
+    (:data:`~shipgym_baselines.leaderboard.figures.LEGEND_TOP_KEY`) is cut above them and its
+    legends returned as text (the page writes them under the image)."""
     data = png.read_bytes()
     from PIL import Image, features
 
@@ -640,8 +641,8 @@ class _Embedded(NamedTuple):
 
 def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
     """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
-    page-sized palette PNG, :func:`shipgym_baselines.figures.write_page_png`, embedded as
-    :func:`page_image` gives it: the page stays light, issue 20), else the SVG; in the
+    page-sized palette PNG, :func:`shipgym_baselines.leaderboard.figures.write_page_png`, embedded
+    as :func:`page_image` gives it: the page stays light), else the SVG; in the
     order of ``figures``."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
@@ -739,10 +740,10 @@ def page(
     headroom: Sequence[Mapping[str, Any]] = (),
 ) -> str:
     """The page's HTML (module doc); ``verdict``: the run's sentences
-    (:mod:`shipgym_baselines.verdict`), the page's first paragraph; ``note``: what the run
-    is ranked against (:func:`~shipgym_baselines.comparison.comparison_note`), under it;
-    ``headroom``: the headroom table's rows
-    (:func:`~shipgym_baselines.ranking.headroom_table`), after the ranking."""
+    (:mod:`shipgym_baselines.leaderboard.verdict`), the page's first paragraph; ``note``: what the
+    run is ranked against (:func:`~shipgym_baselines.leaderboard.comparison.comparison_note`),
+    under it; ``headroom``: the headroom table's rows
+    (:func:`~shipgym_baselines.leaderboard.ranking.headroom_table`), after the ranking."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
         figures, (r["scenario"] for r in rows)
     )
@@ -808,8 +809,9 @@ def write_html(
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
-    :func:`shipgym_baselines.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
-    :mod:`shipgym_baselines.figures`; ``subtitle``: a line under the title (e.g. the suite
+    :func:`shipgym_baselines.leaderboard.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
+    :mod:`shipgym_baselines.leaderboard.figures`; ``subtitle``: a line under the title (e.g. the
+    suite
     and seeds); ``verdict``: the paragraph the page opens with; ``note``: what the run is
     ranked against; ``headroom``: the headroom table's rows.  Returns the page's path."""
     out = Path(out_dir)

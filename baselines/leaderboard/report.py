@@ -178,7 +178,7 @@ def _write(
     vector_figures: bool = False,
 ) -> list[dict[str, Any]]:
     """The report's files in the locked ``target``, each listed in its manifest."""
-    from shipgym_baselines.leaderboard import write_results
+    from shipgym_baselines.leaderboard.outputs import write_results
 
     manifest = Manifest(target)
     with manifest.recording():  # each file listed as it is written

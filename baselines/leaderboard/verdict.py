@@ -9,7 +9,7 @@
    the learned agents stand: the best one's rank and its IQM over the best classical
    controller's.
 2. **What the failures are**: the median failure rate of the table's controllers
-   (:data:`~shipgym_baselines.ranking.FAILED_EPISODES`), and the scenarios the failed
+   (:data:`~shipgym_baselines.leaderboard.ranking.FAILED_EPISODES`), and the scenarios the failed
    episodes come from: those on which most controllers (more than half) fail most of their
    episodes (more than half), with their share of all failed episodes; when there are none,
    the scenario with the most failed episodes.
@@ -18,7 +18,7 @@ When the record has the episodes of both references (``oracle`` and ``oracle_fro
 same NMPC with its truth frozen at the episode's start), two more sentences decompose it:
 
 3. **What knowing the change is worth**: the geometric mean, over the table's trials, of
-   the headroom C_frozen / C_oracle (:func:`shipgym_baselines.ranking.trial_headroom`).
+   the headroom C_frozen / C_oracle (:func:`shipgym_baselines.leaderboard.ranking.trial_headroom`).
 4. **How much of it the leader captures**: its gap closed (IQM of log(C_frozen / C) /
    log(C_frozen / C_oracle) over the trials whose headroom is at least 1.2, with its 95 %
    interval) and how often it beats the optimum that never adapts (P(C < C_frozen)); and
@@ -37,7 +37,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.ranking import (
+from shipgym_baselines.leaderboard.ranking import (
     FAILED_EPISODES,
     GAP_HEADROOM,
     ORACLE,

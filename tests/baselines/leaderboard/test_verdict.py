@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from shipgym_baselines.verdict import (
+from shipgym_baselines.leaderboard.verdict import (
     folder_verdict,
     main_table,
     md_code,

@@ -9,7 +9,7 @@ import yaml
 
 from shipgym.config import list_names
 from shipgym_baselines.errors import ConfigError
-from shipgym_baselines.suite import SuiteConfig, list_suites, load_suite
+from shipgym_baselines.leaderboard.suite import SuiteConfig, list_suites, load_suite
 
 
 def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
@@ -87,14 +87,14 @@ def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
 
 
 def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
-    text = (Path(__file__).resolve().parents[2] / "configs/suites/smoke.yaml").read_text()
+    text = (Path(__file__).resolve().parents[3] / "configs/suites/smoke.yaml").read_text()
     assert load_suite(write(tmp_path, text)) == load_suite("smoke")
 
 
 def test_relative_scenario_paths_are_read_against_the_suite_folder(
     tmp_path: Path, monkeypatch
 ) -> None:
-    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    nominal = (Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml").read_text()
     text = nominal.replace("name: nominal", "name: mine")
     scenario = write(tmp_path, text, "suites/scenarios/mine.yaml")
     suite = write(
@@ -181,11 +181,11 @@ def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
 
 # --- check_suite_file (shipgym scenarios --validate) -----------------------------------------
 
-NOMINAL = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+NOMINAL = (Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml").read_text()
 
 
 def test_a_suite_check_lists_schema_and_later_problems_together(tmp_path: Path) -> None:
-    from shipgym_baselines.suite import check_suite_file
+    from shipgym_baselines.leaderboard.suite import check_suite_file
 
     scenario = write(tmp_path, NOMINAL.replace("name: nominal", "name: my_turn"), "mine.yaml")
     write(tmp_path, NOMINAL.replace("name: nominal", "name: my_turn"), "twin.yaml")
@@ -217,7 +217,7 @@ def test_a_suite_check_lists_schema_and_later_problems_together(tmp_path: Path) 
 
 
 def test_a_good_suite_has_no_problems(tmp_path: Path) -> None:
-    from shipgym_baselines.suite import check_suite_file, is_suite_file
+    from shipgym_baselines.leaderboard.suite import check_suite_file, is_suite_file
 
     for name in list_suites():
         assert is_suite_file(name) and check_suite_file(name) == [], name

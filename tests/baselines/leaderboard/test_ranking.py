@@ -9,7 +9,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from shipgym_baselines.ranking import (
+from shipgym_baselines.leaderboard.ranking import (
     AGGREGATE_FIELDS,
     aggregate_ranking,
     performance_profiles,
@@ -269,7 +269,7 @@ def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     """pid_los not ranked: every row's probability of improvement over it is None, and
     leaderboard.md's and the page's tables drop the column."""
     from shipgym_baselines.leaderboard import ranking_tables
-    from shipgym_baselines.pages import ranking_tables as page_tables
+    from shipgym_baselines.leaderboard.page import ranking_tables as page_tables
 
     eps = _episodes({"nmpc": [1.1] * 3, "lqr": [1.3] * 3})
     rows = aggregate_ranking(eps, {"a": "catalogue", "b": "catalogue"}, reps=100)
@@ -340,7 +340,7 @@ def test_the_fast_metrics_give_rliables_bits() -> None:
     aggregate_iqm and probability_of_improvement exactly, ties and equal columns included."""
     from rliable import metrics as rmetrics
 
-    from shipgym_baselines.ranking import interquartile_mean, probability_of_improvement
+    from shipgym_baselines.leaderboard.ranking import interquartile_mean, probability_of_improvement
 
     rng = np.random.default_rng(3)
     for trial in range(200):
@@ -412,7 +412,7 @@ def test_the_gap_fields_against_a_hand_computed_case() -> None:
 
 
 def test_the_gap_matrices_per_trial() -> None:
-    from shipgym_baselines.ranking import gap_matrices, trial_headroom
+    from shipgym_baselines.leaderboard.ranking import gap_matrices, trial_headroom
 
     scored = scored_episodes(_hand_episodes())
     assert trial_headroom(scored) == pytest.approx(
@@ -435,7 +435,7 @@ def test_the_gap_interval_is_rliables_bootstrap_with_nan_where_a_trial_does_not_
     from rliable import library as rly
     from rliable import metrics as rmetrics
 
-    from shipgym_baselines.ranking import gap_matrices
+    from shipgym_baselines.leaderboard.ranking import gap_matrices
 
     rng = np.random.default_rng(11)
     trials = [(100.0, 100.0 * h, 100.0 * h * g) for h, g in rng.lognormal(0.3, 0.6, (12, 2))]
@@ -498,7 +498,7 @@ def test_scenario_scores_give_the_frozen_optimums_cost_and_the_headroom() -> Non
 
 
 def test_the_frozen_optimum_is_a_reference_whatever_its_kind_says() -> None:
-    from shipgym_baselines.ranking import controller_kinds
+    from shipgym_baselines.leaderboard.ranking import controller_kinds
 
     eps = _hand_episodes()
     for ep in eps:
@@ -509,7 +509,7 @@ def test_the_frozen_optimum_is_a_reference_whatever_its_kind_says() -> None:
 
 
 def test_change_family_follows_the_catalogues_names() -> None:
-    from shipgym_baselines.ranking import change_family
+    from shipgym_baselines.leaderboard.ranking import change_family
 
     assert change_family("esso_osaka_current_shift_curved") == "current_shift"
     assert change_family("rudder_aging_long") == "rudder_aging"
@@ -521,7 +521,7 @@ def test_change_family_follows_the_catalogues_names() -> None:
 
 
 def test_the_headroom_table_per_ship_and_change_family() -> None:
-    from shipgym_baselines.ranking import headroom_table, scenario_ships
+    from shipgym_baselines.leaderboard.ranking import headroom_table, scenario_ships
 
     def trial(scenario: str, seed: int, oracle: float, frozen: float) -> list[dict]:
         return [

@@ -6,7 +6,8 @@ Each writer that puts a name where it could be read as markup escapes it here:
 * :func:`md_cell`: a ``leaderboard.md`` table cell stays one cell;
 * :func:`csv_cell`: a ``leaderboard.csv`` cell is never a spreadsheet formula.
 
-(HTML and SVG escape names themselves: :mod:`shipgym_baselines.pages`, matplotlib's SVG writer.)
+(HTML and SVG escape names themselves: :mod:`shipgym_baselines.leaderboard.page`, matplotlib's SVG
+writer.)
 """
 
 from __future__ import annotations

@@ -10,9 +10,9 @@ from pathlib import Path
 import yaml
 
 from shipgym_baselines.cli import main
-from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
+from shipgym_baselines.leaderboard.escaping import csv_cell, md_cell, plain_text
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 MATHTEXT = r"$\undefinedmacro{x}$"
 FORMULA = "=HYPERLINK(1)|x"
 

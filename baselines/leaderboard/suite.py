@@ -1,5 +1,5 @@
 """Benchmark suites (``configs/suites``): the scenarios, controllers and seeds of a
-leaderboard run (SPEC §9), validated when the file is read."""
+leaderboard run (docs/leaderboard.md), validated when the file is read."""
 
 from __future__ import annotations
 

@@ -64,7 +64,7 @@ def with_stand_in_oracle(run_folder: Path, out: Path) -> Path:
     """A copy of a run record (``run.json``, ``episodes.jsonl``) with a stand-in ``oracle``
     (kind reference): each pid_los episode again, its cost × :data:`STAND_IN`; then the
     report of it in ``out / "report"``, whose folder is returned."""
-    from shipgym_baselines.report import write_report
+    from shipgym_baselines.leaderboard.report import write_report
 
     record = json.loads((run_folder / "run.json").read_text())
     entry = {"name": "oracle", "controller": "oracle", "kind": "reference"}
@@ -211,7 +211,7 @@ def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
 def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     randomised: Path, ranked: Path
 ) -> None:
-    """The run's two sentences (shipgym_baselines.verdict) first; a report folder (no
+    """The run's two sentences (shipgym_baselines.leaderboard.verdict) first; a report folder (no
     episodes of its own) prints those its leaderboard.md opens with; no ranking: none."""
     from shipgym_baselines.leaderboard import terminal_summary
 
@@ -386,7 +386,7 @@ def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, worker
     once the first episode is recorded: every episode still runs the scenario as run.json
     recorded it at the start, in the parent and in the pool's workers."""
     case = tmp_path / "case.yaml"
-    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
+    nominal = (Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml").read_text()
     original = nominal.replace("name: nominal", "name: case")
     case.write_text(original)
     suite = write_suite(tmp_path, scenarios=[str(case)], seeds=4)
@@ -425,7 +425,7 @@ def test_quick_suite_finishes(tmp_path: Path) -> None:
     """The quick suite (issue 18) runs to the end with every controller on its 12
     scenarios (one evaluation seed here, to keep CI short; the suite's own is 3): a row per
     controller and scenario, every applicable one with its episodes."""
-    from shipgym_baselines.suite import load_suite
+    from shipgym_baselines.leaderboard.suite import load_suite
 
     quick = load_suite("quick")
     rows = run_leaderboard("quick", seeds=1, out_dir=tmp_path, workers=2, show_progress=False)
@@ -443,7 +443,7 @@ def test_quick_suite_finishes(tmp_path: Path) -> None:
 
 # --- the suite's own scenarios ---------------------------------------------------------------
 
-NOMINAL = Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml"
+NOMINAL = Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml"
 
 
 def own_scenario(folder: Path, file: str, name: str, time_limit: float = 40.0) -> Path:
@@ -559,7 +559,7 @@ def test_a_scenario_file_named_as_a_catalogue_scenario_is_refused(tmp_path: Path
 
 def test_a_copy_of_a_catalogue_scenario_is_that_scenario(tmp_path: Path) -> None:
     from shipgym_baselines.leaderboard import suite_record, suite_scenarios
-    from shipgym_baselines.suite import load_suite
+    from shipgym_baselines.leaderboard.suite import load_suite
 
     copy = tmp_path / "copy.yaml"
     copy.write_text(NOMINAL.read_text())
@@ -579,7 +579,7 @@ def with_stand_in_references(run_folder: Path, out: Path) -> Path:
     """:func:`with_stand_in_oracle`'s record with a stand-in ``oracle_frozen`` too (kind
     reference): each pid_los episode again, its cost × :data:`FROZEN`; the report of it in
     ``out / "gap"``, whose folder is returned."""
-    from shipgym_baselines.report import write_report
+    from shipgym_baselines.leaderboard.report import write_report
 
     with_stand_in_oracle(run_folder, out)
     record = out / "record"
@@ -639,8 +639,8 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     (``run.json``'s ``scenario_seeds``); its oracle reference is read from the shipped
     table, which holds the default suite's in-range trials."""
     from shipgym_baselines.leaderboard import trials
+    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.references import shipped_table
-    from shipgym_baselines.suite import load_suite
 
     randomize = load_suite("default").randomize.model_dump(mode="json")
     suite = write_suite(

@@ -10,8 +10,8 @@ import pytest
 
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.leaderboard.report import write_report
 from shipgym_baselines.records.runs import read_run
-from shipgym_baselines.report import write_report
 from tests.baselines.records.test_runs import untimed, write_suite
 
 

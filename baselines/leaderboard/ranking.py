@@ -615,7 +615,7 @@ def resolution(board: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """Per main table of ``board`` (aggregate rows): how well the ranking separates its
     controllers — the median width of the ``cost_ratio_iqm`` intervals, the range (max − min)
     of ``cost_ratio_iqm`` over the competitors and whether the width is below a fifth of the
-    range (``resolved``; issue 17's target)."""
+    range (``resolved``: the ranking tells its controllers apart)."""
     out = []
     for split in dict.fromkeys(r["split"] for r in board):
         if is_partial(split):

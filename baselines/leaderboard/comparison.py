@@ -1,7 +1,7 @@
 """What a run is ranked against: the references added to its controllers.
 
 The ranking divides each episode's cost by the ``oracle``'s on the same trial
-(:mod:`shipgym_baselines.ranking`), so a run without the oracle has no ranking.
+(:mod:`shipgym_baselines.leaderboard.ranking`), so a run without the oracle has no ranking.
 ``shipgym evaluate``, ``shipgym leaderboard --controllers`` and a suite that does not list
 the ``oracle`` add the references :data:`REFERENCES` the controllers lack, unless
 ``--no-references`` (a suite that lists the oracle runs as it lists its controllers):
@@ -27,8 +27,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from shipgym_baselines.leaderboard.ranking import REFERENCE_KIND
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
-from shipgym_baselines.ranking import REFERENCE_KIND
 
 #: the references added to a run's controllers (the cost ratio's denominator first)
 REFERENCES = ("oracle", "oracle_frozen", "zero_rudder", "random")

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from shipgym_baselines.leaderboard.style import controller_style
 from shipgym_baselines.registry import CONTROLLERS
-from shipgym_baselines.style import controller_style
 
 
 def test_built_in_controllers_have_distinct_fixed_styles() -> None:

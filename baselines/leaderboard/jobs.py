@@ -1,0 +1,372 @@
+"""The leaderboard's work: a :class:`Job` per controller and scenario, the plan of a run's
+jobs, and the functions a worker runs (locally in a process pool or on a Ray cluster)."""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+from collections import defaultdict
+from collections.abc import Iterable, Iterator, Mapping
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+from typing import Any, NamedTuple
+
+from shipgym.config import is_path
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines import evaluation
+from shipgym_baselines.errors import BackendError, RunError
+from shipgym_baselines.evaluation import ACT_TIMEOUT_S
+from shipgym_baselines.leaderboard.ranking import (
+    controller_failed,
+)
+from shipgym_baselines.leaderboard.suite import scenario_names
+from shipgym_baselines.plugins import ControllerSpec
+from shipgym_baselines.privileged import grants_truth
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.runs import (
+    BACKENDS,
+)
+from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
+from shipgym_baselines.registry import applies_to, controller_kind, controller_label
+from shipgym_baselines.signals import worker_init
+
+
+def check_controllers(names: list[str]) -> list[str]:
+    """The table labels of ``names``; a clear error, before any job runs, for a name that
+    is neither a controller nor a trained agent, and for two names with the same label."""
+    labels = [controller_label(name) for name in names]  # resolves each: a clear error
+    duplicates = sorted({label for label in labels if labels.count(label) > 1})
+    if duplicates:
+        raise RunError(
+            f"controllers {names} give the same table name(s) {duplicates}: give each its "
+            "own name (a suite's long form {controller: ..., name: ...})"
+        )
+    return labels
+
+
+#: the split of the scenarios a suite gives as YAML files (run.json's ``scenario_files``)
+
+
+class Job(NamedTuple):
+    """One unit of work: a controller (trained with ``training_seed``; None: not trained)
+    on the trials of scenario ``scenario`` (its table name, :func:`suite_scenarios`; or a
+    catalogue name, held-out name or YAML path loaded as such) that ``seeds``
+    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
+    ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
+    as recorded whatever its file says now; None: resolved from ``scenario`` here."""
+
+    controller: ControllerSpec
+    scenario: str
+    seeds: tuple[int, ...]
+    training_seed: int | None = None
+    randomize: dict[str, Any] | None = None
+    settings: dict[str, Any] | None = None
+    #: the oracle's episodes: "table" (the shipped reference table, running only a trial it
+    #: lacks) or "recompute" (run every trial)
+    references: str = "table"
+    #: the limit [s] on one ``act`` call: a slower call, or a controller that fails, ends
+    #: its episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
+    act_timeout: float = ACT_TIMEOUT_S
+
+
+@functools.lru_cache(maxsize=128)
+def _cached_scenario(name: str, _stamp: tuple[int, int] | None) -> Scenario:
+    return load_scenario(name)
+
+
+def suite_scenario(name: str) -> Scenario:
+    """A suite's scenario, loaded once per process (a YAML file again when it changed)."""
+    stamp = None
+    if is_path(name):
+        stat = Path(name).stat()
+        stamp = (stat.st_mtime_ns, stat.st_size)
+    return _cached_scenario(name, stamp)
+
+
+def suite_scenarios(entries: Iterable[str]) -> dict[str, Scenario]:
+    """A suite's scenarios (as :func:`~shipgym_baselines.leaderboard.suite.load_suite` gives them)
+    by table name: a catalogue or held-out name as given, a YAML file's under its ``name:``
+    (:func:`~shipgym_baselines.leaderboard.suite.scenario_names`: a name that clashes is refused,
+    naming both files)."""
+    entries = list(entries)
+    names = scenario_names(entries, suite_scenario).names
+    return {names[entry]: suite_scenario(entry) for entry in entries}
+
+
+@functools.lru_cache(maxsize=128)
+def _recorded_scenario(settings: str) -> Scenario:
+    return load_scenario(json.loads(settings))
+
+
+def job_scenario(job: Job) -> Scenario:
+    """The job's scenario: built from its recorded ``settings`` (once per process), else
+    resolved from its name."""
+    if job.settings is None:
+        return suite_scenario(job.scenario)
+    return _recorded_scenario(json.dumps(job.settings, sort_keys=True))
+
+
+def trials(job: Job) -> list[Scenario]:
+    """The job's scenario as each of its seeds draws it (the scenario itself without
+    randomisation)."""
+    base = job_scenario(job)
+    randomization = None if job.randomize is None else TrialRandomization(**job.randomize)
+    return [trial_scenario(base, randomization, seed) for seed in job.seeds]
+
+
+def _named(results: list[EpisodeResult], job: Job) -> list[EpisodeResult]:
+    """``results`` under the table name and the job's scenario name, with the job's
+    training seed."""
+    label = controller_label(job.controller)
+    for result in results:
+        result.controller = label
+        result.scenario = job.scenario
+        if job.training_seed is not None:
+            result.training_seed = job.training_seed
+    return results
+
+
+def run_job(job: tuple) -> EpisodeResult:
+    """One episode ``(controller, scenario, seed[, training_seed[, randomize]])`` (see
+    :class:`Job`); top-level so process pools can pickle it."""
+    one = Job(job[0], job[1], (int(job[2]),), *job[3:])
+    (trial,) = trials(one)
+    seeds = list(one.seeds)
+    result = evaluation.evaluate(
+        one.controller, trial, seeds, training_seed=one.training_seed, guard=_guard(one)
+    )
+    return _named(result, one)[0]
+
+
+def _guard(job: Job) -> evaluation.ActGuard:
+    """How the job's episodes end when their controller fails."""
+    return evaluation.ActGuard(job.act_timeout)
+
+
+def run_batch(job: Job) -> list[EpisodeResult]:
+    """The job's episodes, all seeds at once (:func:`shipgym_baselines.evaluation.evaluate_batch`),
+    in the order of ``job.seeds``."""
+    results = evaluation.evaluate_batch(
+        job.controller,
+        trials(job),
+        list(job.seeds),
+        training_seed=job.training_seed,
+        guard=_guard(job),
+    )
+    return _named(list(results), job)
+
+
+def reference_work(job: Job) -> list[EpisodeResult]:
+    """A privileged reference's episodes of ``job`` (``oracle`` or ``oracle_frozen``): each
+    trial's entry of the reference's shipped table or of its per-user cache
+    (:mod:`shipgym_baselines.references`), the reference run for a trial both lack (and
+    stored in the cache)."""
+    reference = controller_label(job.controller)
+    cache, out = ReferenceCache(reference=reference), []
+    for seed, trial in zip(job.seeds, trials(job), strict=True):
+        entry = lookup(trial, seed, cache, reference)
+        if entry is not None:
+            out.append(result_from_entry(entry, job.scenario, seed, reference))
+        else:
+            (result,) = _named(
+                evaluation.evaluate(job.controller, trial, [seed], guard=_guard(job)), job
+            )
+            if not controller_failed(result.metrics):  # a reference that failed: not kept
+                cache.store(trial, result)
+            out.append(result)
+    return out
+
+
+def announce_references(jobs: Iterable[Job]) -> None:
+    """One line on stderr per privileged reference before its episodes of ``jobs`` that are
+    computed, not read (a trial neither table holds; every trial with
+    ``--recompute-references``): how many, the estimated CPU time."""
+    pending: dict[str, list[Scenario]] = defaultdict(list)
+    where: dict[str, str] = {}
+    for job in jobs:
+        if not grants_truth(job.controller):
+            continue
+        reference = controller_label(job.controller)
+        cache = ReferenceCache(reference=reference)
+        where.setdefault(reference, f"once: cached in {cache.path}")
+        for seed, trial in zip(job.seeds, trials(job), strict=True):
+            if job.references == "recompute":
+                pending[reference].append(trial)
+                where[reference] = (
+                    "--recompute-references: every trial, the cache neither read nor written"
+                )
+            elif lookup(trial, seed, cache, reference) is None:
+                pending[reference].append(trial)
+    for reference, todo in pending.items():
+        announce(todo, where[reference], reference)
+
+
+def work(job: Job) -> list[EpisodeResult]:
+    """A job's episodes: a privileged reference's from its table (:func:`reference_work`), a
+    single seed through :func:`run_job`, several through :func:`run_batch`."""
+    if job.references == "table" and grants_truth(job.controller):
+        return reference_work(job)
+    if len(job.seeds) == 1:
+        return [run_job((job.controller, job.scenario, job.seeds[0], *job[3:]))]
+    return run_batch(job)
+
+
+def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
+    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes,
+    :func:`shipgym_baselines.signals.worker_init`)."""
+    if workers <= 1:
+        for job in jobs:
+            yield work(job)
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=worker_init)
+    try:
+        for fut in as_completed([pool.submit(work, j) for j in jobs]):
+            yield fut.result()
+    except BaseException:  # Ctrl-C, a failed job, or the consumer stopped: stop the workers
+        workers_running = list((pool._processes or {}).values())  # shutdown forgets them
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers_running:
+            process.kill()  # workers ignore SIGTERM (shipgym_baselines.signals)
+        raise
+    pool.shutdown()
+
+
+def _iter_ray(jobs: list[Job]) -> Iterator[list[EpisodeResult]]:
+    try:
+        import ray
+    except ImportError as exc:
+        raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
+    if not ray.is_initialized():
+        ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
+    remote = ray.remote(work)
+    pending = [remote.remote(j) for j in jobs]
+    try:
+        while pending:
+            done, pending = ray.wait(pending)
+            yield from ray.get(done)
+    except BaseException:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        raise
+
+
+def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[EpisodeResult]]:
+    """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), job by job in completion
+    order."""
+    if backend == "local":
+        return _iter_local(jobs, workers)
+    if backend == "ray":
+        return _iter_ray(jobs)
+    raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
+
+
+def _result_key(result: EpisodeResult) -> tuple[str, str, int, int | None]:
+    """(scenario, table name, seed, training seed): the episode's key in ``episodes.jsonl``."""
+    return (result.scenario, result.controller, int(result.seed), result.training_seed)
+
+
+def suite_record(
+    spec: Any,
+    names: list[ControllerSpec],
+    scenarios: Mapping[str, Scenario],
+    seed_list: list[int],
+    seeds_of: Mapping[str, list[int | None]],
+) -> dict[str, Any]:
+    """The resolved suite as ``run.json`` keeps it: evaluation seeds (``scenario_seeds``:
+    the scenarios run on fewer,
+    :meth:`~shipgym_baselines.leaderboard.suite.SuiteConfig.scenario_seeds`),
+    the trial randomisation, controllers (table name, how the suite names it, kind, training seeds),
+    each scenario's settings (by table name), the pairs that do not apply and, when the
+    suite has its own scenarios, ``scenario_files`` (table name → the YAML file read)."""
+    ships = {s: sc.model.name for s, sc in scenarios.items()}
+    controllers = []
+    for c in names:
+        label = controller_label(c)
+        controllers.append(
+            {
+                "name": label,
+                "controller": c if isinstance(c, str) else c.model_dump(),  # the long form
+                "kind": controller_kind(label),
+                "training_seeds": list(seeds_of[label]),
+            }
+        )
+    files = scenario_names(spec.all_scenarios(), suite_scenario).files
+    own = {"scenario_files": {n: f for n, f in files.items() if n in scenarios}}
+    fewer = {s: v for s, v in spec.scenario_seeds(seed_list).items() if s in scenarios}
+    return {
+        "name": spec.name,
+        "seeds": seed_list,
+        **({"scenario_seeds": fewer} if fewer else {}),  # absent without: older records resume
+        "randomize": None if spec.randomize is None else spec.randomize.model_dump(mode="json"),
+        "controllers": controllers,
+        "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
+        "does_not_apply": [
+            [s, c["name"]]
+            for s in scenarios
+            for c in controllers
+            if not applies_to(c["name"], ships[s])
+        ],
+        **(own if own["scenario_files"] else {}),  # absent without: older records resume
+    }
+
+
+def plan_jobs(
+    names: list[ControllerSpec],
+    scenarios: Iterable[str] | Mapping[str, dict[str, Any]],
+    seed_list: list[int],
+    seeds_of: Mapping[str, list[int | None]],
+    randomize: dict[str, Any] | None,
+    skip: set[tuple[str, str]],
+    references: str = "table",
+    scenario_seeds: Mapping[str, list[int]] | None = None,
+) -> list[Job]:
+    """Every job of a run: per scenario and controller that applies, one job of all seeds
+    per training seed (a learned agent's) or of all seeds (a classical controller's: they
+    run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
+    reference table is looked up trial by trial).  ``scenarios``: names, or name →
+    recorded settings (the jobs run those); ``scenario_seeds``: the scenarios run on other
+    seeds than ``seed_list``, with theirs."""
+    jobs = []
+    for scenario in scenarios:
+        settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
+        seeds = list((scenario_seeds or {}).get(scenario, seed_list))
+        for c in names:
+            label = controller_label(c)
+            if (scenario, label) in skip:
+                continue
+            for k in seeds_of[label]:
+                if controller_kind(label) == "learned":
+                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings))
+                elif not grants_truth(c):
+                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings, references))
+                else:
+                    jobs += [
+                        Job(c, scenario, (seed,), k, randomize, settings, references)
+                        for seed in seeds
+                    ]
+    return jobs
+
+
+def longest_first(jobs: list[Job], scenarios: Mapping[str, Scenario]) -> list[Job]:
+    """``jobs`` ordered by their most control steps (the scenario's time limit over its
+    control period, × the job's seeds), longest first: the pool's workers then end
+    together instead of one finishing a long job alone (what a run computes is the same)."""
+
+    def steps(job: Job) -> float:
+        sc = scenarios[job.scenario]
+        return sc.config.time_limit / sc.control_period * len(job.seeds)
+
+    return sorted(jobs, key=steps, reverse=True)  # stable: ties keep the plan's order
+
+
+def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
+    """The jobs with the seeds whose episodes ``done`` (episode keys) does not hold."""
+    todo = []
+    for job in jobs:
+        label = controller_label(job.controller)
+        seeds = [s for s in job.seeds if (job.scenario, label, s, job.training_seed) not in done]
+        if seeds:
+            todo.append(job._replace(seeds=tuple(seeds)))
+    return todo

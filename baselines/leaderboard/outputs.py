@@ -1,0 +1,336 @@
+"""What a run folder gets: the tables, the ranking and the figures written from its
+episodes, the terminal summary, and the plot of ``shipgym run``."""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import os
+from collections.abc import Callable, Iterator, Mapping
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from shipgym.config import is_path
+from shipgym.notices import notice
+from shipgym.scenarios import load_scenario
+from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines.jsonout import dumps, dumps_rows
+from shipgym_baselines.leaderboard.comparison import (
+    comparison_note,
+)
+from shipgym_baselines.leaderboard.escaping import csv_cell, plain_text
+from shipgym_baselines.leaderboard.markdown import (
+    generalisation_table,
+    markdown_table,
+    ranking_markdown,
+    ranking_tables,
+)
+from shipgym_baselines.leaderboard.ranking import (
+    PARTIAL,
+    aggregate_ranking,
+    headroom_table,
+    no_ranking,
+    resolution_lines,
+    scenario_ships,
+)
+from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
+from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
+from shipgym_baselines.leaderboard.tables import (
+    AGGREGATE_FILE,
+    SCENARIO_SCORES_FILE,
+    aggregate_results,
+    episode_rows,
+    generalisation,
+    rankable,
+    scenario_split,
+)
+from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name, verdict
+from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
+from shipgym_baselines.records.runs import (
+    RUN_FILE,
+    episode_result,
+    read_episodes,
+    read_run,
+)
+from shipgym_baselines.signals import worker_init
+from shipgym_baselines.studies.run_costs import tables_line
+
+
+def load_results(folder: str | os.PathLike) -> list[EpisodeResult]:
+    """The episodes recorded in a run folder's ``episodes.jsonl`` (trajectories if kept)."""
+    return [episode_result(r, folder) for r in read_episodes(folder)]
+
+
+def _order(result: EpisodeResult) -> tuple:
+    ts = result.training_seed
+    return (result.scenario, result.controller, ts is not None, ts or 0, result.seed)
+
+
+def write_results(
+    out: str | os.PathLike,
+    suite: Mapping[str, Any],
+    results: list[EpisodeResult],
+    workers: int | None = None,
+    vector_figures: bool = False,
+    announce: bool = True,
+) -> list[dict[str, Any]]:
+    """Tables, ranking and figures into ``out`` from episode results and a suite as
+    ``run.json`` keeps it (:func:`suite_record`); returns the rows.  ``announce``: say so
+    first in one line on stderr, with the time it takes (:func:`tables_line`).
+
+    ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
+    controller × scenario cost ratios, then the rows), ``generalisation.json``,
+    ``aggregate.json`` (:func:`shipgym_baselines.leaderboard.ranking.aggregate_ranking`),
+    ``scenario_scores.json`` and the figures
+    (:mod:`shipgym_baselines.leaderboard.figures`: per scenario the small multiples of each
+    controller's median-ACE episode, per split the ranking's interval estimates and performance
+    profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.leaderboard.page`: all of it on one
+    page).  The ranking of each split and each figure are independent tasks, run in a
+    pool of ``workers`` processes (default: the cores) when there are
+    :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
+    vector copy too (the page shows the PNGs).
+    """
+    from shipgym_baselines.leaderboard import figures, page
+
+    # completion order varies between runs: aggregate in a fixed order (bit-stable means)
+    results = sorted(results, key=_order)
+    out = Path(out)
+    kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
+    episodes = episode_rows(results)
+    splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
+    ranked = rankable(episodes, suite.get("scenario_seeds"))
+    if announce:
+        notice(tables_line(len(splits), workers or os.cpu_count() or 1))
+    drawn = figures.episodes_to_draw(results)
+    shown = sorted({scenario for scenario, _ in drawn})
+    with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
+        boards = [
+            pool.submit(
+                aggregate_ranking, ranked, {s: sp for s, sp in splits.items() if sp == split}, kinds
+            )
+            for split in sorted(set(splits.values()))
+        ]
+        plots = {
+            scenario: pool.submit(
+                carried(figures.plot_scenarios),
+                out,
+                {key: ep for key, ep in drawn.items() if key[0] == scenario},
+                suite["scenarios"],
+                kinds,
+                vector=vector_figures,
+            )
+            for scenario in shown
+        }
+        board = sorted(
+            (row for future in boards for row in future.result()),
+            key=lambda r: (r["split"], r["cost_ratio_iqm"], r["controller"]),
+        )
+        ranking_plots = [
+            pool.submit(
+                carried(figures.plot_ranking),
+                out,
+                [r for r in board if r["split"].removesuffix(PARTIAL) == split],
+                ranked,
+                splits,
+                kinds,
+                vector_figures,
+            )
+            for split in dict.fromkeys(r["split"].removesuffix(PARTIAL) for r in board)
+        ]
+        rows = aggregate_results(
+            results,
+            list(suite["scenarios"]),
+            list(kinds),
+            kinds=kinds,
+            not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
+            splits=splits,
+        )
+        scores = score_table(ranked, splits, kinds)
+        write_text(out / AGGREGATE_FILE, dumps(board, indent=2) + "\n")
+        write_text(out / SCENARIO_SCORES_FILE, dumps_rows(scores))  # one scenario a line
+        left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
+        note = comparison_note(suite, out)
+        headroom = headroom_table(ranked, scenario_ships(suite["scenarios"]), splits)
+        head = ranking_markdown(
+            board, scores, list(suite["scenarios"]), left_out, ranked, note, headroom
+        )
+        write_tables(rows, out, head=head)
+        files = [f for future in ranking_plots for f in future.result()]
+        files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
+        files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
+    lead = verdict(board, ranked, plain_name)
+    page.write_html(
+        out,
+        rows,
+        board,
+        scores,
+        files,
+        subtitle=subtitle(suite, results),
+        verdict=lead,
+        note=note if board else "",
+        headroom=headroom,
+    )
+    return rows
+
+
+def learned_curves(kinds: Mapping[str, str]) -> dict[str, list[dict[str, Any]]]:
+    """The shipped learning curves of the suite's learned controllers (by name)."""
+    from shipgym_baselines.learned.curves import agent_curves
+
+    return {name: agent_curves(name) for name, kind in kinds.items() if kind == "learned"}
+
+
+def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:
+    """The page's line under its title: suite, seeds, trials, training seeds."""
+    trained = {r.training_seed for r in results if r.training_seed is not None}
+    parts = [
+        f"suite {suite.get('name') or '(merged)'}",
+        f"{len(suite['scenarios'])} scenarios",
+        f"{len(suite['controllers'])} controllers",
+        f"{len(suite['seeds'])} evaluation seeds"
+        + (" (randomised trials)" if suite.get("randomize") else ""),
+    ]
+    if trained:
+        parts.append(f"learned agents × {len(trained)} training seeds")
+    return " · ".join(parts)
+
+
+#: scenario figures from which :func:`write_results` draws in a process pool
+POOLED_FIGURES = 4
+
+
+class _Inline:
+    """An executor that runs each task as it is submitted (a small run needs no pool)."""
+
+    def submit(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Future:
+        future: Future = Future()
+        future.set_result(fn(*args, **kwargs))
+        return future
+
+
+@contextlib.contextmanager
+def _pool(workers: int, figures: int) -> Iterator[Executor | _Inline]:
+    """A process pool of ``workers`` for ``figures`` scenario figures and the ranking, or
+    :class:`_Inline` for a few or one worker."""
+    if workers <= 1 or figures < POOLED_FIGURES:
+        yield _Inline()
+        return
+    with ProcessPoolExecutor(max_workers=workers, initializer=worker_init) as pool:
+        yield pool
+
+
+def terminal_summary(folder: str | os.PathLike) -> str:
+    """What ``leaderboard``, ``evaluate`` and ``report`` print: the ranking of the run
+    folder's ``aggregate.json`` (or why there is none), its resolution, and the path of
+    ``leaderboard.html``."""
+    from shipgym_baselines.leaderboard.page import PAGE_FILE
+
+    lead = folder_verdict(folder)
+    board = json.loads((Path(folder) / AGGREGATE_FILE).read_text())
+    lines = [
+        *([lead, ""] if lead else []),
+        "## Ranking (cost over the oracle's; lower is better)",
+        "",
+    ]
+    lines += ranking_tables(board) + resolution_lines(board) if board else [_why_none(folder), ""]
+    lines += _note_lines(folder) if board else []
+    return "\n".join([*lines, f"leaderboard: {Path(folder) / PAGE_FILE}"])
+
+
+def _why_none(folder: str | os.PathLike) -> str:
+    """Why the run folder has no ranking
+    (:func:`~shipgym_baselines.leaderboard.ranking.no_ranking`)."""
+    file = Path(folder) / SCENARIO_SCORES_FILE
+    return no_ranking(json.loads(file.read_text()) if file.is_file() else [])
+
+
+def _note_lines(folder: str | os.PathLike) -> list[str]:
+    """What a run folder's ranking is against (its ``run.json``), as lines; none for a
+    report's folder or a run that added no reference."""
+    if not (Path(folder) / RUN_FILE).is_file():
+        return []
+    note = comparison_note(read_run(folder).get("suite", {}), folder)
+    return [note, ""] if note else []
+
+
+def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
+    """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
+    before the rows (the ranking)."""
+    write_text(out / "leaderboard.json", dumps_rows(rows))  # one row a line
+    keys = list(dict.fromkeys(k for r in rows for k in r))  # learned rows add training cost
+    table = io.StringIO(newline="")
+    writer = csv.DictWriter(table, fieldnames=keys, restval="")
+    writer.writeheader()
+    writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
+    write_text(out / "leaderboard.csv", table.getvalue())
+    rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
+    write_text(
+        out / "leaderboard.md",
+        (head + "\n" if head else "") + rows_part + generalisation_table(rows),
+    )
+    write_text(out / "generalisation.json", dumps(generalisation(rows), indent=2))
+
+
+def plot_file(scenario: str) -> str:
+    """The plot's file name for a scenario: inside the run's folder, whatever the scenario is
+    (``heldout:0`` → ``heldout_0.png``, a YAML path → its stem)."""
+    name = Path(scenario).stem if is_path(scenario) else scenario
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".png"
+
+
+def plot_results(
+    results: list[EpisodeResult],
+    out: Path,
+    scenarios: Mapping[str, Any] | None = None,
+    randomize: Mapping[str, Any] | None = None,
+) -> list[Path]:
+    """Per scenario: tracks over the path, e(t) and δ(t) of the first evaluation seed (of
+    the first training seed) of each controller whose trajectory was kept; returns the
+    files written (:func:`plot_file`).  ``scenarios``: name → settings (as ``run.json``
+    records them; default: each scenario loaded by name); ``randomize``: the trial
+    randomisation (the jump time drawn is that seed's)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    randomization = None if randomize is None else TrialRandomization(**randomize)
+    written = []
+    for scenario in sorted({r.scenario for r in results if r.trajectory}):
+        first: dict[str, EpisodeResult] = {}
+        for r in sorted(results, key=_order):
+            if r.scenario == scenario and r.trajectory:
+                first.setdefault(r.controller, r)
+        seed = min(r.seed for r in first.values())
+        sc = load_scenario(scenarios[scenario] if scenarios else scenario)
+        sc = trial_scenario(sc, randomization, seed)
+        fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+        pts = sc.path.point(np.linspace(0, sc.path.length, 300))
+        axes[0].plot(pts[:, 0], pts[:, 1], "k--", lw=1, label="path")
+        for name, r in first.items():
+            tr, look, label = r.trajectory, controller_style(name).kwargs(), plain_text(name)
+            axes[0].plot(tr["x"], tr["y"], lw=1, label=label, **look)
+            axes[1].plot(tr["t"], tr["cross_track_error"], lw=1, label=label, **look)
+            axes[2].plot(tr["t"], np.degrees(tr["rudder_angle"]), lw=1, label=label, **look)
+        if sc.change_time is not None:
+            for ax in axes[1:]:
+                ax.axvline(sc.change_time, color="gray", ls=":", lw=1)
+        title = f"{plain_text(scenario)}: tracks (seed {seed})"
+        axes[0].set(xlabel="x [m]", ylabel="y [m]", title=title)
+        axes[0].set_aspect("equal", adjustable="datalim")
+        axes[1].set(xlabel="t [s]", ylabel="e [m]", title="cross-track error")
+        axes[2].set(xlabel="t [s]", ylabel="δ [deg]", title="rudder angle")
+        axes[0].legend(fontsize=7)
+        fig.tight_layout()
+        image = io.BytesIO()
+        fig.savefig(image, format="png", dpi=FIGURE_DPI)
+        plt.close(fig)
+        written.append(out / plot_file(scenario))
+        write_bytes(written[-1], image.getvalue())
+    return written
