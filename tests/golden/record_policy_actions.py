@@ -6,9 +6,14 @@ that ``test_safe_loading.py`` keeps checking the data-only loader against it.
 ``observations`` (80 × 9) are kept from the file as they are.  ``observations_context``
 (80 × (9 + context features)) are the same observations with a ship's controller-context
 row appended (the four catalogue ships in turn: nomoto2, esso_osaka, mariner, blanke): what
-an agent trained with ``context_features`` reads.  Run from the checkout::
+an agent trained with ``context_features`` reads.  ``observations_history_K`` (80 ×
+(9 + context features + 7 K)) append K control steps of history to those: step k of row i
+holds row i − k's history entries (its measurements and last rudder command; rows before
+the first wrap round), what an agent trained with
+``history_steps`` K reads.  Run from the checkout::
 
-    python tests/golden/record_policy_actions.py
+    python tests/golden/record_policy_actions.py          # record the agents not in the file
+    python tests/golden/record_policy_actions.py --all    # record every agent again
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from shipgym.envs.context import ControllerContext
+from shipgym.envs.core import HISTORY_MEASUREMENTS, OBS_NAMES
 from shipgym.scenarios import load_scenario
 
 GOLDEN = Path(__file__).resolve().parent / "shipped_policy_actions.npz"
@@ -33,6 +39,19 @@ def context_observations(observations: np.ndarray) -> np.ndarray:
     ]
     wide = [np.concatenate([obs, rows[i % len(rows)]]) for i, obs in enumerate(observations)]
     return np.asarray(wide, dtype=np.float32)
+
+
+def history_observations(observations: np.ndarray, steps: int) -> np.ndarray:
+    """``context_observations(observations)`` with ``steps`` control steps of history appended
+    (module doc; float32)."""
+    columns = [OBS_NAMES.index(name) for name in HISTORY_MEASUREMENTS]
+    columns.append(OBS_NAMES.index("last_rudder_command"))
+    entries = observations[:, columns]
+    rows = len(observations)
+    window = [
+        np.concatenate([entries[(i - k) % rows] for k in range(1, steps + 1)]) for i in range(rows)
+    ]
+    return np.concatenate([context_observations(observations), window], axis=1).astype(np.float32)
 
 
 def record() -> dict[str, np.ndarray]:
@@ -59,7 +78,10 @@ def record() -> dict[str, np.ndarray]:
                 for seed_dir in sorted(agent.glob("seed_*")):
                     seed = int(seed_dir.name.removeprefix("seed_"))
                     policy = LearnedPolicy(agent.name, training_seed=seed)
-                    obs = out["observations_context" if policy.context_features else "observations"]
+                    key = observations_key(policy.context_features, policy.history_steps)
+                    obs = out.get(key)
+                    if obs is None:
+                        obs = out[key] = history_observations(observations, policy.history_steps)
                     actions = np.array([policy.act(o, {}) for o in obs])
                     out[f"{agent.name}__seed_{seed}"] = actions
     finally:
@@ -67,7 +89,21 @@ def record() -> dict[str, np.ndarray]:
     return out
 
 
+def observations_key(context_features: bool, history_steps: int) -> str:
+    """The file's key of the observations an agent with these inputs reads."""
+    if history_steps:
+        if not context_features:
+            raise ValueError("the golden's history observations carry the context features")
+        return f"observations_history_{history_steps}"
+    return "observations_context" if context_features else "observations"
+
+
 if __name__ == "__main__":
+    import sys
+
     arrays = record()
+    if "--all" not in sys.argv[1:]:  # the recorded agents' arrays kept byte for byte
+        with np.load(GOLDEN, allow_pickle=False) as old:
+            arrays.update({key: old[key] for key in old.files})
     np.savez(GOLDEN, **arrays)
     print(f"{GOLDEN}: {sorted(arrays)}")

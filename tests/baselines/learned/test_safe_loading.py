@@ -73,13 +73,19 @@ def test_finding7_shipped_agents_act_as_through_the_pickle_loader() -> None:
     torch.set_num_threads(1)
     golden = np.load(GOLDEN, allow_pickle=False)
     keys = [k for k in golden.files if "__seed_" in k]
-    assert len(keys) == 15  # 5 agents × 3 training seeds
+    assert len(keys) == 24  # 8 agents × 3 training seeds
     for key in keys:
         name, seed = key.split("__seed_")
         policy = LearnedPolicy(name, training_seed=int(seed))
         assert not pickle_trusted()
-        # an agent trained with the context features reads them after the observation
-        observations = golden["observations_context" if policy.context_features else "observations"]
+        # an agent trained with the context features reads them after the observation,
+        # one trained with history_steps K then K steps of history
+        if policy.history_steps:
+            observations = golden[f"observations_history_{policy.history_steps}"]
+        elif policy.context_features:
+            observations = golden["observations_context"]
+        else:
+            observations = golden["observations"]
         actions = np.array([policy.act(obs, {}) for obs in observations])
         # to float32 rounding: torch's CPU kernels differ by a few ulp between machines
         # (≤ 8e-7 on an AMD EPYC against the recording machine); a wrong or
