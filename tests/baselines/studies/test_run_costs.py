@@ -68,26 +68,25 @@ def test_profile_splits_add_up(profile: dict) -> None:
         assert entry["steps"] <= entry["limit_steps"] == limit
 
 
-#: the default suite's whole run, CPU seconds (README: 1,028 CPU s on a quiet 2-core machine)
-DEFAULT_RUN_CPU_S = 1028.0
+#: the default suite's whole run, CPU seconds (README: 1,528 CPU s on a 2-core machine)
+DEFAULT_RUN_CPU_S = 1528.0
 #: how far the estimate may be from it, either way: the recorded costs, measured on a quiet
-#: 2-core VM, estimate 1,055 CPU s with the tables' (1.03×), and a measurement moves by
+#: 2-core VM, estimate 1,273 CPU s with the tables' (0.83×), and a measurement moves by
 #: ±13 % from run to run (docs/leaderboard-cost.md)
 FACTOR = 1.25
-#: the learned rows added to the default suite after that run was recorded
-ADDED_SINCE = ("dagger", "bc", "ppo_history")
+#: the default suite's episodes: 47 scenarios × 10 seeds and 16 in-range ones × 2 seeds for
+#: every controller, × 3 training seeds for a learned one; oracle_frozen's 502 among them
+DEFAULT_EPISODES = 20_582
 
 
-def default_plan(controllers: list | None = None, in_range: bool = True) -> tuple[list[Job], dict]:
-    """The default suite's jobs and scenarios, planned as the leaderboard plans them;
-    ``in_range`` False: without the in-range split (the suite of the recorded run)."""
+def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
+    """The default suite's jobs and scenarios, planned as the leaderboard plans them."""
     spec = load_suite("default")
     names = controllers or list(spec.controllers)
     labels = check_controllers(names)
     seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
     seed_list = [EVAL_SEED_OFFSET + i for i in range(spec.seeds)]
-    chosen = [s for s in spec.all_scenarios() if in_range or not s.startswith("inrange:")]
-    scenarios = {s: suite_scenario(s) for s in chosen}
+    scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
     randomize = record["randomize"]
@@ -99,25 +98,20 @@ def default_plan(controllers: list | None = None, in_range: bool = True) -> tupl
 
 
 def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
-    """The recorded run is the default suite without its in-range split (16 scenarios on
-    2 seeds: 1,024 episodes more)."""
-    recorded = [c for c in load_suite("default").controllers if c not in ADDED_SINCE]
-    whole, _ = default_plan(recorded)
-    assert sum(len(job.seeds) for job in whole) == 15_040 + 1_024
-    jobs, scenarios = default_plan(recorded, in_range=False)
+    jobs, scenarios = default_plan()
     cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
     assert DEFAULT_RUN_CPU_S / FACTOR < cpu < DEFAULT_RUN_CPU_S * FACTOR, cpu
     total = sum(len(job.seeds) for job in jobs)
-    assert total == 15_040  # oracle_frozen's 470 among them
+    assert total == DEFAULT_EPISODES
     line = eta_line(jobs, scenarios, 2, total)
-    assert line.startswith("leaderboard: 15,040 episodes on 2 workers, about ")
+    assert line.startswith(f"leaderboard: {DEFAULT_EPISODES:,} episodes on 2 workers, about ")
     assert line.endswith(
         " min (recorded costs; one-off C compilations on a new machine come on top, each announced)"
     )
     half = jobs[: len(jobs) // 2]
     todo = sum(len(job.seeds) for job in half)
     assert eta_line(half, scenarios, 1, total).startswith(
-        f"leaderboard: {todo:,} of 15,040 episodes on 1 worker, about "
+        f"leaderboard: {todo:,} of {DEFAULT_EPISODES:,} episodes on 1 worker, about "
     )
 
 
