@@ -1,4 +1,4 @@
-"""The import graph of shipgym and baselines follows the layering of issue 11.
+"""The import graph of shipgym and baselines follows the layering of docs/architecture.md.
 
 Every module is parsed with ``ast`` and every import counts: top-level, inside functions
 (lazy), under ``if TYPE_CHECKING:``, in ``try`` blocks.  ``from a.b import c`` is an edge to
@@ -76,7 +76,7 @@ ABOVE_MODELS = (
 #: into SI objects, and no other shipgym module reads it.
 CONFIG_SCHEMA = "shipgym.scenarios.schema"
 
-#: Edges that break the rules above and are being fixed (issue 11).  Empty this set as
+#: Edges that break the rules above and are being fixed.  Empty this set as
 #: they go: a listed edge that no longer exists fails ``test_known_pending_edges_exist``.
 #: (The two edges it listed, shipgym.disturbances and shipgym.envs.context reading
 #: ``shipgym.scenarios.schema``, are fixed.)
@@ -274,6 +274,6 @@ def test_every_project_error_is_a_shipgym_error() -> None:
 
 
 def test_known_pending_edges_exist() -> None:
-    """A fixed edge leaves KNOWN_PENDING (so the set shrinks to empty as issue 11 lands)."""
+    """A fixed edge leaves KNOWN_PENDING (so the set only shrinks)."""
     gone = [(m, t) for m, t in KNOWN_PENDING if t not in import_graph().get(m, ())]
     assert not gone, f"fixed: remove from KNOWN_PENDING: {gone}"
