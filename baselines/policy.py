@@ -18,7 +18,7 @@ class Policy(Protocol):
     """
 
     name: str
-    kind: str  # "classical" | "learned": the ``kind`` column of the leaderboard's rows
+    kind: str  # one of registry.KINDS: the ``kind`` column of the leaderboard's rows
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
 
