@@ -12,15 +12,7 @@ from __future__ import annotations
 import ast
 import importlib
 
-from tests.import_graph import (
-    edges,
-    files,
-    find_cycle,
-    import_graph,
-    imported_names,
-    layer,
-    within,
-)
+from tests.import_graph import edges, files, find_cycle, import_graph, imported_names, layer, within
 
 #: The layer of every shipgym module, lowest first; an entry for a package covers its
 #: submodules unless they have their own.  A module imports only modules of its own or a
