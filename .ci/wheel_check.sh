@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# CI: the wheel works outside the checkout (issue 12).  Builds the wheel, installs it into a
-# fresh venv in a temporary folder (torch==2.13.0 first, as the README does, then the wheel
-# with the `rl` extra so the learned rows run), and from an empty temporary working folder
-# makes every registered env, runs the smoke leaderboard (learned rows included) and the
-# liu2019 reproduction.  pip's cache makes the second install cheap.
+# CI: the wheel works outside the checkout (docs/getting-started.md, "The wheel check").
+# Builds the wheel, installs it into a fresh venv in a temporary folder (torch==2.13.0
+# first, as the README does, then the wheel with the `rl` extra so the learned rows run),
+# and from an empty temporary working folder makes every registered env, runs the smoke
+# leaderboard (learned rows included) and the liu2019 reproduction.  pip's cache makes the
+# second install cheap.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 PYTHON="${PYTHON:-python3}"

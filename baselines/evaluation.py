@@ -1,4 +1,4 @@
-"""The one evaluation loop: any policy, any scenario, a list of seeds (SPEC §8–9).
+"""The one evaluation loop: any policy, any scenario, a list of seeds.
 
 :func:`run_episode` runs one episode; :func:`evaluate_batch` runs several in lockstep, as
 the rows of one :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (a learned

@@ -26,7 +26,7 @@ def finite_or_none(obj: Any) -> Any:
     return obj
 
 
-#: JSON without spaces after separators (a run's record and its long tables: issue 20)
+#: JSON without spaces after separators (a run's record and its long tables: smaller files)
 COMPACT = (",", ":")
 
 

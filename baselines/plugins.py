@@ -1,4 +1,4 @@
-"""Controllers from outside the package: specs, files and installed plug-ins (SPEC §13).
+"""Controllers from outside the package: specs, files and installed plug-ins (docs/plugins.md).
 
 A controller that is not built in enters the benchmark by one of
 

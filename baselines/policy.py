@@ -1,4 +1,4 @@
-"""The one policy interface every controller and agent implements (SPEC §8)."""
+"""The one policy interface every controller and agent implements (docs/plugins.md)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ class Policy(Protocol):
     """
 
     name: str
-    kind: str  # "classical" | "learned" (SPEC §9b)
+    kind: str  # one of registry.KINDS: the ``kind`` column of the leaderboard's rows
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None: ...
 

@@ -11,8 +11,8 @@ from gymnasium.envs.registration import register, registry
 
 __version__ = "0.1.0"
 
-#: env id -> default scenario: one id per ship, same contract and keyword arguments (SPEC §5).
-#: The per-ship ``-v1`` ids default to that ship's rudder aging (a changing plant, issue 18);
+#: env id -> default scenario: one id per ship, same contract and keyword arguments.
+#: The per-ship ``-v1`` ids default to that ship's rudder aging (a changing plant);
 #: their ``-v0`` ids keep the scenarios they always had (Gymnasium's versioning rule: a
 #: different default is a different env).
 ENV_IDS: dict[str, str] = {

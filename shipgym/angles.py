@@ -51,7 +51,7 @@ def unwrap_floats(angles: list[float]) -> list[float]:
     Each step d = a[i+1] − a[i] with |d| ≥ π is replaced by its representative in [−π, π)
     (π itself where d > 0 lands on −π), the corrections summed in order, as numpy does; a
     loop over floats is ≈ 20× faster than the array call on the 5-20 samples of a control
-    period (the L1 controller's per-step unwrap, issue 18).
+    period (the L1 controller's per-step unwrap).
     """
     out = [angles[0]] if angles else []
     correction = 0.0

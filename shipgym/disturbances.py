@@ -1,4 +1,4 @@
-"""Environmental disturbances and sensor models (SPEC §4).
+"""Environmental disturbances and sensor models (docs/disturbances.md).
 
 All randomness is drawn from the generator the env passes in (its seeded ``np_random``);
 nothing here touches a global random state.
@@ -319,7 +319,7 @@ class Disturbances:
         """The period start [s] from which :meth:`fill` writes the same block every period
         (inf: never): no noise and no waves, and a constant mean or a two-phase one past its
         switch (its ramp: with a margin of one ramp).  A batched env need not refill a block
-        filled at such a start (issue 18)."""
+        filled at such a start."""
         if self.n_noise or self._waves is not None:
             return math.inf
         if self._kind != "two_phase":

@@ -1,4 +1,4 @@
-"""Episode metrics for ship path following (SPEC §6).
+"""Episode metrics for ship path following (docs/disturbances.md, "Metrics").
 
 One function, :func:`compute_metrics`, turns an :class:`EpisodeLog` (arrays over the control
 steps of one episode) into a flat ``dict`` of JSON-serialisable numbers. The environment, the
@@ -244,7 +244,7 @@ def _convergence_time(t: np.ndarray, abs_e: np.ndarray, start: float | None, thr
 def compute_metrics(
     log: EpisodeLog, settings: MetricSettings = DEFAULT_SETTINGS
 ) -> dict[str, float]:
-    """Metrics of one episode (SPEC §6). All values are plain Python ``float``/``bool``/``int``.
+    """Metrics of one episode. All values are plain Python ``float``/``bool``/``int``.
 
     Keys:
         ace (m): Liu et al. (2019) eq. (46), e_a = (1/N_T) Σ |e(i)| over the N_T control steps

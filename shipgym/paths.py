@@ -1,4 +1,4 @@
-"""Reference paths for ship path following (SPEC §3).
+"""Reference paths for ship path following.
 
 Conventions (fixed for the whole package): SI units and radians, plane coordinates (x, y),
 heading ψ with ẋ = u cos ψ, ẏ = u sin ψ.  For a leg from P_n to P_{n+1}:

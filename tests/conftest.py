@@ -28,7 +28,7 @@ def working_directory_listing(root: Path) -> set[str]:
 
 @pytest.fixture(autouse=True)
 def leaves_no_trace(request: pytest.FixtureRequest) -> Iterator[None]:
-    """Every test writes only into temporary folders (issue 19, finding 11): the working
+    """Every test writes only into temporary folders: the working
     directory (the checkout, where ``shipgym leaderboard`` writes ``results/``) is as it
     was before the test."""
     root = Path.cwd()

@@ -1,4 +1,4 @@
-"""LICENSE (MIT) and CITATION.cff agree with pyproject.toml (issue 20)."""
+"""LICENSE (MIT) and CITATION.cff agree with pyproject.toml."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Nonlinear MPC path following with LOS reference (Liu et al. 2019 §2.2.3, Algorithm 1).
 
-On every ship (issue 17): nomoto2 with the paper's numbers, every other ship with a Nomoto
+On every ship: nomoto2 with the paper's numbers, every other ship with a Nomoto
 prediction model from its own zig-zag and numbers from its own time scales
 (:mod:`shipgym_baselines.classical.nmpc_ship`, where each rule is stated).
 
@@ -556,7 +556,7 @@ class NMPCLambdaLSSVM(NMPC):
 @register_controller("nmpc_wlssvm_svf")
 class NMPCWeightedLSSVMSVF(NMPCWeightedLSSVM):
     """``nmpc_wlssvm_svf``: ``nmpc_wlssvm`` with the outlier + state-variable-filter front end
-    (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019, issue 14)."""
+    (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019)."""
 
     identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}
 

@@ -24,16 +24,18 @@ The autopilot is the shared :class:`shipgym.autopilot.HeadingPID` with one of tw
   says why (3, 3) reproduces the paper's printed gains).  The 2nd-order model is the ship's
   own parameters on nomoto2 (which *is* that model, as ``first_order_nomoto`` also uses)
   and the fit to the ship's 20/20 zig-zag (:func:`shipgym.identification.zigzag.ship_nomoto`)
-  on every other ship — seed 001's pipeline.
+  on every other ship — the pipeline of Xu & Guedes Soares (2020).
 
-Default tuning per controller (SPEC §8 lists pid_los and pid_vf as Vyshnegradsky-tuned):
+Default tuning per controller (Xu & Guedes Soares (2020) tune the PID by the Vyshnegradsky
+diagram on both LOS and VF guidance):
 
 * ``pid_los``: pole placement — the leaderboard's existing numbers, kept unchanged;
-  ``PIDLOS(tuning="vyshnegradsky")`` is the SPEC §8 variant.
-* ``pid_lookahead_los``, ``pid_vf``: Vyshnegradsky, as seed 001 pairs them.
-* ``pid_tvvf``: pole placement, as seed 002 uses its PID baseline with the TVVF law.
+  ``PIDLOS(tuning="vyshnegradsky")`` is the Vyshnegradsky variant.
+* ``pid_lookahead_los``, ``pid_vf``: Vyshnegradsky, as Xu & Guedes Soares (2020) pair them.
+* ``pid_tvvf``: pole placement, as Xu, Oliveira & Guedes Soares (2021) pair their PID
+  baseline with the TVVF law.
 
-Settings presets (issue 21).  ``preset="paper"`` is the paper-literal design above (what
+Settings presets.  ``preset="paper"`` is the paper-literal design above (what
 ``shipgym reproduce`` uses); ``preset="tuned"``, the registry's default construction, adds
 the ship's section of ``configs/tuning/chosen/<name>.yaml`` (written by ``shipgym tune``,
 docs/tuning.md) under any explicit settings, and is the paper's design on a ship without a
@@ -249,7 +251,7 @@ class PIDLOS(_GuidedPID):
 
 @register_controller("pid_lookahead_los")
 class PIDLookaheadLOS(_GuidedPID):
-    """PID on look-ahead LOS guidance; Vyshnegradsky by default (seed 001's comparison)."""
+    """PID on look-ahead LOS guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
     law = "lookahead_los"
     default_tuning = "vyshnegradsky"
@@ -257,7 +259,7 @@ class PIDLookaheadLOS(_GuidedPID):
 
 @register_controller("pid_vf")
 class PIDVF(_GuidedPID):
-    """PID on vector-field guidance; Vyshnegradsky by default (seed 001)."""
+    """PID on vector-field guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
     law = "vf"
     default_tuning = "vyshnegradsky"
@@ -265,7 +267,7 @@ class PIDVF(_GuidedPID):
 
 @register_controller("pid_tvvf")
 class PIDTVVF(_GuidedPID):
-    """PID on time-varying vector-field guidance; pole placement by default (seed 002)."""
+    """PID on time-varying vector-field guidance; pole placement by default (Xu et al. 2021)."""
 
     law = "tvvf"
     default_tuning = "pole_placement"

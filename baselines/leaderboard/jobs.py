@@ -262,7 +262,7 @@ def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[E
     raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
 
 
-def _result_key(result: EpisodeResult) -> tuple[str, str, int, int | None]:
+def result_key(result: EpisodeResult) -> tuple[str, str, int, int | None]:
     """(scenario, table name, seed, training seed): the episode's key in ``episodes.jsonl``."""
     return (result.scenario, result.controller, int(result.seed), result.training_seed)
 

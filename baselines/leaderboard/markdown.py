@@ -24,8 +24,8 @@ from shipgym_baselines.leaderboard.tables import (
     PROB,
     SPLIT_TITLES,
     TEST_SPLITS,
-    _generalisation_splits,
     generalisation,
+    generalisation_splits,
 )
 from shipgym_baselines.leaderboard.verdict import verdict
 
@@ -240,7 +240,7 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
     if not any(r["split"] in TEST_SPLITS for r in rows):
         return ""
     gen = generalisation(rows)
-    splits = _generalisation_splits(rows)
+    splits = generalisation_splits(rows)
     label = {"catalogue": "catalogue", "heldout": "held-out", "inrange": "in-range"}
     counts = ", ".join(f"{gen[0][f'{s}_scenarios']} {label[s]}" for s in splits)
     header = ["controller", "kind"] + [

@@ -123,7 +123,7 @@ details>summary{cursor:pointer;font-weight:600;margin:8px 0}
 
 _JS = """
 (function () {
-  // a packed table body (issue 20: the long table deflated): its rows, unpacked in place
+  // a packed table body (the long table, deflated for a lighter page): its rows, unpacked in place
   document.querySelectorAll("tbody[data-gzip]").forEach(function (body) {
     var bin = atob(body.getAttribute("data-gzip")), bytes = new Uint8Array(bin.length);
     for (var i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);

@@ -26,13 +26,13 @@ from shipgym_baselines.leaderboard.comparison import (
 from shipgym_baselines.leaderboard.figures import median_ace_episode
 from shipgym_baselines.leaderboard.jobs import (
     Job,
-    _result_key,
     announce_references,
     check_controllers,
     iter_results,
     longest_first,
     missing,
     plan_jobs,
+    result_key,
     suite_record,
     suite_scenarios,
 )
@@ -165,7 +165,7 @@ def run_leaderboard(
             with closing(iter_results(todo, backend, workers)) as results:
                 for batch in results:
                     for result in batch:
-                        if _result_key(result) in log.done:
+                        if result_key(result) in log.done:
                             continue  # recorded before (a resumed job)
                         log.append(result, keep_trajectory=True)
                         keep_drawn(log, rows, (result.scenario, result.controller))

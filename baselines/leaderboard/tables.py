@@ -165,7 +165,7 @@ def rankable(
     return [e for e in episodes if e["scenario"] not in partial]
 
 
-def _generalisation_splits(rows: Sequence[Mapping[str, Any]]) -> tuple[str, ...]:
+def generalisation_splits(rows: Sequence[Mapping[str, Any]]) -> tuple[str, ...]:
     """The splits of :func:`generalisation`: catalogue and held-out always, in-range when
     the run has in-range rows."""
     present = {r["split"] for r in rows}
@@ -181,7 +181,7 @@ def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """
     controllers = list(dict.fromkeys(r["controller"] for r in rows))
     ran = {(r["scenario"], r["controller"]) for r in rows if r.get("applies", True)}
-    splits = _generalisation_splits(rows)
+    splits = generalisation_splits(rows)
     common = {}
     for split in splits:
         scenarios = dict.fromkeys(r["scenario"] for r in rows if r["split"] == split)

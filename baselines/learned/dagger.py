@@ -630,7 +630,7 @@ def _prepare(
     rounds = _read_json(rounds_file) if rounds_file.is_file() else []
     for found in rounds:
         r = found["round"]
-        for file in (_round_file(folder, r), _student_file(folder, r)):
+        for file in (_round_file(folder, r), student_file(folder, r)):
             if not file.is_file():
                 raise RunError(f"{rounds_file} lists round {r} but {file} is missing")
     return rounds
@@ -650,7 +650,7 @@ class _Run:
     def student_after(self, round_: int) -> Any:
         """The student saved after round ``round_``."""
         return load_student(
-            _student_file(self.folder, round_),
+            student_file(self.folder, round_),
             self.observation_space,
             self.action_space,
             self.settings,
@@ -705,7 +705,7 @@ class _Run:
             student = build_student(self.observation_space, self.action_space, s)
         everything = load_dataset(self.folder, round_ + 1)
         fitted = fit_student(student, everything["obs"], everything["label"], s, round_)
-        save_student(student, _student_file(self.folder, round_))
+        save_student(student, student_file(self.folder, round_))
         save_student(student, self.folder / MODEL_FILE)
         rollouts = [found[e] for e in range(s.episodes_per_round)]
         labels = int(sum(r["labels"] for r in rollouts))
@@ -795,7 +795,8 @@ def _round_file(out: Path, round_: int) -> Path:
     return out / DATA_DIR / f"round_{round_:03d}.npz"
 
 
-def _student_file(out: Path, round_: int) -> Path:
+def student_file(out: Path, round_: int) -> Path:
+    """The student saved after DAgger round ``round_`` in the run folder ``out``."""
     return out / STUDENT_DIR / f"round_{round_:03d}.zip"
 
 

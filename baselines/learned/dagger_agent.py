@@ -246,9 +246,9 @@ class _Selection:
     def score(self, record: dict[str, Any], student: Any, wall_s: float) -> bool:
         """Score the student of the round ``record`` describes; False when the run stops
         here (the plateau rule, or the env-step budget reached)."""
-        from shipgym_baselines.learned.dagger import _student_file
+        from shipgym_baselines.learned.dagger import student_file
         from shipgym_baselines.learned.selection import evaluate_relative
-        from shipgym_baselines.learned.train import _write_best
+        from shipgym_baselines.learned.train import write_best
 
         env = self.config.env
         cpu = time.process_time()
@@ -268,8 +268,8 @@ class _Selection:
         self.wall.append(float(wall_s))
         self.eval_cpu.append(time.process_time() - cpu)
         if found["selection"] <= min(self.selection):
-            shutil.copyfile(_student_file(self.out / RUN_DIR, round_), self.out / "best_model.zip")
-            _write_best(self.out, float(found["selection"]), int(record["labels_total"]))
+            shutil.copyfile(student_file(self.out / RUN_DIR, round_), self.out / "best_model.zip")
+            write_best(self.out, float(found["selection"]), int(record["labels_total"]))
         self.write()
         return self.go_on()
 
@@ -330,8 +330,8 @@ def train_dagger(
     from shipgym_baselines.learned.teachers import oracle_teacher
     from shipgym_baselines.learned.train import (
         TRAINING_OUTPUTS,
-        _check_tuned_from,
         check_agent_folder,
+        check_tuned_from,
     )
     from shipgym_baselines.records.runs import clear_outputs
 
@@ -353,7 +353,7 @@ def train_dagger(
         if force:
             clear_outputs(out, TRAINING_OUTPUTS)
     out.mkdir(parents=True, exist_ok=True)
-    _check_tuned_from(out, tuned_from, resuming=resume)
+    check_tuned_from(out, tuned_from, resuming=resume)
     trials = validation_trials(config.eval.distribution, config.eval.n_episodes)
     scores = _Selection(config, out, trials, reference_costs(trials, out / "eval"))
     run_dir = out / RUN_DIR
@@ -376,7 +376,7 @@ def train_dagger(
         env.close()
         for record in done_rounds[len(scores.rounds) :]:
             student = dagger.load_student(
-                dagger._student_file(run_dir, record["round"]), *spaces, run_settings
+                dagger.student_file(run_dir, record["round"]), *spaces, run_settings
             )
             scores.score(record, student, wall())
     run = None
@@ -396,7 +396,7 @@ def train_dagger(
         done_rounds = run.rounds
     if not done_rounds:
         raise RunError(f"{out}: no DAgger round finished")
-    newest = dagger._student_file(run_dir, int(done_rounds[-1]["round"]))
+    newest = dagger.student_file(run_dir, int(done_rounds[-1]["round"]))
     shutil.copyfile(newest, out / "model.zip")
     summary = dagger.DaggerRun(run_dir, None, done_rounds).summary()
     labels = int(done_rounds[-1]["labels_total"])

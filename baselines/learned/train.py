@@ -188,7 +188,10 @@ def _kept_history(steps: list[int], resumed_at: int) -> int:
 BEST_FILE = "best.json"
 
 
-def _write_best(out: Path, value: float, step: int) -> None:
+def write_best(out: Path, value: float, step: int) -> None:
+    """Record in ``out/eval/`` (:data:`BEST_FILE`) the value of the model just saved as
+    ``best_model.zip`` (its mean return, or its relative cost when the run selects on it)
+    and the env step it was evaluated at."""
     (out / "eval").mkdir(parents=True, exist_ok=True)
     (out / "eval" / BEST_FILE).write_text(json.dumps({"value": value, "env_steps": step}))
 
@@ -217,7 +220,7 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
 
     class _NewBest(BaseCallback):  # best_model.zip was just saved: record its value
         def _on_step(self) -> bool:
-            _write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
+            write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
             return True
 
     eval_env = make_eval_env(
@@ -323,7 +326,7 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             if found["selection"] < self.best:
                 self.best = found["selection"]
                 self.model.save(str(out / "best_model.zip"))
-                _write_best(out, self.best, int(self.num_timesteps))
+                write_best(out, self.best, int(self.num_timesteps))
             return curves.after_evaluation(self.steps, self.returns, self.selection)
 
     return _RelativeCostEval()
@@ -389,7 +392,7 @@ def train(
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
         raise RunError(f"--resume: no checkpoint in {out / 'checkpoints'}")
-    _check_tuned_from(out, tuned_from, resuming=previous is not None)
+    check_tuned_from(out, tuned_from, resuming=previous is not None)
     if previous is not None and previous[1] >= config.n_timesteps:
         raise RunError(
             f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
@@ -500,7 +503,7 @@ def train(
     return meta
 
 
-def _check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bool) -> None:
+def check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bool) -> None:
     """A fresh run records the settings it starts with (``tuned_from.json``); a resumed one
     is refused if they changed since (e.g. a study rewrote the chosen settings)."""
     file = out / TUNED_FROM_FILE

@@ -1,6 +1,6 @@
 """stable-baselines3 ``VecEnv`` over the batched :class:`ShipPathFollowVectorEnv`.
 
-SB3 does not accept Gymnasium vector envs (SPEC §5): this adapter exposes the batched env
+SB3 does not accept Gymnasium vector envs: this adapter exposes the batched env
 through SB3's interface, with SB3's same-step autoreset (the terminal observation goes to
 ``info["terminal_observation"]``, truncation to ``info["TimeLimit.truncated"]``) and one
 ``info`` dict per ship with the keys a single env gives (``termination_reason`` and

@@ -1,4 +1,4 @@
-"""Re-runs of the source papers' experiments (``shipgym reproduce PAPER``, SPEC §11).
+"""Re-runs of the source papers' experiments (``shipgym reproduce PAPER``, docs/reproduction.md).
 
 One package per paper, each with the parts of :mod:`shipgym_baselines.reproduce.protocol` (the
 experiment, its claims, the markdown report, the figures) joined in its ``REPRODUCTION``;

@@ -1,9 +1,9 @@
-"""The common shape of a paper reproduction (``shipgym reproduce PAPER``, SPEC §11).
+"""The common shape of a paper reproduction (``shipgym reproduce PAPER``, docs/reproduction.md).
 
 Every paper is a package ``shipgym_baselines.reproduce.<paper>`` with the same parts:
 
 * ``experiment.run_experiment(seeds, progress, **options) -> Outcome``: the episodes and the
-  rows of SPEC §9b (:func:`shipgym_baselines.reproduce.rows.reproduction_row`); no files;
+  rows (:func:`shipgym_baselines.reproduce.rows.reproduction_row`); no files;
 * ``claims`` where the paper states something checkable: rows whose ``paper`` is the claim;
 * ``tables.report(rows) -> str``: the markdown report, its tables made by
   :func:`shipgym_baselines.reproduce.report.table`;
@@ -25,7 +25,7 @@ from typing import Any
 from shipgym_baselines.jsonout import dumps
 from shipgym_baselines.records.outfiles import write_text
 
-#: the rows of SPEC §9b: ``{case, controller, metric, ours, paper, …}``
+#: the rows a reproduction reports (its --json): ``{case, controller, metric, ours, paper, …}``
 Rows = list[dict[str, Any]]
 #: called once per unit of work (an episode, a noise realisation)
 Progress = Callable[[], object]

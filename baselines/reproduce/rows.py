@@ -1,4 +1,4 @@
-"""The row every reproduction reports (SPEC §9b): ``{case, controller, metric, ours, paper}``."""
+"""The row every reproduction reports (its --json): ``{case, controller, metric, ours, paper}``."""
 
 from __future__ import annotations
 

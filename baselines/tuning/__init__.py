@@ -1,4 +1,4 @@
-"""One tuning protocol for every tunable controller, classical and learned (issue 21).
+"""One tuning protocol for every tunable controller, classical and learned (docs/tuning.md).
 
 ``shipgym tune NAME`` (:mod:`shipgym_baselines.cli.tune`) runs an Optuna study whose search
 space, budget and validation trials are ``configs/tuning/<NAME>.yaml``

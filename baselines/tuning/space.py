@@ -91,7 +91,7 @@ class TrainingSpec(StrictModel):
 
 
 #: the final training's default plateau rule: under 2 % gain of the selection metric (the
-#: relative cost) over the last 25 % of training (issue 21's example)
+#: relative cost) over the last 25 % of training (docs/training.md, "Plateau rule")
 FINAL_PLATEAU = PlateauRule(
     min_gain=0.02, window=0.25, min_evaluations=4, metric="selection", min_fraction=0.34
 )

@@ -2,7 +2,7 @@
 
 In the spirit of Gymnasium's functional env (``gymnasium.experimental.functional``): the
 pieces of one control period that are not the plant — the action's rudder command, the
-parameters of the period, the reward (SPEC §5), termination, the observation and ``info`` —
+parameters of the period, the reward, termination, the observation and ``info`` —
 are pure functions of floats (one ship, ``xp = SCALAR``) or arrays (N ships,
 ``xp = ARRAY``) of :mod:`shipgym.numerics`.  :class:`~shipgym.envs.path_follow.ShipPathFollowEnv`
 calls them for one ship, :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` for N; both

@@ -1,4 +1,4 @@
-"""ShipPathFollow: one ship follows a path while its dynamics change (SPEC §5).
+"""ShipPathFollow: one ship follows a path while its dynamics change (docs/environment.md).
 
 Data flow through one ``step`` (one control period Ts):
 
@@ -208,7 +208,7 @@ class ShipPathFollowEnv(gym.Env):
       ``osaka_stochastic_current``, ``mariner_track``, ``blanke_current_shift``:
       disturbances only, no change of dynamics; kept, Gymnasium warns that a ``-v1``
       exists).
-    * ``-v1`` (EssoOsaka, Mariner, Blanke; issue 18): the same env, defaulting to the ship's
+    * ``-v1`` (EssoOsaka, Mariner, Blanke): the same env, defaulting to the ship's
       ``{ship}_rudder_aging`` (a changing plant).
     """
 

@@ -17,7 +17,7 @@ read (its ``info``, the guidance-mode command), as the single env's Python types
 
 A batched tracker costs a fixed ≈ 20 µs (polyline) / ≈ 240 µs (PCHIP curve) of CPU per
 update whatever the number of rows; a scalar one ≈ 2 µs / ≈ 20 µs per row (numpy's per-call
-overhead against Python floats; issue 18, measured with ``time.process_time`` on whole
+overhead against Python floats; measured with ``time.process_time`` on whole
 evaluation episodes): the batched curve tracker pays off from about 16 rows, the polyline
 one from about 10.
 """

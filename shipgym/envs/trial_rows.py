@@ -231,8 +231,8 @@ class TrialRowsVectorEnv(VectorEnv):
         checked and clipped (:func:`core.batch_actions`); the other rows keep their state.
 
         While every row steps (and every plant state stays finite), the masked selections
-        (``np.where(live, new, old)``) are skipped: they would return ``new`` (issue 18:
-        the step's fixed cost is its ≈ 100 numpy calls)."""
+        (``np.where(live, new, old)``) are skipped: they would return ``new`` (the
+        step's fixed cost is its ≈ 100 numpy calls)."""
         k = self._k0
         trials: list[Trial] = self._trials  # type: ignore[assignment]
         tracks = self._tracks

@@ -1,4 +1,4 @@
-"""Batched ShipPathFollow: N ships stepped in one call (SPEC §5 "Batched simulation").
+"""Batched ShipPathFollow: N ships stepped in one call.
 
 Built from a scenario, like the single env (:class:`shipgym.envs.core.EnvParts`).  The plant
 of all N ships is one call of the compiled CasADi period function mapped over the ships (the

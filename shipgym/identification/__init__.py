@@ -1,4 +1,4 @@
-"""Identification toolkit (SPEC §7): LS-SVM, λ-LS-SVM online, continuous LS, zig-zag fits.
+"""Identification toolkit: LS-SVM, λ-LS-SVM online, continuous LS, zig-zag fits.
 
 Public entry points: :func:`fit_nomoto2` (batch, Liu et al. 2019) and :class:`LambdaLSSVM`
 (online, Algorithm 2), fed with ``info["samples"]`` of the env, both with

@@ -51,7 +51,7 @@ from shipgym.identification.errors import (
 
 #: the two sources of the derivatives
 FRONT_ENDS = ("differences", "svf")
-#: SVF bandwidth λ [rad/s] (issue 14: ≈ 3 rad/s on the nomoto2 ships)
+#: SVF bandwidth λ [rad/s] (≈ 3 rad/s suits the nomoto2 ships; docs/identification.md)
 SVF_BANDWIDTH = 3.0
 #: order of the SVF (λ/(s+λ))ⁿ: states up to the 3rd derivative of eq. (36)
 SVF_ORDER = 4

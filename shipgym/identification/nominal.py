@@ -1,4 +1,4 @@
-"""The nominal Nomoto models of a ship, for model-based controller design (SPEC §8).
+"""The nominal Nomoto models of a ship, for model-based controller design.
 
 A model with a closed form (:meth:`ShipModel.closed_form_nomoto`, e.g. nomoto2) gives its
 own parameters; every other ship gets the fit to its own 20/20 zig-zag

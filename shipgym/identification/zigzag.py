@@ -10,7 +10,7 @@ with P = T1·T2, S = T1 + T2.  LS-SVM with a linear kernel and C = 2544 (Luo et 
 the paper) gives w; then P = −h/w_r, S = (1 − w_ṙ)·P/h, K = w_δ·P/h, T3 = w_δ̇/w_δ,
 d0 = b·P/h and T1 > T2 are the roots of s² − S·s + P = 0.  Derivatives are forward
 differences of the sampled r and δ.  The same pipeline gives every model-based controller
-its nominal model on ships without a closed-form Nomoto model (SPEC §8).
+its nominal model on ships without a closed-form Nomoto model.
 """
 
 from __future__ import annotations
@@ -115,7 +115,7 @@ def ship_nomoto(model: ShipModel, rudder_deg: float = 20.0) -> tuple[NomotoFit, 
     """The ship's 2nd-order Nomoto model and servo Tc [s] from its 20/20 zig-zag.
 
     This is the one pipeline that gives model-based controllers their nominal model on
-    ships without a closed-form Nomoto model (Xu & Guedes Soares 2020 §5.2, SPEC §8):
+    ships without a closed-form Nomoto model (Xu & Guedes Soares 2020 §5.2):
     computed from the model's own simulation, never typed in, cached per process for each
     (model, variant, parameters).
     """

@@ -17,8 +17,8 @@ with the rigid-body Coriolis terms X_c = m(v r + x_G r²), Y_c = −m u r, N_c =
 
 Coefficients (defaults): the multipurpose naval vessel of Blanke & Christensen (1993)
 (data file §3.3, dimensional SI): L_pp = 51.5 m, U_nom = 8 m/s, ρ = 1014 kg/m³,
-m = 357 m³ · ρ = 361,998 kg, I_z = 47.934e6 kg m², x_G = −3.38 m, X_vr = 0.33 m.  Seed 004's
-own identified scale-craft coefficients (its eq. (16)) are not recoverable (SPEC §2).
+m = 357 m³ · ρ = 361,998 kg, I_z = 47.934e6 kg m², x_G = −3.38 m, X_vr = 0.33 m.  The scale
+craft coefficients Moreno-Salinas et al. (2013) identified (eq. (16)) are not recoverable.
 
 Rudder (our model; the source has none: "rudder forces enter through τ")
 ------------------------------------------------------------------------

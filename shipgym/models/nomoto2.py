@@ -59,7 +59,7 @@ class UnitReading(enum.StrEnum):
     """How the paper's numbers (d0 in °/s, β with r in unknown units) map to SI.
 
     * ``si`` — δ, ψ, r in rad, rad/s; d0 converted from °/s to rad/s; β applies to r in
-      rad/s.  The reading SPEC §2 asks for by default (radians inside).
+      rad/s.  The default reading (radians inside, as everywhere in the package).
     * ``degrees`` — the whole equation in degrees (δ in °, r in °/s, d0 in °/s), as in
       ``data/ship_models.md`` §4.1.  Dividing (1) by 180/π gives the SI form with
       β_SI = β·(180/π)² and d0_SI = d0·π/180; K unchanged.

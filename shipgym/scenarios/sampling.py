@@ -1,4 +1,4 @@
-"""Randomised scenario distributions for training and held-out testing (SPEC §4).
+"""Randomised scenario distributions for training and held-out testing (docs/learned-agents.md).
 
 A *distribution* (YAML in ``configs/distributions/``) lists ships; each ship gives ranges
 for its nominal parameters, its own parameter jumps (which parameters, how large, when),

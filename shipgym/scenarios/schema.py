@@ -167,7 +167,7 @@ class EventConfig(StrictModel):
 
 
 class RewardConfig(StrictModel):
-    """r = −(|e|/L + w_ψ|ψ̃| + w_δ(δc/δmax)² + w_Δ(Δδc/δmax)²), SPEC §5."""
+    """r = −(|e|/L + w_ψ|ψ̃| + w_δ(δc/δmax)² + w_Δ(Δδc/δmax)²) per step (docs/environment.md)."""
 
     heading_weight: float = Field(0.1, ge=0)
     rudder_weight: float = Field(0.01, ge=0)

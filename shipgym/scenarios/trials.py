@@ -1,4 +1,4 @@
-"""What an evaluation seed varies: the trial randomisation of a scenario (issue 13).
+"""What an evaluation seed varies: the trial randomisation of a scenario (docs/leaderboard.md).
 
 A catalogue scenario is one deterministic task; the leaderboard's evaluation seeds make it
 a distribution of trials.  :class:`TrialRandomization` (a suite's ``randomize:`` block)

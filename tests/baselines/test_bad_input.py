@@ -1,5 +1,5 @@
 """Bad input on the command line: exit code 2, one stderr line naming the bad thing, no
-traceback, and nothing run or written before the check (issue 12, item 5)."""
+traceback, and nothing run or written before the check."""
 
 from __future__ import annotations
 

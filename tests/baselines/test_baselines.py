@@ -1,4 +1,4 @@
-"""Baselines, the evaluation loop and the leaderboard (SPEC §8, §9); the CLI: test_cli.py."""
+"""Baselines, the evaluation loop and the leaderboard; the CLI: test_cli.py."""
 
 from __future__ import annotations
 
@@ -81,7 +81,7 @@ def test_leaderboard_writes_tables_with_contract_keys(smoke: tuple[Path, list[di
     zero = {r["scenario"]: r for r in on_disk if r["controller"] == "zero_rudder"}
     for scenario in pid:
         assert pid[scenario]["ace"] < zero[scenario]["ace"]
-    # the NMPC family runs on every ship (issue 17): a row with numbers on the Mariner too
+    # the NMPC family runs on every ship: a row with numbers on the Mariner too
     nmpc = {r["scenario"]: r for r in on_disk if r["controller"] == "nmpc_lambda_lssvm"}
     assert all(row["applies"] is True for row in nmpc.values())
     assert nmpc["mariner_track"]["ace"] < zero["mariner_track"]["ace"]
@@ -92,15 +92,16 @@ def test_leaderboard_writes_tables_with_contract_keys(smoke: tuple[Path, list[di
     assert_equals_golden(on_disk, GOLDEN / "smoke_leaderboard.json")
 
 
-#: the smoke suite's run before issue 20 (main 195f895): leaderboard.html and the folder's
-#: files [bytes]; the default suite's were 9.6 MB and 51 MB, the targets 3 MB and 15 MB
+#: the smoke suite's run before the page was made lighter (main 195f895): leaderboard.html
+#: and the folder's files [bytes]; the default suite's were 9.6 MB and 51 MB, the targets
+#: 3 MB and 15 MB
 SMOKE_PAGE_BEFORE, SMOKE_FOLDER_BEFORE = 1_072_283, 3_720_279
 DEFAULT_PAGE_BEFORE, DEFAULT_FOLDER_BEFORE = 9.6e6, 51e6
 PAGE_TARGET, FOLDER_TARGET = 3e6, 15e6
 
 
 def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -> None:
-    """issue 20: the page and the folder shrink on the smoke suite as the targets ask of
+    """The page and the folder shrink on the smoke suite as the targets ask of
     the default suite (page ≤ 3 / 9.6, folder ≤ 15 / 51 of their size before), the page
     still showing every figure (as a PNG) and table."""
     out, rows = smoke
@@ -149,7 +150,7 @@ def test_the_smoke_leaderboard_opens_with_its_verdict(smoke: tuple[Path, list[di
 def test_run_replays_the_leaderboards_trial(
     smoke: tuple[Path, list[dict]], tmp_path: Path, capsys
 ) -> None:
-    """issue 20: ``shipgym run SCENARIO CONTROLLER --seed S --suite smoke`` is the smoke
+    """``shipgym run SCENARIO CONTROLLER --seed S --suite smoke`` is the smoke
     leaderboard's episode of that scenario and seed, its randomised trial included: ACE and
     cost equal bit for bit."""
     from shipgym_baselines.cli import main

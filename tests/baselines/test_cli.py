@@ -1,4 +1,4 @@
-"""The ``shipgym`` console script: subcommands, one-line errors, ``--json`` (SPEC §9b)."""
+"""The ``shipgym`` console script: subcommands, one-line errors, ``--json``."""
 
 from __future__ import annotations
 
@@ -206,7 +206,7 @@ def test_cli_bench_env_json(capsys) -> None:
 
 
 def test_cli_bench_identification_json(capsys) -> None:
-    """SPEC §9b: one JSON object; per case and identifier, errors, convergence time and µs."""
+    """``--json``: one JSON object; per case and identifier, errors, convergence time and µs."""
     assert main(["bench", "identification", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)
     assert {"rudder_aging", "current_shift", "maneuverability_change"} <= set(figures)
@@ -237,18 +237,18 @@ def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
         assert entry["family_p99_ms"] == max(
             entry["nmpc_p99_ms"], entry["nmpc_lambda_lssvm_svf_p99_ms"]
         )
-        # the privileged oracle, through its channel as in a run (issue 17)
+        # the privileged oracle, through its channel as in a run
         assert 0 < entry["oracle_median_ms"] <= entry["oracle_p99_ms"], ship
         assert entry["oracle_solves"] == (3 * 30 if ship == "nomoto2" else 30)
 
 
 def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:
-    """SPEC §9b shape: case, controller, metric, ours, paper; all three cases and controllers."""
+    """The rows' shape: case, controller, metric, ours, paper; all three cases and controllers."""
     assert main(["reproduce", "liu2019", "--out", str(tmp_path), "--json", "--no-progress"]) == 0
     rows = json.loads(capsys.readouterr().out)
     assert {"case", "controller", "metric", "ours", "paper"} <= set(rows[0])
     assert {r["case"] for r in rows} == {"rudder_aging", "current_shift", "maneuverability_change"}
-    literal = [r for r in rows if "front_end" not in r]  # issue 14 adds the *_svf rows
+    literal = [r for r in rows if "front_end" not in r]  # beside the SVF extension's *_svf rows
     assert {r["controller"] for r in literal} == {"nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"}
     assert {r["metric"] for r in literal} == {"ace", "t_c"}
     assert {r["controller"] for r in rows if r.get("front_end") == "svf"} == {
@@ -279,7 +279,7 @@ def test_finding11_a_bad_suite_is_named_before_the_state_of_out(
 
 
 def test_no_help_text_points_to_the_unshipped_spec(capsys) -> None:
-    """issue 20: help texts cite no "SPEC §…" (the spec is not shipped)."""
+    """Help texts cite no section of the design spec (it is not shipped)."""
     from shipgym_baselines.cli import SUBCOMMANDS, build_parser
 
     parser = build_parser()

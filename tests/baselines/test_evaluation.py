@@ -1,4 +1,4 @@
-"""The evaluation loop: what a policy sees and what the loop measures (SPEC §8–9)."""
+"""The evaluation loop: what a policy sees and what the loop measures."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Lockstep evaluation through the evaluation trials env (issue 18): a job's seeds, each its
+"""Lockstep evaluation through the evaluation trials env: a job's seeds, each its
 own trial variant as the leaderboard draws it, run as the rows of one vectorized env and
 give, bit for bit, what ``run_episode`` gives one seed at a time (compute times aside)."""
 

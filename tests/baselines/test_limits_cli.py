@@ -1,4 +1,4 @@
-"""The command line's limits (issue 19, finding 8): seeds, workers, a suite's seeds and
+"""The command line's limits (docs/records.md, "Limits"): seeds, workers, a suite's seeds and
 trial ranges — refused before any work in one line naming the option and the limit;
 ``--workers`` above the jobs is clamped to them."""
 

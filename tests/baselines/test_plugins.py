@@ -1,4 +1,4 @@
-"""Anyone's controller enters the benchmark (issue 12 item 2, SPEC §13 "Enter a controller"):
+"""Anyone's controller enters the benchmark (docs/plugins.md, "Enter your controller"):
 specs ``module:Attr`` / ``file.py:Attr``, installed entry points, a suite's long form, in
 worker processes too, and the "Enter your controller" example of docs/plugins.md as written."""
 

@@ -1,4 +1,4 @@
-"""The controller registry: one registration per controller (SPEC §8, §13 "Enter a controller")."""
+"""The controller registry: one registration per controller (docs/plugins.md)."""
 
 from __future__ import annotations
 
@@ -188,7 +188,7 @@ def test_unknown_controller_lists_valid_names() -> None:
 
 
 def test_applies_to_follows_the_registration(scratch_registry: None) -> None:
-    for name in ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"):  # issue 17: every ship
+    for name in ("nmpc", "nmpc_wlssvm", "nmpc_lambda_lssvm"):  # the NMPC family: every ship
         assert all(applies_to(name, s) for s in ("nomoto2", "mariner", "blanke", "esso_osaka"))
     assert applies_to("pid_los", "mariner") and applies_to("ppo", "mariner")
     register_controller("test_mariner_only", lambda: ZeroRudder(), applies_to=["mariner"])

@@ -1,4 +1,4 @@
-"""Signals, killed workers and a full disk (issue 19, finding 6): each ends a run in one
+"""Signals, killed workers and a full disk: each ends a run in one
 line with its record's status, and no worker outlives the run."""
 
 from __future__ import annotations

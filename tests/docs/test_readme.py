@@ -1,4 +1,4 @@
-"""The README is a front door (issue 20): short, its links resolve, and its test command is
+"""The README is a front door: short, its links resolve, and its test command is
 the one CI runs."""
 
 from __future__ import annotations

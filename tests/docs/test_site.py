@@ -1,5 +1,5 @@
 """The docs site builds with warnings as errors, and every env id, catalogue scenario and
-controller has its page (issue 20).  Built from a copy of ``docs/`` in a tmp folder, so that
+controller has its page.  Built from a copy of ``docs/`` in a tmp folder, so that
 the generated pages never land in the checkout.  The full build with the API reference is
 CI's (``.ci/run``)."""
 

@@ -1,4 +1,4 @@
-"""An episode's animation (issue 20): GIF through Pillow, MP4 through the video extra's
+"""An episode's animation: GIF through Pillow, MP4 through the video extra's
 ffmpeg, gymnasium's RecordVideo through moviepy; clear errors before any work."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Stochastic environmental disturbances (SPEC §4): currents, waves, their use in the env.
+"""Stochastic environmental disturbances: currents, waves, their use in the env.
 
 Statistical tolerances are about five standard errors of the estimate for the sample used
 (stated per test), with fixed seeds, so the tests are deterministic and cannot pass by luck

@@ -1,4 +1,4 @@
-"""Documented limits (issue 19, finding 8): a scenario beyond one is refused early, in one
+"""Documented limits (docs/records.md, "Limits"): a scenario beyond one is refused early, in one
 line naming the key and the limit (the audit's probes: 7 GB, hangs, ``std::bad_alloc``)."""
 
 from __future__ import annotations

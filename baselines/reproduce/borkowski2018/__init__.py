@@ -11,8 +11,8 @@ continuous-LS estimates), both with λy = 1/2000, λψ = 1, λδ = 5
 choices around it (both ×½, ×1.5, ×⅓, ×3; c0 alone ×½ (= the truth) and ×3).
 
 Rows per case: J of each controller (eq. (29), :func:`shipgym.metrics.compute_metrics`), the
-ratio J_adaptive/J_fixed, whether the adaptive J is lower (SPEC §11: "adaptive LQR lowers J
-against fixed LQR in every case tried" — the paper gives no J values), the final estimates
+ratio J_adaptive/J_fixed, whether the adaptive J is lower (the claim checked: adaptive LQR lowers J
+against fixed LQR in every case tried; the paper gives no J values), the final estimates
 â, ĉ; and one summary row, the largest reduction 1 − J_adaptive/J_fixed over the cases next
 to the paper's "reduction of the control quality indicator value to 15 %" (§5), read as
 "by up to 15 %" (the literal reading, J_adaptive = 0.15·J_fixed, would be an 85 %

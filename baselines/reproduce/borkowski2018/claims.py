@@ -1,4 +1,4 @@
-"""Borkowski (2018) §5: adaptive LQR lowers J against fixed LQR (SPEC §11), by up to 15 %."""
+"""Borkowski (2018) §5: adaptive LQR lowers J against fixed LQR, by up to 15 %."""
 
 from __future__ import annotations
 

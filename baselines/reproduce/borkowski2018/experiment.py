@@ -51,7 +51,7 @@ def run_experiment(
     guesses: tuple[tuple[float, float], ...] = GUESSES,
     time_limit: float | None = None,
 ) -> Outcome:
-    """The rows of SPEC §9b (plus ``seeds``, ``ours_std``); ``guesses``: initial (a0, c0)
+    """The reproduction rows (plus ``seeds``, ``ours_std``); ``guesses``: initial (a0, c0)
     pairs; ``time_limit`` [s] shortens the 1000 s episode.
 
     ``episodes``: (scenario, {(case, controller): (result, policy) of seed 0}, the case of

@@ -3,7 +3,7 @@
 For every case, controller and unit reading of the nomoto2 parameters (``si``, the
 library's default, and ``rudder_degrees``, the agile reading that reaches the paper's
 convergence times) this runs the catalogue scenario and reports our ACE and t_c beside the
-published ones (SPEC §11), writes ``liu2019.md`` / ``.json`` and, per case and reading, a
+published ones, writes ``liu2019.md`` / ``.json`` and, per case and reading, a
 figure with the tracks, e(t), the identified parameters against the truth and λ_k.
 
 Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the runs and rows),

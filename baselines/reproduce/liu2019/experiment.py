@@ -2,7 +2,7 @@
 
 Beside the paper's nine (case × controller) rows per reading, the same cases with the two
 adaptive controllers on the outlier + state-variable-filter front end of the regression
-(``nmpc_lambda_lssvm_svf``, ``nmpc_wlssvm_svf``; an extension beyond the paper, issue 14):
+(``nmpc_lambda_lssvm_svf``, ``nmpc_wlssvm_svf``; an extension beyond the paper):
 their ACE and t_c (``paper`` null: the paper has no such controller) and the parameters
 they identified against the truth after the change.
 """
@@ -42,7 +42,7 @@ IDENTIFIED = ("K", "T1", "T2", "T3", "d0", "beta", "Tc")
 SCORED = ("K", "T1", "T2", "T3", "Tc")
 READINGS = ("si", "rudder_degrees")
 
-#: Liu et al. (2019) §4.1–4.3 (SPEC §11): ACE [m] and t_c [s]; inf = "never" (|e| never
+#: Liu et al. (2019) §4.1–4.3: ACE [m] and t_c [s]; inf = "never" (|e| never
 #: stays below 0.05 m)
 PUBLISHED = {
     ("rudder_aging", "nmpc_lambda_lssvm"): (0.495, 35.5),
@@ -60,7 +60,7 @@ PUBLISHED = {
 def run_experiment(
     seeds: int = 1, progress: Progress | None = None, readings: tuple[str, ...] = READINGS
 ) -> Outcome:
-    """The rows of SPEC §9b (plus ``unit_reading``, ``seeds``): per reading, case and
+    """The reproduction rows (plus ``unit_reading``, ``seeds``): per reading, case and
     controller our ACE and t_c, means over ``seeds``, beside the paper's; then the rows of
     the SVF controllers (:func:`svf_rows`).
 

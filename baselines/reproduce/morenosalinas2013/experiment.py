@@ -94,7 +94,7 @@ def run_experiment(
     yaw_rate_noise: float = 0.0,
     duration_scale: float = 1.0,
 ) -> Outcome:
-    """The rows of SPEC §9b (plus ``ours_std`` and ``seeds``).
+    """The reproduction rows (plus ``ours_std`` and ``seeds``).
 
     ``seeds``: noise realisations (``ours`` is their mean, ``ours_std`` the spread);
     ``yaw_rate_noise`` [rad/s] one-sigma gyro noise (the paper gives none);

@@ -42,7 +42,7 @@ def run_experiment(
     curved_initial_speed: float | None = CURVED_INITIAL_SPEED,
     current_speed: float | None = None,
 ) -> Outcome:
-    """The rows of SPEC §9b (plus ``setting``, ``gains``, ``seeds``, ``ours_std`` and, on
+    """The reproduction rows (plus ``setting``, ``gains``, ``seeds``, ``ours_std`` and, on
     the path rows, the run's initial speed and current); ``episodes``: :class:`FirstRuns`.
 
     ``settings``, ``gains``, ``cases``: subsets of :data:`SETTINGS`, :data:`GAINS`,

@@ -23,7 +23,7 @@ def setting_row(
     seeds: int,
     std: float | None = None,
 ) -> dict[str, Any]:
-    """A row of SPEC §9b with the plant ``setting`` and the ``gains`` design (None: none)."""
+    """A reproduction row with the plant ``setting`` and the ``gains`` design (None: none)."""
     return reproduction_row(
         case, controller, metric, float(ours), paper, seeds, std, setting=setting, gains=gains
     )

@@ -17,7 +17,7 @@ t = 1000 s; the paper gives neither the switch time nor the fluctuation, see
   drift-angle term −β of eq. (48)).
 
 The paper prints no numbers for its runs, only figures (Figs. 9–15) and what it reads from
-them.  Rows (SPEC §9b, plus ``seeds`` and ``ours_std``) therefore hold:
+them.  Rows (``case, controller, metric, ours, paper``, ``seeds``, ``ours_std``) hold:
 
 * per current phase (``weak_current`` t < t_switch, ``strong_current`` t ≥ t_switch) and
   for the whole ``episode``, per controller: ACE = mean |e| and the |e| spread and maximum;

@@ -46,7 +46,7 @@ def run_experiment(
     controllers: tuple[str, ...] = tuple(CONTROLLERS),
     time_limit: float | None = None,
 ) -> Outcome:
-    """The rows of SPEC §9b (plus ``seeds``, ``ours_std``); ``episodes``: :class:`FirstRuns`.
+    """The reproduction rows (plus ``seeds``, ``ours_std``); ``episodes``: :class:`FirstRuns`.
 
     ``controllers``: labels of :data:`CONTROLLERS`; ``time_limit`` [s] shortens the 2000 s
     episode (the current's switch moves to half of it) for a quick run.

@@ -1,4 +1,4 @@
-"""L1 adaptive backstepping of Xu, Oliveira & Guedes Soares (2021) (issue 6, item 1): the two
+"""L1 adaptive backstepping of Xu, Oliveira & Guedes Soares (2021): the two
 controllers in closed loop.  Their parts are tested in tests/baselines/classical/adaptive/,
 the guidance derivatives, spectral metric and cubic-damping fit beside their modules."""
 

@@ -262,7 +262,7 @@ def test_fast_riccati_solution_equals_scipy_and_solves_the_care() -> None:
 
 @pytest.mark.parametrize("scenario", ["esso_osaka_current_shift", "blanke_current_shift"])
 def test_drift_compensation_takes_the_crab_offset_out(scenario: str) -> None:
-    """issue 21: with the course error ψ + β − ψp in its state (β measured from the
+    """With the course error ψ + β − ψp in its state (β measured from the
     positions, as the PID family and L1 compensate it), the paper's LQR holds a current's
     crab angle without the cross-track offset it needs otherwise: the second half of the
     episode is closer to the path."""

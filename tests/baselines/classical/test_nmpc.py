@@ -179,7 +179,7 @@ def test_svf_controllers_are_registered_for_every_ship() -> None:
 
 
 def test_svf_front_end_restores_the_adaptive_advantage_in_case3() -> None:
-    """Issue 14: Case 3 (heading noise σ = 0.2° and outliers), 3 seeds: the mean ACE of each
+    """Case 3 (heading noise σ = 0.2° and outliers), 3 seeds: the mean ACE of each
     ``*_svf`` controller is below half that of non-adaptive ``nmpc`` (measured 0.53 and
     0.80 m against 3.53 m), where the paper's differences leave λ-LS-SVM worse than ``nmpc``."""
     from shipgym_baselines.classical.nmpc import NMPCLambdaLSSVMSVF, NMPCWeightedLSSVMSVF

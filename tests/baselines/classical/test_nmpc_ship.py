@@ -1,4 +1,4 @@
-"""The NMPC family on every ship (issue 17): numbers from each ship's time scales."""
+"""The NMPC family on every ship: numbers from each ship's time scales."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def test_the_family_keeps_each_ship_in_its_corridor(ship: str) -> None:
     the corridor, finite, no solver failure; ``nmpc`` on the nominal model below the mean
     |e| of pid_los's paper design (the adaptive members need not be: on the Blanke ship the
     paper's differences front end identifies T between 0.2 and 27 s and costs accuracy; the
-    tuned pid_los of issue 21 beats ``nmpc``'s |e| on Esso Osaka and the Mariner)."""
+    tuned pid_los (docs/tuning.md) beats ``nmpc``'s |e| on Esso Osaka and the Mariner)."""
     name, seconds = SHIP_SCENARIOS[ship]
     scenario = load_scenario(name).with_overrides({"time_limit": seconds})
     paper_pid = make_controller("pid_los", preset="paper")[0]

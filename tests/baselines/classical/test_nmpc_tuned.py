@@ -1,4 +1,4 @@
-"""The NMPC family's tuned settings (issue 21): weights as solver parameters, horizon and
+"""The NMPC family's tuned settings (docs/tuning.md): weights as solver parameters, horizon and
 weight factors over the ship rule, the measured drift angle, the family's one study."""
 
 from __future__ import annotations

@@ -508,7 +508,7 @@ def test_a_sample_of_the_shipped_references_recomputes_to_the_same_cost() -> Non
 
 def test_the_oracle_costs_less_than_pid_los_on_the_smoke_suite() -> None:
     """What is achievable: on every smoke trial the oracle's cost is below that of pid_los,
-    its paper design and its tuned settings (issue 21).  Revision 2 lost to the tuned
+    its paper design and its tuned settings.  Revision 2 lost to the tuned
     pid_los on ``mariner_track`` (its 20 equal intervals of 14 s were too coarse for the
     Mariner); revision 3's geometric intervals beat it."""
     table = shipped_table()

@@ -1,4 +1,4 @@
-"""Names written as text (issue 19, finding 5): figures draw them as typed, the Markdown
+"""Names written as text: figures draw them as typed, the Markdown
 and CSV tables escape them."""
 
 from __future__ import annotations

@@ -84,7 +84,7 @@ def scenario_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
 
 
 def test_a_scenario_figure_is_a_page_sized_png_and_an_svgz(scenario_files: list[Path]) -> None:
-    """issue 20: drawn at 200 dpi, written at half (≤ PAGE_WIDTH px) as a palette PNG; the
+    """Drawn at 200 dpi, written at half (≤ PAGE_WIDTH px) as a palette PNG; the
     vector copy deflated."""
     png, svg = scenario_files
     assert (png.name, svg.name) == ("scenario_heldout_0.png", "scenario_heldout_0.svgz")
@@ -96,7 +96,7 @@ def test_a_scenario_figure_is_a_page_sized_png_and_an_svgz(scenario_files: list[
 
 
 def test_the_page_png_keeps_each_controllers_colour(scenario_files: list[Path]) -> None:
-    """issue 20: the page PNG's palette holds each drawn controller's exact colour (an
+    """The page PNG's palette holds each drawn controller's exact colour (an
     adaptive palette had turned them grey), and those pixels are there; the legends' text
     and where they start ride in the PNG for the page."""
     with Image.open(scenario_files[0]) as image:

@@ -1,4 +1,4 @@
-"""The leaderboard's trials, training seeds, row intervals and ranking (issue 13)."""
+"""The leaderboard's trials, training seeds, row intervals and ranking (docs/leaderboard.md)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ RANDOMIZE = {
     "heading_error_deg": [-10.0, 10.0],
     "jump_time_jitter_s": [-5.0, 5.0],
 }
-#: aggregate.json's fields (issue 17), exactly
+#: aggregate.json's fields, exactly
 AGGREGATE_KEYS = {
     "controller",
     "kind",
@@ -422,7 +422,7 @@ def test_finding3_a_scenario_edited_mid_run_has_no_effect(tmp_path: Path, worker
 
 @pytest.mark.slow
 def test_quick_suite_finishes(tmp_path: Path) -> None:
-    """The quick suite (issue 18) runs to the end with every controller on its 12
+    """The quick suite runs to the end with every controller on its 12
     scenarios (one evaluation seed here, to keep CI short; the suite's own is 3): a row per
     controller and scenario, every applicable one with its episodes."""
     from shipgym_baselines.leaderboard.suite import load_suite

@@ -215,7 +215,7 @@ def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page
     # the DOM after the script ran (and its promises: the long table unpacks asynchronously)
     dom = chromium(built_page.as_uri(), tmp, "--virtual-time-budget=10000", "--dump-dom")
     assert sorted(score_rows(dom).names) == sorted(CONTROLLERS)
-    cells = _Cells()  # the long table's rows, unpacked by the script (issue 20)
+    cells = _Cells()  # the long table's rows, unpacked by the page's script
     cells.feed(dom)
     rows, _, _ = synthetic_tables()
     assert len(cells.rows["rows"]) == len(rows)
@@ -297,7 +297,7 @@ def _script_key(cell: list[Any] | None, numeric: bool) -> Any:
 
 
 def test_every_numeric_column_of_the_long_table_sorts_as_its_values() -> None:
-    """issue 20: with data-sort at ≤ 7 digits, or none where a column's texts sort the same,
+    """With data-sort at ≤ 7 digits, or none where a column's texts sort the same,
     every column of the long table sorts its rows as the full-precision values do."""
     rows, aggregate, scores = synthetic_tables()
     for i, r in enumerate(rows):  # values that tie at the 3 decimals shown, differ after

@@ -1,4 +1,4 @@
-"""``shipgym report`` and ``evaluate``'s folders (issue 12): separate runs merge into one
+"""``shipgym report`` and ``evaluate``'s folders: separate runs merge into one
 table, equal to the leaderboard of the same controllers."""
 
 from __future__ import annotations
@@ -115,7 +115,7 @@ def test_report_writes_results_report_by_default_and_never_over_it(
 def test_a_renamed_run_merges_with_the_one_of_its_own_name(
     evaluated: dict[str, Path], tmp_path: Path, capsys
 ) -> None:
-    """issue 20: ``--name`` shows a controller under another name, so ``report`` merges it
+    """``--name`` shows a controller under another name, so ``report`` merges it
     with a run of the controller under its own (a trained agent beside the shipped one)."""
     suite = str(evaluated["pid_los"].parent / "tiny.yaml")
     again = tmp_path / "again"

@@ -42,7 +42,7 @@ def test_packaged_suites_load() -> None:
 
 
 def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
-    """The whole scenario matrix (issue 18) with the nomoto2 and papers' scenarios, and the
+    """The whole scenario matrix with the nomoto2 and papers' scenarios, and the
     held-out scenarios up to heldout:15 (each 3-DOF ship's three families and a combination)."""
     from shipgym_baselines.studies.change_effect import matrix_scenarios
 

@@ -1,4 +1,4 @@
-"""Learning curves, the plateau rule and the relative-cost selection metric (issue 21)."""
+"""Learning curves, the plateau rule and the relative-cost selection metric (docs/training.md)."""
 
 from __future__ import annotations
 

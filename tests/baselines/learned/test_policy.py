@@ -1,7 +1,7 @@
-"""A plain stable-baselines3 zip is scored by its path (issue 12 items 2 and 5): algorithm
+"""A plain stable-baselines3 zip is scored by its path: algorithm
 from the zip, action mode from its action space, ``vecnormalize.pkl`` beside it used (when trusted),
 ``meta.json`` optional and checked, a truncated or corrupt zip a clear error.  An agent
-trained with several seeds is a folder of ``seed_<k>`` folders (issue 13 item 2)."""
+trained with several seeds is a folder of ``seed_<k>`` folders."""
 
 from __future__ import annotations
 
@@ -171,7 +171,7 @@ def test_vecnormalize_beside_the_zip_normalises_the_observation(tmp_path: Path) 
     model.learn(total_timesteps=64)  # the running mean and variance move away from 0, 1
     model.save(tmp_path / "model")
     venv.save(str(tmp_path / "vecnormalize.pkl"))
-    with trusting_pickle(True):  # a pickle: read only when trusted (issue 19, finding 7)
+    with trusting_pickle(True):  # a pickle: read only when trusted
         policy = LearnedPolicy(tmp_path)
     assert policy.obs_normalizer is not None
     for obs in _observations(5):
@@ -264,7 +264,7 @@ def test_a_meta_json_names_the_algorithm_the_zip_does_not(
     with pytest.raises(ControllerError, match=r"cannot tell which algorithm saved it"):
         make_controller(str(custom))
     (custom.parent / "meta.json").write_text('{"algo": "ppo"}')
-    # the user's own class lives only in the pickle (issue 19, finding 7)
+    # the user's own class lives only in the pickle
     with pytest.raises(ControllerError, match=r"my_package\.policies.*--trust-pickle"):
         make_controller(str(custom))
     with trusting_pickle(True):
@@ -372,7 +372,7 @@ def test_every_shipped_agent_loads_each_of_its_training_seeds() -> None:
 
 
 def test_an_sb3_zip_is_named_by_its_file_stem(tmp_path: Path) -> None:
-    """issue 20: ``work/ppo_ship.zip`` is ``ppo_ship``, not its folder's name; a trained
+    """``work/ppo_ship.zip`` is ``ppo_ship``, not its folder's name; a trained
     agent's own model file is its folder's."""
     from shipgym_baselines.learned.policy import policy_label
 
@@ -383,9 +383,9 @@ def test_an_sb3_zip_is_named_by_its_file_stem(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("name", ["ppo", "ppo_guidance", "sac", "td3", "recurrent_ppo"])
 def test_the_lean_forward_is_predict_bit_for_bit(name: str) -> None:
-    """The evaluation's forward without ``predict``'s per-call overhead (issue 18: the
-    default run's CPU) gives ``predict``'s deterministic actions exactly; a recurrent
-    policy keeps ``predict``."""
+    """The evaluation's forward without ``predict``'s per-call overhead (≈ 30
+    CPU s of the default run, docs/leaderboard-cost.md) gives ``predict``'s deterministic
+    actions exactly; a recurrent policy keeps ``predict``."""
     import torch
 
     from shipgym_baselines.learned.policy import BATCH_ROWS, LearnedPolicy, lean_forward

@@ -1,4 +1,4 @@
-"""Model files are read as data (issue 19, finding 7): an SB3 zip's pickled values are never
+"""Model files are read as data (docs/records.md): an SB3 zip's pickled values are never
 unpickled, the weights load with ``weights_only``, observation statistics come from JSON; a
 file that needs unpickling is refused unless ``--trust-pickle``.  The shipped agents act
 exactly as through SB3's pickle loader (golden actions recorded before the change)."""

@@ -1,5 +1,5 @@
 """Training writes learning curves, selects on the relative cost and stops on a plateau;
-the per-ship batched path with context features trains end to end (issue 21)."""
+the per-ship batched path with context features trains end to end."""
 
 from __future__ import annotations
 

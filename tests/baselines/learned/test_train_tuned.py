@@ -1,6 +1,6 @@
 """``shipgym train AGENT --settings tuned``: the study's chosen settings reach the trained
 model, the refusal is one line naming the file, and the pipeline command resumes an
-interrupted sweep (issue 21, parts 4 and 6)."""
+interrupted sweep."""
 
 from __future__ import annotations
 

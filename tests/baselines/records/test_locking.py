@@ -1,4 +1,4 @@
-"""One run per output folder (issue 19, finding 1): the lock on ``--out``."""
+"""One run per output folder: the lock on ``--out``."""
 
 from __future__ import annotations
 

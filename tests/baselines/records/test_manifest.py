@@ -1,4 +1,4 @@
-"""The manifest ``--force`` deletes by (issue 19, finding 4)."""
+"""The manifest ``--force`` deletes by: only what a run wrote."""
 
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ def test_finding4_force_deletes_the_listed_and_refuses_anything_else(tmp_path: P
 
 
 def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -> None:
-    """issue 20: a run writes each episode's trajectory (via a temporary) and removes those
+    """A run writes each episode's trajectory (via a temporary) and removes those
     no figure draws; once it finishes its manifest lists neither the removed files nor any
     temporary, and ``--force`` still clears the folder and refuses a user's file."""
     import numpy as np

@@ -1,4 +1,4 @@
-"""Run records (issue 12): run.json, episodes.jsonl, refusal of a used --out, --force,
+"""Run records (docs/records.md): run.json, episodes.jsonl, refusal of a used --out, --force,
 --resume, Ctrl-C; the train refusal."""
 
 from __future__ import annotations
@@ -396,7 +396,7 @@ def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
         train("ppo", out_dir=out, n_timesteps=64, progress=False, force=True)
 
 
-# --- issue 19, finding 2: episodes.jsonl is a set keyed by the episode key ----------------
+# --- episodes.jsonl is a set keyed by the episode key --------------------------------------
 
 
 def copy_run(source: Path, target: Path) -> Path:

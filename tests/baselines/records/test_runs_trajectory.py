@@ -1,5 +1,5 @@
-"""A record's ``trajectory`` field names only a file inside its run folder (issue 19,
-finding 7): ``report`` never reads a file elsewhere."""
+"""A record's ``trajectory`` field names only a file inside its run folder:
+``report`` never reads a file elsewhere."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""M4 thinning of a kept trajectory (issue 20): what a figure draws is what it would draw of
-the full signal."""
+"""M4 thinning of a kept trajectory (a lighter run folder): what a figure draws is what it
+would draw of the full signal."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Liu et al. (2019) reproduction: the paper-literal rows and the SVF extension (issue 14)."""
+"""Liu et al. (2019) reproduction: the paper-literal rows and the SVF extension."""
 
 from __future__ import annotations
 

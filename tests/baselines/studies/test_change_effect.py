@@ -1,4 +1,4 @@
-"""Each change of the scenario matrix matters (issue 18): pid_los, a non-adaptive
+"""Each change of the scenario matrix matters (docs/scenario-matrix.md): pid_los, a non-adaptive
 controller, pays ≥ 1.3× per step after the change what it pays on the nominal twin over
 the same time window, averaged over the first three leaderboard trials."""
 

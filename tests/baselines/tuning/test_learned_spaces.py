@@ -12,7 +12,7 @@ LEARNED = [n for n in list_tuning() if load_tuning(n).kind == "learned"]
 
 
 def test_every_learned_agent_has_a_study() -> None:
-    """Issue 21: PPO, PPO-guidance, SAC, TD3 and the adaptive agent are all tuned."""
+    """PPO, PPO-guidance, SAC, TD3 and the adaptive agent are all tuned."""
     assert {"ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3"} <= set(LEARNED)
 
 

@@ -1,5 +1,5 @@
 """--settings tuned: the chosen settings and the final block over an agent config, the
-refusal without chosen settings, and the final block's validation (issue 21, parts 1, 4)."""
+refusal without chosen settings, and the final block's validation (docs/tuning.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The envs pass the clients' own checks (issue 12, item 6): Gymnasium's
+"""The envs pass the clients' own checks: Gymnasium's
 ``check_environments_match`` with ``info_comparison="equivalence"`` (no wall-clock number in
 ``info``), ``gym.make_vec`` in the default batched mode with ``max_episode_steps``, the
 batched ``episode_metrics`` dtypes of ``SyncVectorEnv``, and the module-qualified id

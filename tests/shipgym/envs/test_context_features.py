@@ -1,4 +1,5 @@
-"""The optional controller-context observation features (issue 21: equal information)."""
+"""The optional controller-context observation features: what the classical controllers
+are designed from (docs/observation.md)."""
 
 from __future__ import annotations
 

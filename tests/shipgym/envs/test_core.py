@@ -1,4 +1,4 @@
-"""The step core: reward, termination and observation as closed forms (SPEC §5)."""
+"""The step core: reward, termination and observation as closed forms (docs/environment.md)."""
 
 from __future__ import annotations
 

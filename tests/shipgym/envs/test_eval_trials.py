@@ -1,5 +1,5 @@
 """The evaluation trials env: given trials as rows, each row the single env's episode of its
-trial and seed, bit for bit: observations, rewards, ends and every ``info`` key (issue 18)."""
+trial and seed, bit for bit: observations, rewards, ends and every ``info`` key."""
 
 from __future__ import annotations
 

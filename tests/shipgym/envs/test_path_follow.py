@@ -1,4 +1,4 @@
-"""Tests of the public env contract (SPEC §5, §12): conformance, seeding, vectorisation,
+"""Tests of the public env contract (docs/environment.md): conformance, seeding, vectorisation,
 pickling, bad actions, info, observation bounds, reward, termination and rendering."""
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ def seeded_actions(space: gym.spaces.Box, n: int, seed: int) -> list[np.ndarray]
 def test_registered_ids() -> None:
     assert "ShipPathFollow-v0" in ENV_IDS
     env = gym.make("ShipPathFollow-v0")
-    assert env.unwrapped.scenario.name == "rudder_aging"  # SPEC §5 default
+    assert env.unwrapped.scenario.name == "rudder_aging"  # the -v0 default
     assert env.unwrapped.model.name == "nomoto2"
     assert env.unwrapped.action_mode == "rudder"
 
@@ -471,7 +471,7 @@ def test_non_finite_on_the_first_step_still_reports_episode_metrics() -> None:
     env.reset(seed=0)
     _, reward, terminated, _, info = env.step(np.ones(1, dtype=np.float32))
     assert terminated and info["termination_reason"] == "non_finite_state"
-    assert "episode_metrics" in info  # SPEC §5: on the last step of an episode
+    assert "episode_metrics" in info  # on the last step of an episode
     assert info["episode_metrics"]["return"] == pytest.approx(reward, rel=1e-12)
 
 

@@ -1,4 +1,4 @@
-"""Row tracking of the batched trial envs (issue 18): rows of one route are followed by one
+"""Row tracking of the batched trial envs: rows of one route are followed by one
 batched PathTracker (or by one scalar tracker each below MIN_BATCHED_ROWS), and every row's
 frame is its own scalar tracker's, bit for bit and in the single env's Python types."""
 

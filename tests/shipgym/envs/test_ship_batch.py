@@ -1,5 +1,5 @@
 """The per-ship trial env: a fresh trial per env at every reset, drawn as the distribution
-draws them, each env's episode that of a single env on its trial (issue 21)."""
+draws them, each env's episode that of a single env on its trial."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The batched env equals N single envs (SPEC §5 batched simulation)."""
+"""The batched env equals N single envs."""
 
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def test_batched_env_equals_single_envs_bit_for_bit(scenario: str) -> None:
 
 
 def with_law(scenario: str, law: str, time_limit: float | None = None) -> Scenario:
-    """A catalogue scenario with another guidance law (SPEC §3) and time limit."""
+    """A catalogue scenario with another guidance law and time limit."""
     overrides: dict = {"guidance": {"law": law}}
     if time_limit is not None:
         overrides["time_limit"] = time_limit
@@ -149,7 +149,7 @@ def test_sb3_adapter_trains_ppo_and_autoresets_same_step() -> None:
 
 
 def stochastic_disturbance_scenario() -> Scenario:
-    """Nominal with a saturating Gauss–Markov current, waves and heading noise (SPEC §4)."""
+    """Nominal with a saturating Gauss–Markov current, waves and heading noise."""
     data = load_scenario("nominal").config.model_dump()
     data["name"] = "nominal_stochastic_disturbances"
     data["time_limit"] = 15.0  # short episodes: autoresets re-draw the initial states

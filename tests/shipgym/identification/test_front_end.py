@@ -1,5 +1,5 @@
 """Front ends of the Nomoto regression: the Hampel filter, the state-variable filter and the
-two sources of the rows of eq. (36) (issue 14)."""
+two sources of the rows of eq. (36) (docs/identification.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Identification toolkit (SPEC §7): each test asserts a mathematical or physical fact."""
+"""Identification toolkit: each test asserts a mathematical or physical fact."""
 
 from __future__ import annotations
 
@@ -280,7 +280,7 @@ def test_persistent_excitation_has_the_requested_spread() -> None:
 
 
 def test_persistent_excitation_holds_each_draw_for_hold_calls() -> None:
-    """hold = 3 (a slower ship, issue 17): the paper's draws, each kept for three calls."""
+    """hold = 3 (a slower ship than the paper's): the paper's draws, each kept for three calls."""
     paper = PersistentExcitation(0.02, np.random.default_rng(6))
     held = PersistentExcitation(0.02, np.random.default_rng(6), hold=3)
     draws = [paper(0.0) for _ in range(4)]
@@ -373,8 +373,8 @@ def test_degenerate_window_keeps_the_nu_rhythm() -> None:
 # ----------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize("h", [0.0, -0.01, math.nan, math.inf, "0.01"])
 def test_a_bad_sampling_step_is_refused_by_name_before_any_work(h) -> None:
-    """Issue 12 item 5: h = 0, h < 0 or non-finite → IdentificationError naming h, even with
-    data that would fail later for another reason (empty arrays)."""
+    """A sampling step h = 0, h < 0 or non-finite → IdentificationError naming h, even
+    with data that would fail later for another reason (empty arrays)."""
     empty = np.zeros(0)
     with pytest.raises(IdentificationError, match="sampling step h"):
         fit_nomoto2(empty, empty, empty, h)
@@ -389,7 +389,7 @@ def test_a_bad_sampling_step_is_refused_by_name_before_any_work(h) -> None:
 
 @pytest.mark.parametrize("cls", [LambdaLSSVM, WeightedLSSVMOnline])
 def test_samples_without_a_key_are_refused_naming_it_and_the_keys_needed(cls) -> None:
-    """Issue 12 item 5: a dict lacking "delta_c" → IdentificationError naming the missing key
+    """A dict lacking "delta_c" → IdentificationError naming the missing key
     and the keys the identifier needs; nothing is fed."""
     ident = cls(H)
     samples = {"psi": np.zeros(50), "delta": np.zeros(50)}

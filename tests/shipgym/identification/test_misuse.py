@@ -1,4 +1,4 @@
-"""Identification misuse is named, never a wrong model (issue 19, finding 10): a NaN names
+"""Identification misuse is named, never a wrong model: a NaN names
 its array and index, arrays of different lengths name the arrays, a log too short for the
 model's time constants names the minimum length."""
 

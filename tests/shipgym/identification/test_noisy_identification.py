@@ -1,5 +1,5 @@
 """Identification that survives sensor noise: the SVF front end against the paper's
-differences on noisy headings (issue 14)."""
+differences on noisy headings."""
 
 from __future__ import annotations
 

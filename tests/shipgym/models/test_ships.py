@@ -116,7 +116,7 @@ def test_every_classical_controller_keeps_the_error_bounded_on_every_ship(ship: 
     data["time_limit"] = 60 * (config.control_period or MODELS[ship].control_period)
     scenario = scenario_from_dict(data)
     for name in CLASSICAL:
-        assert applies_to(name, ship), name  # the NMPC family too (issue 17)
+        assert applies_to(name, ship), name  # the NMPC family too
         result = evaluate(name, scenario, [0])[0]
         e = result.trajectory["cross_track_error"]
         assert np.all(np.isfinite(e)), name

@@ -3,7 +3,7 @@
 Each file is a catalogue scenario whose numeric leaves (ship parameters, start, path,
 guidance, events, times, reward, disturbances) are changed at random: scaled by 10^U(−3, 3),
 negated, set to 0 or to a small integer.  Used by the property test that every file
-``shipgym scenarios --validate`` accepts makes an env that steps (issue 19, finding 9)."""
+``shipgym scenarios --validate`` accepts makes an env that steps."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The scenario matrix (issue 18): every ship faces every change.
+"""The scenario matrix (docs/scenario-matrix.md): every ship faces every change.
 
 For esso_osaka, mariner and blanke: ``{ship}_nominal`` and, for each family (rudder aging,
 current shift, manoeuvrability change), ``{ship}_{family}`` and ``{ship}_{family}_curved``.

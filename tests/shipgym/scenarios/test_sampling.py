@@ -150,7 +150,7 @@ def test_heldout_interleaves_the_ships_and_keeps_the_one_ship_scenarios() -> Non
             assert {k for k in a if a[k] != b[k]} <= {"time_limit"}
 
 
-#: per ship, the parameter whose factor measures each parameter family (issue 18): servo
+#: per ship, the parameter whose factor measures each parameter family: servo
 #: time constant (aging), the steering gain (gain), the loading change's key parameter
 #: (loading: Esso Osaka's draught T, Blanke's mass, the Mariner's a3)
 AGING = {"nomoto2": "Tc", "esso_osaka": "T_servo", "mariner": "T_delta", "blanke": "T_delta"}

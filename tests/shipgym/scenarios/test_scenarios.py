@@ -29,7 +29,7 @@ DEG = math.pi / 180.0
 CATALOGUE = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
 
 #: (event time [s], parameters changed, their SI values before and after) — Liu et al. (2019)
-#: §4 Cases 1–3 as listed in SPEC §4.
+#: §4 Cases 1–3.
 EVENTS: dict[str, tuple[float, dict[str, tuple[float, float]]]] = {
     "rudder_aging": (12.0, {"Tc": (0.1, 1.0)}),
     "current_shift": (12.0, {"d0": (-1.2370 * DEG, -4.0 * DEG)}),
@@ -334,7 +334,7 @@ def test_ramp_event_through_the_env_matches_an_independent_simulation() -> None:
 
 
 # --------------------------------------------------------------------------------------------
-# Bad inputs: clear errors (SPEC §12)
+# Bad inputs: clear errors
 # --------------------------------------------------------------------------------------------
 
 

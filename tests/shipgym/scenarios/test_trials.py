@@ -1,4 +1,4 @@
-"""Trial randomisation: what an evaluation seed draws (issue 13)."""
+"""Trial randomisation: what an evaluation seed draws (docs/leaderboard.md)."""
 
 from __future__ import annotations
 

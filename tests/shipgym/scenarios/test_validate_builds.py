@@ -1,4 +1,4 @@
-"""What validates must run (issue 19, finding 9): ``shipgym scenarios --validate`` builds
+"""What validates must run: ``shipgym scenarios --validate`` builds
 what construction builds — the nominal model's identification included — so every file it
 accepts makes an env that steps, and construction errors name the scenario key."""
 
@@ -32,8 +32,8 @@ def _steps(file: Path, mode: str) -> None:
 def test_finding9_every_file_validate_accepts_makes_an_env_and_steps(tmp_path: Path) -> None:
     """The property, on 200 fuzzed files (seeded: catalogue scenarios with 1–3 numbers
     changed, half of them the ship's own).  The seed is one whose 200 files reach both sides
-    of the nominal-model check with the catalogue as it is (issue 18 added 20 scenarios: seed
-    19 no longer did)."""
+    of the nominal-model check with the catalogue as it is (the scenario matrix added 20
+    scenarios: seed 19 no longer did)."""
     accepted, nominal = 0, 0
     for file in write_fuzzed(tmp_path, 200, seed=22):
         problems = check_scenario_file(file)
