@@ -26,11 +26,14 @@ from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError, RunError
-from shipgym_baselines.leaderboard.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import (
+    CONTROLLER_ERROR,
+    CONTROLLER_TIMEOUT,
+    EpisodeResult,
+)
 from shipgym_baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"

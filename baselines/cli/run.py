@@ -112,8 +112,8 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.manifest import check_listed
-    from shipgym_baselines.records.runs import check_out_dir
     from shipgym_baselines.registry import applies_to, training_seeds
 
     guard = ActGuard(args.act_timeout)
@@ -169,10 +169,11 @@ def _write(out: Path, force: bool, metrics: str, draw: Callable[[], list[Path]])
     """``metrics.json`` (the text ``metrics``) and the figures (``draw`` writes them and
     returns their paths) into ``out``, locked, each file listed in its manifest as it is
     written (``force``: what the manifest lists deleted first); the figures' names."""
+    from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.locking import out_lock
     from shipgym_baselines.records.manifest import Manifest, clear_listed
     from shipgym_baselines.records.outfiles import write_text
-    from shipgym_baselines.records.runs import check_out_dir, now
+    from shipgym_baselines.records.runrecord import now
 
     with out_lock(out, now()):
         check_out_dir(out, force=force)  # again, now that no other run can start there

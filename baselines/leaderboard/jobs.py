@@ -18,13 +18,10 @@ from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.errors import BackendError, RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
-from shipgym_baselines.leaderboard.ranking import (
-    controller_failed,
-)
 from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult, controller_failed
 from shipgym_baselines.records.runs import (
     BACKENDS,
 )
