@@ -112,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.records.episodes import EpisodeLabel
     from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.manifest import check_listed
     from shipgym_baselines.registry import applies_to, training_seeds
@@ -135,10 +136,10 @@ def run(args: argparse.Namespace) -> int:
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
     settings = {} if training_seed is None else {"training_seed": training_seed}
-    result = evaluate(args.controller, trial, [args.seed], guard=guard, **settings)[0]
     # as the leaderboard names them: a scenario file under its name:
     table_name = scenario.name if is_path(args.scenario) else args.scenario
-    result.controller, result.scenario = label, table_name
+    named = EpisodeLabel(table_name, label, training_seed)
+    (result,) = evaluate(args.controller, trial, [args.seed], guard=guard, label=named, **settings)
     row = result.row()
     # after "seed": which of the agent's policies ran (as the leaderboard's episodes name it)
     at = list(row).index("seed") + 1

@@ -1,7 +1,7 @@
 """One episode's result and its record: the metrics and trajectory of a (controller,
-scenario, seed) episode as the evaluation loop gives it (:class:`EpisodeResult`), and the
-line of a run's ``episodes.jsonl`` that keeps it (:func:`episode_record`, read back by
-:func:`read_episodes`).
+scenario, seed) episode as the evaluation loop gives it (:class:`EpisodeResult`, labelled
+as :class:`EpisodeLabel` says), and the line of a run's ``episodes.jsonl`` that keeps it
+(:func:`episode_record`, read back by :func:`read_episodes`).
 
 ``episodes.jsonl`` holds one JSON object per finished episode (scenario, controller, kind,
 seed, training_seed and every metric); an episode's key is (scenario, controller, seed,
@@ -66,6 +66,16 @@ class EpisodeResult:
             "seed": self.seed,
             **self.metrics,
         }
+
+
+class EpisodeLabel(NamedTuple):
+    """What the evaluation loop labels an episode's result with, as a run keys it: the
+    scenario's table name (not its trial's), the controller's display name and the
+    training seed of the policy that ran (None: the policy's own, as it reports it)."""
+
+    scenario: str
+    controller: str
+    training_seed: int | None = None
 
 
 def controller_failed(episode: Mapping[str, Any]) -> bool:
@@ -288,6 +298,7 @@ __all__ = [
     "EPISODES_FILE",
     "EPISODE_KEYS",
     "TEXT_METRICS",
+    "EpisodeLabel",
     "EpisodeResult",
     "Key",
     "controller_failed",
