@@ -27,6 +27,21 @@ def write_suite(folder: Path, **changes: object) -> str:
     return str(file)
 
 
+def resume_tiny(folder: Path, out: Path) -> tuple[list[object], list[dict]]:
+    """The tiny suite (written in ``folder``) resumed in ``out``: the episodes it ran and
+    the table's rows."""
+    ran: list[object] = []
+    rows = run_leaderboard(
+        write_suite(folder),
+        out_dir=out,
+        workers=1,
+        show_progress=False,
+        resume=True,
+        on_episode=ran.append,
+    )
+    return ran, rows
+
+
 def untimed(rows: list[dict]) -> list[dict]:
     """Rows as leaderboard.json holds them, wall-clock timings aside."""
     return [

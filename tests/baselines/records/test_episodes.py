@@ -16,7 +16,7 @@ from shipgym_baselines.leaderboard import run_leaderboard
 from shipgym_baselines.records.episodes import episode_key, read_episodes
 from shipgym_baselines.records.runrecord import read_run
 from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
-from tests.baselines.records.conftest import copy_run, write_suite
+from tests.baselines.records.conftest import copy_run, resume_tiny, write_suite
 
 
 def test_episodes_jsonl_holds_every_episode_with_its_metrics(clean_run: Path) -> None:
@@ -56,15 +56,7 @@ def test_finding2_a_duplicated_line_counts_once_on_resume_and_report(
     lines = (out / "episodes.jsonl").read_text().splitlines(keepends=True)
     (out / "episodes.jsonl").write_text("".join(lines[:5]) + lines[0] + lines[2])  # 2 repeated
     assert len(read_episodes(out)) == 5
-    ran: list[object] = []
-    rows = run_leaderboard(
-        write_suite(tmp_path),
-        out_dir=out,
-        workers=1,
-        show_progress=False,
-        resume=True,
-        on_episode=ran.append,
-    )
+    ran, rows = resume_tiny(tmp_path, out)
     assert len(ran) == 3 and all(r["episodes"] == 2 for r in rows)
     assert main(["report", str(out), "--out", str(tmp_path / "report"), "--json"]) == 0
     assert [r["episodes"] for r in json.loads(capsys.readouterr().out)] == [2, 2, 2, 2]

@@ -24,7 +24,7 @@ from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runlog import RunInterrupted
 from shipgym_baselines.records.runrecord import read_run
 from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder
-from tests.baselines.records.conftest import untimed, write_suite
+from tests.baselines.records.conftest import resume_tiny, untimed, write_suite
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -62,10 +62,7 @@ def test_an_interrupted_run_resumes_to_the_clean_table(tmp_path: Path, clean_run
     )
     assert read_run(out)["status"] == "interrupted" and len(read_episodes(out)) == 3
     assert not (out / "leaderboard.json").exists()
-    ran: list[object] = []
-    rows = run_leaderboard(
-        suite, out_dir=out, workers=1, show_progress=False, resume=True, on_episode=ran.append
-    )
+    ran, rows = resume_tiny(tmp_path, out)
     assert len(ran) == 5  # only the missing jobs
     record = read_run(out)
     assert record["status"] == "complete" and record["episodes"] == 8
@@ -109,15 +106,7 @@ def test_a_killed_run_keeps_its_episodes_and_resumes(tmp_path: Path, clean_run: 
     (out / "episodes.jsonl").write_text("".join(lines[:4]) + lines[4][:30])
     (out / "run.json").write_text((clean_run / "run.json").read_text())
     assert len(read_episodes(out)) == 4
-    ran: list[object] = []
-    run_leaderboard(
-        write_suite(tmp_path),
-        out_dir=out,
-        workers=1,
-        show_progress=False,
-        resume=True,
-        on_episode=ran.append,
-    )
+    ran, _ = resume_tiny(tmp_path, out)
     assert len(ran) == 4 and len(read_episodes(out)) == 8
 
 
@@ -237,15 +226,7 @@ def test_finding6_a_line_the_disk_cannot_hold_is_cut_off(tmp_path: Path, clean_r
             log.append(episode_result(records[1], clean_run))
     assert len((log.episodes_file).read_text().splitlines()) == 1
     assert read_run(tmp_path / "out")["status"] == "failed"
-    ran: list[object] = []
-    run_leaderboard(
-        write_suite(tmp_path),
-        out_dir=tmp_path / "out",
-        workers=1,
-        show_progress=False,
-        resume=True,
-        on_episode=ran.append,
-    )
+    ran, _ = resume_tiny(tmp_path, tmp_path / "out")
     assert len(ran) == 7 and len(read_episodes(tmp_path / "out")) == 8
 
 

@@ -13,35 +13,17 @@ from tests.test_architecture import import_graph
 
 #: every public name ``records.runs`` defined before it was split, by its module now
 HOMES = {
-    "episodes": (
-        "BOOL_METRICS",
-        "EPISODES_FILE",
-        "EPISODE_KEYS",
-        "Key",
-        "TEXT_METRICS",
-        "episode_key",
-        "episode_record",
-        "read_episodes",
-    ),
-    "folders": ("check_out_dir", "check_out_usable", "clear_outputs"),
-    "jsonfiles": ("as_json", "differences", "from_plain", "plain", "write_json"),
-    "runlog": (
-        "FSYNC_INTERVAL_S",
-        "NO_ROOM",
-        "RunInterrupted",
-        "RunLog",
-        "cpu_seconds",
-        "outside_problem",
-    ),
-    "runrecord": ("PACKAGES", "RUN_FILE", "git_commit", "now", "read_run", "versions"),
-    "trajectories": (
-        "TRAJECTORY_DIR",
-        "episode_result",
-        "light_trajectory",
-        "read_trajectory",
-        "trajectory_file",
-    ),
+    "episodes": "BOOL_METRICS EPISODES_FILE EPISODE_KEYS Key TEXT_METRICS episode_key "
+    "episode_record read_episodes",
+    "folders": "check_out_dir check_out_usable clear_outputs",
+    "jsonfiles": "as_json differences from_plain plain write_json",
+    "runlog": "FSYNC_INTERVAL_S NO_ROOM RunInterrupted RunLog cpu_seconds outside_problem",
+    "runrecord": "PACKAGES RUN_FILE git_commit now read_run versions",
+    "trajectories": "TRAJECTORY_DIR episode_result light_trajectory read_trajectory "
+    "trajectory_file",
 }
+#: (home module, name) of every former name
+FORMER = [(module, name) for module, names in HOMES.items() for name in names.split()]
 #: what the records may import: shipgym and the ground floor of ``baselines``
 BELOW = (
     "shipgym",
@@ -53,9 +35,7 @@ BELOW = (
 )
 
 
-@pytest.mark.parametrize(
-    ("module", "name"), [(module, name) for module, names in HOMES.items() for name in names]
-)
+@pytest.mark.parametrize(("module", "name"), FORMER)
 def test_a_former_name_imports_from_runs_as_its_home_holds_it(module: str, name: str) -> None:
     home = importlib.import_module(f"shipgym_baselines.records.{module}")
     assert getattr(runs, name) is getattr(home, name)
@@ -64,8 +44,7 @@ def test_a_former_name_imports_from_runs_as_its_home_holds_it(module: str, name:
 
 def test_runs_holds_the_backends_and_no_other_name_of_its_own() -> None:
     assert runs.BACKENDS == ("local", "ray")
-    homed = {name for names in HOMES.values() for name in names}
-    assert set(runs.__all__) == homed | {"BACKENDS"}
+    assert set(runs.__all__) == {name for _, name in FORMER} | {"BACKENDS"}
 
 
 def test_the_records_import_nothing_above_them() -> None:
