@@ -4,7 +4,9 @@
 the rows of one :class:`~shipgym.envs.eval_trials.EvaluationTrialsVectorEnv` (a learned
 policy with one network forward per step for all), with the same bits.  Given an
 :class:`ActGuard` (the leaderboard, ``evaluate`` and ``run`` give one), a controller that
-fails ends its episode as a result, not the run.
+fails ends its episode as a result, not the run.  Given an :class:`EpisodeLabel` (the
+leaderboard's job gives one), each episode's result is made under it: the scenario's table
+name, the controller's display name and the training seed.
 """
 
 from __future__ import annotations
@@ -26,11 +28,15 @@ from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines.errors import ControllerError, RunError
-from shipgym_baselines.leaderboard.ranking import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import (
+    CONTROLLER_ERROR,
+    CONTROLLER_TIMEOUT,
+    EpisodeLabel,
+    EpisodeResult,
+)
 from shipgym_baselines.registry import make_controller
 
 ENV_ID = "ShipPathFollow-v0"
@@ -173,9 +179,14 @@ class _Record:
                 self.rows.append(_traj_row(info))
 
     def result(
-        self, policy: Policy, trajectory: dict[str, np.ndarray] | None = None
+        self,
+        policy: Policy,
+        trajectory: dict[str, np.ndarray] | None = None,
+        label: EpisodeLabel | None = None,
     ) -> EpisodeResult:
-        """The episode's result; ``trajectory``: a record without rows (the env's)."""
+        """The episode's result; ``trajectory``: a record without rows (the env's);
+        ``label``: its scenario, controller and training seed (None: the trial's name, the
+        policy's name and its training seed)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
         if self.failure is not None:
@@ -191,14 +202,17 @@ class _Record:
         if trajectory is None:
             traj = np.array(self.rows)
             trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
+        if label is None:
+            label = EpisodeLabel(self.scenario_name, policy.name)
+        trained = label.training_seed
         return EpisodeResult(
-            controller=policy.name,
+            controller=label.controller,
             kind=policy.kind,
-            scenario=self.scenario_name,
+            scenario=label.scenario,
             seed=self.seed,
             metrics=metrics,
             trajectory=trajectory,
-            training_seed=training_seed(policy),
+            training_seed=training_seed(policy) if trained is None else trained,
         )
 
 
@@ -234,8 +248,8 @@ class _Episode:
         self.record.failure = failure
         self.done = True
 
-    def result(self, policy: Policy) -> EpisodeResult:
-        return self.record.result(policy)
+    def result(self, policy: Policy, label: EpisodeLabel | None = None) -> EpisodeResult:
+        return self.record.result(policy, label=label)
 
 
 def run_episode(
@@ -247,6 +261,7 @@ def run_episode(
     after_episode: Callable[[Any], None] | None = None,
     privileged: bool = False,
     guard: ActGuard | None = None,
+    label: EpisodeLabel | None = None,
 ) -> EpisodeResult:
     """Run one episode; the policy sees only obs, info and the controller context.
 
@@ -258,7 +273,9 @@ def run_episode(
     ``privileged``: set by :func:`evaluate` / :func:`evaluate_batch` for the built-in
     references ``oracle`` and ``oracle_frozen`` only (:mod:`shipgym_baselines.privileged`):
     they then read the true plant.  ``guard``: a failing controller ends the episode
-    (:class:`ActGuard`); None: its error propagates.
+    (:class:`ActGuard`); None: its error propagates.  ``label``: the result's scenario,
+    controller and training seed (:class:`EpisodeLabel`; None: the scenario's name, the
+    policy's name and its training seed).
     """
     if action_mode is None:
         action_mode = getattr(policy, "action_mode", "rudder")
@@ -280,7 +297,7 @@ def run_episode(
                 episode.step(action, took)
         if failure is not None:
             episode.abandon(failure, took)
-        result = episode.result(policy)
+        result = episode.result(policy, label)
         if after_episode is not None:
             after_episode(episode.base)
         return result
@@ -308,6 +325,7 @@ def evaluate_batch(
     action_mode: str | None = None,
     env_id: str = ENV_ID,
     guard: ActGuard | None = None,
+    label: EpisodeLabel | None = None,
 ) -> list[EpisodeResult]:
     """The episodes of ``seeds``, the i-th on ``scenarios[i]`` (a list, one scenario per
     seed: e.g. each seed's trial variant) or all on one scenario; equal, bit for bit, to
@@ -330,7 +348,8 @@ def evaluate_batch(
     One by one (:func:`run_episode`) run the privileged references (they read their env's
     truth) and a non-batch Policy *instance* (one instance cannot act for several
     episodes at once).  ``guard``: a failing controller ends its episodes
-    (:class:`ActGuard`); None: its error propagates.
+    (:class:`ActGuard`); None: its error propagates.  ``label``: every episode's scenario,
+    controller and training seed (:class:`EpisodeLabel`; None: as :func:`run_episode`).
     """
     seeds = list(seeds)
     per_seed = list(scenarios) if isinstance(scenarios, list | tuple) else [scenarios] * len(seeds)
@@ -350,20 +369,21 @@ def evaluate_batch(
     if isinstance(policy, BatchPolicy):
         # a batch policy acts on the observations alone: its rows skip the per-step infos
         episodes = _episodes(per_seed, seeds, mode, env_id, lean=True)
-        return _run_lockstep(policy, episodes, guard)
+        return _run_lockstep(policy, episodes, guard, label)
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
             make_controller(controller, training_seed=training_seed)[0] for _ in seeds[1:]
         ]
-        return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id), guard)
+        return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id), guard, label)
     results = []
     for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
         if made and i > 0:
             policy, _ = make_controller(controller, training_seed=training_seed)
-        results.append(
-            run_episode(policy, scenario, seed, mode, env_id, privileged=privileged, guard=guard)
+        result = run_episode(
+            policy, scenario, seed, mode, env_id, privileged=privileged, guard=guard, label=label
         )
+        results.append(result)
     return results
 
 
@@ -388,7 +408,7 @@ class _Episodes(Protocol):
 
     def abandon(self, i: int, failure: _Failure, act_time: float | None) -> None: ...
 
-    def result(self, i: int, policy: Policy) -> EpisodeResult: ...
+    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult: ...
 
     def close(self) -> None: ...
 
@@ -452,8 +472,8 @@ class _VectorEpisodes:
         self.records[i].failure = failure
         self.done[i] = True
 
-    def result(self, i: int, policy: Policy) -> EpisodeResult:
-        return self.records[i].result(policy, self.env.trajectory(i))
+    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult:
+        return self.records[i].result(policy, self.env.trajectory(i), label)
 
     def close(self) -> None:
         self.env.close()
@@ -497,8 +517,8 @@ class _SingleEpisodes:
         self.episodes[i].abandon(failure, act_time)
         self.done[i] = True
 
-    def result(self, i: int, policy: Policy) -> EpisodeResult:
-        return self.episodes[i].result(policy)
+    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult:
+        return self.episodes[i].result(policy, label)
 
     def close(self) -> None:
         for e in self.episodes:
@@ -525,11 +545,14 @@ def _episodes(
 
 
 def _run_lockstep(
-    policy: BatchPolicy | list[Policy], episodes: _Episodes, guard: ActGuard | None = None
+    policy: BatchPolicy | list[Policy],
+    episodes: _Episodes,
+    guard: ActGuard | None = None,
+    label: EpisodeLabel | None = None,
 ) -> list[EpisodeResult]:
     """:func:`evaluate_batch`'s loop: every episode steps in lockstep, acted on by one
     :class:`BatchPolicy` or by its own policy of a list; ``guard``: a failing controller
-    ends its episodes (:class:`ActGuard`)."""
+    ends its episodes (:class:`ActGuard`); ``label``: every result's (:class:`EpisodeLabel`)."""
     n = len(episodes.obs)
     batch = not isinstance(policy, list)
     try:
@@ -563,7 +586,7 @@ def _run_lockstep(
             if stepped:
                 episodes.step(stepped, actions, times)
             live = [i for i in live if not episodes.done[i]]
-        return [episodes.result(i, policy if batch else policy[i]) for i in range(n)]
+        return [episodes.result(i, policy if batch else policy[i], label) for i in range(n)]
     finally:
         episodes.close()
 
@@ -662,6 +685,7 @@ def evaluate(
     *,
     suite: str | os.PathLike | None = None,
     guard: ActGuard | None = None,
+    label: EpisodeLabel | None = None,
     **settings: Any,
 ) -> list[EpisodeResult]:
     """Evaluate a controller on a scenario over seeds.
@@ -673,6 +697,8 @@ def evaluate(
     (:func:`suite_trials`: start, jump time and current from the seed; seed 10000 + i is
     the leaderboard's i-th); None: every seed runs the scenario as written.  ``guard``: a
     failing controller ends its episode (:class:`ActGuard`); None: its error propagates.
+    ``label``: every episode's scenario, controller and training seed
+    (:class:`EpisodeLabel`; None: as :func:`run_episode`).
     """
     trials = [scenario] * len(seeds) if suite is None else suite_trials(scenario, seeds, suite)
     results = []
@@ -684,5 +710,7 @@ def evaluate(
             privileged = plain and grants_truth(controller)
         else:
             policy, mode = controller, settings.get("action_mode")
-        results.append(run_episode(policy, trial, seed, mode, privileged=privileged, guard=guard))
+        results.append(
+            run_episode(policy, trial, seed, mode, privileged=privileged, guard=guard, label=label)
+        )
     return results

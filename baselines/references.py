@@ -59,7 +59,7 @@ from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult
-from shipgym_baselines.records.runs import from_plain, plain
+from shipgym_baselines.records.jsonfiles import from_plain, plain
 
 #: the references with a table, in the order they are computed
 REFERENCES = (ORACLE, ORACLE_FROZEN)

@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     except ShipgymError as exc:
         sys.stderr.write(f"shipgym {args.command}: error: {exc}\n")
         return EXIT_USAGE
-    # a run says what it kept (shipgym_baselines.records.runs.RunInterrupted)
+    # a run says what it kept (shipgym_baselines.records.runlog.RunInterrupted)
     except KeyboardInterrupt as exc:
         signum = signal_number(exc)
         by = "" if signum == signal.SIGINT else f" by {signal.Signals(signum).name}"

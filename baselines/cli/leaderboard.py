@@ -177,7 +177,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
     the rows)."""
     from shipgym_baselines.leaderboard.suite import load_suite
-    from shipgym_baselines.records.runs import check_out_dir, check_out_usable
+    from shipgym_baselines.records.folders import check_out_dir, check_out_usable
 
     policy = getattr(args, "policy", None)
     if policy is not None:
@@ -221,7 +221,7 @@ def run(args: argparse.Namespace) -> int:
         retry_failed=args.retry_failed,
     )
     if not args.json:
-        from shipgym_baselines.records.runs import read_run
+        from shipgym_baselines.records.runrecord import read_run
 
         record = read_run(out)
         sys.stderr.write(

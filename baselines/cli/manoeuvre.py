@@ -78,7 +78,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the ship and ``--out`` (a writable folder; its plot of the same manoeuvre is
     replaced), run the manoeuvre, save its plot, print the figures."""
-    from shipgym_baselines.records.runs import check_out_dir
+    from shipgym_baselines.records.folders import check_out_dir
 
     if args.ship not in MODELS:
         raise RunError(f"unknown ship {args.ship!r}; valid: {', '.join(sorted(MODELS))}")

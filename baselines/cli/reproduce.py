@@ -28,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
     (or the rows with ``--json``).  The report's files in ``--out`` are replaced."""
     from tqdm import tqdm
 
-    from shipgym_baselines.records.runs import check_out_dir
+    from shipgym_baselines.records.folders import check_out_dir
 
     check_seeds(args.seeds, "--seeds")
     out = args.out or f"results/reproduce/{args.paper}"

@@ -112,8 +112,9 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.records.episodes import EpisodeLabel
+    from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.manifest import check_listed
-    from shipgym_baselines.records.runs import check_out_dir
     from shipgym_baselines.registry import applies_to, training_seeds
 
     guard = ActGuard(args.act_timeout)
@@ -135,10 +136,10 @@ def run(args: argparse.Namespace) -> int:
     # the suite's trial of this seed, as the leaderboard draws it (leaderboard.trials)
     trial = trial_scenario(scenario, suite.randomize, args.seed)
     settings = {} if training_seed is None else {"training_seed": training_seed}
-    result = evaluate(args.controller, trial, [args.seed], guard=guard, **settings)[0]
     # as the leaderboard names them: a scenario file under its name:
     table_name = scenario.name if is_path(args.scenario) else args.scenario
-    result.controller, result.scenario = label, table_name
+    named = EpisodeLabel(table_name, label, training_seed)
+    (result,) = evaluate(args.controller, trial, [args.seed], guard=guard, label=named, **settings)
     row = result.row()
     # after "seed": which of the agent's policies ran (as the leaderboard's episodes name it)
     at = list(row).index("seed") + 1
@@ -169,10 +170,11 @@ def _write(out: Path, force: bool, metrics: str, draw: Callable[[], list[Path]])
     """``metrics.json`` (the text ``metrics``) and the figures (``draw`` writes them and
     returns their paths) into ``out``, locked, each file listed in its manifest as it is
     written (``force``: what the manifest lists deleted first); the figures' names."""
+    from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.locking import out_lock
     from shipgym_baselines.records.manifest import Manifest, clear_listed
     from shipgym_baselines.records.outfiles import write_text
-    from shipgym_baselines.records.runs import check_out_dir, now
+    from shipgym_baselines.records.runrecord import now
 
     with out_lock(out, now()):
         check_out_dir(out, force=force)  # again, now that no other run can start there

@@ -184,8 +184,9 @@ __all__ = sorted(_HOMES)
 
 
 def __getattr__(name: str) -> Any:
-    """A public name from its module, imported on first use: ``evaluation``, ``records``
-    and ``privileged`` import :mod:`.ranking`, so this package imports no module eagerly."""
+    """A public name from its module, imported on first use: ``privileged`` and
+    ``references`` import :mod:`.ranking` (and ``evaluation`` through ``privileged``), so
+    this package imports no module eagerly."""
     if name not in _HOMES:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)

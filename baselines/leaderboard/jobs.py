@@ -18,13 +18,10 @@ from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.errors import BackendError, RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
-from shipgym_baselines.leaderboard.ranking import (
-    controller_failed,
-)
 from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult, controller_failed
 from shipgym_baselines.records.runs import (
     BACKENDS,
 )
@@ -55,7 +52,8 @@ class Job(NamedTuple):
     catalogue name, held-out name or YAML path loaded as such) that ``seeds``
     draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
     ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
-    as recorded whatever its file says now; None: resolved from ``scenario`` here."""
+    as recorded whatever its file says now; None: resolved from ``scenario`` here.  The
+    evaluation loop labels the job's episodes with :attr:`label`."""
 
     controller: ControllerSpec
     scenario: str
@@ -69,6 +67,13 @@ class Job(NamedTuple):
     #: the limit [s] on one ``act`` call: a slower call, or a controller that fails, ends
     #: its episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
     act_timeout: float = ACT_TIMEOUT_S
+
+    @property
+    def label(self) -> EpisodeLabel:
+        """What the job's episodes are labelled with: the scenario's table name (not its
+        trials'), the controller's table name and the job's training seed (None: the
+        policy's own)."""
+        return EpisodeLabel(self.scenario, controller_label(self.controller), self.training_seed)
 
 
 @functools.lru_cache(maxsize=128)
@@ -116,28 +121,20 @@ def trials(job: Job) -> list[Scenario]:
     return [trial_scenario(base, randomization, seed) for seed in job.seeds]
 
 
-def _named(results: list[EpisodeResult], job: Job) -> list[EpisodeResult]:
-    """``results`` under the table name and the job's scenario name, with the job's
-    training seed."""
-    label = controller_label(job.controller)
-    for result in results:
-        result.controller = label
-        result.scenario = job.scenario
-        if job.training_seed is not None:
-            result.training_seed = job.training_seed
-    return results
-
-
 def run_job(job: tuple) -> EpisodeResult:
     """One episode ``(controller, scenario, seed[, training_seed[, randomize]])`` (see
     :class:`Job`); top-level so process pools can pickle it."""
     one = Job(job[0], job[1], (int(job[2]),), *job[3:])
     (trial,) = trials(one)
-    seeds = list(one.seeds)
-    result = evaluation.evaluate(
-        one.controller, trial, seeds, training_seed=one.training_seed, guard=_guard(one)
+    (result,) = evaluation.evaluate(
+        one.controller,
+        trial,
+        list(one.seeds),
+        training_seed=one.training_seed,
+        guard=_guard(one),
+        label=one.label,
     )
-    return _named(result, one)[0]
+    return result
 
 
 def _guard(job: Job) -> evaluation.ActGuard:
@@ -148,14 +145,14 @@ def _guard(job: Job) -> evaluation.ActGuard:
 def run_batch(job: Job) -> list[EpisodeResult]:
     """The job's episodes, all seeds at once (:func:`shipgym_baselines.evaluation.evaluate_batch`),
     in the order of ``job.seeds``."""
-    results = evaluation.evaluate_batch(
+    return evaluation.evaluate_batch(
         job.controller,
         trials(job),
         list(job.seeds),
         training_seed=job.training_seed,
         guard=_guard(job),
+        label=job.label,
     )
-    return _named(list(results), job)
 
 
 def reference_work(job: Job) -> list[EpisodeResult]:
@@ -163,15 +160,16 @@ def reference_work(job: Job) -> list[EpisodeResult]:
     trial's entry of the reference's shipped table or of its per-user cache
     (:mod:`shipgym_baselines.references`), the reference run for a trial both lack (and
     stored in the cache)."""
-    reference = controller_label(job.controller)
+    label = job.label
+    reference = label.controller
     cache, out = ReferenceCache(reference=reference), []
     for seed, trial in zip(job.seeds, trials(job), strict=True):
         entry = lookup(trial, seed, cache, reference)
         if entry is not None:
             out.append(result_from_entry(entry, job.scenario, seed, reference))
         else:
-            (result,) = _named(
-                evaluation.evaluate(job.controller, trial, [seed], guard=_guard(job)), job
+            (result,) = evaluation.evaluate(
+                job.controller, trial, [seed], guard=_guard(job), label=label
             )
             if not controller_failed(result.metrics):  # a reference that failed: not kept
                 cache.store(trial, result)

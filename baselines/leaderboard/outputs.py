@@ -50,14 +50,10 @@ from shipgym_baselines.leaderboard.tables import (
     scenario_split,
 )
 from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name, verdict
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
 from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
-from shipgym_baselines.records.runs import (
-    RUN_FILE,
-    episode_result,
-    read_episodes,
-    read_run,
-)
+from shipgym_baselines.records.runrecord import RUN_FILE, read_run
+from shipgym_baselines.records.trajectories import episode_result
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.studies.run_costs import tables_line
 

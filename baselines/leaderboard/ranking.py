@@ -59,6 +59,13 @@ from typing import Any
 
 import numpy as np
 
+# an episode its controller ended is told by its record, in records.episodes; these names
+# stay importable from here
+from shipgym_baselines.records.episodes import CONTROLLER_ERROR as CONTROLLER_ERROR
+from shipgym_baselines.records.episodes import CONTROLLER_FAILURES
+from shipgym_baselines.records.episodes import CONTROLLER_TIMEOUT as CONTROLLER_TIMEOUT
+from shipgym_baselines.records.episodes import controller_failed as controller_failed
+
 #: the reference of the cost ratio (its cost is the denominator)
 ORACLE = "oracle"
 #: the second reference: the same NMPC with its truth frozen at the episode's start (the
@@ -68,14 +75,6 @@ ORACLE_FROZEN = "oracle_frozen"
 BASELINE = "pid_los"
 #: the kind of the controllers shown on every scenario but never ranked
 REFERENCE_KIND = "reference"
-#: the ``termination_reason`` of an episode its controller ended: ``reset`` or ``act``
-#: raised, or gave an action that is malformed or not finite
-#: (:class:`~shipgym_baselines.evaluation.ActGuard`)
-CONTROLLER_ERROR = "controller_error"
-#: ... or a call took longer than the limit (``--act-timeout``)
-CONTROLLER_TIMEOUT = "controller_timeout"
-#: the ``termination_reason`` values of an episode its controller ended
-CONTROLLER_FAILURES = (CONTROLLER_ERROR, CONTROLLER_TIMEOUT)
 #: the ``termination_reason`` values of a failed episode
 FAILURE_REASONS = ("corridor", "non_finite_state", *CONTROLLER_FAILURES)
 #: what a failed episode is, in the words of the tables and the verdict
@@ -255,12 +254,6 @@ def is_failure(episode: Mapping[str, Any]) -> bool:
     return episode.get("termination_reason") in FAILURE_REASONS or not math.isfinite(
         _number(episode.get("cost"))
     )
-
-
-def controller_failed(episode: Mapping[str, Any]) -> bool:
-    """The episode was ended by its controller's error or timeout
-    (:data:`CONTROLLER_FAILURES`)."""
-    return episode.get("termination_reason") in CONTROLLER_FAILURES
 
 
 def scored_episodes(

@@ -21,24 +21,14 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.errors import RunError, RunFailed
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeResult, Key, episode_key, read_episodes
+from shipgym_baselines.records.folders import check_out_dir, check_out_usable
+from shipgym_baselines.records.jsonfiles import differences, write_json
 from shipgym_baselines.records.locking import out_lock
 from shipgym_baselines.records.manifest import Manifest, clear_listed
-from shipgym_baselines.records.runs import (
-    Key,
-    check_out_dir,
-    check_out_usable,
-    differences,
-    episode_key,
-    episode_result,
-    git_commit,
-    now,
-    outside_problem,
-    read_episodes,
-    read_run,
-    versions,
-    write_json,
-)
+from shipgym_baselines.records.runlog import outside_problem
+from shipgym_baselines.records.runrecord import git_commit, now, read_run, versions
+from shipgym_baselines.records.trajectories import episode_result
 
 REPORT_FILE = "report.json"
 

@@ -37,19 +37,13 @@ from shipgym_baselines.leaderboard.jobs import (
     suite_scenarios,
 )
 from shipgym_baselines.leaderboard.outputs import load_results, write_results
-from shipgym_baselines.leaderboard.ranking import (
-    controller_failed,
-)
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerSpec
-from shipgym_baselines.records.episodes import EpisodeResult
-from shipgym_baselines.records.runs import (
-    BACKENDS,
-    RunLog,
-    check_out_dir,
-    check_out_usable,
-    read_run,
-)
+from shipgym_baselines.records.episodes import EpisodeResult, controller_failed
+from shipgym_baselines.records.folders import check_out_dir, check_out_usable
+from shipgym_baselines.records.runlog import RunLog
+from shipgym_baselines.records.runrecord import read_run
+from shipgym_baselines.records.runs import BACKENDS
 from shipgym_baselines.registry import controller_label, training_seeds
 from shipgym_baselines.studies.run_costs import eta_line
 
@@ -90,7 +84,7 @@ def run_leaderboard(
     ``show_progress``: a progress bar on stderr, after one line before the first episode: the
     episodes, workers and the time estimated from the recorded costs
     (:func:`shipgym_baselines.studies.run_costs.eta_line`).  Ctrl-C raises
-    :class:`~shipgym_baselines.records.runs.RunInterrupted`.
+    :class:`~shipgym_baselines.records.runlog.RunInterrupted`.
 
     A controller that fails (raises, gives a malformed or non-finite action, or takes
     longer than ``act_timeout`` [s] for one ``act`` call) ends that episode, recorded with

@@ -315,7 +315,7 @@ def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_co
     """The verdict of a run folder: from its ``aggregate.json`` and ``episodes.jsonl``; a
     ``report`` folder (no episodes of its own) gives the one its ``leaderboard.md`` opens
     with (written from the merged episodes)."""
-    from shipgym_baselines.records.runs import read_episodes
+    from shipgym_baselines.records.episodes import read_episodes
 
     folder = Path(folder)
     board = json.loads((folder / "aggregate.json").read_text())

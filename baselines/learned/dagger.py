@@ -68,8 +68,9 @@ from pydantic import Field, field_validator
 from shipgym.config import StrictModel
 from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.records.folders import check_out_usable, clear_outputs
 from shipgym_baselines.records.locking import LOCK_FILE, out_lock
-from shipgym_baselines.records.runs import check_out_usable, clear_outputs, now, versions
+from shipgym_baselines.records.runrecord import now, versions
 
 SETTINGS_FILE = "dagger.json"
 ROUNDS_FILE = "rounds.json"

@@ -333,7 +333,7 @@ def train_dagger(
         check_agent_folder,
         check_tuned_from,
     )
-    from shipgym_baselines.records.runs import clear_outputs
+    from shipgym_baselines.records.folders import clear_outputs
 
     torch.set_num_threads(1)
     check_config(config)

@@ -51,7 +51,7 @@ from shipgym_baselines.learned.agents import (
     make_training_env,
 )
 from shipgym_baselines.learned.meta import training_meta
-from shipgym_baselines.records.runs import check_out_dir, clear_outputs
+from shipgym_baselines.records.folders import check_out_dir, clear_outputs
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 #: what a training run writes into its directory (``force`` clears these, and only these)

@@ -1,5 +1,7 @@
-"""Thinning a trajectory to what a figure can show, without aliasing, so that a run folder
-stays small.
+"""The trajectories a run folder keeps (``trajectories/``, one file per drawn episode:
+:func:`trajectory_file`), thinned to what a figure can show, without aliasing, and packed,
+so that a run folder stays small; an episode record read back with its trajectory
+(:func:`episode_result`).
 
 :func:`m4_indices` is M4 (Jugel et al. 2014, "M4: a visualization-oriented time series data
 aggregation", PVLDB 7(10)): the time axis is cut into ``buckets`` equal spans (one per pixel
@@ -13,10 +15,26 @@ so the arrays stay aligned).
 
 from __future__ import annotations
 
+import hashlib
+import json
+import os
 from collections.abc import Iterable, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.records.episodes import (
+    EPISODE_KEYS,
+    EPISODES_FILE,
+    EpisodeResult,
+    Key,
+    episode_key,
+)
+
+#: the folder of a run's kept trajectories
+TRAJECTORY_DIR = "trajectories"
 
 #: the arrays a scenario figure draws (:func:`shipgym_baselines.leaderboard.figures.plot_scenario`),
 #: the only ones a run folder keeps of a trajectory: time [s], position [m], cross-track error
@@ -107,11 +125,76 @@ def unpack_trajectory(packed: Mapping[str, Any]) -> dict[str, np.ndarray]:
     return out
 
 
+def light_trajectory(trajectory: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """A trajectory as its file keeps it, compact so that a run folder stays small: only the
+    arrays a figure draws (:data:`DRAWN_KEYS`), thinned to what a figure can show without
+    aliasing (M4, :func:`thin_trajectory`), packed as 16-bit codes over each array's range
+    (:func:`pack_trajectory`: within range / 131068, far below a figure's pixel; the
+    episode's metrics are computed before, at full precision); the file is deflated
+    (``np.savez_compressed``).  :func:`read_trajectory` reads it back."""
+    return pack_trajectory(thin_trajectory(trajectory, DRAWN_KEYS))
+
+
+def read_trajectory(file: Path) -> dict[str, np.ndarray]:
+    """A kept trajectory's arrays (:func:`light_trajectory`'s file, or an earlier
+    version's file of plain arrays)."""
+    with np.load(file, allow_pickle=False) as data:
+        fields = {k: data[k] for k in data.files}
+    if set(fields) == {"keys", "ranges", "codes"}:
+        return unpack_trajectory(fields)
+    return fields
+
+
+def trajectory_file(key: Key) -> str:
+    """Where an episode's trajectory is kept in its run folder: ``trajectories/`` and a
+    hash of its key (scenario names may be paths, controller names anything)."""
+    digest = hashlib.sha256(json.dumps(list(key)).encode()).hexdigest()[:20]
+    return f"{TRAJECTORY_DIR}/{digest}.npz"
+
+
+def _inside(folder: Path, name: Any) -> Path:
+    """``folder / name`` if that is a file path inside ``folder`` (a record's
+    ``trajectory`` may name nothing else), else a :class:`RunError`."""
+    file = folder / str(name)
+    if not isinstance(name, str) or not file.resolve().is_relative_to(folder.resolve()):
+        raise RunError(
+            f"{folder / EPISODES_FILE}: a record's trajectory {name!r} is not a file inside "
+            "its run folder"
+        )
+    return file
+
+
+def episode_result(record: Mapping[str, Any], folder: str | os.PathLike) -> EpisodeResult:
+    """An :class:`~shipgym_baselines.records.episodes.EpisodeResult` from a record of ``folder``'s
+    ``episodes.jsonl`` (its trajectory read if it was kept, else empty; a record of an
+    earlier version names its file as ``trajectory``)."""
+    trajectory: dict[str, np.ndarray] = {}
+    name = record.get("trajectory") or trajectory_file(episode_key(record))
+    if name:
+        file = _inside(Path(folder), name)
+        if file.is_file():
+            trajectory = read_trajectory(file)
+    return EpisodeResult(
+        controller=record["controller"],
+        kind=record["kind"],
+        scenario=record["scenario"],
+        seed=int(record["seed"]),
+        metrics={k: v for k, v in record.items() if k not in EPISODE_KEYS},
+        trajectory=trajectory,
+        training_seed=record.get("training_seed"),
+    )
+
+
 __all__ = [
     "DRAWN_KEYS",
     "TRACE_BUCKETS",
+    "TRAJECTORY_DIR",
+    "episode_result",
+    "light_trajectory",
     "m4_indices",
     "pack_trajectory",
+    "read_trajectory",
     "thin_trajectory",
+    "trajectory_file",
     "unpack_trajectory",
 ]

@@ -205,7 +205,7 @@ def record_costs(
 
     from shipgym_baselines.leaderboard import Job, suite_scenario, work
     from shipgym_baselines.leaderboard.suite import load_suite
-    from shipgym_baselines.records.runs import git_commit
+    from shipgym_baselines.records.runrecord import git_commit
     from shipgym_baselines.registry import controller_kind, controller_label
 
     spec = load_suite(suite)

@@ -25,7 +25,7 @@ from shipgym_baselines.evaluation import (
     evaluate_batch,
     run_episode,
 )
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult
 from shipgym_baselines.registry import make_controller, register_controller, training_seeds
 
 SLEEP_S = 0.002
@@ -399,6 +399,39 @@ def test_a_batch_policy_fails_the_rows_its_call_failed(
             assert result.metrics["steps"] == FAIL_AT
         else:
             assert result.metrics["steps"] > FAIL_AT
+
+
+# --- what the loop labels each episode with (EpisodeLabel) ------------------------------------
+
+
+class TrainedZero(ZeroRudder):
+    """Zero rudder that says it was trained with seed 5."""
+
+    name = "trained_zero"
+    training_seed = 5
+
+
+def test_the_loop_labels_each_episode_as_told() -> None:
+    """Given a label, every path of the loop makes each result under it: in lockstep (a
+    policy made per seed, or one batch policy) and one by one; the label's training seed
+    None leaves the policy's own.  Without a label: the trial's and the policy's names."""
+    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
+    label = EpisodeLabel("table name", "shown name", 3)
+    zeros = Batch(lambda n: np.zeros((n, 1)))
+    labelled = [
+        *evaluate_batch("zero_rudder", "nominal", seeds, label=label),
+        *evaluate_batch(zeros, "nominal", seeds, label=label),
+        *evaluate(ZeroRudder(), "nominal", seeds[:1], label=label),
+    ]
+    assert [(r.scenario, r.controller, r.training_seed, r.seed) for r in labelled] == [
+        ("table name", "shown name", 3, seed) for seed in (*seeds, *seeds, seeds[0])
+    ]
+    untrained = EpisodeLabel("table name", "shown name")
+    (own,) = evaluate(TrainedZero(), "nominal", seeds[:1], label=untrained)
+    assert (own.scenario, own.controller, own.training_seed) == ("table name", "shown name", 5)
+    (plain,) = evaluate(TrainedZero(), "nominal", seeds[:1])
+    assert (plain.scenario, plain.controller, plain.training_seed) == ("nominal", "trained_zero", 5)
+    assert own.kind == plain.kind == "reference"
 
 
 def test_the_error_line_is_one_printable_bounded_line() -> None:

@@ -83,8 +83,6 @@ def _edge_table(text: str) -> dict[Edge, str]:
 #: ``test_every_exception_is_still_an_edge``: remove it then.
 EXCEPTIONS = _edge_table(
     """
-    records.runs -> leaderboard.ranking: controller_failed, read by the record: being removed
-    evaluation -> leaderboard.ranking: the failure labels an episode records
     evaluation -> leaderboard: suite_trials (lazy) draws a suite's trials as the board does
     evaluation -> leaderboard.suite: suite_trials (lazy) reads the suite
     privileged -> leaderboard.ranking: the references' names ORACLE, ORACLE_FROZEN

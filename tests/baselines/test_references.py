@@ -17,7 +17,7 @@ from shipgym.scenarios import Scenario, load_scenario
 from shipgym_baselines import evaluation, leaderboard, references
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard import Job, announce_references, reference_work, trials
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult
 from shipgym_baselines.references import (
     ORACLE_CPU_S_PER_STEP,
     ReferenceCache,
@@ -77,15 +77,22 @@ class CountingOracle:
     def __init__(self) -> None:
         self.runs: list[tuple[str, int]] = []
 
-    def __call__(self, controller: Any, scenario: Scenario, seeds: list[int], **_: Any) -> list:
+    def __call__(
+        self,
+        controller: Any,
+        scenario: Scenario,
+        seeds: list[int],
+        label: EpisodeLabel | None = None,
+        **_: Any,
+    ) -> list:
         (seed,) = seeds
         self.runs.append((scenario.name, seed))
         t = np.arange(3.0)
         return [
             EpisodeResult(
-                controller="oracle",
+                controller="oracle" if label is None else label.controller,
                 kind="reference",
-                scenario=scenario.name,
+                scenario=scenario.name if label is None else label.scenario,
                 seed=seed,
                 metrics={"cost": 1 + seed / 1e5, "termination_reason": "goal"},
                 trajectory={"t": t, "x": t, "y": t},

@@ -13,8 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from shipgym_baselines.records.runs import read_episodes, read_run
-from tests.baselines.records.test_runs import write_suite
+from shipgym_baselines.records.episodes import read_episodes
+from shipgym_baselines.records.runrecord import read_run
+from tests.baselines.records.conftest import write_suite
 
 ROOT = Path(__file__).resolve().parents[2]
 

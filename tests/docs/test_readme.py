@@ -47,7 +47,7 @@ def test_the_evaluate_example_gives_the_leaderboards_episodes(
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import run_leaderboard
     from shipgym_baselines.leaderboard.suite import load_suite
-    from shipgym_baselines.records.runs import read_episodes
+    from shipgym_baselines.records.episodes import read_episodes
 
     blocks = re.findall(r"```python\n(.*?)```", README, flags=re.S)
     (block,) = [b for b in blocks if "suite=" in b and "evaluate(" in b]

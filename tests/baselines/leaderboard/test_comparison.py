@@ -24,7 +24,8 @@ from shipgym_baselines.leaderboard.comparison import (
 )
 from shipgym_baselines.leaderboard.ranking import NO_RANKING, NOTHING_TO_RANK
 from shipgym_baselines.leaderboard.suite import load_suite
-from shipgym_baselines.records.runs import read_episodes, read_run
+from shipgym_baselines.records.episodes import read_episodes
+from shipgym_baselines.records.runrecord import read_run
 
 #: a user's controller, as docs/plugins.md enters one
 POLICY_FILE = """

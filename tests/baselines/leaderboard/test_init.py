@@ -155,7 +155,7 @@ def test_unknown_name_is_an_attribute_error() -> None:
 
 @pytest.mark.parametrize(
     "first",
-    ["shipgym_baselines.evaluation", "shipgym_baselines.records.runs", "shipgym_baselines.cli"],
+    ["shipgym_baselines.evaluation", "shipgym_baselines.privileged", "shipgym_baselines.cli"],
 )
 def test_modules_that_read_the_ranking_import_first(first: str) -> None:
     """A module below the leaderboard that reads :mod:`.ranking` imports on its own in a

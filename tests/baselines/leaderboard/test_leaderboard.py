@@ -20,8 +20,9 @@ from shipgym_baselines.leaderboard import (
     run_leaderboard,
 )
 from shipgym_baselines.learned.policy import model_zip
-from shipgym_baselines.records.runs import read_episodes, read_run
-from tests.baselines.records.test_runs import TIMING, untimed, write_suite
+from shipgym_baselines.records.episodes import read_episodes
+from shipgym_baselines.records.runrecord import read_run
+from tests.baselines.records.conftest import TIMING, untimed, write_suite
 
 RANDOMIZE = {
     "cross_track_offset_L": [-1.0, 1.0],

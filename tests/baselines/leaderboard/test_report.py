@@ -11,8 +11,8 @@ import pytest
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard.report import write_report
-from shipgym_baselines.records.runs import read_run
-from tests.baselines.records.test_runs import untimed, write_suite
+from shipgym_baselines.records.runrecord import read_run
+from tests.baselines.records.conftest import untimed, write_suite
 
 
 @pytest.fixture(scope="module")

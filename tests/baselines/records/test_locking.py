@@ -13,10 +13,11 @@ import pytest
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.locking import LOCK_FILE, out_lock
-from shipgym_baselines.records.runs import read_episodes, read_run
+from shipgym_baselines.records.runrecord import read_run
 from tests.baselines.conftest import copy_folder
-from tests.baselines.records.test_runs import write_suite
+from tests.baselines.records.conftest import write_suite
 
 ROOT = Path(__file__).resolve().parents[3]
 HOLD = """

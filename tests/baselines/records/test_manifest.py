@@ -71,8 +71,9 @@ def test_a_finished_run_lists_what_it_kept_not_what_it_removed(tmp_path: Path) -
     temporary, and ``--force`` still clears the folder and refuses a user's file."""
     import numpy as np
 
-    from shipgym_baselines.records.episodes import EpisodeResult
-    from shipgym_baselines.records.runs import RunLog, episode_key, episode_record, trajectory_file
+    from shipgym_baselines.records.episodes import EpisodeResult, episode_key, episode_record
+    from shipgym_baselines.records.runlog import RunLog
+    from shipgym_baselines.records.trajectories import trajectory_file
 
     out = tmp_path / "out"
     suite = {"scenarios": {"nominal": {}}, "controllers": [], "seeds": [0, 1, 2]}
@@ -134,7 +135,7 @@ def test_pool_workers_list_the_figures_they_write(
 ) -> None:
     """Figures drawn in a process pool are listed by the workers as they write them."""
     from shipgym_baselines.leaderboard import outputs
-    from shipgym_baselines.records.runs import read_run
+    from shipgym_baselines.records.runrecord import read_run
 
     monkeypatch.setattr(outputs, "POOLED_FIGURES", 1)  # a pool for three figures
     out = tmp_path / "out"

@@ -1,17 +1,26 @@
-"""M4 thinning of a kept trajectory (a lighter run folder): what a figure draws is what it
-would draw of the full signal."""
+"""The kept trajectories: M4 thinning (what a figure draws is what it would draw of the
+full signal), packing, and a record's ``trajectory`` naming only a file inside its run
+folder (``report`` never reads a file elsewhere)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
+import pytest
+import yaml
 
-from shipgym_baselines.records.runs import light_trajectory, read_trajectory
+from shipgym_baselines.cli import main
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.records.episodes import EPISODES_FILE
 from shipgym_baselines.records.trajectories import (
     DRAWN_KEYS,
+    episode_result,
+    light_trajectory,
     m4_indices,
     pack_trajectory,
+    read_trajectory,
     thin_trajectory,
     unpack_trajectory,
 )
@@ -82,3 +91,43 @@ def test_a_packed_trajectory_keeps_non_finite_values_constants_and_big_steps(
     assert back["x"][2] == -3.5  # the range's low end exactly
     np.testing.assert_array_equal(back["c"], np.full(7, 2.5))
     np.testing.assert_allclose(back["t"], np.arange(7.0), rtol=0, atol=6 / 131068)
+
+
+def test_finding7_a_records_trajectory_names_only_a_file_in_its_run_folder(
+    tmp_path: Path, capsys
+) -> None:
+    run = tmp_path / "run"
+    suite = tmp_path / "one.yaml"
+    suite.write_text(
+        yaml.safe_dump(
+            {"name": "one", "scenarios": ["nominal"], "controllers": ["zero_rudder"], "seeds": 1}
+        )
+    )
+    assert (
+        main(
+            [
+                "leaderboard",
+                "--suite",
+                str(suite),
+                "--out",
+                str(run),
+                "--workers",
+                "1",
+                "--no-progress",
+                "--no-references",
+                "--json",
+            ]
+        )
+        == 0
+    )
+    outside = tmp_path / "elsewhere.npz"
+    np.savez(outside, t=np.arange(3.0))
+    (record,) = [json.loads(line) for line in (run / EPISODES_FILE).read_text().splitlines()]
+    for name in (str(outside), "../elsewhere.npz", "trajectories/../../elsewhere.npz"):
+        with pytest.raises(RunError, match="not a file inside its run folder"):
+            episode_result({**record, "trajectory": name}, run)
+    (run / EPISODES_FILE).write_text(json.dumps({**record, "trajectory": str(outside)}) + "\n")
+    capsys.readouterr()
+    code = main(["report", str(run), "--out", str(tmp_path / "report")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "not a file inside its run folder" in err and len(err.splitlines()) == 1
