@@ -7,8 +7,8 @@ import sys
 from typing import Any
 
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
+from shipgym_baselines.executor import BACKENDS
 from shipgym_baselines.jsonout import dumps
-from shipgym_baselines.records.runs import BACKENDS
 
 
 def add_json_option(parser: argparse.ArgumentParser, help: str) -> None:

@@ -19,6 +19,7 @@ import sys
 from typing import Any
 
 from shipgym_baselines.cli.options import add_json_option, emit
+from shipgym_baselines.executor import BACKENDS
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -31,7 +32,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="continue the existing study (refused if its config changed since it started)",
     )
     p.add_argument("--storage", default=None, help="Optuna storage URL (default: SQLite in --out)")
-    p.add_argument("--backend", choices=("local", "ray"), default="local")
+    p.add_argument("--backend", choices=BACKENDS, default="local")
     p.add_argument("--workers", type=int, default=1, help="Ray tasks at once (--backend ray)")
     p.add_argument("--ship", default=None, help="only this ship's study (per-ship configs)")
     p.add_argument("--out", default=None, help="study folder (default results/tuning/NAME)")

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import functools
 import json
-import os
 from collections import defaultdict
 from collections.abc import Iterable, Iterator, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -16,15 +14,15 @@ from shipgym.config import is_path
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines import evaluation
-from shipgym_baselines.errors import BackendError, RunError
+from shipgym_baselines.errors import BackendError as BackendError  # re-exported by the package
+from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
+from shipgym_baselines.executor import BACKENDS as BACKENDS  # re-exported by the package
+from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult, controller_failed
-from shipgym_baselines.records.runs import (
-    BACKENDS,
-)
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label
 from shipgym_baselines.signals import worker_init
@@ -211,53 +209,11 @@ def work(job: Job) -> list[EpisodeResult]:
     return run_batch(job)
 
 
-def _iter_local(jobs: list[Job], workers: int) -> Iterator[list[EpisodeResult]]:
-    """The jobs' results as they finish (in turn, or in a pool of ``workers`` processes,
-    :func:`shipgym_baselines.signals.worker_init`)."""
-    if workers <= 1:
-        for job in jobs:
-            yield work(job)
-        return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=worker_init)
-    try:
-        for fut in as_completed([pool.submit(work, j) for j in jobs]):
-            yield fut.result()
-    except BaseException:  # Ctrl-C, a failed job, or the consumer stopped: stop the workers
-        workers_running = list((pool._processes or {}).values())  # shutdown forgets them
-        pool.shutdown(wait=False, cancel_futures=True)
-        for process in workers_running:
-            process.kill()  # workers ignore SIGTERM (shipgym_baselines.signals)
-        raise
-    pool.shutdown()
-
-
-def _iter_ray(jobs: list[Job]) -> Iterator[list[EpisodeResult]]:
-    try:
-        import ray
-    except ImportError as exc:
-        raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
-    if not ray.is_initialized():
-        ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
-    remote = ray.remote(work)
-    pending = [remote.remote(j) for j in jobs]
-    try:
-        while pending:
-            done, pending = ray.wait(pending)
-            yield from ray.get(done)
-    except BaseException:
-        for ref in pending:
-            ray.cancel(ref, force=True)
-        raise
-
-
 def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[EpisodeResult]]:
     """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), job by job in completion
-    order."""
-    if backend == "local":
-        return _iter_local(jobs, workers)
-    if backend == "ray":
-        return _iter_ray(jobs)
-    raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
+    order (in turn, or in a pool of ``workers`` processes started with
+    :func:`shipgym_baselines.signals.worker_init`; :mod:`shipgym_baselines.executor`)."""
+    return map_jobs(work, jobs, backend, workers, initializer=worker_init)
 
 
 def result_key(result: EpisodeResult) -> tuple[str, str, int, int | None]:

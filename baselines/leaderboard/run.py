@@ -17,6 +17,7 @@ from shipgym.notices import notice
 from shipgym_baselines import evaluation
 from shipgym_baselines.errors import RunError, check_seeds
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S, EVAL_SEED_OFFSET
+from shipgym_baselines.executor import check_backend
 from shipgym_baselines.leaderboard.comparison import (
     RECORD_KEY,
     references_record,
@@ -43,7 +44,6 @@ from shipgym_baselines.records.episodes import EpisodeResult, controller_failed
 from shipgym_baselines.records.folders import check_out_dir, check_out_usable
 from shipgym_baselines.records.runlog import RunLog
 from shipgym_baselines.records.runrecord import read_run
-from shipgym_baselines.records.runs import BACKENDS
 from shipgym_baselines.registry import controller_label, training_seeds
 from shipgym_baselines.studies.run_costs import eta_line
 
@@ -96,8 +96,7 @@ def run_leaderboard(
         out_dir = suite_folder(suite)
     check_failure_options(act_timeout, retry_failed, resume)  # before any work
     check_out_usable(out_dir, resume=resume, force=force)
-    if backend not in BACKENDS:
-        raise RunError(f"unknown backend {backend!r}; valid: {', '.join(BACKENDS)}")
+    check_backend(backend)
     spec = load_suite(suite)  # a bad suite is named before the state of out_dir
     check_out_dir(out_dir, resume=resume, force=force)
     n_seeds = int(seeds if seeds is not None else spec.seeds)

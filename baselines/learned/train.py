@@ -40,8 +40,9 @@ from typing import Any
 import numpy as np
 
 from shipgym.limits import worker_count
-from shipgym_baselines.errors import BackendError, RunError
+from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.learned.agents import (
     AgentConfig,
     algo_class,
@@ -660,22 +661,6 @@ def train_sweep(
     the metas come back in job order.  Each run is seeded, so where it runs does not change
     its result (tested).  ``workers`` below 1 is refused, more than the jobs clamped."""
     workers = worker_count(workers, len(jobs))
-    if backend == "ray":
-        try:
-            import ray
-        except ImportError as exc:
-            raise BackendError("--backend ray needs Ray: pip install 'shipgym[ray]'") from exc
-        import os
-
-        if not ray.is_initialized():
-            ray.init(address=os.environ.get("RAY_ADDRESS"), ignore_reinit_error=True)
-        remote = ray.remote(run_train_job)
-        return ray.get([remote.remote(job) for job in jobs])
-    if backend != "local":
-        raise RunError(f"unknown backend {backend!r}; valid: local, ray")
-    if workers <= 1 or len(jobs) == 1:
-        return [run_train_job(job) for job in jobs]
-    from concurrent.futures import ProcessPoolExecutor
-
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(run_train_job, jobs))
+    # a failed run lets the runs already training finish, their outputs kept; the workers
+    # have no initializer, so Ctrl-C reaches them too
+    return list(map_jobs(run_train_job, jobs, backend, workers, ordered=True, finish_running=True))

@@ -48,6 +48,7 @@ names: the output folder (:mod:`~shipgym_baselines.records.folders`), ``run.json
 
 from __future__ import annotations
 
+from shipgym_baselines.executor import BACKENDS  # the backends of --backend, public here too
 from shipgym_baselines.records.episodes import (
     BOOL_METRICS,
     EPISODE_KEYS,
@@ -89,9 +90,6 @@ from shipgym_baselines.records.trajectories import (
     read_trajectory,
     trajectory_file,
 )
-
-#: where a run's jobs execute (``--backend``): a local process pool or a Ray cluster
-BACKENDS = ("local", "ray")
 
 __all__ = [
     "BACKENDS",

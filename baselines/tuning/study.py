@@ -32,6 +32,7 @@ study from the shared storage.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import os
@@ -41,6 +42,8 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.executor import BACKENDS as BACKENDS  # public here too
+from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
 from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
@@ -52,7 +55,6 @@ REPORT_FILE = "tuning_report.json"
 STORAGE_FILE = "study.db"
 #: the folder under ``--out`` that a study's chosen settings go to unless promoted
 CHOSEN_FOLDER = "chosen"
-BACKENDS = ("local", "ray")
 #: Optuna's states of a finished trial
 FINISHED = ("COMPLETE", "PRUNED", "FAIL")
 #: a tuning config's keys that do not change a study's scores: its name and words, its budget
@@ -334,8 +336,7 @@ def run_study(
     """Run (or continue) one study to ``n_trials`` finished trials (default: the config's
     budget), then write its report and chosen settings (``force``: even over better
     settings; module doc); returns the report."""
-    if backend not in BACKENDS:
-        raise RunError(f"--backend {backend!r}: valid: {', '.join(BACKENDS)}")
+    check_backend(backend)
     total = int(n_trials if n_trials is not None else plan.config.budget)
     if total < 1:
         raise RunError(f"--trials {total}: at least 1")
@@ -552,19 +553,16 @@ def _jsonable(value: Any) -> Any:
 
 
 def _run_on_ray(plan: StudyPlan, total: int, workers: int) -> None:
-    """The remaining trials as Ray tasks, ``workers`` at once, sharing the storage."""
-    import ray
-
-    started = not ray.is_initialized()
-    if started:
-        ray.init(num_cpus=max(1, workers), include_dashboard=False, log_to_driver=False)
-    try:
-        task = ray.remote(num_cpus=1)(_ray_worker)
-        args = (plan.tuning, plan.ship, str(plan.folder), plan.storage, total)
-        ray.get([task.remote(*args) for _ in range(max(1, workers))])
-    finally:
-        if started:
-            ray.shutdown()
+    """The remaining trials as Ray tasks, ``workers`` at once, sharing the storage (a Ray
+    started here has ``workers`` CPUs and is shut down after)."""
+    n = max(1, workers)
+    setup = RaySetup(
+        init={"num_cpus": n, "include_dashboard": False, "log_to_driver": False},
+        task={"num_cpus": 1},
+        shutdown=True,
+    )
+    task = functools.partial(_ray_worker, plan.tuning, plan.ship, str(plan.folder), plan.storage)
+    list(map_jobs(task, [total] * n, "ray", ray_setup=setup))  # until every task ends
 
 
 def _ray_worker(tuning: str, ship: str | None, folder: str, storage: str, total: int) -> int:

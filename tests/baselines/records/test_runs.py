@@ -8,6 +8,7 @@ import importlib
 
 import pytest
 
+from shipgym_baselines import executor
 from shipgym_baselines.records import runs
 from tests.import_graph import import_graph
 
@@ -28,6 +29,7 @@ FORMER = [(module, name) for module, names in HOMES.items() for name in names.sp
 BELOW = (
     "shipgym",
     "shipgym_baselines.errors",
+    "shipgym_baselines.executor",
     "shipgym_baselines.extras",
     "shipgym_baselines.jsonout",
     "shipgym_baselines.records",
@@ -43,7 +45,7 @@ def test_a_former_name_imports_from_runs_as_its_home_holds_it(module: str, name:
 
 
 def test_runs_holds_the_backends_and_no_other_name_of_its_own() -> None:
-    assert runs.BACKENDS == ("local", "ray")
+    assert runs.BACKENDS is executor.BACKENDS == ("local", "ray")
     assert set(runs.__all__) == {name for _, name in FORMER} | {"BACKENDS"}
 
 
