@@ -135,7 +135,7 @@ JUMP_CASES = {
 
 def _jump_case(name: str) -> Any:
     """A catalogue scenario, or ``<name>_noise_free``: the same without its sensor model."""
-    from shipgym_baselines.variants import scenario_variant
+    from shipgym_baselines.reproduce.variants import scenario_variant
 
     base = name.removesuffix("_noise_free")
     return scenario_variant(base, noise_free=name != base)

@@ -12,7 +12,7 @@ import json
 
 from shipgym.models.nomoto2 import UnitReading
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from shipgym_baselines.variants import scenario_variant
+from shipgym_baselines.reproduce.variants import scenario_variant
 
 SCENARIOS = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
 

@@ -1,6 +1,6 @@
 """The import graph of ``baselines/`` (``shipgym_baselines``) follows its layers, ground up:
-ground floor → records → controllers → evaluation → tuning, reproduce, variants →
-leaderboard → studies → cli.  A module imports only modules of its
+ground floor → records → controllers → evaluation → tuning, reproduce → leaderboard →
+studies → cli.  A module imports only modules of its
 own layer or a lower one, save the edges of :data:`EXCEPTIONS`, and no import cycle runs
 through baselines, save through :data:`CYCLE_EXCEPTIONS`.
 
@@ -53,10 +53,9 @@ LAYERS: dict[str, int] = {
     f"{B}.learned": 2,
     # 3 — the evaluation loop
     f"{B}.evaluation": 3,
-    # 4 — tuning, the papers' reproductions, scenario variants
+    # 4 — tuning, the papers' reproductions (with the scenario variants they use)
     f"{B}.tuning": 4,
     f"{B}.reproduce": 4,
-    f"{B}.variants": 4,
     # 5 — the leaderboard
     f"{B}.leaderboard": 5,
     # 6 — one-off studies beside the leaderboard

@@ -26,7 +26,7 @@ from shipgym_baselines.errors import check_seeds
 from shipgym_baselines.reproduce.episodes import seeded_episodes
 from shipgym_baselines.reproduce.protocol import Outcome, Progress
 from shipgym_baselines.reproduce.rows import reproduction_row
-from shipgym_baselines.variants import scenario_variant
+from shipgym_baselines.reproduce.variants import scenario_variant
 
 CASES = {  # scenario -> (paper's case, parameters that change)
     "rudder_aging": ("Case 1", ("Tc",)),

@@ -27,7 +27,8 @@ def raw(name: str) -> dict[str, Any]:
 @pytest.mark.parametrize("name", NOMOTO)
 @pytest.mark.parametrize(("unit_reading", "noise_free"), [("degrees", False), (None, True)])
 def test_variant_equals_the_edited_yaml(name: str, unit_reading: str | None, noise_free: bool):
-    """The old route of shipgym_baselines.variants: edit the catalogue file's dict, then load it."""
+    """The old route of shipgym_baselines.reproduce.variants: edit the catalogue file's dict,
+    then load it."""
     data = copy.deepcopy(raw(name))
     overrides: dict[str, Any] = {}
     drop = []
