@@ -1,7 +1,14 @@
-"""The one policy interface every controller and agent implements (docs/plugins.md)."""
+"""The one policy interface every controller and agent implements (docs/plugins.md), and how
+the figures draw a controller: its family (the column, :data:`FAMILIES`) and its look
+(:class:`Style`), traits of its registration
+(:func:`shipgym_baselines.registry.register_controller`; the learned agents':
+:data:`shipgym_baselines.learned.policy.AGENT_LOOKS`), read by
+:func:`shipgym_baselines.leaderboard.figures.controller_family` and
+:func:`shipgym_baselines.leaderboard.style.controller_style`."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -37,3 +44,20 @@ def check_action_mode(policy: Any, context: ControllerContext) -> None:
             f"{policy.name} drives action_mode {mode!r}, the env uses "
             f"{context.action_mode!r}: make the env with action_mode={mode!r}"
         )
+
+
+#: controller families, the order of the figures' columns
+FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
+
+
+@dataclass(frozen=True)
+class Style:
+    """Matplotlib keyword arguments of one controller: colour (``#rrggbb``), line style
+    and marker."""
+
+    color: str
+    linestyle: str
+    marker: str
+
+    def kwargs(self) -> dict[str, str]:
+        return {"color": self.color, "linestyle": self.linestyle}

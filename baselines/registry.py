@@ -2,17 +2,22 @@
 
 A controller declares itself once, where it is defined::
 
-    @register_controller("pid_los")
+    @register_controller("pid_los", family="PID", look=Style("#1f77b4", "-", "o"))
     class PIDLOS: ...
 
     register_controller("pid_los_fast", make_fast_pid)  # a factory function
 
-The registration is the single record of the controller's name, the action mode it drives
-and the ships it applies to; the instances made by :func:`make_controller` carry that name
-and action mode (a class as class attributes, a factory function's policy as attributes
-set on it).
-The built-in controllers register when their modules are imported, which this module does
-(so the registry is full once ``shipgym_baselines.registry`` is imported).
+The registration is the single record of the controller's name, the action mode it drives,
+the ships it applies to and how the figures draw it (its family and look,
+:mod:`shipgym_baselines.policy`); the instances made by :func:`make_controller` carry that
+name and action mode (a class as class attributes, a factory function's policy as
+attributes set on it).
+The built-in controllers register when :mod:`shipgym_baselines.classical` is imported.
+This module imports that package in one place, :func:`_load_builtins`, lazily: every reader
+of the registry (:data:`CONTROLLERS`, :func:`resolve_controller` and all built on it,
+:func:`declared_traits`, :func:`register_controller`) calls it first, so
+``make_controller("pid_los")`` works in a fresh interpreter and
+``import shipgym_baselines.registry`` alone imports no controller.
 
 Every other controller is found by :func:`resolve_controller` (all that :func:`make_controller`
 accepts): an installed plug-in's entry point, a spec ``module.path:Attr`` or
@@ -26,13 +31,11 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import importlib
 import inspect
 import types
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from importlib.metadata import EntryPoint
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, TypeVar, overload
 
 from shipgym.envs.core import ACTION_MODES
@@ -49,17 +52,7 @@ from shipgym_baselines.plugins import (
     looks_like_path,
     parse_spec,
 )
-from shipgym_baselines.policy import Policy
-
-#: modules whose controllers register themselves on import
-BUILTIN_MODULES = (
-    "shipgym_baselines.classical.pid",
-    "shipgym_baselines.classical.lqr",
-    "shipgym_baselines.classical.l1_backstepping",
-    "shipgym_baselines.classical.nmpc",
-    "shipgym_baselines.classical.reference",
-    "shipgym_baselines.classical.oracle",
-)
+from shipgym_baselines.policy import FAMILIES, Policy, Style
 
 Factory = TypeVar("Factory", bound=Callable[..., Any])
 
@@ -76,7 +69,9 @@ class ControllerRecord:
     ``action_mode`` is the env mode it drives; ``applies_to`` the ship ids it runs on
     (None: every ship); ``kind`` is ``"classical"`` unless the factory says otherwise;
     ``training_seeds``: a learned policy's (the factory takes ``training_seed=k``), else
-    ``(None,)``.
+    ``(None,)``.  ``family`` (one of :data:`~shipgym_baselines.policy.FAMILIES`) and
+    ``look``: how the figures draw it, as registered (None: not declared; the figures
+    derive them from the kind and name).
     """
 
     name: str
@@ -85,11 +80,54 @@ class ControllerRecord:
     applies_to: tuple[str, ...] | None = None
     kind: str = "classical"
     training_seeds: tuple[int | None, ...] = (None,)
+    family: str | None = None
+    look: Style | None = None
 
 
 _RECORDS: dict[str, ControllerRecord] = {}
+#: whether :func:`_load_builtins` has imported the built-in controllers
+_BUILTINS_LOADED = False
+
+
+def _load_builtins() -> None:
+    """Import :mod:`shipgym_baselines.classical`, whose modules register the built-in
+    controllers, once per process.
+
+    The one import of the controllers by the registry, lazy (inside this function) because
+    they import the registry to register: a reader calls it before reading the records.
+    """
+    global _BUILTINS_LOADED
+    if _BUILTINS_LOADED:
+        return
+    _BUILTINS_LOADED = True  # set first: the package's modules register while it imports
+    try:
+        import shipgym_baselines.classical  # noqa: F401
+    except BaseException:
+        _BUILTINS_LOADED = False
+        raise
+
+
+class _Registered(Mapping[str, ControllerRecord]):
+    """The registrations, read-only, the built-in controllers loaded on first read."""
+
+    def __getitem__(self, name: str) -> ControllerRecord:
+        _load_builtins()
+        return _RECORDS[name]
+
+    def __iter__(self) -> Iterator[str]:
+        _load_builtins()
+        return iter(_RECORDS)
+
+    def __len__(self) -> int:
+        _load_builtins()
+        return len(_RECORDS)
+
+    def __repr__(self) -> str:
+        return f"CONTROLLERS({list(self)})"
+
+
 #: read-only view: name -> record, in registration order
-CONTROLLERS: Mapping[str, ControllerRecord] = MappingProxyType(_RECORDS)
+CONTROLLERS: Mapping[str, ControllerRecord] = _Registered()
 
 
 @overload
@@ -99,6 +137,8 @@ def register_controller(
     *,
     action_mode: str = "rudder",
     applies_to: Sequence[str] | None = None,
+    family: str | None = None,
+    look: Style | None = None,
 ) -> Callable[[Factory], Factory]: ...
 
 
@@ -109,6 +149,8 @@ def register_controller(
     *,
     action_mode: str = "rudder",
     applies_to: Sequence[str] | None = None,
+    family: str | None = None,
+    look: Style | None = None,
 ) -> Factory: ...
 
 
@@ -118,6 +160,8 @@ def register_controller(
     *,
     action_mode: str = "rudder",
     applies_to: Sequence[str] | None = None,
+    family: str | None = None,
+    look: Style | None = None,
 ) -> Factory | Callable[[Factory], Factory]:
     """Register ``factory`` (a Policy class or a function returning a Policy) as ``name``.
 
@@ -126,19 +170,32 @@ def register_controller(
     ``action_mode`` as class attributes (so it must not declare different ones: register
     an alias through a factory function).  ``action_mode``: "rudder" | "guidance";
     ``applies_to``: the ship ids of :data:`shipgym.models.MODELS` the controller runs on
-    (None: every ship).  A name registered to another factory is an error.
+    (None: every ship).  ``family``: the figures' column, one of
+    :data:`~shipgym_baselines.policy.FAMILIES` (every built-in declares one); ``look``: its
+    :class:`~shipgym_baselines.policy.Style` in every figure (None: the figures derive
+    both from the kind and name, :mod:`shipgym_baselines.leaderboard.style`).  A name
+    registered to another factory is an error.
     """
     if factory is None:
 
         def decorate(f: Factory) -> Factory:
-            return register_controller(name, f, action_mode=action_mode, applies_to=applies_to)
+            return register_controller(
+                name, f, action_mode=action_mode, applies_to=applies_to, family=family, look=look
+            )
 
         return decorate
+    _load_builtins()
     if not (isinstance(name, str) and name):
         raise ValueError(f"a controller name must be a non-empty string, got {name!r}")
     if action_mode not in ACTION_MODES:
         raise ValueError(
             f"controller {name!r}: action_mode must be one of {ACTION_MODES}, got {action_mode!r}"
+        )
+    if family is not None and family not in FAMILIES:
+        raise ValueError(f"controller {name!r}: family must be one of {FAMILIES}, got {family!r}")
+    if look is not None and not isinstance(look, Style):
+        raise TypeError(
+            f"controller {name!r}: look is a shipgym_baselines.policy.Style, not {look!r}"
         )
     record = ControllerRecord(
         name=name,
@@ -146,8 +203,14 @@ def register_controller(
         action_mode=action_mode,
         applies_to=_ships(f"controller {name!r}", applies_to),
         kind=getattr(factory, "kind", "classical"),
+        family=family,
+        look=look,
     )
     existing = _RECORDS.get(name)
+    if existing is not None and existing.factory is factory:  # again: keep what it declared
+        record = dataclasses.replace(
+            record, family=family or existing.family, look=look or existing.look
+        )
     if existing is not None and existing != record:
         raise ValueError(
             f"controller name {name!r} is taken: {_qualname(existing.factory)} is registered "
@@ -208,14 +271,17 @@ def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
     bound to the factory (checked against its signature here, before any episode).
     Anything else is a :class:`ControllerError` that lists the valid names.
     """
+    _load_builtins()
     entry = as_entry(controller)
     base = _record_of(entry.controller)
+    name = entry.name or base.name
     record = dataclasses.replace(
         base,
-        name=entry.name or base.name,
+        name=name,
         factory=functools.partial(base.factory, **entry.settings)
         if entry.settings
         else base.factory,
+        look=base.look if name == base.name else None,  # another name: not its look
     )
     _check_settings(base, entry)
     if "training_seed" in entry.settings:  # a long form naming one training seed
@@ -264,7 +330,12 @@ def _record_of(text: str) -> ControllerRecord:
 def _learned_record(name_or_path: str) -> ControllerRecord:
     """A shipped policy, trained agent's folder or model zip, the files of every training
     seed checked now (one action mode for all)."""
-    from shipgym_baselines.learned.policy import LearnedPolicy, policy_label, read_policy
+    from shipgym_baselines.learned.policy import (
+        AGENT_LOOKS,
+        LearnedPolicy,
+        policy_label,
+        read_policy,
+    )
     from shipgym_baselines.learned.policy import training_seeds as policy_seeds
 
     seeds = policy_seeds(name_or_path)
@@ -280,6 +351,8 @@ def _learned_record(name_or_path: str) -> ControllerRecord:
         action_mode=files[0].model.action_mode,
         kind=LearnedPolicy.kind,
         training_seeds=tuple(seeds),
+        family="learned",
+        look=AGENT_LOOKS.get(label),
     )
 
 
@@ -424,6 +497,7 @@ def controller_label(controller: ControllerSpec) -> str:
 def _known(controller: ControllerSpec) -> ControllerRecord | None:
     """The record of a table name or controller resolved before, else resolved now (None
     when it is none)."""
+    _load_builtins()
     if isinstance(controller, str):
         record = _RECORDS.get(controller) or _RESOLVED.get(controller)
         if record is not None:
@@ -461,6 +535,7 @@ def unknown_controller(name: str) -> str:
     """The error message for a name :func:`is_controller` rejects: the valid names."""
     from shipgym_baselines.learned.policy import shipped_policies
 
+    _load_builtins()
     plugins = [n for n in entry_point_names() if n not in _RECORDS]
     installed = f", the installed plug-ins {', '.join(plugins)}" if plugins else ""
     return (
@@ -515,5 +590,17 @@ def make_controller(
     return policy, record.action_mode
 
 
-for _module in BUILTIN_MODULES:
-    importlib.import_module(_module)
+def declared_traits(name: str) -> tuple[str | None, Style | None]:
+    """(family, look) the figures draw the table name ``name`` with, as declared: by its
+    registration, or for a learned agent by
+    :data:`shipgym_baselines.learned.policy.AGENT_LOOKS` (family ``"learned"``); each None
+    where nothing declares it (the figures derive it from the kind and name)."""
+    _load_builtins()
+    record = _RECORDS.get(name)
+    if record is not None:
+        return record.family, record.look
+    from shipgym_baselines.learned.policy import AGENT_LOOKS
+
+    if name in AGENT_LOOKS:
+        return "learned", AGENT_LOOKS[name]
+    return None, None

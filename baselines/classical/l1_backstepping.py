@@ -95,7 +95,7 @@ from shipgym_baselines.classical.adaptive.settings import (
     L1BacksteppingSettings,
 )
 from shipgym_baselines.classical.drift import course_and_drift
-from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.policy import Style, check_action_mode
 from shipgym_baselines.registry import register_controller
 from shipgym_baselines.tuning.chosen import tuned_settings
 
@@ -123,7 +123,7 @@ __all__ = [
 ]
 
 
-@register_controller("l1_backstepping")
+@register_controller("l1_backstepping", family="backstepping", look=Style("#756bb1", "-", "D"))
 class L1Backstepping:
     """L1 adaptive backstepping heading control on TVVF guidance (``l1_backstepping``)."""
 
@@ -307,7 +307,9 @@ class L1Backstepping:
         return stats
 
 
-@register_controller("adaptive_backstepping")
+@register_controller(
+    "adaptive_backstepping", family="backstepping", look=Style("#bcbddc", "--", "D")
+)
 class AdaptiveBackstepping(L1Backstepping):
     """The same controller with C(s) off (``adaptive_backstepping``; Xu et al. 2021 §5.2)."""
 

@@ -69,7 +69,7 @@ from shipgym.envs.context import ControllerContext
 from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
 from shipgym_baselines.classical.drift import course_and_drift
-from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.policy import Style, check_action_mode
 from shipgym_baselines.registry import register_controller
 from shipgym_baselines.tuning.chosen import tuned_settings
 
@@ -175,7 +175,7 @@ def initial_guess(context: ControllerContext) -> tuple[float, float]:
     return 1.0 / T, K / T
 
 
-@register_controller("lqr")
+@register_controller("lqr", family="LQR", look=Style("#31a354", "-", "s"))
 class LQR:
     """Track-keeping LQR of Borkowski (2018) eq. (28)–(30) with a fixed model (a0, c0).
 
@@ -317,7 +317,7 @@ class LQR:
         return {"riccati_solves": float(self.solves)}
 
 
-@register_controller("adaptive_lqr")
+@register_controller("adaptive_lqr", family="LQR", look=Style("#74c476", "--", "s"))
 class AdaptiveLQR(LQR):
     """Borkowski (2018) adaptive LQR: the gain of the continuous-LS estimates (â, ĉ).
 

@@ -162,6 +162,7 @@ from shipgym.identification import first_order_nomoto
 from shipgym.models.base import ShipModel
 from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
 from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.policy import Style
 from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
@@ -806,7 +807,9 @@ def predicted_disturbances(
     return rows
 
 
-@register_controller("oracle")
+# its look colours its name in the page's tables; the scenario figures draw its episode black
+# and dashed, the reference (shipgym_baselines.leaderboard.figures)
+@register_controller("oracle", family="references", look=Style("#17becf", "-", "s"))
 class Oracle:
     """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
 
@@ -917,7 +920,7 @@ class Oracle:
         }
 
 
-@register_controller("oracle_frozen")
+@register_controller("oracle_frozen", family="references", look=Style("#525252", "-.", "x"))
 class OracleFrozen(Oracle):
     """``oracle_frozen``: the oracle with its truth frozen at the episode's start (module
     doc): the optimum of a controller that never adapts."""

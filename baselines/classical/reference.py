@@ -7,10 +7,11 @@ from typing import Any
 import numpy as np
 
 from shipgym.envs.context import ControllerContext
+from shipgym_baselines.policy import Style
 from shipgym_baselines.registry import register_controller
 
 
-@register_controller("zero_rudder")
+@register_controller("zero_rudder", family="references", look=Style("#7f7f7f", ":", "."))
 class ZeroRudder:
     """Always commands zero (rudder mode) / the default guidance action."""
 
@@ -23,7 +24,7 @@ class ZeroRudder:
         return np.zeros(self._dim, dtype=np.float32)
 
 
-@register_controller("random")
+@register_controller("random", family="references", look=Style("#c7c7c7", ":", "."))
 class RandomRudder:
     """Uniform random action in [-1, 1], seeded per episode."""
 

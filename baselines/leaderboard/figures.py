@@ -60,10 +60,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipgym_baselines.leaderboard.escaping import plain_text
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN, REFERENCE_KIND
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
+from shipgym_baselines.policy import FAMILIES
 from shipgym_baselines.records.outfiles import write_bytes
 from shipgym_baselines.records.trajectories import DRAWN_KEYS, thin_trajectory
+from shipgym_baselines.registry import declared_traits
 
 #: most controllers drawn in one panel; a bigger family is split over several columns
 PANEL_CONTROLLERS = 5
@@ -99,10 +101,6 @@ LEGEND_TOP_KEY = "shipgym:legend-top"
 #: page; an adaptive 64-colour palette spent itself on near-whites and greyed the lines)
 PAGE_COLOURS = 256
 PAGE_GREYS = 9
-#: controller families, the order of the columns
-FAMILIES = ("PID", "LQR", "NMPC", "backstepping", "learned", "other", "references")
-REFERENCES = ("zero_rudder", "random", ORACLE, ORACLE_FROZEN)
-_LEARNED = ("ppo", "ppo_guidance", "recurrent_ppo", "sac", "td3", "ppo_history", "dagger", "bc")
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
 #: the oracle's episode, drawn in every column as the reference
 _ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}
@@ -329,11 +327,20 @@ def _as_drawn(value: Any) -> DrawnEpisode:
 
 # ---------------------------------------------------------------------------- families
 def controller_family(name: str, kind: str | None = None) -> str:
-    """The controller's family (one of :data:`FAMILIES`): the column it is drawn in."""
-    if name in REFERENCES:
-        return "references"
-    if kind == "learned" or name in _LEARNED:
+    """The controller's family (one of :data:`FAMILIES`): the column it is drawn in.
+
+    The family its registration declares (a shipped learned agent's: ``learned``,
+    :func:`shipgym_baselines.registry.declared_traits`); for a name nothing declares one
+    for (a plug-in, a renamed long form, a trained agent's folder), its ``kind``'s
+    (``learned``; ``reference``: ``references``), else the family its name reads as,
+    else ``other``."""
+    family, _ = declared_traits(name)
+    if family is not None:
+        return family
+    if kind == "learned":
         return "learned"
+    if kind == REFERENCE_KIND:
+        return "references"
     if name.startswith("pid"):
         return "PID"
     if name.endswith("lqr"):

@@ -63,9 +63,21 @@ from shipgym_baselines.errors import ControllerError, UnsafeFileError
 from shipgym_baselines.learned.loading import load_data_only
 from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
 from shipgym_baselines.learned.trust import pickle_trusted
-from shipgym_baselines.policy import check_action_mode
+from shipgym_baselines.policy import Style, check_action_mode
 
 POLICY_DIR = Path(__file__).resolve().parent / "policies"
+#: the look of each learned agent (``configs/agents``: the shipped policies and ``bc``) in
+#: every figure, its family ``learned`` (:func:`shipgym_baselines.registry.declared_traits`)
+AGENT_LOOKS: dict[str, Style] = {
+    "ppo": Style("#d62728", "-", "P"),
+    "ppo_guidance": Style("#ff9896", "--", "P"),
+    "recurrent_ppo": Style("#8c564b", "-", "X"),
+    "sac": Style("#e377c2", "-.", "*"),
+    "td3": Style("#c49c94", ":", "*"),
+    "ppo_history": Style("#ad494a", "--", "P"),
+    "dagger": Style("#67000d", "-", "h"),
+    "bc": Style("#e7969c", ":", "h"),
+}
 
 #: algorithm id -> (module, class) of the SB3 / sb3-contrib algorithm that loads its zips
 ALGORITHMS: dict[str, tuple[str, str]] = {

@@ -13,8 +13,9 @@ from shipgym_baselines import registry
 
 @pytest.fixture
 def scratch_registry() -> Iterator[None]:
-    """Controllers registered (or resolved) inside a test are gone after it."""
-    records, resolved = dict(registry._RECORDS), dict(registry._RESOLVED)
+    """Controllers registered (or resolved) inside a test are gone after it (the built-ins
+    loaded first, by reading CONTROLLERS, so that they are kept)."""
+    records, resolved = dict(registry.CONTROLLERS), dict(registry._RESOLVED)
     yield
     registry._RECORDS.clear()
     registry._RECORDS.update(records)

@@ -100,7 +100,7 @@ EXCEPTIONS = _edge_table(
 #: Edges left out of the cycle check, with the reason (same form as :data:`EXCEPTIONS`).
 CYCLE_EXCEPTIONS = _edge_table(
     """
-    registry -> classical.*: registers the built-ins through importlib: being removed
+    registry -> classical.*: _load_builtins, lazy, loads the built-ins, which register there
     learned.agents -> learned.dagger_agent: a config checks its DAgger block there (lazy)
     learned.train -> learned.dagger_agent: train hands a DAgger config to its agent (lazy)
     """

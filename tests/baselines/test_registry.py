@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from typing import Any
 
 import numpy as np
@@ -13,11 +15,14 @@ from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.classical.reference import ZeroRudder
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.learned.policy import shipped_policies
 from shipgym_baselines.plugins import ControllerEntry
+from shipgym_baselines.policy import FAMILIES, Style
 from shipgym_baselines.registry import (
     CONTROLLERS,
     applies_to,
     controller_kind,
+    declared_traits,
     make_controller,
     register_controller,
     resolve_controller,
@@ -63,6 +68,45 @@ def test_made_controller_carries_its_registered_name(name: str) -> None:
     policy, mode = make_controller(name)
     assert policy.name == name
     assert mode == BUILTINS[name][0]
+
+
+def test_every_controller_declares_a_family_and_a_look() -> None:
+    """Every registered controller and every shipped learned agent: a family of the figures
+    and a look (none is left to the name's hash)."""
+    for name in [*CONTROLLERS, *shipped_policies()]:
+        family, look = declared_traits(name)
+        assert family in FAMILIES, name
+        assert isinstance(look, Style), name
+    assert {declared_traits(name)[0] for name in shipped_policies()} == {"learned"}
+    assert {declared_traits(name)[0] for name in REFERENCES} == {"references"}
+    assert declared_traits("my_module:MyPolicy") == (None, None)
+
+
+def test_a_registration_carries_its_family_and_look(scratch_registry: None) -> None:
+    look = Style("#123456", "--", "o")
+    register_controller("test_styled", lambda: ZeroRudder(), family="PID", look=look)
+    assert (CONTROLLERS["test_styled"].family, CONTROLLERS["test_styled"].look) == ("PID", look)
+    register_controller("test_plain", lambda: ZeroRudder())
+    assert declared_traits("test_plain") == (None, None)  # the figures derive both
+    with pytest.raises(ValueError, match="family must be one of"):
+        register_controller("test_bad_family", ZeroRudder, family="MPC")
+    with pytest.raises(TypeError, match=r"look is a shipgym_baselines\.policy\.Style"):
+        register_controller("test_bad_look", ZeroRudder, look=("#000000", "-", "o"))  # type: ignore[arg-type]
+    assert not {"test_bad_family", "test_bad_look"} & set(CONTROLLERS)
+
+
+def test_the_registry_loads_the_built_ins_on_first_read() -> None:
+    """Importing the registry imports no controller; its first reader imports
+    shipgym_baselines.classical, in a fresh interpreter too."""
+    code = (
+        "import sys\n"
+        "from shipgym_baselines.registry import make_controller\n"
+        "assert 'shipgym_baselines.classical' not in sys.modules\n"
+        "policy, mode = make_controller('pid_los')\n"
+        "print(policy.name, mode)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.split() == ["pid_los", "rudder"]
 
 
 def test_the_registry_is_read_only() -> None:

@@ -19,6 +19,7 @@ from shipgym_baselines.leaderboard.figures import (
     PAGE_COLOURS,
     PAGE_WIDTH,
     DrawnEpisode,
+    controller_family,
     episodes_to_draw,
     family_panels,
     median_ace_episode,
@@ -27,6 +28,8 @@ from shipgym_baselines.leaderboard.figures import (
 )
 from shipgym_baselines.leaderboard.ranking import aggregate_ranking
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
+from shipgym_baselines.policy import Style
+from shipgym_baselines.registry import register_controller
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -221,6 +224,20 @@ def test_a_big_family_is_split_over_panels() -> None:
     ]
     assert all(len(members) <= figures.PANEL_CONTROLLERS for _, members in panels)
     assert sorted(n for _, members in panels for n in members) == sorted(names)
+
+
+def test_the_figures_draw_a_controller_as_registered(scratch_registry: None) -> None:
+    """Family and look come from the registration (its name says nothing); a name nothing
+    declares them for takes its kind's family and its name's hashed look."""
+    from shipgym_baselines.classical.reference import ZeroRudder
+
+    look = Style("#123456", "--", "o")
+    register_controller("test_mine", lambda: ZeroRudder(), family="NMPC", look=look)
+    assert (controller_family("test_mine"), controller_style("test_mine")) == ("NMPC", look)
+    assert controller_family("ppo") == "learned" and controller_family("oracle") == "references"
+    assert controller_family("my_ref", "reference") == "references"
+    assert controller_family("my_agent", "learned") == "learned"
+    assert controller_family("my_plugin", "classical") == "other"
 
 
 def test_both_references_are_drawn_in_every_column(tmp_path: Path) -> None:

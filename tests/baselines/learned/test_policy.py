@@ -19,7 +19,9 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, ActGuard, evaluate, evaluate_batch
+from shipgym_baselines.learned.agents import list_agent_configs
 from shipgym_baselines.learned.policy import (
+    AGENT_LOOKS,
     ALGORITHMS,
     BATCH_ROWS,
     LearnedPolicy,
@@ -369,6 +371,14 @@ def test_every_shipped_agent_loads_each_of_its_training_seeds() -> None:
             policy, _ = make_controller(name, training_seed=seed)
             assert (policy.name, policy.training_seed) == (name, seed)
             assert policy.episode_stats()["train_env_steps"] > 0
+
+
+def test_every_agent_has_one_look_of_its_own() -> None:
+    """The looks of the learned agents: one per agent config (the shipped policies among
+    them), no two alike."""
+    assert set(AGENT_LOOKS) == set(list_agent_configs())
+    assert set(shipped_policies()) <= set(AGENT_LOOKS)
+    assert len({(s.color, s.linestyle) for s in AGENT_LOOKS.values()}) == len(AGENT_LOOKS)
 
 
 def test_an_sb3_zip_is_named_by_its_file_stem(tmp_path: Path) -> None:
