@@ -21,10 +21,13 @@ from collections.abc import Callable
 from typing import Any
 
 from shipgym_baselines.errors import ControllerError
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.plugins import ControllerEntry, as_entry
-from shipgym_baselines.registry import CONTROLLERS
 
+#: the reference of the leaderboard's cost ratio (its cost is the denominator)
+ORACLE = "oracle"
+#: the second reference: the same NMPC with its truth frozen at the episode's start (the
+#: optimum that never adapts); C_frozen / C_oracle is what knowing the change is worth
+ORACLE_FROZEN = "oracle_frozen"
 #: the names that receive the truth
 PRIVILEGED_NAMES = (ORACLE, ORACLE_FROZEN)
 
@@ -38,6 +41,7 @@ def grants_truth(controller: Any) -> bool:
     if name not in PRIVILEGED_NAMES or entry.settings or entry.name not in (None, name):
         return False
     from shipgym_baselines.classical.oracle import PRIVILEGED
+    from shipgym_baselines.registry import CONTROLLERS
 
     record = CONTROLLERS.get(name)
     return record is not None and record.factory is PRIVILEGED[name]

@@ -57,14 +57,14 @@ from shipgym.envs.core import ENV_REVISION
 from shipgym.notices import duration, notice
 from shipgym.scenarios import Scenario
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.records.jsonfiles import from_plain, plain
 
 #: the references with a table, in the order they are computed
 REFERENCES = (ORACLE, ORACLE_FROZEN)
 #: the oracle's table file (each reference's: :func:`table_file`)
-TABLE_FILE = "oracle.json.gz"
+TABLE_FILE = f"{ORACLE}.json.gz"
 FORMAT = 2
 #: the columns of a reference episode's trajectory kept in the table (the figures' traces)
 TRACE_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")

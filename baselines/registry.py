@@ -54,6 +54,10 @@ from shipgym_baselines.plugins import (
 )
 from shipgym_baselines.policy import FAMILIES, Policy, Style
 
+#: the controller every other is compared with: the leaderboard's probability of improvement
+#: over it, and a learned agent's selection reference where the oracle's table has none
+BASELINE = "pid_los"
+
 Factory = TypeVar("Factory", bound=Callable[..., Any])
 
 #: what a controller is; a "reference" (zero_rudder, random, oracle, oracle_frozen) is shown on

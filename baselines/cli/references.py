@@ -36,7 +36,7 @@ from contextlib import closing
 from typing import Any
 
 from shipgym_baselines.cli.options import add_json_option, emit
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 #: the references with a table (:data:`shipgym_baselines.references.REFERENCES`)
 REFERENCES = (ORACLE, ORACLE_FROZEN)

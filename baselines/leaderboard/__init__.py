@@ -184,9 +184,8 @@ __all__ = sorted(_HOMES)
 
 
 def __getattr__(name: str) -> Any:
-    """A public name from its module, imported on first use: ``privileged`` and
-    ``references`` import :mod:`.ranking` (and ``evaluation`` through ``privileged``), so
-    this package imports no module eagerly."""
+    """A public name from its module, imported on first use, so that importing one module
+    of this package (:mod:`.ranking`, say) imports no other."""
     if name not in _HOMES:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     return getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)

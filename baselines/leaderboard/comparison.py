@@ -29,9 +29,10 @@ from typing import Any
 
 from shipgym_baselines.leaderboard.ranking import REFERENCE_KIND
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 #: the references added to a run's controllers (the cost ratio's denominator first)
-REFERENCES = ("oracle", "oracle_frozen", "zero_rudder", "random")
+REFERENCES = (ORACLE, ORACLE_FROZEN, "zero_rudder", "random")
 #: the key of ``run.json``'s suite record that :func:`references_record` fills
 RECORD_KEY = "references"
 #: the folder of the leaderboard's default ``--out`` (:func:`suite_folder`)

@@ -60,7 +60,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipgym_baselines.leaderboard.escaping import plain_text
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN, REFERENCE_KIND
+from shipgym_baselines.leaderboard.ranking import BASELINE, ORACLE, ORACLE_FROZEN, REFERENCE_KIND
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.policy import FAMILIES
 from shipgym_baselines.records.outfiles import write_bytes
@@ -707,7 +707,7 @@ _RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"
 _INTERVAL_PANELS = (
     ("cost_ratio_iqm", "IQM cost ratio", _RATIO_LABEL, (1.0,)),
     ("cost_ratio_gmean", "geometric-mean cost ratio", _RATIO_LABEL, (1.0,)),
-    ("prob_improvement_over_pid_los", "P(ratio < pid_los's)", "probability [–]", (0.5,)),
+    (f"prob_improvement_over_{BASELINE}", f"P(ratio < {BASELINE}'s)", "probability [–]", (0.5,)),
     ("failure_rate", "failure rate", "fraction of episodes [–]", ()),
 )
 

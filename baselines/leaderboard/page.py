@@ -394,7 +394,7 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
             ("training_seeds", "training seeds", "number"),
             ("cost_ratio_iqm", "IQM cost ratio", "lower"),
             ("cost_ratio_gmean", "geometric mean", "lower"),
-            ("prob", "P(ratio &lt; pid_los&#x27;s)", "number"),
+            ("prob", _e(f"P(ratio < {BASELINE}'s)"), "number"),
             ("failure_rate", "failure rate", "lower"),
             (GAIN, "adaptation gain", "number"),
             ("prob_beats_frozen", "P(C &lt; C_frozen)", "number"),

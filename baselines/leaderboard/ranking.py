@@ -59,6 +59,9 @@ from typing import Any
 
 import numpy as np
 
+# the references: ORACLE (its cost is the cost ratio's denominator) and ORACLE_FROZEN
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
+
 # an episode its controller ended is told by its record, in records.episodes; these names
 # stay importable from here
 from shipgym_baselines.records.episodes import CONTROLLER_ERROR as CONTROLLER_ERROR
@@ -66,13 +69,9 @@ from shipgym_baselines.records.episodes import CONTROLLER_FAILURES
 from shipgym_baselines.records.episodes import CONTROLLER_TIMEOUT as CONTROLLER_TIMEOUT
 from shipgym_baselines.records.episodes import controller_failed as controller_failed
 
-#: the reference of the cost ratio (its cost is the denominator)
-ORACLE = "oracle"
-#: the second reference: the same NMPC with its truth frozen at the episode's start (the
-#: optimum that never adapts); C_frozen / C_oracle is what knowing the change is worth
-ORACLE_FROZEN = "oracle_frozen"
-#: the controller of the probability of improvement
-BASELINE = "pid_los"
+# the controller of the probability of improvement
+from shipgym_baselines.registry import BASELINE
+
 #: the kind of the controllers shown on every scenario but never ranked
 REFERENCE_KIND = "reference"
 #: the ``termination_reason`` values of a failed episode

@@ -172,6 +172,7 @@ def identity(config: Any) -> dict[str, Any]:
     """What the DAgger run records of env and teacher (a resumed run must match)."""
     from shipgym.envs.core import ENV_REVISION
     from shipgym_baselines.classical.oracle import ORACLE_REVISION, OracleSettings
+    from shipgym_baselines.privileged import ORACLE
 
     env = config.env
     return {
@@ -184,7 +185,7 @@ def identity(config: Any) -> dict[str, Any]:
             "env_revision": ENV_REVISION,
         },
         "teacher": {
-            "name": "oracle",
+            "name": ORACLE,
             "revision": ORACLE_REVISION,
             "settings": dataclasses.asdict(OracleSettings()),
         },

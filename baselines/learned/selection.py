@@ -28,9 +28,11 @@ import numpy as np
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.privileged import ORACLE
+from shipgym_baselines.registry import BASELINE
 
 #: the fallback reference where the oracle's table has no entry for a trial
-FALLBACK_REFERENCE = "pid_los"
+FALLBACK_REFERENCE = BASELINE
 #: costs below this are floored in the ratio (a perfect episode costs > 0 anyway)
 COST_FLOOR = 1e-9
 REFERENCE_FILE = "reference_costs.json"
@@ -79,7 +81,7 @@ def reference_cost(scenario_name: str, seed: int, action_mode: str = "rudder") -
 
     entry = shipped_table().lookup(load_scenario(scenario_name), seed)
     if entry is not None:
-        return {"cost": float(entry["metrics"]["cost"]), "reference": "oracle"}
+        return {"cost": float(entry["metrics"]["cost"]), "reference": ORACLE}
     result = evaluate(FALLBACK_REFERENCE, scenario_name, [seed])[0]
     return {"cost": float(result.metrics["cost"]), "reference": FALLBACK_REFERENCE}
 

@@ -84,8 +84,6 @@ EXCEPTIONS = _edge_table(
     """
     evaluation -> leaderboard: suite_trials (lazy) draws a suite's trials as the board does
     evaluation -> leaderboard.suite: suite_trials (lazy) reads the suite
-    privileged -> leaderboard.ranking: the references' names ORACLE, ORACLE_FROZEN
-    references -> leaderboard.ranking: the references' names ORACLE, ORACLE_FROZEN
     classical.* -> tuning.chosen: the 'tuned' preset reads a study's chosen settings (YAML)
     learned.agents -> tuning.validation: an agent config refuses test-only scenarios (lazy)
     learned.selection -> tuning.validation: model selection runs on the validation split

@@ -18,7 +18,9 @@ from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.learned.policy import shipped_policies
 from shipgym_baselines.plugins import ControllerEntry
 from shipgym_baselines.policy import FAMILIES, Style
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.registry import (
+    BASELINE,
     CONTROLLERS,
     applies_to,
     controller_kind,
@@ -80,6 +82,11 @@ def test_every_controller_declares_a_family_and_a_look() -> None:
     assert {declared_traits(name)[0] for name in shipped_policies()} == {"learned"}
     assert {declared_traits(name)[0] for name in REFERENCES} == {"references"}
     assert declared_traits("my_module:MyPolicy") == (None, None)
+
+
+def test_the_baseline_and_the_references_are_registered_controllers() -> None:
+    assert CONTROLLERS[BASELINE].kind == "classical"
+    assert CONTROLLERS[ORACLE].kind == CONTROLLERS[ORACLE_FROZEN].kind == "reference"
 
 
 def test_a_registration_carries_its_family_and_look(scratch_registry: None) -> None:
