@@ -43,7 +43,8 @@ LAYERS: dict[str, int] = {
     # 1 — what a run leaves on disk
     f"{B}.records": 1,
     # 2 — controllers: what a controller is, how it enters, its privileged channel, the
-    #     references' tables, the classical controllers and the learned agents
+    #     references' tables, the classical controllers and the learned policies (loading
+    #     and acting; their training sits in layer 4)
     f"{B}.policy": 2,
     f"{B}.plugins": 2,
     f"{B}.registry": 2,
@@ -53,8 +54,14 @@ LAYERS: dict[str, int] = {
     f"{B}.learned": 2,
     # 3 — the evaluation loop
     f"{B}.evaluation": 3,
-    # 4 — tuning, the papers' reproductions (with the scenario variants they use)
+    # 4 — tuning, training the learned agents (their configs, the trainers, model
+    #     selection), the papers' reproductions (with the scenario variants they use)
     f"{B}.tuning": 4,
+    f"{B}.learned.agents": 4,
+    f"{B}.learned.train": 4,
+    f"{B}.learned.selection": 4,
+    f"{B}.learned.dagger_agent": 4,
+    f"{B}.learned.meta": 4,
     f"{B}.reproduce": 4,
     # 5 — the leaderboard
     f"{B}.leaderboard": 5,
@@ -85,11 +92,6 @@ EXCEPTIONS = _edge_table(
     evaluation -> leaderboard: suite_trials (lazy) draws a suite's trials as the board does
     evaluation -> leaderboard.suite: suite_trials (lazy) reads the suite
     classical.* -> tuning.chosen: the 'tuned' preset reads a study's chosen settings (YAML)
-    learned.agents -> tuning.validation: an agent config refuses test-only scenarios (lazy)
-    learned.selection -> tuning.validation: model selection runs on the validation split
-    learned.selection -> evaluation: model selection scores a checkpoint with the loop
-    learned.train -> evaluation: EVAL_SEED_OFFSET, where the evaluation seeds start
-    learned.dagger_agent -> evaluation: EVAL_SEED_OFFSET, where the evaluation seeds start
     leaderboard.run -> studies.run_costs: eta_line, the run's time estimate
     leaderboard.outputs -> studies.run_costs: tables_line, the tables' time estimate
     """
