@@ -23,6 +23,7 @@ from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.leaderboard.comparison import (
     comparison_note,
 )
+from shipgym_baselines.leaderboard.costs import tables_line
 from shipgym_baselines.leaderboard.escaping import csv_cell, plain_text
 from shipgym_baselines.leaderboard.markdown import (
     generalisation_table,
@@ -55,7 +56,6 @@ from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
 from shipgym_baselines.records.runrecord import RUN_FILE, read_run
 from shipgym_baselines.records.trajectories import episode_result
 from shipgym_baselines.signals import worker_init
-from shipgym_baselines.studies.run_costs import tables_line
 
 
 def load_results(folder: str | os.PathLike) -> list[EpisodeResult]:

@@ -24,6 +24,7 @@ from shipgym_baselines.leaderboard.comparison import (
     suite_folder,
     with_references,
 )
+from shipgym_baselines.leaderboard.costs import eta_line
 from shipgym_baselines.leaderboard.figures import median_ace_episode
 from shipgym_baselines.leaderboard.jobs import (
     Job,
@@ -45,7 +46,6 @@ from shipgym_baselines.records.folders import check_out_dir, check_out_usable
 from shipgym_baselines.records.runlog import RunLog
 from shipgym_baselines.records.runrecord import read_run
 from shipgym_baselines.registry import controller_label, training_seeds
-from shipgym_baselines.studies.run_costs import eta_line
 
 
 def run_leaderboard(
@@ -83,7 +83,7 @@ def run_leaderboard(
     ``results/<suite>`` (:func:`~shipgym_baselines.leaderboard.comparison.suite_folder`).
     ``show_progress``: a progress bar on stderr, after one line before the first episode: the
     episodes, workers and the time estimated from the recorded costs
-    (:func:`shipgym_baselines.studies.run_costs.eta_line`).  Ctrl-C raises
+    (:func:`shipgym_baselines.leaderboard.costs.eta_line`).  Ctrl-C raises
     :class:`~shipgym_baselines.records.runlog.RunInterrupted`.
 
     A controller that fails (raises, gives a malformed or non-finite action, or takes
