@@ -2,30 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-from shipgym_baselines.leaderboard import (
-    Job,
-    check_controllers,
-    plan_jobs,
-    suite_record,
-    suite_scenario,
-    work,
-)
+from shipgym_baselines.leaderboard import Job, suite_scenario, work
+from shipgym_baselines.leaderboard.costs import limit_steps
 from shipgym_baselines.leaderboard.suite import load_suite
-from shipgym_baselines.registry import training_seeds
-from shipgym_baselines.studies.run_costs import (
-    TABLES_CPU_S_PER_SCENARIO,
-    estimate_cpu_s,
-    eta_line,
-    limit_steps,
-    profile_suite,
-    recorded_costs,
-    step_cost,
-)
+from shipgym_baselines.studies.run_costs import profile_suite
 
 
 @pytest.fixture(scope="module")
@@ -66,71 +49,3 @@ def test_profile_splits_add_up(profile: dict) -> None:
     limit = limit_steps(suite_scenario("rudder_aging"))
     for entry in profile["per_controller"].values():  # the time limit bounds the steps
         assert entry["steps"] <= entry["limit_steps"] == limit
-
-
-#: the default suite's whole run, CPU seconds (README: 1,528 CPU s on a 2-core machine)
-DEFAULT_RUN_CPU_S = 1528.0
-#: how far the estimate may be from it, either way: the recorded costs, measured on a quiet
-#: 2-core VM, estimate 1,273 CPU s with the tables' (0.83×), and a measurement moves by
-#: ±13 % from run to run (docs/leaderboard-cost.md)
-FACTOR = 1.25
-#: the default suite's episodes: 47 scenarios × 10 seeds and 16 in-range ones × 2 seeds for
-#: every controller, × 3 training seeds for a learned one; oracle_frozen's 502 among them
-DEFAULT_EPISODES = 20_582
-
-
-def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
-    """The default suite's jobs and scenarios, planned as the leaderboard plans them."""
-    spec = load_suite("default")
-    names = controllers or list(spec.controllers)
-    labels = check_controllers(names)
-    seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
-    seed_list = [EVAL_SEED_OFFSET + i for i in range(spec.seeds)]
-    scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
-    record = suite_record(spec, names, scenarios, seed_list, seeds_of)
-    skip = {tuple(pair) for pair in record["does_not_apply"]}
-    randomize = record["randomize"]
-    fewer = record.get("scenario_seeds")
-    jobs = plan_jobs(
-        names, record["scenarios"], seed_list, seeds_of, randomize, skip, "table", fewer
-    )
-    return jobs, scenarios
-
-
-def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
-    jobs, scenarios = default_plan()
-    cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
-    assert DEFAULT_RUN_CPU_S / FACTOR < cpu < DEFAULT_RUN_CPU_S * FACTOR, cpu
-    total = sum(len(job.seeds) for job in jobs)
-    assert total == DEFAULT_EPISODES
-    line = eta_line(jobs, scenarios, 2, total)
-    assert line.startswith(f"leaderboard: {DEFAULT_EPISODES:,} episodes on 2 workers, about ")
-    assert line.endswith(
-        " min (recorded costs; one-off C compilations on a new machine come on top, each announced)"
-    )
-    half = jobs[: len(jobs) // 2]
-    todo = sum(len(job.seeds) for job in half)
-    assert eta_line(half, scenarios, 1, total).startswith(
-        f"leaderboard: {todo:,} of {DEFAULT_EPISODES:,} episodes on 1 worker, about "
-    )
-
-
-def test_a_controller_without_recorded_costs_takes_its_kinds(tmp_path: Path) -> None:
-    costs = recorded_costs()
-    (tmp_path / "mine.py").write_text(
-        "class Mine:\n    name = 'mine'\n    kind = 'classical'\n"
-        "    def reset(self, context, seed=None): pass\n"
-        "    def act(self, obs, info): return [0.0]\n"
-    )
-    plugin = Job(f"{tmp_path / 'mine.py'}:Mine", "rudder_aging", (EVAL_SEED_OFFSET,))
-    assert step_cost(plugin, "nomoto2") == costs["fallback"]["classical"]["nomoto2"]
-    pid = Job("pid_los", "rudder_aging", (EVAL_SEED_OFFSET,))
-    assert step_cost(pid, "mariner") == costs["cpu_s_per_limit_step"]["pid_los"]["mariner"]
-    oracle = Job("oracle", "rudder_aging", (EVAL_SEED_OFFSET,))
-    table, computed = step_cost(oracle, "blanke"), step_cost(oracle, "blanke", from_table=False)
-    assert computed == costs["oracle_computed"]["blanke"] > 10 * table
-    recompute = oracle._replace(references="recompute")
-    assert step_cost(recompute, "blanke") == computed
-    assert set(costs["fallback"]) == {"classical", "learned"}
-    for per_ship in costs["cpu_s_per_limit_step"].values():
-        assert all(value > 0 for value in per_ship.values())
