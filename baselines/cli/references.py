@@ -4,7 +4,8 @@ The tables (:mod:`shipgym_baselines.references`, one per reference: ``oracle`` a
 ``oracle_frozen``) ship with the package; the leaderboard reads them, then the per-user
 cache, and runs a reference only for a trial neither holds.  This command runs each
 reference of ``--reference`` (default: both) on every trial of the given suites (scenarios ×
-the suite's seeds, the in-range ones × its ``inrange_seeds``, drawn with its ``randomize``
+the suite's seeds, the held-out and in-range ones × its ``heldout_seeds`` and
+``inrange_seeds``, drawn with its ``randomize``
 ranges) and, with ``--validation``, the ``oracle`` on the validation split that ``shipgym
 tune`` scores on (:func:`~shipgym_baselines.tuning.validation.validation_trials`; tuning
 needs no other reference), that its target does not hold yet.  It writes after every

@@ -36,6 +36,7 @@ _DEFINED = {
         "longest_first",
         "missing",
         "plan_jobs",
+        "plan_run",
         "reference_work",
         "run_batch",
         "run_job",

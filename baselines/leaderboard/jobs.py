@@ -23,6 +23,7 @@ from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult, controller_failed
+from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, dealt_seeds, shares_trials
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label
 from shipgym_baselines.signals import worker_init
@@ -249,10 +250,12 @@ def suite_record(
     files = scenario_names(spec.all_scenarios(), suite_scenario).files
     own = {"scenario_files": {n: f for n, f in files.items() if n in scenarios}}
     fewer = {s: v for s, v in spec.scenario_seeds(seed_list).items() if s in scenarios}
+    shared = {LEARNED_TRIALS: SHARED} if spec.learned_trials == SHARED else {}
     return {
         "name": spec.name,
         "seeds": seed_list,
         **({"scenario_seeds": fewer} if fewer else {}),  # absent without: older records resume
+        **shared,  # absent: every training seed plays every seed (and older records resume)
         "randomize": None if spec.randomize is None else spec.randomize.model_dump(mode="json"),
         "controllers": controllers,
         "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
@@ -275,13 +278,15 @@ def plan_jobs(
     skip: set[tuple[str, str]],
     references: str = "table",
     scenario_seeds: Mapping[str, list[int]] | None = None,
+    shared: bool = False,
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job of all seeds
-    per training seed (a learned agent's) or of all seeds (a classical controller's: they
-    run in lockstep, :func:`run_batch`), one job per seed for the privileged oracle (its
-    reference table is looked up trial by trial).  ``scenarios``: names, or name →
-    recorded settings (the jobs run those); ``scenario_seeds``: the scenarios run on other
-    seeds than ``seed_list``, with theirs."""
+    per training seed (a learned agent's; with ``shared``, of the seeds dealt to it,
+    :func:`~shipgym_baselines.records.trials.dealt_seeds`) or of all seeds (a classical
+    controller's: they run in lockstep, :func:`run_batch`), one job per seed for the
+    privileged oracle (its reference table is looked up trial by trial).  ``scenarios``:
+    names, or name → recorded settings (the jobs run those); ``scenario_seeds``: the
+    scenarios run on other seeds than ``seed_list``, with theirs."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
@@ -290,9 +295,12 @@ def plan_jobs(
             label = controller_label(c)
             if (scenario, label) in skip:
                 continue
+            dealt = dealt_seeds(scenario, seeds, seeds_of[label]) if shared else None
             for k in seeds_of[label]:
                 if controller_kind(label) == "learned":
-                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings))
+                    mine = seeds if dealt is None else dealt[k]
+                    if mine:  # a training seed may be dealt none of a scenario's few seeds
+                        jobs.append(Job(c, scenario, tuple(mine), k, randomize, settings))
                 elif not grants_truth(c):
                     jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings, references))
                 else:
@@ -301,6 +309,28 @@ def plan_jobs(
                         for seed in seeds
                     ]
     return jobs
+
+
+def plan_run(
+    names: list[ControllerSpec],
+    record: Mapping[str, Any],
+    seeds_of: Mapping[str, list[int | None]],
+    references: str = "table",
+) -> list[Job]:
+    """The jobs of a run whose resolved suite is ``record`` (:func:`suite_record`, as
+    ``run.json`` keeps it): :func:`plan_jobs` on its scenarios' recorded settings, seeds,
+    randomisation, the pairs that do not apply and its deal of learned trials."""
+    return plan_jobs(
+        names,
+        record["scenarios"],
+        list(record["seeds"]),
+        seeds_of,
+        record["randomize"],
+        {tuple(pair) for pair in record["does_not_apply"]},
+        references,
+        record.get("scenario_seeds"),
+        shares_trials(record),
+    )
 
 
 def longest_first(jobs: list[Job], scenarios: Mapping[str, Scenario]) -> list[Job]:

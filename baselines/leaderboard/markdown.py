@@ -290,8 +290,10 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
             lines.append("| " + " | ".join(cells + ["does not apply"] + [""] * 11) + " |")
             continue
         seeds = str(r["seeds"])
-        if r.get("training_seeds"):
+        if r.get("training_seeds") and r["episodes"] == r["seeds"] * r["training_seeds"]:
             seeds += f" × {r['training_seeds']} trained"
+        elif r.get("training_seeds"):  # the training seeds share the trials
+            seeds += f" shared by {r['training_seeds']} trained"
         values = {k: _fmt(r[k], r.get(f"{k}_std")) for k in ("ace", *keys)}
         cells += [seeds, values["ace"], _ci(r.get("ace_ci95")), values["ace_L"], values["t_c"]]
         cells += [values["return"], _ci(r.get("return_ci95"))]

@@ -55,6 +55,7 @@ from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
 from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
 from shipgym_baselines.records.runrecord import RUN_FILE, read_run
 from shipgym_baselines.records.trajectories import episode_result
+from shipgym_baselines.records.trials import shares_trials
 from shipgym_baselines.signals import worker_init
 
 
@@ -100,7 +101,7 @@ def write_results(
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     episodes = episode_rows(results)
     splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
-    ranked = rankable(episodes, suite.get("scenario_seeds"))
+    ranked = rankable(episodes, suite.get("scenario_seeds"), shares_trials(suite))
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
     drawn = figures.episodes_to_draw(results)
@@ -192,7 +193,9 @@ def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:
         f"{len(suite['seeds'])} evaluation seeds"
         + (" (randomised trials)" if suite.get("randomize") else ""),
     ]
-    if trained:
+    if trained and shares_trials(suite):
+        parts.append(f"learned agents' {len(trained)} training seeds share the trials")
+    elif trained:
         parts.append(f"learned agents × {len(trained)} training seeds")
     return " · ".join(parts)
 

@@ -284,21 +284,27 @@ def run_matrix(
     key: str = "cost_ratio",
 ) -> np.ndarray:
     """(runs, tasks) values ``key`` of one controller's episodes that have a cost ratio: a
-    run is a (training seed, evaluation seed) pair, a task a scenario (rliable's layout).
-    Raises ValueError if a scenario lacks a run the others have (unequal seeds)."""
+    run is a (training seed, evaluation seed) pair, a task a scenario (rliable's layout);
+    each task's runs in the order (training seed, evaluation seed).  The runs of a row are
+    rliable's independent samples per task (its stratified bootstrap resamples each task on
+    its own): where the training seeds share the trials, each task has its own pairs.
+    Raises ValueError if a scenario has more or fewer runs than another (unequal seeds)."""
     cells: dict[str, dict[tuple[Any, int], float]] = {s: {} for s in scenarios}
     for ep in scored:
         if ep["controller"] == controller and ep["scenario"] in cells:
             if ep.get("cost_ratio") is not None:
                 cells[ep["scenario"]][(ep.get("training_seed"), int(ep["seed"]))] = ep[key]
-    runs = sorted(cells[scenarios[0]], key=lambda r: (r[0] is None, r[0] or 0, r[1]))
+    order = {s: sorted(cells[s], key=lambda r: (r[0] is None, r[0] or 0, r[1])) for s in cells}
+    first = order[scenarios[0]]
     for s in scenarios:
-        if set(cells[s]) != set(runs):
+        if len(order[s]) != len(first):
             raise ValueError(
-                f"{controller}: scenario {s!r} has runs {sorted(cells[s])} but "
-                f"{scenarios[0]!r} has {runs}: every scenario needs the same seeds"
+                f"{controller}: scenario {s!r} has runs {order[s]} but "
+                f"{scenarios[0]!r} has {first}: every scenario needs the same seeds"
             )
-    return np.array([[cells[s][r] for s in scenarios] for r in runs], dtype=np.float64)
+    return np.array(
+        [[cells[s][order[s][i]] for s in scenarios] for i in range(len(first))], dtype=np.float64
+    )
 
 
 def interquartile_mean(scores: np.ndarray) -> float:

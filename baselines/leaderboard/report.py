@@ -29,6 +29,7 @@ from shipgym_baselines.records.manifest import Manifest, clear_listed
 from shipgym_baselines.records.runlog import outside_problem
 from shipgym_baselines.records.runrecord import git_commit, now, read_run, versions
 from shipgym_baselines.records.trajectories import episode_result
+from shipgym_baselines.records.trials import ALL, LEARNED_TRIALS, SHARED, shares_trials
 
 REPORT_FILE = "report.json"
 
@@ -38,7 +39,8 @@ def merge_runs(
 ) -> tuple[dict[str, Any], list[EpisodeResult], list[dict[str, Any]]]:
     """(suite, episodes, sources) of run folders merged: scenarios and controllers in order
     of first appearance, seeds (each scenario's too: ``scenario_seeds``, when some ran on
-    fewer) and "does not apply" pairs united; ``sources`` describes each
+    fewer) and "does not apply" pairs united, the deal of learned agents' trials
+    (``learned_trials``) the same in every run; ``sources`` describes each
     run (folder, command, status, times, episodes of jobs)."""
     suite: dict[str, Any] = {
         "name": None,
@@ -65,6 +67,14 @@ def merge_runs(
                 "trials; report runs of one randomisation"
             )
         suite["randomize"] = randomize
+        if sources and shares_trials(run_suite) != shares_trials(suite):
+            raise RunError(
+                f"{folder} and {sources[0]['folder']} deal learned agents' trials differently "
+                f"({LEARNED_TRIALS} {run_suite.get(LEARNED_TRIALS, ALL)} and "
+                f"{suite.get(LEARNED_TRIALS, ALL)}): report runs of one deal"
+            )
+        if shares_trials(run_suite):
+            suite[LEARNED_TRIALS] = SHARED
         for name, settings in run_suite["scenarios"].items():
             if name not in suite["scenarios"]:
                 suite["scenarios"][name] = settings

@@ -33,7 +33,7 @@ from shipgym_baselines.leaderboard.jobs import (
     iter_results,
     longest_first,
     missing,
-    plan_jobs,
+    plan_run,
     result_key,
     suite_record,
     suite_scenarios,
@@ -115,18 +115,8 @@ def run_leaderboard(
     if add_references:
         given = list(controllers) if controllers else None
         record[RECORD_KEY] = references_record(suite, spec.controllers, given, added)
-    skip = {tuple(pair) for pair in record["does_not_apply"]}
     references = "recompute" if recompute_references else "table"
-    jobs = plan_jobs(
-        names,
-        record["scenarios"],
-        seed_list,
-        seeds_of,
-        record["randomize"],
-        skip,
-        references,
-        record.get("scenario_seeds"),
-    )
+    jobs = plan_run(names, record, seeds_of, references)
     jobs = [job._replace(act_timeout=act_timeout) for job in jobs]
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
     n_episodes = sum(len(job.seeds) for job in jobs)

@@ -33,6 +33,7 @@ from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
 from shipgym.scenarios.trials import TrialRandomization
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec, anchored
+from shipgym_baselines.records.trials import ALL, LearnedTrials
 
 
 def _controller_form(value: Any) -> str:
@@ -51,30 +52,35 @@ class SuiteConfig(StrictModel):
 
     ``scenarios``: catalogue names, named test scenarios (``heldout:3``) or YAML paths (a
     relative path is read against the suite file's folder); ``heldout_scenarios`` N adds
-    ``heldout:0 … heldout:N-1`` (jumps outside the training ranges), ``inrange_scenarios``
-    M adds ``inrange:0 … inrange:M-1`` (drawn from the training ranges; each split ranked in
-    its own table) on the first ``inrange_seeds`` evaluation seeds (None: all ``seeds``);
+    ``heldout:0 … heldout:N-1`` (jumps outside the training ranges) on the first
+    ``heldout_seeds`` evaluation seeds (None: all ``seeds``), ``inrange_scenarios`` M adds
+    ``inrange:0 … inrange:M-1`` (drawn from the training ranges; each split ranked in its
+    own table) on the first ``inrange_seeds``;
     ``controllers``: what ``shipgym evaluate`` accepts
     (registered controllers, installed plug-ins, specs ``module.path:Attr`` /
     ``path/to/file.py:Attr``, shipped learned policies, trained agents' folders, SB3 model
     zips), each a string or the long form ``{controller: SPEC, name: TABLE_NAME, settings:
     {keyword: value}}`` (:class:`~shipgym_baselines.plugins.ControllerEntry`); a relative file path
     among them is read against the suite file's folder.  ``seeds``: evaluation seeds per
-    (controller, scenario, training seed).  ``randomize``: what each evaluation seed draws
-    for its trial of a scenario (:class:`~shipgym.scenarios.trials.TrialRandomization`:
-    start offset and heading error, jump-time jitter, current speed and direction; the
-    sensor noise varies with the seed anyway); absent: every seed runs the scenario as
-    written.
+    (controller, scenario, training seed); ``learned_trials``: ``all`` (every training seed
+    of a learned agent plays every seed) or ``shared`` (each seed is played by one training
+    seed, :func:`~shipgym_baselines.records.trials.dealt_seeds`).  ``randomize``: what each
+    evaluation seed draws for its trial of a scenario
+    (:class:`~shipgym.scenarios.trials.TrialRandomization`: start offset and heading
+    error, jump-time jitter, current speed and direction; the sensor noise varies with the
+    seed anyway); absent: every seed runs the scenario as written.
     """
 
     name: Name
     description: str = ""
     scenarios: list[str] = Field(default_factory=list)
     heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
+    heldout_seeds: int | None = Field(None, ge=1, le=MAX_SEEDS)
     inrange_scenarios: int = Field(0, ge=0, le=MAX_INRANGE_SCENARIOS)
     inrange_seeds: int | None = Field(None, ge=1, le=MAX_SEEDS)
     controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1, le=MAX_SEEDS)
+    learned_trials: LearnedTrials = ALL
     randomize: TrialRandomization | None = None
 
     @field_validator("scenarios")
@@ -104,11 +110,16 @@ class SuiteConfig(StrictModel):
 
     def scenario_seeds(self, seeds: Sequence[int]) -> dict[str, list[int]]:
         """The scenarios that run on fewer evaluation seeds than ``seeds`` (the run's), with
-        theirs: each in-range scenario on the first ``inrange_seeds``; empty when none do."""
-        if self.inrange_seeds is None or self.inrange_seeds >= len(seeds):
-            return {}
-        fewer = list(seeds[: self.inrange_seeds])
-        return {f"inrange:{i}": fewer for i in range(self.inrange_scenarios)}
+        theirs: each held-out scenario on the first ``heldout_seeds``, each in-range one on
+        the first ``inrange_seeds``; empty when none do."""
+        fewer: dict[str, list[int]] = {}
+        for split, count, first in (
+            ("heldout", self.heldout_scenarios, self.heldout_seeds),
+            ("inrange", self.inrange_scenarios, self.inrange_seeds),
+        ):
+            if first is not None and first < len(seeds):
+                fewer |= {f"{split}:{i}": list(seeds[:first]) for i in range(count)}
+        return fewer
 
 
 def list_suites() -> list[str]:

@@ -143,13 +143,16 @@ def _metric_cells(
 
 
 def rankable(
-    episodes: list[dict[str, Any]], scenario_seeds: Mapping[str, Collection[int]] | None = None
+    episodes: list[dict[str, Any]],
+    scenario_seeds: Mapping[str, Collection[int]] | None = None,
+    shared: bool = False,
 ) -> list[dict[str, Any]]:
     """The episodes the ranking is computed from: those of the scenarios on which every
     controller that ran there has all its runs (each of its training seeds × every
-    evaluation seed of the record; ``scenario_seeds``: the scenarios run on fewer, with
-    theirs).  A complete run keeps them all; an interrupted or merged record leaves out the
-    scenarios it holds only in part."""
+    evaluation seed of the record; with ``shared``, one training seed per evaluation seed,
+    :mod:`shipgym_baselines.records.trials`; ``scenario_seeds``: the scenarios run on fewer
+    seeds, with theirs).  A complete run keeps them all; an interrupted or merged record
+    leaves out the scenarios it holds only in part."""
     every = {int(e["seed"]) for e in episodes}
     fewer = scenario_seeds or {}
     trained: dict[str, set[Any]] = defaultdict(set)
@@ -160,7 +163,8 @@ def rankable(
     partial = {
         scenario
         for (scenario, controller), runs in cells.items()
-        if len(runs) != len(trained[controller]) * len(fewer.get(scenario, every))
+        if len(runs)
+        != (1 if shared else len(trained[controller])) * len(fewer.get(scenario, every))
     }
     return [e for e in episodes if e["scenario"] not in partial]
 

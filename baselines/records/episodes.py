@@ -27,6 +27,7 @@ import numpy as np
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.jsonfiles import from_plain, plain, short_json
 from shipgym_baselines.records.outfiles import open_regular
+from shipgym_baselines.records.trials import runs_of, shares_trials
 
 EPISODES_FILE = "episodes.jsonl"
 #: the keys of an ``episodes.jsonl`` object that are not metrics
@@ -194,21 +195,22 @@ class _SuiteKeys(NamedTuple):
     scenarios: set[str]
     pairs: set[tuple[str, str]]
     seeds: dict[str, set[int]]  # scenario → its evaluation seeds
-    trained: dict[str, set[int | None]]
+    trained: dict[str, list[int | None]]
+    shared: bool  # each evaluation seed played by one training seed
 
 
 def _suite_keys(suite: Mapping[str, Any]) -> _SuiteKeys:
     skip = {tuple(pair) for pair in suite["does_not_apply"]}
-    trained = {c["name"]: set(c["training_seeds"]) for c in suite["controllers"]}
+    trained = {c["name"]: list(c["training_seeds"]) for c in suite["controllers"]}
     pairs = {(s, c) for s in suite["scenarios"] for c in trained if (s, c) not in skip}
     fewer = suite.get("scenario_seeds", {})
-    seeds = {s: set(fewer.get(s, suite["seeds"])) for s in suite["scenarios"]}
-    return _SuiteKeys(set(suite["scenarios"]), pairs, seeds, trained)
+    seeds = {s: list(fewer.get(s, suite["seeds"])) for s in suite["scenarios"]}
+    return _SuiteKeys(set(suite["scenarios"]), pairs, seeds, trained, shares_trials(suite))
 
 
 def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
     """Why the episode ``key`` is not one of a suite's (``keys``), or None when it is."""
-    scenarios, pairs, seeds, trained = keys
+    scenarios, pairs, seeds, trained, shared = keys
     scenario, controller, seed, training_seed = key
     if controller not in trained:
         return f"controller {controller!r} is not in the run's suite"
@@ -220,6 +222,13 @@ def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
         return f"seed {seed} is not one of the run's seeds of {scenario!r}"
     if training_seed not in trained[controller]:
         return f"training seed {training_seed} is not one of {controller!r}'s in the run"
+    if shared and (training_seed, seed) not in runs_of(
+        scenario, seeds[scenario], trained[controller], shared
+    ):
+        return (
+            f"seed {seed} of {scenario!r} is dealt to another training seed of "
+            f"{controller!r} than {training_seed} (the run shares the trials)"
+        )
     return None
 
 

@@ -94,6 +94,7 @@ def profile_suite(
     )
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.privileged import grants_truth
+    from shipgym_baselines.records.trials import SHARED
     from shipgym_baselines.registry import controller_label, training_seeds
 
     torch.set_num_threads(1)
@@ -132,7 +133,7 @@ def profile_suite(
     per_pair: dict[str, dict[str, dict[str, float]]] = defaultdict(lambda: defaultdict(_entry))
     for (label, scenario), cell in cells.items():
         suite_seeds = len(spec.scenario_seeds(range(spec.seeds)).get(scenario, range(spec.seeds)))
-        runs = suite_seeds * len(seeds_of[label])
+        runs = suite_seeds * (1 if spec.learned_trials == SHARED else len(seeds_of[label]))
         cell["suite_cpu_s"] = cell["cpu_s"] / max(cell["episodes"], 1) * runs
         for target in (
             per_controller[label],

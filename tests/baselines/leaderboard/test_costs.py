@@ -8,7 +8,7 @@ from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.leaderboard import (
     Job,
     check_controllers,
-    plan_jobs,
+    plan_run,
     suite_record,
     suite_scenario,
 )
@@ -42,12 +42,7 @@ def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
     seed_list = [EVAL_SEED_OFFSET + i for i in range(spec.seeds)]
     scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
-    skip = {tuple(pair) for pair in record["does_not_apply"]}
-    randomize = record["randomize"]
-    fewer = record.get("scenario_seeds")
-    jobs = plan_jobs(
-        names, record["scenarios"], seed_list, seeds_of, randomize, skip, "table", fewer
-    )
+    jobs = plan_run(names, record, seeds_of)
     return jobs, scenarios
 
 
