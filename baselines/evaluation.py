@@ -17,7 +17,7 @@ import functools
 import math
 import os
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import gymnasium as gym
@@ -326,10 +326,15 @@ def evaluate_batch(
     env_id: str = ENV_ID,
     guard: ActGuard | None = None,
     label: EpisodeLabel | None = None,
+    training_seeds: Sequence[int | None] | None = None,
 ) -> list[EpisodeResult]:
     """The episodes of ``seeds``, the i-th on ``scenarios[i]`` (a list, one scenario per
     seed: e.g. each seed's trial variant) or all on one scenario; equal, bit for bit, to
     :func:`run_episode` one by one (compute times aside).
+
+    ``training_seeds`` (one per seed; a learned agent given by name): the i-th episode is
+    played by the agent trained with ``training_seeds[i]``, all in lockstep
+    (:class:`DealtPolicy`), each labelled with its own training seed.
 
     ``controller``: a name, spec or long form (made with ``training_seed``, one of
     :func:`~shipgym_baselines.registry.training_seeds`; None: a learned policy's first) or a Policy
@@ -356,6 +361,10 @@ def evaluate_batch(
     if len(per_seed) != len(seeds):
         raise ValueError(f"{len(per_seed)} scenarios for {len(seeds)} seeds: give one per seed")
     made = isinstance(controller, str | ControllerEntry)
+    if training_seeds is not None:
+        return _evaluate_dealt(
+            controller, per_seed, seeds, training_seeds, action_mode, env_id, guard, label
+        )
     if made:
         policy, mode = make_controller(controller, training_seed=training_seed)
     elif training_seed is not None:
@@ -385,6 +394,85 @@ def evaluate_batch(
         )
         results.append(result)
     return results
+
+
+class DealtPolicy:
+    """Several trained agents of one learned controller acting in lockstep, each for its own
+    episodes: ``policies`` maps a training seed to its :class:`BatchPolicy`, ``owners`` the
+    training seed of each episode of :meth:`reset_batch`.  Each agent acts for its episodes
+    with one ``act_batch``: the actions it would give them alone, bit for bit (a learned
+    policy's rows do not depend on the other rows of its batch)."""
+
+    def __init__(self, policies: Mapping[int | None, BatchPolicy], owners: Sequence[int | None]):
+        missing = sorted({k for k in owners if k not in policies}, key=str)
+        if missing:
+            raise ValueError(f"no policy for training seeds {missing}")
+        first = next(iter(policies.values()))
+        self.policies = dict(policies)
+        self.owners = list(owners)
+        self.name, self.kind = first.name, first.kind
+        self.action_mode = getattr(first, "action_mode", "rudder")
+        #: episode → its position among its owner's episodes
+        self._local = [self.owners[:i].count(k) for i, k in enumerate(self.owners)]
+
+    def reset(self, context: Any, seed: int | None = None) -> None:
+        raise TypeError("a DealtPolicy acts for several episodes: use reset_batch")
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        raise TypeError("a DealtPolicy acts for several episodes: use act_batch")
+
+    def reset_batch(self, contexts: Sequence[Any]) -> None:
+        for k, policy in self.policies.items():
+            policy.reset_batch(
+                [c for c, owner in zip(contexts, self.owners, strict=True) if owner == k]
+            )
+
+    def act_batch(self, obs: np.ndarray, episodes: Sequence[int]) -> np.ndarray:
+        out: np.ndarray | None = None
+        for k, policy in self.policies.items():
+            rows = [j for j, i in enumerate(episodes) if self.owners[i] == k]
+            if not rows:
+                continue
+            actions = np.asarray(
+                policy.act_batch(obs[rows], [self._local[episodes[j]] for j in rows])
+            )
+            if out is None:
+                out = np.empty((len(episodes), *actions.shape[1:]), dtype=actions.dtype)
+            out[rows] = actions
+        assert out is not None  # episodes is never empty
+        return out
+
+
+def _evaluate_dealt(
+    controller: ControllerSpec | Policy,
+    scenarios: list[Any],
+    seeds: list[int],
+    training_seeds: Sequence[int | None],
+    action_mode: str | None,
+    env_id: str,
+    guard: ActGuard | None,
+    label: EpisodeLabel | None,
+) -> list[EpisodeResult]:
+    """:func:`evaluate_batch` of a learned agent's training seeds sharing ``seeds``."""
+    owners = list(training_seeds)
+    if len(owners) != len(seeds):
+        raise ValueError(f"{len(owners)} training seeds for {len(seeds)} seeds: give one per seed")
+    if not isinstance(controller, str | ControllerEntry):
+        raise ControllerError("training_seeds: give the learned controller by name, not a Policy")
+    made = {k: make_controller(controller, training_seed=k) for k in dict.fromkeys(owners)}
+    if not all(isinstance(policy, BatchPolicy) for policy, _ in made.values()):
+        raise ControllerError(f"training_seeds: {controller!r} is not a learned agent")
+    policy = DealtPolicy({k: p for k, (p, _) in made.items()}, owners)
+    mode = action_mode or next(iter(made.values()))[1] or policy.action_mode
+    episodes = _episodes(scenarios, seeds, mode, env_id, lean=True)
+    if label is not None:
+        labels = [label._replace(training_seed=k) for k in owners]
+    else:  # as the loop labels an episode: its scenario's name and the policy's
+        loaded = [load_scenario(sc) if isinstance(sc, str) else sc for sc in scenarios]
+        labels = [
+            EpisodeLabel(sc.name, policy.name, k) for sc, k in zip(loaded, owners, strict=True)
+        ]
+    return _run_lockstep(policy, episodes, guard, labels)
 
 
 class _Episodes(Protocol):
@@ -548,11 +636,12 @@ def _run_lockstep(
     policy: BatchPolicy | list[Policy],
     episodes: _Episodes,
     guard: ActGuard | None = None,
-    label: EpisodeLabel | None = None,
+    label: EpisodeLabel | Sequence[EpisodeLabel] | None = None,
 ) -> list[EpisodeResult]:
     """:func:`evaluate_batch`'s loop: every episode steps in lockstep, acted on by one
     :class:`BatchPolicy` or by its own policy of a list; ``guard``: a failing controller
-    ends its episodes (:class:`ActGuard`); ``label``: every result's (:class:`EpisodeLabel`)."""
+    ends its episodes (:class:`ActGuard`); ``label``: every result's (:class:`EpisodeLabel`),
+    or one per episode."""
     n = len(episodes.obs)
     batch = not isinstance(policy, list)
     try:
@@ -586,9 +675,19 @@ def _run_lockstep(
             if stepped:
                 episodes.step(stepped, actions, times)
             live = [i for i in live if not episodes.done[i]]
-        return [episodes.result(i, policy if batch else policy[i], label) for i in range(n)]
+        labels = label if isinstance(label, list) else [label] * n
+        return [episodes.result(i, _policy_of(policy, i), labels[i]) for i in range(n)]
     finally:
         episodes.close()
+
+
+def _policy_of(policy: BatchPolicy | list[Policy], i: int) -> Policy:
+    """The policy that played episode ``i`` (its name, kind and figures go in the result)."""
+    if isinstance(policy, list):
+        return policy[i]
+    if isinstance(policy, DealtPolicy):
+        return policy.policies[policy.owners[i]]
+    return policy
 
 
 def _act_batch(

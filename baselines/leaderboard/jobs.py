@@ -66,13 +66,21 @@ class Job(NamedTuple):
     #: the limit [s] on one ``act`` call: a slower call, or a controller that fails, ends
     #: its episode (:class:`~shipgym_baselines.evaluation.ActGuard`)
     act_timeout: float = ACT_TIMEOUT_S
+    #: a learned agent whose training seeds share the trials: the training seed that plays
+    #: each of ``seeds`` (``training_seed`` is then None); the job runs them all in lockstep
+    dealt: tuple[int | None, ...] | None = None
 
     @property
     def label(self) -> EpisodeLabel:
         """What the job's episodes are labelled with: the scenario's table name (not its
         trials'), the controller's table name and the job's training seed (None: the
-        policy's own)."""
+        policy's own; a dealt job's episodes each carry their own, :meth:`runs`)."""
         return EpisodeLabel(self.scenario, controller_label(self.controller), self.training_seed)
+
+    def runs(self) -> list[tuple[int, int | None]]:
+        """(evaluation seed, training seed) of each of the job's episodes."""
+        owners = self.dealt if self.dealt is not None else [self.training_seed] * len(self.seeds)
+        return list(zip(self.seeds, owners, strict=True))
 
 
 @functools.lru_cache(maxsize=128)
@@ -143,7 +151,7 @@ def _guard(job: Job) -> evaluation.ActGuard:
 
 def run_batch(job: Job) -> list[EpisodeResult]:
     """The job's episodes, all seeds at once (:func:`shipgym_baselines.evaluation.evaluate_batch`),
-    in the order of ``job.seeds``."""
+    in the order of ``job.seeds``; a dealt job's each by its own training seed."""
     return evaluation.evaluate_batch(
         job.controller,
         trials(job),
@@ -151,6 +159,7 @@ def run_batch(job: Job) -> list[EpisodeResult]:
         training_seed=job.training_seed,
         guard=_guard(job),
         label=job.label,
+        training_seeds=job.dealt,
     )
 
 
@@ -205,7 +214,7 @@ def work(job: Job) -> list[EpisodeResult]:
     single seed through :func:`run_job`, several through :func:`run_batch`."""
     if job.references == "table" and grants_truth(job.controller):
         return reference_work(job)
-    if len(job.seeds) == 1:
+    if len(job.seeds) == 1 and job.dealt is None:
         return [run_job((job.controller, job.scenario, job.seeds[0], *job[3:]))]
     return run_batch(job)
 
@@ -281,9 +290,10 @@ def plan_jobs(
     shared: bool = False,
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job of all seeds
-    per training seed (a learned agent's; with ``shared``, of the seeds dealt to it,
-    :func:`~shipgym_baselines.records.trials.dealt_seeds`) or of all seeds (a classical
-    controller's: they run in lockstep, :func:`run_batch`), one job per seed for the
+    per training seed (a learned agent's; with ``shared`` one job of all seeds, each played
+    by the training seed :func:`~shipgym_baselines.records.trials.dealt_seeds` deals it,
+    :attr:`Job.dealt`) or of all seeds (a classical controller's: they run in lockstep,
+    :func:`run_batch`), one job per seed for the
     privileged oracle (its reference table is looked up trial by trial).  ``scenarios``:
     names, or name → recorded settings (the jobs run those); ``scenario_seeds``: the
     scenarios run on other seeds than ``seed_list``, with theirs."""
@@ -295,12 +305,19 @@ def plan_jobs(
             label = controller_label(c)
             if (scenario, label) in skip:
                 continue
-            dealt = dealt_seeds(scenario, seeds, seeds_of[label]) if shared else None
+            learned = controller_kind(label) == "learned"
+            if learned and shared:  # one job: each seed played by the training seed dealt it
+                owner = {
+                    s: k
+                    for k, mine in dealt_seeds(scenario, seeds, seeds_of[label]).items()
+                    for s in mine
+                }
+                dealt = tuple(owner[s] for s in seeds)
+                jobs.append(Job(c, scenario, tuple(seeds), None, randomize, settings, dealt=dealt))
+                continue
             for k in seeds_of[label]:
-                if controller_kind(label) == "learned":
-                    mine = seeds if dealt is None else dealt[k]
-                    if mine:  # a training seed may be dealt none of a scenario's few seeds
-                        jobs.append(Job(c, scenario, tuple(mine), k, randomize, settings))
+                if learned:
+                    jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings))
                 elif not grants_truth(c):
                     jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings, references))
                 else:
@@ -350,7 +367,9 @@ def missing(jobs: list[Job], done: set[Any]) -> list[Job]:
     todo = []
     for job in jobs:
         label = controller_label(job.controller)
-        seeds = [s for s in job.seeds if (job.scenario, label, s, job.training_seed) not in done]
-        if seeds:
-            todo.append(job._replace(seeds=tuple(seeds)))
+        runs = [(s, k) for s, k in job.runs() if (job.scenario, label, s, k) not in done]
+        if runs:
+            seeds = tuple(s for s, _ in runs)
+            dealt = None if job.dealt is None else tuple(k for _, k in runs)
+            todo.append(job._replace(seeds=seeds, dealt=dealt))
     return todo

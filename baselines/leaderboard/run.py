@@ -194,8 +194,8 @@ def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
     rows: dict[tuple[str, str], set[tuple]] = defaultdict(set)
     for job in jobs:
         label = controller_label(job.controller)
-        for seed in job.seeds:
-            rows[(job.scenario, label)].add((job.scenario, label, seed, job.training_seed))
+        for seed, training_seed in job.runs():
+            rows[(job.scenario, label)].add((job.scenario, label, seed, training_seed))
     return rows
 
 

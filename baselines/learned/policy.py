@@ -507,6 +507,23 @@ def load_model(
         raise ControllerError(f"{path}: cannot load it as a {name} model: {exc}") from exc
 
 
+@functools.lru_cache(maxsize=32)
+def _cached_model(
+    path: Path,
+    stamp: tuple[int, int],
+    trusted: bool,
+    algo: str,
+    action_mode: str,
+    context_features: bool,
+    history_steps: int,
+) -> Any:
+    """:func:`load_model`, once per process for a file of the same ``stamp`` (its
+    modification time [ns] and size [bytes]) and the same trust in pickles: a leaderboard
+    worker plays the same agents on many scenarios.  Inference leaves a model unchanged
+    (evaluation mode, no gradient); episode state (history, LSTM) lives in the policy."""
+    return load_model(path, algo, action_mode, context_features, history_steps)
+
+
 def lean_forward(policy: Any) -> Any:
     """The deterministic action of an SB3 policy as ``policy.predict(obs,
     deterministic=True)`` computes it, bit for bit, for a batch of observations (n, d),
@@ -621,8 +638,11 @@ class LearnedPolicy:
         #: window of each episode from the observations it is given (core.ObservationHistory)
         self.history_steps = files.model.history_steps
         self._history: ObservationHistory | None = None
-        self.model = load_model(
-            self.model_path,
+        stat = Path(self.model_path).stat()
+        self.model = _cached_model(
+            Path(self.model_path).resolve(),
+            (stat.st_mtime_ns, stat.st_size),
+            pickle_trusted(),
             self.algo,
             self.action_mode,
             self.context_features,

@@ -15,6 +15,7 @@ from shipgym_baselines.leaderboard import (
     COLUMNS,
     Job,
     plan_jobs,
+    plan_run,
     run_batch,
     run_job,
     run_leaderboard,
@@ -327,6 +328,85 @@ def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
     assert [c["training_seeds"] for c in controllers] == [[0, 1], [None], [None]]
     # one kept trajectory per row: the episode its figure draws
     assert len(list((clean / "trajectories").iterdir())) == 3
+
+
+def test_shared_trials_give_each_seed_to_one_training_seed(agent: Path, tmp_path: Path) -> None:
+    """``learned_trials: shared``: the agent's two training seeds share three evaluation
+    seeds, each played once as :func:`dealt_seeds` deals them; its row has three episodes and
+    three runs, like a classical controller's; ``run.json`` records the deal, an episode of
+    the other training seed is refused, and a run of the other deal is not reported with it."""
+    from shipgym_baselines.leaderboard.report import merge_runs
+    from shipgym_baselines.records.trials import dealt_seeds
+
+    suite = write_suite(
+        tmp_path,
+        scenarios=["rudder_aging"],
+        controllers=[str(agent), "pid_los"],
+        seeds=3,
+        randomize=RANDOMIZE,
+        learned_trials="shared",
+    )
+    out = tmp_path / "out"
+    run(suite, out)
+    record = read_run(out)["suite"]
+    assert record["learned_trials"] == "shared"
+    learned = [e for e in read_episodes(out) if e["controller"] == "agent"]
+    seeds = [10_000, 10_001, 10_002]
+    dealt = dealt_seeds("rudder_aging", seeds, [0, 1])
+    assert sorted((e["training_seed"], e["seed"]) for e in learned) == sorted(
+        (k, s) for k, mine in dealt.items() for s in mine
+    )
+    assert sorted(e["seed"] for e in learned) == seeds
+    # one lockstep job for both training seeds: each episode as its training seed alone
+    (job,) = [
+        j
+        for j in plan_run([str(agent), "pid_los"], record, {"agent": [0, 1], "pid_los": [None]})
+        if j.dealt
+    ]
+    assert job.training_seed is None and sorted(job.runs()) == sorted(
+        (s, k) for k, s in [(e["training_seed"], e["seed"]) for e in learned]
+    )
+    for result in run_batch(job):
+        alone = run_job((str(agent), "rudder_aging", result.seed, result.training_seed, RANDOMIZE))
+        assert untimed([result.row()]) == untimed([alone.row()])
+    rows = json.loads((out / "leaderboard.json").read_text())
+    (row,) = [r for r in rows if r["kind"] == "learned"]
+    assert (row["seeds"], row["training_seeds"], row["episodes"]) == (3, 2, 3)
+    assert "| 3 shared by 2 trained |" in (out / "leaderboard.md").read_text()
+    ranked = with_stand_in_oracle(out, tmp_path)
+    board = {r["controller"]: r for r in json.loads((ranked / "aggregate.json").read_text())}
+    assert (board["agent"]["training_seeds"], board["agent"]["runs"]) == (2, 3)
+    assert board["agent"]["runs"] == board["pid_los"]["runs"]
+    # cut short inside the agent's job, then resumed: the same rows as the clean run
+    cut = tmp_path / "cut"
+
+    def stop_after_two(result: object, seen: list[int] = []) -> None:  # noqa: B006
+        seen.append(1)
+        if len(seen) == 2:  # inside the agent's job: its third episode is left to resume
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(suite, cut, on_episode=stop_after_two)
+    ran: list = []
+    resumed = run(suite, cut, resume=True, on_episode=ran.append)
+    assert "agent" in {r.controller for r in ran}
+    assert len(read_episodes(cut)) == len(read_episodes(out)) == 6
+    assert untimed(resumed) == untimed(json.loads((out / "leaderboard.json").read_text()))
+    # an episode of the training seed the seed was not dealt to
+    other = tmp_path / "other"
+    shutil.copytree(out, other)
+    first = learned[0]
+    with open(other / "episodes.jsonl", "a") as fh:
+        fh.write(json.dumps({**first, "training_seed": 1 - first["training_seed"]}) + "\n")
+    with pytest.raises(RunError, match="dealt to another training seed"):
+        read_episodes(other, suite=read_run(other)["suite"])
+    every = tmp_path / "every"
+    alone = write_suite(
+        tmp_path, scenarios=["rudder_aging"], controllers=["pid_los"], randomize=RANDOMIZE
+    )
+    run(alone, every)
+    with pytest.raises(RunError, match="deal learned agents' trials differently"):
+        merge_runs([out, every])
 
 
 def test_resume_with_training_seeds_equals_a_clean_run(

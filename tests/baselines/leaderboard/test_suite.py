@@ -54,19 +54,27 @@ def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
 
 
 def test_the_in_range_split_follows_the_held_out_one() -> None:
-    """The default suite ranks 16 in-range scenarios (inrange:0-15) after the held-out ones,
-    each on the suite's first two evaluation seeds (the others on all ten)."""
+    """The default suite ranks 16 in-range scenarios (inrange:0-15) after the 16 held-out
+    ones, each on the suite's first two evaluation seeds, the held-out ones on the first five
+    (the catalogue on all ten); a learned agent's training seeds share the trials."""
     default = load_suite("default")
     assert default.inrange_scenarios == 16 and default.inrange_seeds == 2
+    assert default.heldout_scenarios == 16 and default.heldout_seeds == 5
+    assert default.learned_trials == "shared"
     assert default.all_scenarios()[31:] == [
         *(f"heldout:{i}" for i in range(16)),
         *(f"inrange:{i}" for i in range(16)),
     ]
     seeds = list(range(10_000, 10_010))
     fewer = default.scenario_seeds(seeds)
-    assert fewer == {f"inrange:{i}": [10_000, 10_001] for i in range(16)}
+    assert fewer == {
+        **{f"heldout:{i}": seeds[:5] for i in range(16)},
+        **{f"inrange:{i}": seeds[:2] for i in range(16)},
+    }
     assert default.scenario_seeds(seeds[:2]) == {}  # --seeds 2: every scenario on both
-    assert default.model_copy(update={"inrange_seeds": None}).scenario_seeds(seeds) == {}
+    every = {"inrange_seeds": None, "heldout_seeds": None}
+    assert default.model_copy(update=every).scenario_seeds(seeds) == {}
+    assert load_suite("smoke").learned_trials == "all"  # the default of a suite file
 
 
 def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
@@ -77,6 +85,7 @@ def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
     quick, default = load_suite("quick"), load_suite("default")
     assert quick.seeds == 3 and quick.heldout_scenarios == 0
     assert quick.controllers == default.controllers and quick.randomize == default.randomize
+    assert quick.learned_trials == default.learned_trials == "shared"
     families = ("rudder_aging", "current_shift", "maneuverability_change")
     cells = set()
     for name in quick.scenarios:
@@ -165,6 +174,8 @@ def test_unknown_suite_lists_the_suites() -> None:
         ("inrange_scenarios: -1\n", "inrange_scenarios"),
         ("inrange_scenarios: 1001\n", "inrange_scenarios"),
         ("inrange_seeds: 0\n", "inrange_seeds"),
+        ("heldout_seeds: 0\n", "heldout_seeds"),
+        ("learned_trials: some\n", "learned_trials"),
     ],
 )
 def test_counts_are_validated(tmp_path: Path, extra: str, key: str) -> None:
