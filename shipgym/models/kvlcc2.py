@@ -53,10 +53,12 @@ to port) gives Y_R < 0, N_R > 0 and a starboard turn r > 0, the project conventi
 Propeller and speed
 -------------------
 Constant propeller revolutions, as the paper's simulations and the SIMMAN free-running tests
-(n_P = 17.95 rps, the model self-propulsion point).  The nominal speed is the straight-run
-equilibrium at n_P (X_H + X_P = 0 with v = r = δ = 0, closed form): 1.173 m/s at the defaults
-(the paper's U0 = 1.179 m/s: 0.5 % less; :meth:`KVLCC2.cruise_state` starts there, steady).
-No shaft dynamics and no speed controller: the ship slows in a turn and regains speed after.
+(the rps of the longitudinal equilibrium at 15.5 kn full scale).  The default n_P = 11.85 rps
+is that rps for this R'_0 and K_T (ours: X_H + X_P = 0 at u = 1.179 m/s, v = r = δ = 0); the
+17.95 rps that shipmmg uses gives a straight run of 1.79 m/s (Fn 0.22) with these
+coefficients.  The nominal speed is the straight-run speed at n_P (closed form), 1.1788 m/s
+at the defaults; :meth:`KVLCC2.cruise_state` starts there, steady.  No shaft dynamics and no
+speed controller: the ship slows in a turn and regains speed after.
 
 Steering gear (our choices where the paper is silent)
 -----------------------------------------------------
@@ -69,13 +71,14 @@ Scale
 Dimensional fields are the L7 model's (the paper's model column); ``scale`` = λ Froude-scales
 the simulated craft *up* from the model: lengths ×λ, areas ×λ², volume ×λ³, speeds and times
 ×√λ, rps and the rudder rate ÷√λ (angles and prime coefficients unchanged).  λ = 1 (default)
-is the 7 m model; λ = 320/7 = 45.714 (:func:`full_scale`) the 320 m ship (U0 = 7.93 m/s
-= 15.4 kn, n_P = 2.65 rps, rudder rate 2.32 °/s).  Trajectories scale exactly (tested).
+is the 7 m model; λ = 320/7 = 45.714 (:func:`full_scale`) the 320 m ship (U0 = 7.97 m/s
+= 15.5 kn, n_P = 1.75 rps, rudder rate 2.32 °/s).  Trajectories scale exactly (tested).
 
 Time steps
 ----------
 Ts = 0.5 s, h = 0.05 s at λ = 1 (L/U = 6.0 s: 12 control steps per ship length; h is a
-tenth of the yaw time constants' smallest, ≈ 0.6 s); both ×√λ at other scales.
+tenth of the smallest time constant of its 20/20 Nomoto fit, T2 = 0.54 s); both ×√λ at
+other scales.
 """
 
 from __future__ import annotations
