@@ -90,7 +90,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
+from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
 
 DEG = math.pi / 180.0
 #: regularisation of the speed U divided by at rest [m/s]; far below any used speed
@@ -199,10 +199,13 @@ class KVLCC2Params(ParameterRecord):
     )
 
     def problems(self) -> list[str]:
-        out = super().problems()
-        if out:
-            return out
+        """The signs and numbers of the base record, then the ratios (:meth:`_ratio_problems`)."""
+        return super().problems() or self._ratio_problems()
+
+    def _ratio_problems(self) -> list[str]:
+        """Fractions in [0, 1), η = D_P/H_R ≤ 1 and thrust at J = 0 (k0 > 0)."""
         cls = type(self).__name__
+        out = []
         for name in ("t_P", "w_P0", "t_R"):
             if not 0.0 <= getattr(self, name) < 1.0:
                 out.append(f"{cls}.{name} must be in [0, 1), got {getattr(self, name)}")
@@ -312,6 +315,12 @@ def _rudder(
     return x_r, y_r, n_r
 
 
+def _servo(command: Any, delta: Any, p: Any, s: SimpleNamespace, ops: SimpleNamespace) -> Any:
+    """δ̇ [rad/s]: the command saturated at ±δ_max, a first-order lag T_servo, the rate limit."""
+    target = ops.clip(command, -p.delta_max, p.delta_max)
+    return ops.clip((target - delta) / s.T_servo, -s.rate, s.rate)
+
+
 class KVLCC2(ShipModel):
     """kvlcc2: the KVLCC2 tanker (L7 model by default) by the MMG standard method."""
 
@@ -338,8 +347,7 @@ class KVLCC2(ShipModel):
         s = _scaled(p, ops)
         cos_psi, sin_psi = ops.cos(psi), ops.sin(psi)
         # water-relative velocities (current flowing *to* (Vcx, Vcy))
-        u_cur = w[0] * cos_psi + w[1] * sin_psi
-        v_cur = -w[0] * sin_psi + w[1] * cos_psi
+        u_cur, v_cur = current_in_body(w, cos_psi, sin_psi)
         ur = u_g - u_cur
         vr = v_g - v_cur
         U = ops.sqrt(ur * ur + vr * vr + _EPS_SPEED**2)
@@ -362,26 +370,15 @@ class KVLCC2(ShipModel):
         a23 = x_g * m
         a33 = i_zg + x_g * x_g * m + j_z
         det = a22 * a33 - a23 * a23
-        ur_dot = f_x / (m + m_x)
-        vr_dot = (a33 * f_y - a23 * f_n) / det
-        r_dot = (a22 * f_n - a23 * f_y) / det + w[2]
-        # over-ground body velocities (constant current)
-        u_dot = ur_dot + r * v_cur
-        v_dot = vr_dot - r * u_cur
-        # rudder servo: saturation, first-order lag, rate limit
-        delta_c = ops.clip(u[0], -p.delta_max, p.delta_max)
-        delta_dot = ops.clip((delta_c - delta) / s.T_servo, -s.rate, s.rate)
-        return ops.stack(
-            [
-                u_g * cos_psi - v_g * sin_psi,
-                u_g * sin_psi + v_g * cos_psi,
-                r,
-                u_dot,
-                v_dot,
-                r_dot,
-                delta_dot,
-            ]
-        )
+        # over-ground body accelerations (constant current): u̇ = u̇_r + r·v_c, v̇ = v̇_r − r·u_c
+        accelerations = [
+            f_x / (m + m_x) + r * v_cur,
+            (a33 * f_y - a23 * f_n) / det - r * u_cur,
+            (a22 * f_n - a23 * f_y) / det + w[2],
+        ]
+        north = u_g * cos_psi - v_g * sin_psi
+        east = u_g * sin_psi + v_g * cos_psi
+        return ops.stack([north, east, r, *accelerations, _servo(u[0], delta, p, s, ops)])
 
     # -- declared figures -------------------------------------------------------------------
     @property
@@ -412,9 +409,7 @@ class KVLCC2(ShipModel):
 
     def cruise_state(self, **values: float) -> np.ndarray:
         """Straight ahead at the straight-run speed (v = r = δ = 0 is an equilibrium)."""
-        values = dict(values)
-        values.setdefault("u", self.nominal_speed)
-        return self.initial_state(**values)
+        return self.initial_state(**{"u": self.nominal_speed, **values})
 
     @property
     def mass(self) -> float:

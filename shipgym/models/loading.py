@@ -97,6 +97,30 @@ HULLS: dict[str, Hull] = {
     "kvlcc2": Hull(L=320.0, B=58.0, T=20.8, C_B=0.810),
 }
 
+#: parameter -> the factor it is multiplied by, for the ships whose change is a product
+SCALED_BY: dict[str, dict[str, str]] = {
+    "blanke": {
+        "m": "mass",
+        "Iz": "mass",
+        "Y_vdot": "Yvdot",
+        "N_rdot": "Nrdot",
+        "Y_auv": "Yv",
+        "Y_ur": "Yr",
+        "N_auv": "Nv",
+        "N_aur": "Nr",
+    },
+    "kvlcc2": {
+        "volume": "mass",
+        "m_x": "mass",
+        "m_y": "Yvdot",
+        "J_z": "Nrdot",
+        "Y_v": "Yv",
+        "Y_R": "Yr",
+        "N_v": "Nv",
+        "N_R": "Nr",
+    },
+}
+
 #: Mariner yaw inertia split (Fossen's mariner.m, prime ×1e-5 removed): I'_z, N'_ṙ
 MARINER_IZ, MARINER_NRDOT = 39.2e-5, -43.8e-5
 
@@ -128,30 +152,8 @@ def loading_change(model: str, params: object, draught_ratio: float) -> dict[str
             "Nr": p.Nr * f["Nr"],  # type: ignore[attr-defined]
             "T": p.T * draught_ratio,  # type: ignore[attr-defined]
         }
-    if model == "blanke":
-        scaled = {
-            "m": "mass",
-            "Iz": "mass",
-            "Y_vdot": "Yvdot",
-            "N_rdot": "Nrdot",
-            "Y_auv": "Yv",
-            "Y_ur": "Yr",
-            "N_auv": "Nv",
-            "N_aur": "Nr",
-        }
-        return {name: getattr(p, name) * f[key] for name, key in scaled.items()}
-    if model == "kvlcc2":
-        factors = {
-            "volume": "mass",
-            "m_x": "mass",
-            "m_y": "Yvdot",
-            "J_z": "Nrdot",
-            "Y_v": "Yv",
-            "Y_R": "Yr",
-            "N_v": "Nv",
-            "N_R": "Nr",
-        }
-        return {name: getattr(p, name) * f[key] for name, key in factors.items()}
+    if model in SCALED_BY:
+        return {name: getattr(p, name) * f[key] for name, key in SCALED_BY[model].items()}
     f_inertia = _inertia(MARINER_IZ, MARINER_NRDOT, f, "Nrdot") / (MARINER_IZ - MARINER_NRDOT)
     return {
         "a1": p.a1 * f["Nr"] / f_inertia,  # type: ignore[attr-defined]
