@@ -4,8 +4,9 @@ Yasukawa, H. & Yoshimura, Y. (2015), "Introduction of MMG standard method for sh
 maneuvering predictions", J. Mar. Sci. Technol. 20:37–52, with the KVLCC2 data of its
 numerical example (the SIMMAN 2008/2014/2020 free-running case: L_pp = 7.00 m model,
 λ = 45.714, Fn = 0.142 i.e. U0 = 1.179 m/s, rudder rate 15.68 °/s at model scale).
-Equation numbers below are the paper's (see docs/ships.md, "KVLCC2", for the numbering
-and the tables every coefficient comes from).
+Equation and table numbers below are the paper's as recalled when this model was written:
+only eq. (18), the rudder forces, was confirmed by a second source (docs/ships.md, "KVLCC2",
+lists every coefficient with its table; check the numbers against the paper before citing).
 
 Motion equations about midship (eq. (4)), velocities through the water::
 
