@@ -23,6 +23,7 @@ ENV_IDS: dict[str, str] = {
     "ShipPathFollow-EssoOsaka-v1": "esso_osaka_rudder_aging",
     "ShipPathFollow-Mariner-v1": "mariner_rudder_aging",
     "ShipPathFollow-Blanke-v1": "blanke_rudder_aging",
+    "ShipPathFollow-KVLCC2-v1": "kvlcc2_rudder_aging",
 }
 
 for _env_id, _scenario in ENV_IDS.items():

@@ -10,6 +10,7 @@ from shipgym.models.base import (
 )
 from shipgym.models.blanke import Blanke, BlankeParams
 from shipgym.models.esso_osaka import EssoOsaka, EssoOsakaParams
+from shipgym.models.kvlcc2 import KVLCC2, KVLCC2Params
 from shipgym.models.mariner import Mariner, MarinerParams
 from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params, UnitReading, params_from_paper
 
@@ -19,16 +20,19 @@ MODELS: dict[str, type[ShipModel]] = {
     "mariner": Mariner,
     "blanke": Blanke,
     "esso_osaka": EssoOsaka,
+    "kvlcc2": KVLCC2,
 }
 
 __all__ = [
     "CASADI",
+    "KVLCC2",
     "MODELS",
     "NUMPY",
     "Blanke",
     "BlankeParams",
     "EssoOsaka",
     "EssoOsakaParams",
+    "KVLCC2Params",
     "Mariner",
     "MarinerParams",
     "Nomoto2",

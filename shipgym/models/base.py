@@ -194,6 +194,12 @@ def parameter_view(names: Sequence[str], vector: Any) -> SimpleNamespace:
     return SimpleNamespace(**{n: vector[i] for i, n in enumerate(names)})
 
 
+def current_in_body(w: Any, cos_psi: Any, sin_psi: Any) -> tuple[Any, Any]:
+    """Body-frame components (u_c, v_c) [m/s] of the earth-frame current (w[0], w[1]) [m/s,
+    flowing *to*] at heading ψ (given as cos ψ, sin ψ); numpy or CasADi alike."""
+    return w[0] * cos_psi + w[1] * sin_psi, -w[0] * sin_psi + w[1] * cos_psi
+
+
 def rk4_step(
     f: Callable[[Any, Any, Any, Any], Any], x: Any, u: Any, w: Any, p: Any, h: float
 ) -> Any:

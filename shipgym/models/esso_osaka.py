@@ -128,7 +128,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy.optimize import root
 
-from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
+from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
 
 DEG = math.pi / 180.0
 #: regularisation of the speeds divided by (U, c) at rest [m/s]; far below any used speed
@@ -317,8 +317,7 @@ class EssoOsaka(ShipModel):
         L = s.L
         cos_psi, sin_psi = ops.cos(psi), ops.sin(psi)
         # Xu et al. (2020) eq. (8): water-relative velocities (current flowing *to* Vc)
-        u_cur = w[0] * cos_psi + w[1] * sin_psi
-        v_cur = -w[0] * sin_psi + w[1] * cos_psi
+        u_cur, v_cur = current_in_body(w, cos_psi, sin_psi)
         ur = u_g - u_cur
         vr = v_g - v_cur
         U = ops.sqrt(ur * ur + vr * vr + _EPS_SPEED**2)

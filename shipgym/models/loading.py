@@ -29,6 +29,11 @@ change sign within the draughts used: a ratio means nothing there).
   factors; the draught T itself (wetted surface).
 * ``blanke`` (SI): m, I_z × f_m; Y_v̇, N_ṙ, Y_|u|v, Y_ur, N_|u|v, N_|u|r × the factors of
   Y'_v̇, N'_ṙ, Y'_v, Y'_r, N'_v, N'_r.
+* ``kvlcc2`` (MMG standard method, prime on ½ρL²d at the reference draught d, which stays:
+  the factors then scale the dimensional forces): the displacement volume ∇ and m'_x × the
+  mass factor (I_zG follows ∇ at the same k_zz), m'_y and J'_z × the factors of Y'_v̇ and
+  N'_ṙ (they are −Y'_v̇, −N'_ṙ), Y'_v, Y'_R, N'_v, N'_R × theirs; the resistance R'_0 is kept
+  (the straight-run speed at the same revolutions stays: an assumption).
 * ``mariner`` (de Wit–Oppe, ṙ = −a1·r − a2·r³ + a3·δ): read as the yaw row of the linear
   model without sway coupling, a1 = −N_r/(I_z − N_ṙ), a3 = N_δ/(I_z − N_ṙ), so a1 × f_Nr/f_I
   and a3 × 1/f_I with f_I the factor of (I_z − N_ṙ), split as Fossen's ``mariner.m``
@@ -81,6 +86,7 @@ def draught_factors(hull: Hull, draught_ratio: float) -> dict[str, float]:
 
 
 #: the particulars each ship's regression is evaluated with: Esso Osaka data file §1.2;
+#: KVLCC2 full scale (Yasukawa & Yoshimura 2015, Table 1);
 #: Mariner class after Chislett & Strøm-Tejsen (1965) (B, C_B as commonly quoted, T from
 #: Fossen's m' = 798e-5 = C_B·B·T/(½L²): an assumption); Blanke & Christensen (1993) naval
 #: vessel, C_B = ∇/(LBT) = 357/(51.5·8.6·2.3)
@@ -88,6 +94,31 @@ HULLS: dict[str, Hull] = {
     "esso_osaka": Hull(L=325.0, B=53.0, T=21.73, C_B=0.831),
     "mariner": Hull(L=160.93, B=23.17, T=7.47, C_B=0.6),
     "blanke": Hull(L=51.5, B=8.6, T=2.3, C_B=357.0 / (51.5 * 8.6 * 2.3)),
+    "kvlcc2": Hull(L=320.0, B=58.0, T=20.8, C_B=0.810),
+}
+
+#: parameter -> the factor it is multiplied by, for the ships whose change is a product
+SCALED_BY: dict[str, dict[str, str]] = {
+    "blanke": {
+        "m": "mass",
+        "Iz": "mass",
+        "Y_vdot": "Yvdot",
+        "N_rdot": "Nrdot",
+        "Y_auv": "Yv",
+        "Y_ur": "Yr",
+        "N_auv": "Nv",
+        "N_aur": "Nr",
+    },
+    "kvlcc2": {
+        "volume": "mass",
+        "m_x": "mass",
+        "m_y": "Yvdot",
+        "J_z": "Nrdot",
+        "Y_v": "Yv",
+        "Y_R": "Yr",
+        "N_v": "Nv",
+        "N_R": "Nr",
+    },
 }
 
 #: Mariner yaw inertia split (Fossen's mariner.m, prime ×1e-5 removed): I'_z, N'_ṙ
@@ -121,18 +152,8 @@ def loading_change(model: str, params: object, draught_ratio: float) -> dict[str
             "Nr": p.Nr * f["Nr"],  # type: ignore[attr-defined]
             "T": p.T * draught_ratio,  # type: ignore[attr-defined]
         }
-    if model == "blanke":
-        scaled = {
-            "m": "mass",
-            "Iz": "mass",
-            "Y_vdot": "Yvdot",
-            "N_rdot": "Nrdot",
-            "Y_auv": "Yv",
-            "Y_ur": "Yr",
-            "N_auv": "Nv",
-            "N_aur": "Nr",
-        }
-        return {name: getattr(p, name) * f[key] for name, key in scaled.items()}
+    if model in SCALED_BY:
+        return {name: getattr(p, name) * f[key] for name, key in SCALED_BY[model].items()}
     f_inertia = _inertia(MARINER_IZ, MARINER_NRDOT, f, "Nrdot") / (MARINER_IZ - MARINER_NRDOT)
     return {
         "a1": p.a1 * f["Nr"] / f_inertia,  # type: ignore[attr-defined]

@@ -405,6 +405,28 @@ def test_every_number_of_the_manoeuvre_output_has_its_unit(
         assert document["units"]["overshoot_1"] == "deg"
 
 
+def test_manoeuvre_kvlcc2_gives_its_imo_criteria_rows(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``shipgym manoeuvre kvlcc2 turning|zigzag`` runs and judges the IMO criteria (the
+    docs/imo_criteria.md row: 3.08 L, 3.12 L, 5.04°, 13.72°, 10.61°, every one a pass)."""
+    out = ["--out", str(tmp_path), "--json"]
+    rows = {}
+    for kind, options in (("turning", []), ("zigzag", ["--rudder", "10"]), ("zigzag", [])):
+        assert main(["manoeuvre", "kvlcc2", kind, *options, *out]) == 0
+        rows |= {c["criterion"]: c for c in json.loads(capsys.readouterr().out)["imo_criteria"]}
+    expected = {
+        "advance": 3.08,
+        "tactical_diameter": 3.12,
+        "first_overshoot_10_10": 5.04,
+        "second_overshoot_10_10": 13.72,
+        "first_overshoot_20_20": 10.61,
+    }
+    assert set(rows) == set(expected)
+    for name, value in expected.items():
+        assert rows[name]["value"] == pytest.approx(value, abs=0.006) and rows[name]["passed"]
+
+
 @pytest.mark.parametrize(
     ("extra", "message"),
     [

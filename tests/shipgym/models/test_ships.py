@@ -1,4 +1,4 @@
-"""All four ships through gym.make under every disturbance; identified nominal models."""
+"""All five ships through gym.make under every disturbance; identified nominal models."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ SHIP_IDS = {
     "esso_osaka": "ShipPathFollow-EssoOsaka-v0",
     "mariner": "ShipPathFollow-Mariner-v0",
     "blanke": "ShipPathFollow-Blanke-v0",
+    "kvlcc2": "ShipPathFollow-KVLCC2-v1",
 }
 
 DISTURBANCES = {
