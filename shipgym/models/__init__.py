@@ -23,11 +23,16 @@ MODELS: dict[str, type[ShipModel]] = {
     "kvlcc2": KVLCC2,
 }
 
+#: hulls no controller is tuned or trained on: the leaderboard's unseen-hull split.  Only a
+#: ``test_only`` distribution may list one (:mod:`shipgym.scenarios.sampling`).
+UNSEEN_HULLS: frozenset[str] = frozenset({"kvlcc2"})
+
 __all__ = [
     "CASADI",
     "KVLCC2",
     "MODELS",
     "NUMPY",
+    "UNSEEN_HULLS",
     "Blanke",
     "BlankeParams",
     "EssoOsaka",

@@ -29,7 +29,8 @@ outside the training ranges, on every ship (the leaderboard's generalisation row
 evaluates on to keep its best model; ``inrange`` (training ranges, test seed space under
 its own name, so none of its scenarios is a validation one) is the leaderboard's in-range
 split.  ``heldout`` and ``inrange`` are ``test_only``: tuning and model selection refuse
-them.
+them.  An unseen hull (:data:`shipgym.models.UNSEEN_HULLS`: the KVLCC2) may be listed only
+by a ``test_only`` distribution, so no training or validation trial is ever on it.
 
 Units are those of scenario configs: lengths in ship lengths where a key ends in ``_L``,
 angles in degrees where it ends in ``_deg``, times in s, speeds in m/s, ship parameters in
@@ -55,6 +56,7 @@ from shipgym.config import (
     read_yaml,
     resolve,
 )
+from shipgym.models import UNSEEN_HULLS
 from shipgym.models.loading import HULLS, loading_change
 from shipgym.scenarios.schema import ScenarioConfig
 
@@ -251,6 +253,11 @@ class DistributionConfig(StrictModel):
         self._check_split()
         for i, ship in enumerate(self.ships):
             _check_ship(ship, f"ships.{i}", self.split, self.path)
+            if ship.model in UNSEEN_HULLS and not self.test_only:
+                raise ValueError(
+                    f"ships.{i}.model: {ship.model} is an unseen hull (no controller is tuned "
+                    "or trained on it): only a test_only distribution may list it"
+                )
         return self
 
     def _check_split(self) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import collections
 import itertools
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -477,3 +478,45 @@ def test_the_leaderboards_splits_are_test_only_and_a_train_split_cannot_be() -> 
     data = {**_raw("train"), "test_only": True}
     with pytest.raises(ValueError, match="test_only: only a test split"):
         DistributionConfig.model_validate(data)
+
+
+@pytest.mark.parametrize("name", ["train", "heldout"])
+def test_an_unseen_hull_is_refused_by_a_distribution_that_is_not_test_only(
+    name: str, tmp_path: Path
+) -> None:
+    """The KVLCC2 (UNSEEN_HULLS) may be listed only by a test_only distribution: a copy of
+    the training file, or of the held-out one without ``test_only``, that lists it is
+    refused, naming the key (the validation split reads its ships from the training one)."""
+    data = _raw(name)
+    data.pop("test_only", None)
+    share = {"weight": 1.0} if name == "train" else {"count": 1}
+    data["ships"].append({"model": "kvlcc2", **share})
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    key = f"ships.{len(data['ships']) - 1}.model"
+    with pytest.raises(DistributionError, match=rf"{re.escape(key)}: kvlcc2 is an unseen hull"):
+        load_distribution(bad)
+
+
+def test_training_and_validation_never_build_the_unseen_hull(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A spy on the KVLCC2 model's construction: 400 training draws and the 32 validation
+    trials never build it (while a kvlcc2 catalogue scenario does)."""
+    from shipgym.models.kvlcc2 import KVLCC2
+
+    built: list[str] = []
+    real = KVLCC2.from_config.__func__  # type: ignore[attr-defined]
+
+    def spy(cls: type, *args: Any, **kwargs: Any) -> Any:
+        built.append(cls.__name__)
+        return real(cls, *args, **kwargs)
+
+    monkeypatch.setattr(KVLCC2, "from_config", classmethod(spy))
+    _train_draws(400)
+    validation = load_distribution("validation")
+    for index in range(32):
+        validation.test_scenario(index)
+    assert built == []
+    load_scenario("kvlcc2_nominal")
+    assert built  # the spy sees a construction
