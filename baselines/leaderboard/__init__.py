@@ -56,17 +56,19 @@ _DEFINED = {
     "tables": (
         "AGGREGATE_FILE",
         "COLUMNS",
-        "GENERALISATION_SPLITS",
         "PROB",
         "SCENARIO_SCORES_FILE",
-        "SPLIT_TITLES",
-        "TEST_SPLITS",
         "TRAINING_COLUMNS",
-        "YOURS",
         "aggregate_results",
         "episode_rows",
         "generalisation",
         "rankable",
+    ),
+    "splits": (
+        "GENERALISATION_SPLITS",
+        "SPLIT_TITLES",
+        "TEST_SPLITS",
+        "YOURS",
         "scenario_split",
     ),
     "markdown": (

@@ -61,6 +61,7 @@ import numpy as np
 
 from shipgym_baselines.leaderboard.escaping import plain_text
 from shipgym_baselines.leaderboard.ranking import BASELINE, ORACLE, ORACLE_FROZEN, REFERENCE_KIND
+from shipgym_baselines.leaderboard.splits import figure_title
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.policy import FAMILIES
 from shipgym_baselines.records.outfiles import write_bytes
@@ -696,12 +697,6 @@ def plot_scenarios(
 
 
 # ----------------------------------------------------------------------------- ranking
-SPLIT_TITLES = {
-    "catalogue": "catalogue scenarios",
-    "heldout": "held-out scenarios",
-    "inrange": "in-range scenarios",
-    "yours": "your scenarios",
-}
 _RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"
 #: the intervals drawn per controller: key, panel title, axis label, reference lines
 _INTERVAL_PANELS = (
@@ -820,7 +815,7 @@ def _plot_intervals(
             for bar in bars:
                 bar.set_gid(f"{bars.get_label()}/interval/{keys[i]}")
     fig.suptitle(
-        f"Aggregate over {SPLIT_TITLES.get(split, split)}: point estimate (black) and 95 % "
+        f"Aggregate over {figure_title(split)}: point estimate (black) and 95 % "
         "stratified-bootstrap interval (bar), rliable; 1 = the oracle's cost, lower is better",
         fontsize=10,
         y=1.0 + 0.5 / fig.get_figheight(),  # above the panels' titles, however few rows
@@ -927,7 +922,7 @@ def _plot_profiles(
         ax.set_xlim(taus[0], taus[-1])
         _legend_below(ax)
     fig.suptitle(
-        f"Performance profiles of the cost ratio, {SPLIT_TITLES.get(split, split)} (95 % "
+        f"Performance profiles of the cost ratio, {figure_title(split)} (95 % "
         "intervals shaded; dashed: the oracle = 1; lower curves are better)",
         fontsize=10,
         y=1.0 - 0.15 / fig.get_figheight(),

@@ -20,13 +20,8 @@ from shipgym_baselines.leaderboard.ranking import (
     no_ranking,
     resolution_lines,
 )
-from shipgym_baselines.leaderboard.tables import (
-    PROB,
-    SPLIT_TITLES,
-    TEST_SPLITS,
-    generalisation,
-    generalisation_splits,
-)
+from shipgym_baselines.leaderboard.splits import TEST_SPLITS, split_label, table_title
+from shipgym_baselines.leaderboard.tables import PROB, generalisation, generalisation_splits
 from shipgym_baselines.leaderboard.verdict import verdict
 
 
@@ -43,7 +38,7 @@ def _table_title(split: str, rows: Sequence[Mapping[str, Any]]) -> str:
     """A ranking table's heading: the split, and its scenarios (every controller's in a
     main table; a partial table's controllers have their own)."""
     base = split.removesuffix(PARTIAL)
-    name = SPLIT_TITLES.get(base, base)
+    name = table_title(base)
     if is_partial(split):
         return (
             f"{name}: controllers that do not apply to every scenario (each ranked on the "
@@ -241,12 +236,11 @@ def generalisation_table(rows: list[dict[str, Any]]) -> str:
         return ""
     gen = generalisation(rows)
     splits = generalisation_splits(rows)
-    label = {"catalogue": "catalogue", "heldout": "held-out", "inrange": "in-range"}
-    counts = ", ".join(f"{gen[0][f'{s}_scenarios']} {label[s]}" for s in splits)
+    counts = ", ".join(f"{gen[0][f'{s}_scenarios']} {split_label(s)}" for s in splits)
     header = ["controller", "kind"] + [
-        f"{what} {label[s]}" for what in ("ACE/L", "return", "success") for s in splits
+        f"{what} {split_label(s)}" for what in ("ACE/L", "return", "success") for s in splits
     ]
-    title = " vs ".join(label[s] for s in splits)
+    title = " vs ".join(split_label(s) for s in splits)
     lines = [
         f"\n## Generalisation: {title} scenarios\n\nMeans over the scenarios "
         f"of each split on which every controller ran ({counts}).\n",

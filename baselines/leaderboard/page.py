@@ -63,6 +63,7 @@ from shipgym_baselines.leaderboard.ranking import (
     no_ranking,
     resolution_lines,
 )
+from shipgym_baselines.leaderboard.splits import table_title
 from shipgym_baselines.leaderboard.style import controller_style
 from shipgym_baselines.records.outfiles import write_bytes
 
@@ -72,12 +73,6 @@ PROB = f"prob_improvement_over_{BASELINE}"
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
 SORT_DIGITS = 7
-SPLIT_TITLES = {
-    "catalogue": "Catalogue scenarios",
-    "heldout": "Held-out scenarios",
-    "inrange": "In-range scenarios, drawn from the training ranges",
-    "yours": "Your scenarios",
-}
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
     "ace": "ACE [m]",
@@ -428,7 +423,7 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
                 ]
             )
         base = split.removesuffix(PARTIAL)
-        title = SPLIT_TITLES.get(base, base)
+        title = table_title(base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
         keys = [c[0] for c in columns]

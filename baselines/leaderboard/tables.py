@@ -1,5 +1,5 @@
-"""The leaderboard's rows: episodes aggregated per (scenario, controller), the scenario
-splits, the episodes the ranking reads and the generalisation means."""
+"""The leaderboard's rows: episodes aggregated per (scenario, controller), the episodes the
+ranking reads and the generalisation means (the scenario splits: :mod:`.splits`)."""
 
 from __future__ import annotations
 
@@ -10,12 +10,18 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.config import is_path
 from shipgym.metrics import aggregate
 from shipgym_baselines.leaderboard.ranking import (
     BASELINE,
     row_intervals,
 )
+
+# the splits are defined in .splits; these names stay importable from here
+from shipgym_baselines.leaderboard.splits import GENERALISATION_SPLITS as GENERALISATION_SPLITS
+from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES
+from shipgym_baselines.leaderboard.splits import TEST_SPLITS as TEST_SPLITS
+from shipgym_baselines.leaderboard.splits import YOURS as YOURS
+from shipgym_baselines.leaderboard.splits import scenario_split as scenario_split
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.registry import controller_kind
 
@@ -40,31 +46,6 @@ TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
 AGGREGATE_FILE = "aggregate.json"
 PROB = f"prob_improvement_over_{BASELINE}"
 SCENARIO_SCORES_FILE = "scenario_scores.json"
-
-
-YOURS = "yours"
-#: the ranking tables' headings, by split
-SPLIT_TITLES = {
-    "catalogue": "Catalogue scenarios",
-    "heldout": "Held-out scenarios",
-    "inrange": "In-range scenarios, drawn from the training ranges",
-    YOURS: "Your scenarios",
-}
-#: the splits of the named test scenarios (``<split>:<index>``): jumps outside the learned
-#: agents' training ranges (extrapolation), and inside them (interpolation)
-TEST_SPLITS = ("heldout", "inrange")
-#: the splits of :func:`generalisation`, in its order
-GENERALISATION_SPLITS = ("catalogue", *TEST_SPLITS)
-
-
-def scenario_split(scenario: str, own: Collection[str] = ()) -> str:
-    """``heldout`` / ``inrange`` for named held-out / in-range test scenarios
-    (``heldout:3``, ``inrange:3``), :data:`YOURS` for the suite's own scenarios (``own``:
-    their table names; a YAML path, as older records name them), else ``catalogue``."""
-    for split in TEST_SPLITS:
-        if scenario.startswith(f"{split}:"):
-            return split
-    return YOURS if scenario in own or is_path(scenario) else "catalogue"
 
 
 def episode_rows(results: Iterable[EpisodeResult]) -> list[dict[str, Any]]:

@@ -47,6 +47,7 @@ from shipgym_baselines.leaderboard.ranking import (
     is_partial,
     trial_headroom,
 )
+from shipgym_baselines.leaderboard.splits import split_label
 
 #: the kinds the second half of the first sentence compares
 LEARNED, CLASSICAL = "learned", "classical"
@@ -113,14 +114,10 @@ def _overlap(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool | None:
     return max(ca[0], cb[0]) <= min(ca[1], cb[1])
 
 
-#: a split's name in a sentence (others as they are)
-SPLIT_LABELS = {"heldout": "held-out", "inrange": "in-range"}
-
-
 def _scope(table: Sequence[Mapping[str, Any]]) -> str:
     n = len(table[0]["scenarios"])
     split = table[0]["split"]
-    label = SPLIT_LABELS.get(split, split)
+    label = split_label(split)
     return f"the {n} {label} scenario{'s' if n != 1 else ''}"
 
 
@@ -256,7 +253,7 @@ def gap_sentences(
     if found is None:
         return None
     headroom, trials = found
-    label = SPLIT_LABELS.get(table[0]["split"], table[0]["split"])
+    label = split_label(table[0]["split"])
     worth = (
         f"Knowing the change is worth {headroom:.2f}× here: the cost of {code(ORACLE_FROZEN)}, "
         f"the optimum that never adapts, over {code(ORACLE)}'s (geometric mean over the "

@@ -1,0 +1,80 @@
+"""The leaderboard's scenario splits: their names, which split a scenario falls in, and how
+the tables, the figures and the sentences title each.
+
+Every split is one entry of :data:`SPLITS` (the ranking is computed per split, each in its
+own table and figures); a new split needs its entry there, with ``test=True`` when its
+scenarios are named test scenarios ``<split>:<index>`` (:func:`scenario_split`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass
+
+from shipgym.config import is_path
+
+
+@dataclass(frozen=True)
+class Split:
+    """How one split is titled: ``table`` heads its ranking tables (``leaderboard.md`` and
+    the page), ``figure`` names it in a figure's title, ``label`` in a sentence (the
+    generalisation table, the verdict); ``test``: its scenarios are the named test scenarios
+    ``<split>:<index>``."""
+
+    table: str
+    figure: str
+    label: str
+    test: bool = False
+
+
+#: the split of the suite's own scenarios (scenario files)
+YOURS = "yours"
+#: every split, by the name the rows' ``split`` holds, in the order the generalisation
+#: table reads them
+SPLITS = {
+    "catalogue": Split("Catalogue scenarios", "catalogue scenarios", "catalogue"),
+    # jumps outside the learned agents' training ranges (extrapolation)
+    "heldout": Split("Held-out scenarios", "held-out scenarios", "held-out", test=True),
+    # jumps inside them (interpolation)
+    "inrange": Split(
+        "In-range scenarios, drawn from the training ranges",
+        "in-range scenarios",
+        "in-range",
+        test=True,
+    ),
+    YOURS: Split("Your scenarios", "your scenarios", "yours"),
+}
+#: the ranking tables' headings, by split
+SPLIT_TITLES = {name: split.table for name, split in SPLITS.items()}
+#: the splits of the named test scenarios (``<split>:<index>``)
+TEST_SPLITS = tuple(name for name, split in SPLITS.items() if split.test)
+#: the splits of :func:`~shipgym_baselines.leaderboard.tables.generalisation`, in its order
+GENERALISATION_SPLITS = ("catalogue", *TEST_SPLITS)
+
+
+def table_title(split: str) -> str:
+    """The heading of ``split``'s ranking table (an unknown split: its name)."""
+    found = SPLITS.get(split)
+    return found.table if found else split
+
+
+def figure_title(split: str) -> str:
+    """``split`` as a figure's title names it (an unknown split: its name)."""
+    found = SPLITS.get(split)
+    return found.figure if found else split
+
+
+def split_label(split: str) -> str:
+    """``split`` in a sentence (an unknown split: its name)."""
+    found = SPLITS.get(split)
+    return found.label if found else split
+
+
+def scenario_split(scenario: str, own: Collection[str] = ()) -> str:
+    """``heldout`` / ``inrange`` for named held-out / in-range test scenarios
+    (``heldout:3``, ``inrange:3``), :data:`YOURS` for the suite's own scenarios (``own``:
+    their table names; a YAML path, as older records name them), else ``catalogue``."""
+    for split in TEST_SPLITS:
+        if scenario.startswith(f"{split}:"):
+            return split
+    return YOURS if scenario in own or is_path(scenario) else "catalogue"

@@ -1,0 +1,50 @@
+"""The scenario splits: which split a scenario falls in, and each split's titles."""
+
+from __future__ import annotations
+
+import pytest
+
+from shipgym_baselines.leaderboard.splits import (
+    GENERALISATION_SPLITS,
+    SPLIT_TITLES,
+    SPLITS,
+    TEST_SPLITS,
+    YOURS,
+    figure_title,
+    scenario_split,
+    split_label,
+    table_title,
+)
+
+
+@pytest.mark.parametrize(
+    ("scenario", "own", "split"),
+    [
+        ("heldout:3", (), "heldout"),
+        ("inrange:0", (), "inrange"),
+        ("mariner_rudder_aging", (), "catalogue"),
+        ("my_harbour", ("my_harbour",), YOURS),
+        ("scenarios/mine.yaml", (), YOURS),
+    ],
+)
+def test_a_scenario_falls_in_its_split(scenario: str, own: tuple[str, ...], split: str) -> None:
+    assert scenario_split(scenario, own) == split
+
+
+def test_the_test_splits_are_the_named_test_scenarios_in_order() -> None:
+    assert TEST_SPLITS == ("heldout", "inrange")
+    assert GENERALISATION_SPLITS == ("catalogue", "heldout", "inrange")
+
+
+def test_each_split_has_its_titles_in_one_entry() -> None:
+    """The tables, the figures and the sentences read one entry per split."""
+    assert SPLIT_TITLES == {name: split.table for name, split in SPLITS.items()}
+    assert table_title("heldout") == "Held-out scenarios"
+    assert figure_title("inrange") == "in-range scenarios"
+    assert split_label("heldout") == "held-out"
+    assert figure_title(YOURS) == "your scenarios"
+
+
+def test_an_unknown_split_is_titled_by_its_name() -> None:
+    assert table_title("unseen_hull") == figure_title("unseen_hull") == "unseen_hull"
+    assert split_label("unseen_hull") == "unseen_hull"
