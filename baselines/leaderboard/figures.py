@@ -60,7 +60,13 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipgym_baselines.leaderboard.escaping import plain_text
-from shipgym_baselines.leaderboard.ranking import BASELINE, ORACLE, ORACLE_FROZEN, REFERENCE_KIND
+from shipgym_baselines.leaderboard.ranking import (
+    BASELINE,
+    ORACLE,
+    ORACLE_FROZEN,
+    PROB,
+    REFERENCE_KIND,
+)
 from shipgym_baselines.leaderboard.splits import figure_title
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.policy import FAMILIES
@@ -702,7 +708,7 @@ _RATIO_LABEL = "cost ratio C / C_oracle [–] (log)"
 _INTERVAL_PANELS = (
     ("cost_ratio_iqm", "IQM cost ratio", _RATIO_LABEL, (1.0,)),
     ("cost_ratio_gmean", "geometric-mean cost ratio", _RATIO_LABEL, (1.0,)),
-    (f"prob_improvement_over_{BASELINE}", f"P(ratio < {BASELINE}'s)", "probability [–]", (0.5,)),
+    (PROB, f"P(ratio < {BASELINE}'s)", "probability [–]", (0.5,)),
     ("failure_rate", "failure rate", "fraction of episodes [–]", ()),
 )
 

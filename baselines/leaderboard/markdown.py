@@ -7,9 +7,14 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from shipgym_baselines.leaderboard.columns import (
+    RankingColumn,
+    count,
+    markdown_columns,
+    shown,
+)
 from shipgym_baselines.leaderboard.escaping import md_cell
 from shipgym_baselines.leaderboard.ranking import (
-    BASELINE,
     GAIN,
     HEADROOM_EXPLAINED,
     ORACLE,
@@ -21,7 +26,7 @@ from shipgym_baselines.leaderboard.ranking import (
     resolution_lines,
 )
 from shipgym_baselines.leaderboard.splits import TEST_SPLITS, split_label, table_title
-from shipgym_baselines.leaderboard.tables import PROB, generalisation, generalisation_splits
+from shipgym_baselines.leaderboard.tables import generalisation, generalisation_splits
 from shipgym_baselines.leaderboard.verdict import verdict
 
 
@@ -52,26 +57,12 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
     column of the probability of improvement over ``pid_los`` only where a row has one (the
     run has ``pid_los`` and another controller), the columns against the frozen optimum
     (adaptation gain, P(beats it), gap closed) only where a row has them (the run has
-    ``oracle_frozen``)."""
+    ``oracle_frozen``); the columns: :mod:`.columns`."""
     lines: list[str] = []
     for split in dict.fromkeys(r["split"] for r in board):
         mine = [r for r in board if r["split"] == split]
-        with_prob = any(r[PROB] is not None for r in mine)
-        prob = [f"P(improvement over {BASELINE}) [95 % CI]"] if with_prob else []
-        with_gap = any(r.get(GAIN) is not None for r in mine)
-        gap = list(GAP_HEADERS) if with_gap else []
-        header = [
-            "rank",
-            "controller",
-            "kind",
-            "training seeds",
-            "scenarios",
-            "cost ratio IQM [95 % CI]",
-            "geometric mean [95 % CI]",
-            *prob,
-            "failure rate [95 % CI]",
-            *gap,
-        ]
+        columns = shown(markdown_columns(), mine)
+        header = [str(c.markdown) for c in columns]
         lines += [
             f"### {_table_title(split, mine)}",
             "",
@@ -79,40 +70,29 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
             "|" + "---|" * len(header),
         ]
         for rank, r in enumerate(mine, start=1):
-            cells = [
-                str(rank),
-                md_cell(r["controller"]),
-                md_cell(r["kind"]),
-                str(r["training_seeds"] or "–"),
-                str(len(r["scenarios"])),
-                _interval(r["cost_ratio_iqm"], r["cost_ratio_iqm_ci95"], 3),
-                _interval(r["cost_ratio_gmean"], r["cost_ratio_gmean_ci95"], 3),
-                *([_interval(r[PROB], r[f"{PROB}_ci95"])] if with_prob else []),
-                _interval(r["failure_rate"], r["failure_rate_ci95"]),
-                *(_gap_cells(r) if with_gap else []),
-            ]
+            cells = [_ranking_cell(c, r, rank) for c in columns]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     return lines
 
 
 #: the ranking tables' columns against the frozen optimum
-GAP_HEADERS = (
-    "adaptation gain [95 % CI]",
-    "P(C < C_frozen) [95 % CI]",
-    "gap closed IQM [95 % CI] (trials)",
-)
+GAP_HEADERS = tuple(str(c.markdown) for c in markdown_columns() if c.only_with == GAIN)
 
 
-def _gap_cells(row: Mapping[str, Any]) -> list[str]:
-    """A ranking row's cells against the frozen optimum (:data:`GAP_HEADERS`)."""
-    trials = row.get("gap_trials")
-    gap = _interval(row.get("gap_closed_iqm"), row.get("gap_closed_iqm_ci95"))
-    return [
-        _interval(row.get(GAIN), row.get(f"{GAIN}_ci95")),
-        _interval(row.get("prob_beats_frozen"), row.get("prob_beats_frozen_ci95")),
-        gap + (f" ({trials})" if gap != "–" and trials else ""),
-    ]
+def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> str:
+    """A ranking row's cell in ``column``: the value and its interval on one line (the
+    count of trials after it where the column has one), "–" where there is none."""
+    value = column.value(row)
+    if column.cell == "rank":
+        return str(rank)
+    if column.cell in ("name", "text"):
+        return md_cell(value)
+    if column.cell == "count":
+        return str(count(value) or "–")
+    text = _interval(value, column.interval(row), column.digits)
+    trials = row.get(column.trials) if column.trials else None
+    return text + (f" ({trials})" if text != "–" and trials else "")
 
 
 def ranking_markdown(

@@ -44,6 +44,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
+from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
 from shipgym_baselines.leaderboard.figures import (
     LEARNING_CURVES_STEM,
     LEGEND_KEY,
@@ -51,8 +52,6 @@ from shipgym_baselines.leaderboard.figures import (
     figure_stem,
 )
 from shipgym_baselines.leaderboard.ranking import (
-    BASELINE,
-    GAIN,
     HEADROOM_EXPLAINED,
     ORACLE,
     ORACLE_FROZEN,
@@ -63,12 +62,11 @@ from shipgym_baselines.leaderboard.ranking import (
     no_ranking,
     resolution_lines,
 )
+from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
+from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES  # re-exported
 from shipgym_baselines.leaderboard.splits import table_title
 from shipgym_baselines.leaderboard.style import controller_style
 from shipgym_baselines.records.outfiles import write_bytes
-
-#: the aggregate rows' probability of improvement (None: no comparison with ``pid_los``)
-PROB = f"prob_improvement_over_{BASELINE}"
 
 PAGE_FILE = "leaderboard.html"
 #: most significant digits of a cell's sort key (``data-sort``)
@@ -379,72 +377,45 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     whose rows have no probability of improvement (``pid_los`` not ranked there) has no
     such column; a row without one (``pid_los`` itself) shows "–".  The columns against
     the frozen optimum (adaptation gain, P(beats it), gap closed) only where a row has
-    them."""
-    columns = [
-            ("controller", "controller", "text"),
-            ("rank", "rank", "number"),
-            ("kind", "kind", "text"),
-            ("scenarios", "scenarios", "number"),
-            ("runs", "runs", "number"),
-            ("training_seeds", "training seeds", "number"),
-            ("cost_ratio_iqm", "IQM cost ratio", "lower"),
-            ("cost_ratio_gmean", "geometric mean", "lower"),
-            ("prob", _e(f"P(ratio < {BASELINE}'s)"), "number"),
-            ("failure_rate", "failure rate", "lower"),
-            (GAIN, "adaptation gain", "number"),
-            ("prob_beats_frozen", "P(C &lt; C_frozen)", "number"),
-            ("gap_closed_iqm", "gap closed IQM", "number"),
-    ]  # fmt: skip
+    them; the columns: :mod:`.columns`."""
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):
         rows = [r for r in aggregate if r["split"] == split]
-        body = []
-        for rank, r in enumerate(rows, start=1):
-            scenarios = r.get("scenarios")
-            n = len(scenarios) if isinstance(scenarios, Sequence) else scenarios
-            body.append(
-                [
-                    _name_cell(r["controller"]),
-                    _Td(str(rank), -rank, rank),  # best-first on the first click
-                    _text_cell(r.get("kind", "")),
-                    _cell(n),
-                    _cell(r.get("runs")),
-                    _cell(r.get("training_seeds")),
-                    _cell(r.get("cost_ratio_iqm"), r.get("cost_ratio_iqm_ci95")),
-                    _cell(r.get("cost_ratio_gmean"), r.get("cost_ratio_gmean_ci95")),
-                    _cell(
-                        r.get(PROB),
-                        r.get(f"{PROB}_ci95"),
-                    ),
-                    _cell(r.get("failure_rate"), r.get("failure_rate_ci95")),
-                    _cell(r.get(GAIN), r.get(f"{GAIN}_ci95")),
-                    _cell(r.get("prob_beats_frozen"), r.get("prob_beats_frozen_ci95")),
-                    _gap_cell(r),
-                ]
-            )
+        mine = shown(page_columns(), rows)
+        columns = [(c.name, _e(c.page), _sort_kind(c)) for c in mine]
+        body = [[_ranking_cell(c, r, rank) for c in mine] for rank, r in enumerate(rows, 1)]
         base = split.removesuffix(PARTIAL)
         title = table_title(base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        keys = [c[0] for c in columns]
-        skip = set()
-        if all(r.get(PROB) is None for r in rows):  # pid_los not ranked here: no comparison
-            skip.add(keys.index("prob"))
-        if all(r.get(GAIN) is None for r in rows):  # no frozen optimum: no gap columns
-            skip |= {keys.index(k) for k in (GAIN, "prob_beats_frozen", "gap_closed_iqm")}
-        mine = [c for i, c in enumerate(columns) if i not in skip]
-        body = [[td for i, td in enumerate(cells) if i not in skip] for cells in body]
-        table = _table(f"ranking-{split}", mine, body, compact=True, cls="ranking")
+        table = _table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
         parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
     notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
 
 
-def _gap_cell(row: Mapping[str, Any]) -> _Td:
-    """A ranking row's gap closed: the IQM, its interval and the qualifying trials."""
-    td = _cell(row.get("gap_closed_iqm"), row.get("gap_closed_iqm_ci95"))
-    trials = row.get("gap_trials")
-    if row.get("gap_closed_iqm") is None or not trials:
+def _sort_kind(column: RankingColumn) -> str:
+    """How the page sorts a ranking column (:func:`_head`): text, or numbers (``lower``:
+    ascending on the first click)."""
+    if column.cell in ("name", "text"):
+        return "text"
+    return "lower" if column.lower else "number"
+
+
+def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> _Td:
+    """A ranking row's cell in ``column``: the value, its interval below it (the count of
+    trials after it where the column has one)."""
+    if column.cell == "rank":
+        return _Td(str(rank), -rank, rank)  # best-first on the first click
+    if column.cell == "name":
+        return _name_cell(row["controller"])
+    if column.cell == "text":
+        return _text_cell(row.get(column.key, ""))
+    if column.cell == "count":
+        return _cell(count(column.value(row)))
+    td = _cell(column.value(row), column.interval(row))
+    trials = row.get(column.trials) if column.trials else None
+    if column.value(row) is None or not trials:
         return td
     return td._replace(html=f"{td.html}<i>{_e(trials)} trials</i>")
 

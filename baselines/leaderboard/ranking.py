@@ -90,6 +90,8 @@ AGGREGATE_REPS = 2000
 #: the gap closed is averaged over the trials where knowing the change is worth at least
 #: this factor (headroom C_frozen / C_oracle)
 GAP_HEADROOM = 1.2
+#: an aggregate row's probability of improvement over ``pid_los`` (None: no comparison)
+PROB = f"prob_improvement_over_{BASELINE}"
 #: the fields of an ``aggregate.json`` object, in order
 AGGREGATE_FIELDS = (
     "controller",
@@ -102,8 +104,8 @@ AGGREGATE_FIELDS = (
     "cost_ratio_iqm_ci95",
     "cost_ratio_gmean",
     "cost_ratio_gmean_ci95",
-    f"prob_improvement_over_{BASELINE}",
-    f"prob_improvement_over_{BASELINE}_ci95",
+    PROB,
+    f"{PROB}_ci95",
     "failure_rate",
     "failure_rate_ci95",
     "adaptation_gain_gmean",
@@ -559,8 +561,8 @@ def ranking_row(
         "cost_ratio_iqm_ci95": _pairs(interval, 0),
         "cost_ratio_gmean": float(point[1]),
         "cost_ratio_gmean_ci95": _pairs(interval, 1),
-        f"prob_improvement_over_{BASELINE}": prob,
-        f"prob_improvement_over_{BASELINE}_ci95": prob_ci,
+        PROB: prob,
+        f"{PROB}_ci95": prob_ci,
         "failure_rate": float(fail_point[0]),
         "failure_rate_ci95": _pairs(fail_interval, 0),
         **gap_fields(scored, controller, tasks, reps, seed),

@@ -11,10 +11,9 @@ from typing import Any
 import numpy as np
 
 from shipgym.metrics import aggregate
-from shipgym_baselines.leaderboard.ranking import (
-    BASELINE,
-    row_intervals,
-)
+from shipgym_baselines.leaderboard.ranking import BASELINE as BASELINE  # re-exported
+from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
+from shipgym_baselines.leaderboard.ranking import row_intervals
 
 # the splits are defined in .splits; these names stay importable from here
 from shipgym_baselines.leaderboard.splits import GENERALISATION_SPLITS as GENERALISATION_SPLITS
@@ -44,7 +43,6 @@ COLUMNS = (
 TRAINING_COLUMNS = ("train_env_steps", "train_wall_s")
 
 AGGREGATE_FILE = "aggregate.json"
-PROB = f"prob_improvement_over_{BASELINE}"
 SCENARIO_SCORES_FILE = "scenario_scores.json"
 
 
