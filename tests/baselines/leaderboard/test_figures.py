@@ -19,17 +19,13 @@ from shipgym_baselines.leaderboard.figures import (
     PAGE_COLOURS,
     PAGE_WIDTH,
     DrawnEpisode,
-    controller_family,
     episodes_to_draw,
-    family_panels,
     median_ace_episode,
     plot_ranking,
     plot_scenario,
 )
 from shipgym_baselines.leaderboard.ranking import aggregate_ranking
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
-from shipgym_baselines.policy import Style
-from shipgym_baselines.registry import register_controller
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -210,34 +206,6 @@ def test_episodes_to_draw_keeps_the_median_episode_with_its_trajectory() -> None
     drawn = episodes_to_draw([Result(1, 5.0, True), Result(2, 1.0, True), Result(3, 2.0, True)])
     assert drawn[("s", "lqr")].seed == 3
     assert episodes_to_draw([Result(1, 5.0, True), Result(3, 2.0, False)]) == {}
-
-
-def test_a_big_family_is_split_over_panels() -> None:
-    names = [f"pid_{i}" for i in range(7)] + ["lqr", "zero_rudder", "my_plugin"]
-    panels = family_panels(names, {"my_plugin": "learned"})
-    assert [title for title, _ in panels] == [
-        "PID (1/2)",
-        "PID (2/2)",
-        "LQR",
-        "learned",
-        "references",
-    ]
-    assert all(len(members) <= figures.PANEL_CONTROLLERS for _, members in panels)
-    assert sorted(n for _, members in panels for n in members) == sorted(names)
-
-
-def test_the_figures_draw_a_controller_as_registered(scratch_registry: None) -> None:
-    """Family and look come from the registration (its name says nothing); a name nothing
-    declares them for takes its kind's family and its name's hashed look."""
-    from shipgym_baselines.classical.reference import ZeroRudder
-
-    look = Style("#123456", "--", "o")
-    register_controller("test_mine", lambda: ZeroRudder(), family="NMPC", look=look)
-    assert (controller_family("test_mine"), controller_style("test_mine")) == ("NMPC", look)
-    assert controller_family("ppo") == "learned" and controller_family("oracle") == "references"
-    assert controller_family("my_ref", "reference") == "references"
-    assert controller_family("my_agent", "learned") == "learned"
-    assert controller_family("my_plugin", "classical") == "other"
 
 
 def test_both_references_are_drawn_in_every_column(tmp_path: Path) -> None:

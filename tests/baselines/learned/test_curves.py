@@ -172,7 +172,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
 ) -> None:
     """A run that selects on the validation cost ratio is drawn on it (log axis, the oracle
     at 1, each seed's best point ringed); one without it on its return."""
-    from shipgym_baselines.leaderboard import figures
+    from shipgym_baselines.leaderboard import curve_figures, figures
 
     drawn = {}
 
@@ -180,7 +180,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
         drawn[stem] = fig
         return []
 
-    monkeypatch.setattr(figures, "save_figure", keep)
+    monkeypatch.setattr(curve_figures, "save_figure", keep)
     ratio = {"env_steps": [10, 20, 30], "mean_return": [-3.0, -2.0, -2.5], "std_return": [1.0] * 3}
     curves = {
         "dagger": [{**ratio, "selection": [5.0, 2.0, 2.5], "seed": 0}],
