@@ -32,58 +32,34 @@ writes the page and returns its path.
 
 from __future__ import annotations
 
-import base64
-import gzip
-import html
-import io
-import itertools
-import json
-import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
-from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
-from shipgym_baselines.leaderboard.figures import (
-    LEARNING_CURVES_STEM,
-    LEGEND_KEY,
-    LEGEND_TOP_KEY,
-    figure_stem,
-)
-from shipgym_baselines.leaderboard.ranking import (
-    HEADROOM_EXPLAINED,
-    ORACLE,
-    ORACLE_FROZEN,
-    PARTIAL,
-    SCORE_EXPLAINED,
-    headroom_grid,
-    is_partial,
-    no_ranking,
-    resolution_lines,
-)
+# the page's tables, cells and figures have their own modules (html_cells, page_sections,
+# page_figures); their names stay importable from here
+from shipgym_baselines.leaderboard.html_cells import SORT_DIGITS as SORT_DIGITS
+from shipgym_baselines.leaderboard.html_cells import esc
+from shipgym_baselines.leaderboard.html_cells import packed_body as packed_body
+from shipgym_baselines.leaderboard.html_cells import sort_keys as sort_keys
+from shipgym_baselines.leaderboard.html_cells import swatch_css as swatch_css
+from shipgym_baselines.leaderboard.html_cells import unpacked_body as unpacked_body
+from shipgym_baselines.leaderboard.page_figures import REFERENCE_CSS
+from shipgym_baselines.leaderboard.page_figures import PageImage as PageImage
+from shipgym_baselines.leaderboard.page_figures import embedded_figures as embedded_figures
+from shipgym_baselines.leaderboard.page_figures import figure_sections as figure_sections
+from shipgym_baselines.leaderboard.page_figures import page_image as page_image
+from shipgym_baselines.leaderboard.page_sections import ROW_METRICS as ROW_METRICS
+from shipgym_baselines.leaderboard.page_sections import headroom_html as headroom_html
+from shipgym_baselines.leaderboard.page_sections import ranking_tables as ranking_tables
+from shipgym_baselines.leaderboard.page_sections import row_table as row_table
+from shipgym_baselines.leaderboard.page_sections import score_table as score_table
+from shipgym_baselines.leaderboard.ranking import ORACLE_FROZEN, SCORE_EXPLAINED, no_ranking
 from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
 from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES  # re-exported
-from shipgym_baselines.leaderboard.splits import table_title
-from shipgym_baselines.leaderboard.style import controller_style
 from shipgym_baselines.records.outfiles import write_bytes
 
 PAGE_FILE = "leaderboard.html"
-#: most significant digits of a cell's sort key (``data-sort``)
-SORT_DIGITS = 7
-#: the long table's metric columns: key → header (with units)
-ROW_METRICS = {
-    "ace": "ACE [m]",
-    "ace_L": "ACE/L [–]",
-    "t_c": "t_c [s]",
-    "return": "return [–]",
-    "cost": "cost [–]",
-    "rudder_travel": "rudder travel [rad]",
-    "J": "J [–]",
-    "success": "success [–]",
-    "compute_ms": "compute [ms]",
-}
-
 _CSS = """
 body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:24px;
 color:#1b1f24;background:#fff}
@@ -182,518 +158,6 @@ _JS = """
 """
 
 
-def _e(text: Any) -> str:
-    """HTML-escaped text (quotes too: safe in attributes)."""
-    return html.escape(str(text), quote=True)
-
-
-def _finite(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return None
-    return float(value) if math.isfinite(value) else None
-
-
-def _number(value: Any) -> str:
-    """A number for a cell: 3 significant decimals, ∞ as "never" (t_c), none as "–"."""
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        if math.isinf(value):
-            return "never" if value > 0 else "−∞"
-        if math.isnan(value):
-            return "–"
-        return f"{value:.3f}" if isinstance(value, float) else str(value)
-    return "–" if value is None else str(value)
-
-
-def _interval(ci: Any) -> str:
-    if isinstance(ci, Sequence) and len(ci) == 2 and all(_finite(v) is not None for v in ci):
-        return f"[{ci[0]:.3f}, {ci[1]:.3f}]"
-    return ""
-
-
-class _Td(NamedTuple):
-    """A body cell: its inner HTML, its sort value (a finite number; None sorts last; for a
-    text cell unused: the script sorts by the text), the number its text starts with (what
-    the script reads without ``data-sort``) and further attributes."""
-
-    html: str
-    value: float | None = None
-    shown: float | None = None
-    attrs: str = ""
-
-
-def _leading_number(text: str) -> float | None:
-    """The number ``parseFloat`` reads at the start of a cell's text (None: NaN)."""
-    match = _LEADING_NUMBER.match(text)
-    return float(match.group(0)) if match else None
-
-
-_LEADING_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
-
-
-def _cell(value: Any, ci: Any = None, std: Any = None, shade: bool = False) -> _Td:
-    """A numeric cell: the value, its interval (or ± std) below, the value as sort key."""
-    sort = _finite(value)
-    extra = _interval(ci) or (f"± {std:.3f}" if _finite(std) is not None else "")
-    style = f' style="background:{_shade(sort)}"' if shade and sort is not None else ""
-    small = f"<i>{_e(extra)}</i>" if extra else ""
-    text = _number(value)
-    return _Td(f"{_e(text)}{small}", sort, _leading_number(text), style)
-
-
-def _shade(ratio: float) -> str:
-    """Background of a cost-ratio cell: green (≤ 1, the oracle) → yellow → red (≥ 4), on a
-    log scale."""
-    t = min(max(math.log(ratio) / math.log(4.0), 0.0), 1.0) if ratio > 0 else 0.0
-    return f"hsl({120 * (1.0 - t):.0f},65%,88%)"
-
-
-def _text_cell(text: Any) -> _Td:
-    return _Td(_e(text))
-
-
-def _swatch_class(name: str) -> tuple[str, str]:
-    """(class, CSS rule) of a controller's swatch: its line's colour and style."""
-    style = controller_style(name)
-    border = {"-": "solid", "--": "dashed", "-.": "dashed", ":": "dotted"}.get(
-        style.linestyle, "solid"
-    )
-    cls = "k" + "".join(c for c in style.color if c.isalnum()).lower() + border[:2]
-    return cls, f".{cls}{{border-top-style:{border};border-top-color:{_e(style.color)}}}"
-
-
-def swatch_css(names: Iterable[str]) -> str:
-    """The swatch classes of these controllers, each rule once."""
-    return "".join(sorted({_swatch_class(n)[1] for n in names}))
-
-
-def _name_cell(name: str) -> _Td:
-    return _Td(f'<span class="{_swatch_class(name)[0]}"></span>{_e(name)}')
-
-
-def _head(columns: Iterable[tuple[str, str, str]]) -> str:
-    """``<thead>`` of (key, header text, "number" | "lower" | "text") columns (``lower``: a
-    number that is better lower, sorted ascending on the first click); the first is the
-    name."""
-    cells = []
-    for i, (key, text, kind) in enumerate(columns):
-        first = ' data-first="ascending"' if kind == "lower" else ""
-        cells.append(
-            f'<th data-key="{_e(key)}" data-type="{"number" if kind == "lower" else kind}"'
-            + first
-            + (' class="text"' if kind == "text" and i else "")
-            + f">{text}</th>"
-        )
-    return "<thead><tr>" + "".join(cells) + "</tr></thead>"
-
-
-def _same_order(values: Sequence[float | None], keys: Sequence[float | None]) -> bool:
-    """Whether ``keys`` sort the cells as ``values`` do: equal values equal keys, distinct
-    ones in the same order, None (last) where None."""
-    pairs = sorted({(v, k) for v, k in zip(values, keys, strict=True) if v is not None})
-    if any((v is None) != (k is None) for v, k in zip(values, keys, strict=True)):
-        return False
-    for (v0, k0), (v1, k1) in itertools.pairwise(pairs):
-        if v0 == v1 or k0 is None or k1 is None or not k0 < k1:
-            return False
-    return True
-
-
-def sort_keys(values: Sequence[float | None], shown: Sequence[float | None]) -> list[str] | None:
-    """A numeric column's ``data-sort`` keys: None where the numbers its cells' texts start
-    with sort them as their values do (the script reads the text), else each value at the
-    fewest significant digits that keep the values' order and ties, at most 7 (values that
-    differ only beyond the 7th digit tie, and keep their order in the page; "" for none)."""
-    if _same_order(values, shown):
-        return None
-    for digits in range(1, SORT_DIGITS + 1):
-        keys = ["" if v is None else f"{v:.{digits}g}" for v in values]
-        if _same_order(values, [float(k) if k else None for k in keys]):
-            break
-    return keys
-
-
-def _table(
-    table_id: str,
-    columns: Sequence[tuple[str, str, str]],
-    body: Sequence[Sequence[_Td]],
-    compact: bool = False,
-    cls: str = "",
-) -> str:
-    """A sortable table; ``compact``: intervals beside the values, not below.  A numeric
-    column carries ``data-sort`` keys only where its texts would sort otherwise
-    (:func:`sort_keys`); the script sorts a text column by its texts."""
-    keys: dict[int, list[str]] = {}
-    for col, (_, _, kind) in enumerate(columns):
-        if kind == "text":
-            continue
-        cells = [(row, row[col]) for row in body if col < len(row)]
-        found = sort_keys([c.value for _, c in cells], [c.shown for _, c in cells])
-        if found is not None:
-            keys[col] = found
-    where = {col: 0 for col in keys}
-    rows = []
-    for row in body:
-        tds = []
-        for col, td in enumerate(row):
-            sort = ""
-            if col in keys:
-                sort = f' data-sort="{keys[col][where[col]]}"'
-                where[col] += 1
-            tds.append(f"<td{sort}{td.attrs}>{td.html}</td>")
-        rows.append("<tr>" + "".join(tds) + "</tr>")
-    classes = " ".join(c for c in ("sortable", "compact" if compact else "", cls) if c)
-    return (
-        f'<div class="scroll"><table class="{classes}" id="{_e(table_id)}">{_head(columns)}'
-        f"<tbody>{''.join(rows)}</tbody></table></div>"
-    )
-
-
-def packed_body(table: str) -> str:
-    """``table`` (:func:`_table`'s HTML) with its body's rows deflated into the body's
-    ``data-gzip`` attribute (gzip, base64; the page's script unpacks them with the
-    browser's ``DecompressionStream``): the long table's markup is ≈ 6 times lighter."""
-    head, sep, rest = table.partition("<tbody>")
-    inner, end, tail = rest.partition("</tbody>")
-    if not sep or not end:
-        raise ValueError("packed_body: the table has no <tbody>")
-    packed = gzip.compress(inner.encode("utf-8"), compresslevel=9, mtime=0)
-    data = base64.b64encode(packed).decode("ascii")
-    return f'{head}<tbody data-gzip="{data}"></tbody>{tail}'
-
-
-def unpacked_body(table: str) -> str:
-    """The inverse of :func:`packed_body` (tests, and readers of the page's source)."""
-    match = re.search(r'<tbody data-gzip="([A-Za-z0-9+/=]*)"></tbody>', table)
-    if match is None:
-        return table
-    inner = gzip.decompress(base64.b64decode(match.group(1))).decode("utf-8")
-    return table[: match.start()] + f"<tbody>{inner}</tbody>" + table[match.end() :]
-
-
-# ----------------------------------------------------------------------------- sections
-def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
-    """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
-    cost ratio's IQM, lowest first); a split's partial table is titled as such.  A table
-    whose rows have no probability of improvement (``pid_los`` not ranked there) has no
-    such column; a row without one (``pid_los`` itself) shows "–".  The columns against
-    the frozen optimum (adaptation gain, P(beats it), gap closed) only where a row has
-    them; the columns: :mod:`.columns`."""
-    parts = []
-    for split in dict.fromkeys(r["split"] for r in aggregate):
-        rows = [r for r in aggregate if r["split"] == split]
-        mine = shown(page_columns(), rows)
-        columns = [(c.name, _e(c.page), _sort_kind(c)) for c in mine]
-        body = [[_ranking_cell(c, r, rank) for c in mine] for rank, r in enumerate(rows, 1)]
-        base = split.removesuffix(PARTIAL)
-        title = table_title(base)
-        if is_partial(split):
-            title += ": controllers that do not apply to every scenario (each on its own)"
-        table = _table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
-        parts.append(f"<div><h3>{_e(title)}</h3>{table}</div>")
-    notes = "".join(f'<p class="note">{_e(line)}</p>' for line in resolution_lines(aggregate))
-    return '<div class="splits">' + "".join(parts) + "</div>" + notes
-
-
-def _sort_kind(column: RankingColumn) -> str:
-    """How the page sorts a ranking column (:func:`_head`): text, or numbers (``lower``:
-    ascending on the first click)."""
-    if column.cell in ("name", "text"):
-        return "text"
-    return "lower" if column.lower else "number"
-
-
-def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> _Td:
-    """A ranking row's cell in ``column``: the value, its interval below it (the count of
-    trials after it where the column has one)."""
-    if column.cell == "rank":
-        return _Td(str(rank), -rank, rank)  # best-first on the first click
-    if column.cell == "name":
-        return _name_cell(row["controller"])
-    if column.cell == "text":
-        return _text_cell(row.get(column.key, ""))
-    if column.cell == "count":
-        return _cell(count(column.value(row)))
-    td = _cell(column.value(row), column.interval(row))
-    trials = row.get(column.trials) if column.trials else None
-    if column.value(row) is None or not trials:
-        return td
-    return td._replace(html=f"{td.html}<i>{_e(trials)} trials</i>")
-
-
-def _controller_order(
-    rows: Sequence[Mapping[str, Any]],
-    aggregate: Sequence[Mapping[str, Any]],
-    cells: Mapping[tuple[str, str], Mapping[str, Any]],
-) -> list[str]:
-    """Controllers by the first split's ranking, then any other in the order they appear."""
-    names = [r["controller"] for r in aggregate if r["split"] == aggregate[0]["split"]]
-    names += [r["controller"] for r in aggregate]
-    names += [r["controller"] for r in rows] + [c for c, _ in cells]
-    return list(dict.fromkeys(names))
-
-
-def score_table(
-    rows: Sequence[Mapping[str, Any]],
-    aggregate: Sequence[Mapping[str, Any]],
-    scores: Sequence[Mapping[str, Any]],
-) -> str:
-    """The sortable controller × scenario table (``id="scores"``): each controller's IQM cost
-    ratio per split, then its geometric-mean cost ratio with interval per scenario (whose
-    header gives the oracle's mean cost); "n/a" where it does not apply."""
-    scenarios = list(dict.fromkeys([r["scenario"] for r in rows] + [s["scenario"] for s in scores]))
-    split_of = {r["scenario"]: r.get("split", "") for r in rows}
-    split_of.update({s["scenario"]: s.get("split", "") for s in scores})
-    splits = list(dict.fromkeys(r["split"] for r in aggregate))
-    cell = {(c["controller"], s["scenario"]): c for s in scores for c in s["controllers"]}
-    oracle = {s["scenario"]: s for s in scores}
-    iqm = {(r["controller"], r["split"]): r for r in aggregate}
-    kinds = {r["controller"]: r.get("kind", "") for r in [*rows, *aggregate]}
-    kinds.update({c: v.get("kind", "") for (c, _), v in cell.items()})
-    not_applicable = {
-        (r["controller"], r["scenario"]) for r in rows if r.get("applies", True) is False
-    }
-    columns = [("controller", "controller", "text"), ("kind", "kind", "text")]
-    columns += [(f"iqm:{sp}", f"IQM<br>{_e(sp)}", "lower") for sp in splits]
-    columns += [
-        (s, f'<a href="#fig-{_e(_anchor(s))}">{_e(s)}</a><br><small>{_e(split_of[s])}'
-         f"{_oracle_cost(oracle.get(s))}</small>", "lower")
-        for s in scenarios
-    ]  # fmt: skip
-    body = []
-    for name in _controller_order(rows, aggregate, cell):
-        if name == ORACLE:
-            continue
-        tds = [_name_cell(name), _text_cell(kinds.get(name, ""))]
-        for sp in splits:
-            agg = iqm.get((name, sp), {})
-            tds.append(_cell(agg.get("cost_ratio_iqm"), agg.get("cost_ratio_iqm_ci95")))
-        for s in scenarios:
-            if (name, s) in not_applicable:
-                tds.append(_Td("n/a", attrs=' class="na" title="does not apply"'))
-            else:
-                sc = cell.get((name, s), {})
-                tds.append(
-                    _cell(sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True)
-                )
-        body.append(tds)
-    return _table("scores", columns, body)
-
-
-def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
-    """A scenario header's line on the oracle's mean cost (the ratios' denominator), and
-    the frozen optimum's where it ran."""
-    if not entry:
-        return ""
-    text = f"<br>{_e(ORACLE)} cost {_e(_number(entry.get('oracle_cost')))}"
-    if entry.get("oracle_frozen_cost") is not None:
-        text += f"<br>{_e(ORACLE_FROZEN)} cost {_e(_number(entry['oracle_frozen_cost']))}"
-    return text
-
-
-def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
-    """The headroom table (:func:`shipgym_baselines.leaderboard.ranking.headroom_table` rows): one
-    row per ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
-    over its trials (how many beside it); empty without rows."""
-    if not headroom:
-        return ""
-    ships, families, cells = headroom_grid(headroom)
-    columns = [("ship", "ship", "text")]
-    columns += [(f, _e(f.replace("_", " ")), "number") for f in families]
-    body = []
-    for ship in ships:
-        tds = [_text_cell(ship)]
-        for family in families:
-            found = cells.get((ship, family))
-            if found is None:
-                tds.append(_Td("–"))
-                continue
-            trials = found["trials"]
-            value = _finite(found["headroom_gmean"])
-            text = _number(found["headroom_gmean"])
-            small = f"<i>{trials} trial{'s' if trials != 1 else ''}</i>"
-            tds.append(_Td(f"{_e(text)}{small}", value, _leading_number(text)))
-        body.append(tds)
-    return (
-        '<h3 id="headroom">Headroom per ship and change family</h3>'
-        f'<p class="note">{_e(HEADROOM_EXPLAINED)}</p>'
-        f"{_table('headroom', columns, body, compact=True)}"
-    )
-
-
-def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
-    """The long table: one row per (scenario, controller), every metric with its interval
-    (``*_ci95``, else ± std)."""
-    metrics = [k for k in ROW_METRICS if any(k in r for r in rows)]
-    columns = [
-        ("controller", "controller", "text"),
-        ("scenario", "scenario", "text"),
-        ("split", "split", "text"),
-        ("kind", "kind", "text"),
-        ("seeds", "seeds", "number"),
-        ("training_seeds", "training seeds", "number"),
-    ] + [(k, _e(ROW_METRICS[k]), "number") for k in metrics]
-    body = []
-    for r in rows:
-        tds = [_name_cell(r["controller"])] + [
-            _text_cell(r.get(k, "")) for k in ("scenario", "split", "kind")
-        ]
-        tds += [_cell(r.get("seeds")), _cell(r.get("training_seeds"))]
-        if r.get("applies", True) is False:
-            attrs = f' class="na" colspan="{len(metrics)}" style="text-align:left"'
-            tds.append(_Td("does not apply", attrs=attrs))
-        else:
-            tds += [_cell(r.get(k), r.get(f"{k}_ci95"), r.get(f"{k}_std")) for k in metrics]
-        body.append(tds)
-    return _table("rows", columns, body)
-
-
-# ------------------------------------------------------------------------------ figures
-def _anchor(name: str) -> str:
-    """The id of a scenario's figure (the stem
-    :func:`shipgym_baselines.leaderboard.figures.plot_scenario` gives
-    its files)."""
-    return "scenario_" + figure_stem(name)
-
-
-class PageImage(NamedTuple):
-    """A figure as the page embeds it: MIME type, bytes, and the legends it carries as text
-    (a scenario figure's :data:`~shipgym_baselines.leaderboard.figures.LEGEND_KEY`; None: in the
-    image)."""
-
-    mime: str
-    data: bytes
-    legends: list[tuple[str, list[tuple[str, str]]]] | None = None
-
-
-def page_image(png: Path) -> PageImage:
-    """A PNG as the page embeds it: the same pixels as lossless WebP where that is smaller
-    (a palette figure: ≈ 20 % smaller; every current browser shows WebP; effort 4 of 6:
-    0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the PNG as it is.  A
-    scenario figure whose PNG says where its legends start
-    (:data:`~shipgym_baselines.leaderboard.figures.LEGEND_TOP_KEY`) is cut above them and its
-    legends returned as text (the page writes them under the image)."""
-    data = png.read_bytes()
-    from PIL import Image, features
-
-    with Image.open(png) as image:
-        image.load()
-        text = dict(getattr(image, "text", {}))
-        legends = None
-        if LEGEND_KEY in text and LEGEND_TOP_KEY in text:
-            legends = [
-                (t, [tuple(e) for e in entries]) for t, entries in json.loads(text[LEGEND_KEY])
-            ]
-            top = round(float(text[LEGEND_TOP_KEY]) * image.height)
-            image = image.crop((0, 0, image.width, top))
-        if not features.check("webp"):
-            if legends is None:
-                return PageImage("image/png", data)
-            out = io.BytesIO()
-            image.save(out, format="PNG", optimize=True)
-            return PageImage("image/png", out.getvalue(), legends)
-        out = io.BytesIO()
-        image.save(out, format="WEBP", lossless=True, quality=100, method=4)
-    webp = out.getvalue()
-    if legends is None and len(webp) >= len(data):
-        return PageImage("image/png", data)
-    return PageImage("image/webp", webp, legends)
-
-
-class _Embedded(NamedTuple):
-    uri: str
-    file: str
-    legends: list[tuple[str, list[tuple[str, str]]]] | None
-
-
-def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
-    """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
-    page-sized palette PNG, :func:`shipgym_baselines.leaderboard.figures.write_page_png`, embedded
-    as :func:`page_image` gives it: the page stays light), else the SVG; in the
-    order of ``figures``."""
-    by_stem: dict[str, Path] = {}
-    for f in map(Path, figures):
-        if f.suffix.lower() not in (".svg", ".png"):
-            continue
-        if f.stem not in by_stem or f.suffix.lower() == ".png":
-            by_stem[f.stem] = f
-    out = {}
-    for stem, f in by_stem.items():
-        if f.suffix.lower() == ".png":
-            image = page_image(f)
-        else:
-            image = PageImage("image/svg+xml", f.read_bytes())
-        data = base64.b64encode(image.data).decode("ascii")
-        out[stem] = _Embedded(f"data:{image.mime};base64,{data}", f.name, image.legends)
-    return out
-
-
-#: the oracle's line in the scenario figures (black, dashed) and the frozen optimum's (its
-#: grey, dash-dotted: dashed here, CSS has no dash-dot), as legend swatches
-_REFERENCE_SWATCH = "kref"
-_FROZEN_SWATCH = "kfrozen"
-_REFERENCE_CSS = (
-    f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
-    f".{_FROZEN_SWATCH}{{border-top-style:dashed;"
-    f"border-top-color:{controller_style(ORACLE_FROZEN).color}}}"
-)
-_REFERENCE_SWATCHES = {ORACLE: _REFERENCE_SWATCH, ORACLE_FROZEN: _FROZEN_SWATCH}
-
-
-def _legend_swatch(name: str) -> str:
-    """The swatch class of a legend entry: the oracle's or the frozen optimum's reference
-    line, else the controller's."""
-    return _REFERENCE_SWATCHES.get(name) or _swatch_class(name)[0]
-
-
-def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
-    """A scenario figure's legends as text: one block per panel column, each episode's line
-    swatch and label."""
-    blocks = []
-    for title, entries in legends:
-        items = "".join(
-            f'<li><span class="{_legend_swatch(name)}"></span>{_e(label)}</li>'
-            for name, label in entries
-        )
-        blocks.append(f"<div><b>{_e(title)}</b><ul>{items}</ul></div>")
-    return f'<div class="legend">{"".join(blocks)}</div>'
-
-
-def _figure(stem: str, fig: _Embedded, caption: str) -> str:
-    legend = _legend_html(fig.legends) if fig.legends else ""
-    return (
-        f'<figure id="fig-{_e(stem)}"><img src="{fig.uri}" alt="{_e(caption)}" loading="lazy">'
-        f"{legend}<figcaption>{_e(caption)} — <code>{_e(fig.file)}</code></figcaption></figure>"
-    )
-
-
-def figure_sections(
-    figures: Iterable[str | Path], scenarios: Iterable[str] = ()
-) -> tuple[str, str, list[str]]:
-    """(ranking figures, scenario figures, the controllers their legends name) as HTML: per
-    split its interval estimates, then its performance profiles; the scenario figures in
-    the order of ``figures``, captioned with the scenario's name where ``scenarios`` has
-    it."""
-    names = {_anchor(s): s for s in scenarios}
-    ranking: list[tuple[str, int, str]] = []
-    drawn = []
-    legend_names: list[str] = []
-    for stem, fig in embedded_figures(figures).items():
-        kind, _, split = stem.partition("_")
-        legend_names += [n for _, entries in fig.legends or () for n, _ in entries]
-        if stem == LEARNING_CURVES_STEM:  # after the ranking figures of every split
-            caption = "learning curves of the learned agents (validation return per seed)"
-            ranking.append(("~", True, _figure(stem, fig, caption)))
-        elif kind in ("ranking", "profile"):
-            what = "interval estimates" if kind == "ranking" else "performance profiles"
-            ranking.append((split, kind == "profile", _figure(stem, fig, f"{what}, {split}")))
-        else:
-            label = names.get(stem, stem.removeprefix("scenario_"))
-            drawn.append(_figure(stem, fig, f"scenario {label}"))
-    ranking_html = "".join(h for *_, h in sorted(ranking, key=lambda r: r[:2]))
-    return ranking_html, "".join(drawn), legend_names
-
-
-# --------------------------------------------------------------------------------- page
 def page(
     rows: Sequence[Mapping[str, Any]],
     aggregate: Sequence[Mapping[str, Any]],
@@ -715,18 +179,18 @@ def page(
     )
     names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
     names += [c["controller"] for s in scores for c in s["controllers"]]
-    sub = f'<p class="note">{_e(subtitle)}</p>' if subtitle else ""
-    sub += f'<p id="verdict">{_e(verdict)}</p>' if verdict else ""
-    sub += f'<p class="note" id="ranked-against">{_e(note.replace("`", ""))}</p>' if note else ""
+    sub = f'<p class="note">{esc(subtitle)}</p>' if subtitle else ""
+    sub += f'<p id="verdict">{esc(verdict)}</p>' if verdict else ""
+    sub += f'<p class="note" id="ranked-against">{esc(note.replace("`", ""))}</p>' if note else ""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{_e(title)}</title><style>{_CSS}{swatch_css(names)}{_REFERENCE_CSS}</style>"
+        f"<title>{esc(title)}</title><style>{_CSS}{swatch_css(names)}{REFERENCE_CSS}</style>"
         "</head><body>"
-        f"<h1>{_e(title)}</h1>{sub}"
+        f"<h1>{esc(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'
-        f"{_e(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
+        f"{esc(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
         f"{ranking_tables(aggregate) if aggregate else _no_ranking(scores)}"
         f"{headroom_html(headroom)}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
@@ -758,7 +222,7 @@ def _frozen_note(scores: Sequence[Mapping[str, Any]]) -> str:
 
 
 def _no_ranking(scores: Sequence[Mapping[str, Any]]) -> str:
-    return f'<p class="note">{_e(no_ranking(scores).replace("`", ""))}</p>'
+    return f'<p class="note">{esc(no_ranking(scores).replace("`", ""))}</p>'
 
 
 def write_html(

@@ -371,7 +371,7 @@ def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
 
 
 def test_the_frozen_optimum_has_its_own_legend_swatch() -> None:
-    from shipgym_baselines.leaderboard.page import _legend_html
+    from shipgym_baselines.leaderboard.page_figures import _legend_html
     from shipgym_baselines.leaderboard.style import controller_style
 
     html = _legend_html([("PID", [("oracle", "o"), ("oracle_frozen", "f"), ("pid_los", "p")])])

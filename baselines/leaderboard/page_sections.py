@@ -1,0 +1,222 @@
+"""The page's tables: the ranking per split, the controller × scenario cost ratios, the
+headroom per ship × change family and the long per-row table (:mod:`.page`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
+from shipgym_baselines.leaderboard.html_cells import (
+    Td,
+    esc,
+    finite_number,
+    html_table,
+    leading_number,
+    name_cell,
+    number_text,
+    text_cell,
+    value_cell,
+)
+from shipgym_baselines.leaderboard.page_figures import anchor
+from shipgym_baselines.leaderboard.ranking import (
+    HEADROOM_EXPLAINED,
+    ORACLE,
+    ORACLE_FROZEN,
+    PARTIAL,
+    headroom_grid,
+    is_partial,
+    resolution_lines,
+)
+from shipgym_baselines.leaderboard.splits import table_title
+
+#: the long table's metric columns: key → header (with units)
+ROW_METRICS = {
+    "ace": "ACE [m]",
+    "ace_L": "ACE/L [–]",
+    "t_c": "t_c [s]",
+    "return": "return [–]",
+    "cost": "cost [–]",
+    "rudder_travel": "rudder travel [rad]",
+    "J": "J [–]",
+    "success": "success [–]",
+    "compute_ms": "compute [ms]",
+}
+
+
+def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
+    """One table per split of the ``aggregate.json`` rows, in their order (ranked by the
+    cost ratio's IQM, lowest first); a split's partial table is titled as such.  A table
+    whose rows have no probability of improvement (``pid_los`` not ranked there) has no
+    such column; a row without one (``pid_los`` itself) shows "–".  The columns against
+    the frozen optimum (adaptation gain, P(beats it), gap closed) only where a row has
+    them; the columns: :mod:`.columns`."""
+    parts = []
+    for split in dict.fromkeys(r["split"] for r in aggregate):
+        rows = [r for r in aggregate if r["split"] == split]
+        mine = shown(page_columns(), rows)
+        columns = [(c.name, esc(c.page), _sort_kind(c)) for c in mine]
+        body = [[_ranking_cell(c, r, rank) for c in mine] for rank, r in enumerate(rows, 1)]
+        base = split.removesuffix(PARTIAL)
+        title = table_title(base)
+        if is_partial(split):
+            title += ": controllers that do not apply to every scenario (each on its own)"
+        table = html_table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
+        parts.append(f"<div><h3>{esc(title)}</h3>{table}</div>")
+    notes = "".join(f'<p class="note">{esc(line)}</p>' for line in resolution_lines(aggregate))
+    return '<div class="splits">' + "".join(parts) + "</div>" + notes
+
+
+def _sort_kind(column: RankingColumn) -> str:
+    """How the page sorts a ranking column (:func:`_head`): text, or numbers (``lower``:
+    ascending on the first click)."""
+    if column.cell in ("name", "text"):
+        return "text"
+    return "lower" if column.lower else "number"
+
+
+def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> Td:
+    """A ranking row's cell in ``column``: the value, its interval below it (the count of
+    trials after it where the column has one)."""
+    if column.cell == "rank":
+        return Td(str(rank), -rank, rank)  # best-first on the first click
+    if column.cell == "name":
+        return name_cell(row["controller"])
+    if column.cell == "text":
+        return text_cell(row.get(column.key, ""))
+    if column.cell == "count":
+        return value_cell(count(column.value(row)))
+    td = value_cell(column.value(row), column.interval(row))
+    trials = row.get(column.trials) if column.trials else None
+    if column.value(row) is None or not trials:
+        return td
+    return td._replace(html=f"{td.html}<i>{esc(trials)} trials</i>")
+
+
+def _controller_order(
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    cells: Mapping[tuple[str, str], Mapping[str, Any]],
+) -> list[str]:
+    """Controllers by the first split's ranking, then any other in the order they appear."""
+    names = [r["controller"] for r in aggregate if r["split"] == aggregate[0]["split"]]
+    names += [r["controller"] for r in aggregate]
+    names += [r["controller"] for r in rows] + [c for c, _ in cells]
+    return list(dict.fromkeys(names))
+
+
+def score_table(
+    rows: Sequence[Mapping[str, Any]],
+    aggregate: Sequence[Mapping[str, Any]],
+    scores: Sequence[Mapping[str, Any]],
+) -> str:
+    """The sortable controller × scenario table (``id="scores"``): each controller's IQM cost
+    ratio per split, then its geometric-mean cost ratio with interval per scenario (whose
+    header gives the oracle's mean cost); "n/a" where it does not apply."""
+    scenarios = list(dict.fromkeys([r["scenario"] for r in rows] + [s["scenario"] for s in scores]))
+    split_of = {r["scenario"]: r.get("split", "") for r in rows}
+    split_of.update({s["scenario"]: s.get("split", "") for s in scores})
+    splits = list(dict.fromkeys(r["split"] for r in aggregate))
+    cell = {(c["controller"], s["scenario"]): c for s in scores for c in s["controllers"]}
+    oracle = {s["scenario"]: s for s in scores}
+    iqm = {(r["controller"], r["split"]): r for r in aggregate}
+    kinds = {r["controller"]: r.get("kind", "") for r in [*rows, *aggregate]}
+    kinds.update({c: v.get("kind", "") for (c, _), v in cell.items()})
+    not_applicable = {
+        (r["controller"], r["scenario"]) for r in rows if r.get("applies", True) is False
+    }
+    columns = [("controller", "controller", "text"), ("kind", "kind", "text")]
+    columns += [(f"iqm:{sp}", f"IQM<br>{esc(sp)}", "lower") for sp in splits]
+    columns += [
+        (s, f'<a href="#fig-{esc(anchor(s))}">{esc(s)}</a><br><small>{esc(split_of[s])}'
+         f"{_oracle_cost(oracle.get(s))}</small>", "lower")
+        for s in scenarios
+    ]  # fmt: skip
+    body = []
+    for name in _controller_order(rows, aggregate, cell):
+        if name == ORACLE:
+            continue
+        tds = [name_cell(name), text_cell(kinds.get(name, ""))]
+        for sp in splits:
+            agg = iqm.get((name, sp), {})
+            tds.append(value_cell(agg.get("cost_ratio_iqm"), agg.get("cost_ratio_iqm_ci95")))
+        for s in scenarios:
+            if (name, s) in not_applicable:
+                tds.append(Td("n/a", attrs=' class="na" title="does not apply"'))
+            else:
+                sc = cell.get((name, s), {})
+                tds.append(
+                    value_cell(
+                        sc.get("cost_ratio_gmean"), sc.get("cost_ratio_gmean_ci95"), shade=True
+                    )
+                )
+        body.append(tds)
+    return html_table("scores", columns, body)
+
+
+def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
+    """A scenario header's line on the oracle's mean cost (the ratios' denominator), and
+    the frozen optimum's where it ran."""
+    if not entry:
+        return ""
+    text = f"<br>{esc(ORACLE)} cost {esc(number_text(entry.get('oracle_cost')))}"
+    if entry.get("oracle_frozen_cost") is not None:
+        text += f"<br>{esc(ORACLE_FROZEN)} cost {esc(number_text(entry['oracle_frozen_cost']))}"
+    return text
+
+
+def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
+    """The headroom table (:func:`shipgym_baselines.leaderboard.ranking.headroom_table` rows): one
+    row per ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
+    over its trials (how many beside it); empty without rows."""
+    if not headroom:
+        return ""
+    ships, families, cells = headroom_grid(headroom)
+    columns = [("ship", "ship", "text")]
+    columns += [(f, esc(f.replace("_", " ")), "number") for f in families]
+    body = []
+    for ship in ships:
+        tds = [text_cell(ship)]
+        for family in families:
+            found = cells.get((ship, family))
+            if found is None:
+                tds.append(Td("–"))
+                continue
+            trials = found["trials"]
+            value = finite_number(found["headroom_gmean"])
+            text = number_text(found["headroom_gmean"])
+            small = f"<i>{trials} trial{'s' if trials != 1 else ''}</i>"
+            tds.append(Td(f"{esc(text)}{small}", value, leading_number(text)))
+        body.append(tds)
+    return (
+        '<h3 id="headroom">Headroom per ship and change family</h3>'
+        f'<p class="note">{esc(HEADROOM_EXPLAINED)}</p>'
+        f"{html_table('headroom', columns, body, compact=True)}"
+    )
+
+
+def row_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """The long table: one row per (scenario, controller), every metric with its interval
+    (``*_ci95``, else ± std)."""
+    metrics = [k for k in ROW_METRICS if any(k in r for r in rows)]
+    columns = [
+        ("controller", "controller", "text"),
+        ("scenario", "scenario", "text"),
+        ("split", "split", "text"),
+        ("kind", "kind", "text"),
+        ("seeds", "seeds", "number"),
+        ("training_seeds", "training seeds", "number"),
+    ] + [(k, esc(ROW_METRICS[k]), "number") for k in metrics]
+    body = []
+    for r in rows:
+        tds = [name_cell(r["controller"])] + [
+            text_cell(r.get(k, "")) for k in ("scenario", "split", "kind")
+        ]
+        tds += [value_cell(r.get("seeds")), value_cell(r.get("training_seeds"))]
+        if r.get("applies", True) is False:
+            attrs = f' class="na" colspan="{len(metrics)}" style="text-align:left"'
+            tds.append(Td("does not apply", attrs=attrs))
+        else:
+            tds += [value_cell(r.get(k), r.get(f"{k}_ci95"), r.get(f"{k}_std")) for k in metrics]
+        body.append(tds)
+    return html_table("rows", columns, body)
