@@ -96,8 +96,8 @@ from shipgym_baselines.classical.adaptive.settings import (
 )
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
-from shipgym_baselines.tuning.chosen import tuned_settings
 
 #: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
 cubic_damping_from_zigzag = ship_cubic_damping

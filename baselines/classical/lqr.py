@@ -70,8 +70,8 @@ from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
 from shipgym.paths import wrap_angle
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
-from shipgym_baselines.tuning.chosen import tuned_settings
 
 #: Borkowski (2018) §5: initial estimates on the Mariner (a0 [1/s], c0 [1/s²])
 PAPER_INITIAL_GUESS = {"mariner": (0.02, 0.002)}

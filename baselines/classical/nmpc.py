@@ -65,8 +65,8 @@ from shipgym_baselines.classical.nmpc_ship import (
     ship_plan,
 )
 from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
-from shipgym_baselines.tuning.chosen import tuned_settings
 
 
 @dataclasses.dataclass(frozen=True)

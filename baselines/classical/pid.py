@@ -77,8 +77,8 @@ from shipgym.models.base import ShipModel
 from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
-from shipgym_baselines.tuning.chosen import tuned_settings
 
 TUNINGS = ("pole_placement", "vyshnegradsky")
 #: "tuned": the chosen settings of ``shipgym tune`` (docs/tuning.md) for the ship, where

@@ -9,9 +9,11 @@ every ship, e.g. a learned agent's hyperparameters)::
     studies:
       mariner: {study: "pid_los:mariner", best_value: 1.83, default_value: 7.2, ...}
 
-:func:`tuned_settings` is what a controller's default construction (``preset="tuned"``)
-reads at reset; :func:`write_chosen` is what ``shipgym tune`` writes when a study ends (into
-the study's own folder unless it is promoted: :mod:`~shipgym_baselines.tuning.promotion`).
+:func:`~shipgym_baselines.records.chosen.tuned_settings` is what a controller's default
+construction (``preset="tuned"``) reads at reset (the reader sits below the controllers, in
+:mod:`shipgym_baselines.records.chosen`; its names stay importable from here);
+:func:`write_chosen` is what ``shipgym tune`` writes when a study ends (into the study's own
+folder unless it is promoted: :mod:`~shipgym_baselines.tuning.promotion`).
 
 Each study summary records the validation objective of the settings it chose and, under
 ``validation``, the trials it was scored on with their cost ratios and the env and oracle
@@ -21,61 +23,21 @@ revisions: a later study compares its winner with these settings on the same tri
 
 from __future__ import annotations
 
-import functools
 import os
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from shipgym.config import catalogue
-
-#: the section of settings that hold for every ship
-ALL_SHIPS = "all"
-
-
-def chosen_dir() -> Path:
-    """The packaged folder of chosen settings (``configs/tuning/chosen``)."""
-    return Path(str(catalogue("tuning"))) / "chosen"
-
-
-def chosen_file(controller: str, folder: str | os.PathLike | None = None) -> Path:
-    return Path(folder if folder is not None else chosen_dir()) / f"{controller}.yaml"
-
-
-def read_chosen(controller: str, folder: str | os.PathLike | None = None) -> dict[str, Any]:
-    """The chosen-settings document of ``controller`` (empty when there is none)."""
-    file = chosen_file(controller, folder)
-    if not file.is_file():
-        return {}
-    data = yaml.safe_load(file.read_text(encoding="utf-8")) or {}
-    if not isinstance(data, dict):
-        raise ValueError(f"{file}: a mapping of 'controller', 'ships', 'studies' expected")
-    return data
-
-
-@functools.cache
-def _packaged(controller: str) -> dict[str, Any]:
-    return read_chosen(controller)
-
-
-def section_record(
-    controller: str, section: str, folder: str | os.PathLike | None = None
-) -> tuple[dict[str, Any], dict[str, Any]] | None:
-    """The settings of ``section`` and the summary of the study that chose them, or None
-    when the file has no such section."""
-    data = read_chosen(controller, folder)
-    ships = data.get("ships") or {}
-    if section not in ships:
-        return None
-    return dict(ships[section] or {}), dict((data.get("studies") or {}).get(section) or {})
-
-
-def tuned_settings(controller: str, ship: str) -> dict[str, Any]:
-    """The packaged chosen settings of ``controller`` on ``ship`` (its ship section, else the
-    ``all`` section, else none: the paper's settings)."""
-    ships = _packaged(controller).get("ships") or {}
-    return dict(ships.get(ship, ships.get(ALL_SHIPS)) or {})
+# the reader sits below the controllers (records/chosen.py: a controller's 'tuned' preset
+# reads it); its names stay importable from here
+from shipgym_baselines.records.chosen import ALL_SHIPS as ALL_SHIPS
+from shipgym_baselines.records.chosen import chosen_dir as chosen_dir
+from shipgym_baselines.records.chosen import chosen_file as chosen_file
+from shipgym_baselines.records.chosen import packaged_chosen as packaged_chosen
+from shipgym_baselines.records.chosen import read_chosen as read_chosen
+from shipgym_baselines.records.chosen import section_record as section_record
+from shipgym_baselines.records.chosen import tuned_settings as tuned_settings
 
 
 def write_chosen(
@@ -108,7 +70,7 @@ def write_chosen(
     staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
     staged.write_text(header + yaml.safe_dump(document, sort_keys=False), encoding="utf-8")
     os.replace(staged, file)
-    _packaged.cache_clear()
+    packaged_chosen.cache_clear()
     return file, replaced
 
 

@@ -91,7 +91,6 @@ EXCEPTIONS = _edge_table(
     """
     evaluation -> leaderboard: suite_trials (lazy) draws a suite's trials as the board does
     evaluation -> leaderboard.suite: suite_trials (lazy) reads the suite
-    classical.* -> tuning.chosen: the 'tuned' preset reads a study's chosen settings (YAML)
     """
 )
 

@@ -16,6 +16,7 @@ from shipgym.scenarios.sampling import ScenarioDistribution
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.records import chosen as chosen_reader
 from shipgym_baselines.tuning import chosen
 from shipgym_baselines.tuning.objective import controller_ratios, geometric_mean
 from shipgym_baselines.tuning.space import ParamSpec, TuningConfig, load_tuning
@@ -168,8 +169,8 @@ def test_chosen_settings_reach_the_default_construction(
     from shipgym.scenarios import load_scenario
 
     chosen.write_chosen("pid_los", "nomoto2", {"natural_frequency_T": 2.9}, {}, tmp_path)
-    monkeypatch.setattr(chosen, "chosen_dir", lambda: tmp_path)
-    chosen._packaged.cache_clear()
+    monkeypatch.setattr(chosen_reader, "chosen_dir", lambda: tmp_path)  # the reader's folder
+    chosen.packaged_chosen.cache_clear()
     try:
         ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
         tuned, paper = PIDLOS(), PIDLOS(preset="paper")
@@ -188,7 +189,7 @@ def test_chosen_settings_reach_the_default_construction(
         from shipgym_baselines.classical.l1_backstepping import L1Backstepping
 
         chosen.write_chosen("l1_backstepping", "nomoto2", {"K2": 30.0, "K1": 0.05}, {}, tmp_path)
-        chosen._packaged.cache_clear()
+        chosen.packaged_chosen.cache_clear()
         l1, l1_paper, l1_given = (
             L1Backstepping(),
             L1Backstepping(preset="paper"),
@@ -209,7 +210,7 @@ def test_chosen_settings_reach_the_default_construction(
 
         weights = {"lambda_y": 0.3, "lambda_psi": 4.0, "lambda_delta": 2.0}
         chosen.write_chosen("lqr", "nomoto2", weights, {}, tmp_path)
-        chosen._packaged.cache_clear()
+        chosen.packaged_chosen.cache_clear()
         lqr, lqr_paper, lqr_given, adaptive = (
             LQR(),
             LQR(preset="paper"),
@@ -224,7 +225,7 @@ def test_chosen_settings_reach_the_default_construction(
         assert as_tuple(lqr_paper.weights) == paper == as_tuple(adaptive.weights)
         assert as_tuple(lqr_given.weights) == (0.3, 9.0, 2.0)
     finally:
-        chosen._packaged.cache_clear()
+        chosen.packaged_chosen.cache_clear()
 
 
 def test_bad_tuning_configs_name_the_key(tmp_path: Path) -> None:
