@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import json
 import math
 import os
 import time
@@ -27,6 +28,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
@@ -763,18 +765,22 @@ def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) 
     or settings dict) that each seed draws with ``suite``'s ``randomize`` ranges: the
     leaderboard's own drawing (:func:`shipgym_baselines.leaderboard.trials`), so seed
     10000 + i is the leaderboard's trial i of the scenario."""
-    from shipgym_baselines.leaderboard import Job, trials
+    # the suite file's reader sits beside this loop (the leaderboard's suite module imports
+    # nothing above it); the drawing is the leaderboard job's: the scenario loaded by name,
+    # else rebuilt from its settings, each seed's trial from the suite's ranges
     from shipgym_baselines.leaderboard.suite import load_suite
 
     spec = load_suite(suite)
-    randomize = None if spec.randomize is None else spec.randomize.model_dump(mode="json")
     if isinstance(scenario, str | os.PathLike):
-        name, settings = str(scenario), None
+        base = load_scenario(str(scenario))
     else:
         loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-        name, settings = loaded.name, loaded.config.model_dump(mode="json")
-    seeds = tuple(int(seed) for seed in seeds)
-    return trials(Job("zero_rudder", name, seeds, None, randomize, settings))  # any controller
+        settings = json.dumps(loaded.config.model_dump(mode="json"), sort_keys=True)
+        base = load_scenario(json.loads(settings))
+    randomization = None
+    if spec.randomize is not None:
+        randomization = TrialRandomization(**spec.randomize.model_dump(mode="json"))
+    return [trial_scenario(base, randomization, int(seed)) for seed in seeds]
 
 
 def evaluate(
