@@ -40,6 +40,7 @@ from shipgym_baselines.leaderboard.ranking import (
     scenario_ships,
 )
 from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
+from shipgym_baselines.leaderboard.splits import scenario_split, unseen_hull_scenarios
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.leaderboard.tables import (
     AGGREGATE_FILE,
@@ -48,7 +49,6 @@ from shipgym_baselines.leaderboard.tables import (
     episode_rows,
     generalisation,
     rankable,
-    scenario_split,
 )
 from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name, verdict
 from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
@@ -100,7 +100,8 @@ def write_results(
     out = Path(out)
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     episodes = episode_rows(results)
-    splits = {s: scenario_split(s, suite.get("scenario_files", {})) for s in suite["scenarios"]}
+    own, unseen = suite.get("scenario_files", {}), unseen_hull_scenarios(suite["scenarios"])
+    splits = {s: scenario_split(s, own, unseen) for s in suite["scenarios"]}
     ranked = rankable(episodes, suite.get("scenario_seeds"), shares_trials(suite))
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))

@@ -1,4 +1,4 @@
-"""Interval estimates and the aggregate ranking of the leaderboard (issues 13 and 17).
+"""Interval estimates and the aggregate ranking of the leaderboard.
 
 After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" (the
 ``rliable`` library):

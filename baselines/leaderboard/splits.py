@@ -8,10 +8,12 @@ scenarios are named test scenarios ``<split>:<index>`` (:func:`scenario_split`).
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from shipgym.config import is_path
+from shipgym.models import UNSEEN_HULLS
 
 
 @dataclass(frozen=True)
@@ -29,6 +31,8 @@ class Split:
 
 #: the split of the suite's own scenarios (scenario files)
 YOURS = "yours"
+#: the split of the scenarios on an unseen hull
+UNSEEN_HULL = "unseen_hull"
 #: every split, by the name the rows' ``split`` holds, in the order the generalisation
 #: table reads them
 SPLITS = {
@@ -42,6 +46,12 @@ SPLITS = {
         "in-range",
         test=True,
     ),
+    # scenarios on a hull no controller is tuned or trained on (shipgym.models.UNSEEN_HULLS)
+    UNSEEN_HULL: Split(
+        "Unseen-hull scenarios, on a hull no controller was tuned or trained on",
+        "unseen-hull scenarios",
+        "unseen-hull",
+    ),
     YOURS: Split("Your scenarios", "your scenarios", "yours"),
 }
 #: the ranking tables' headings, by split
@@ -49,7 +59,9 @@ SPLIT_TITLES = {name: split.table for name, split in SPLITS.items()}
 #: the splits of the named test scenarios (``<split>:<index>``)
 TEST_SPLITS = tuple(name for name, split in SPLITS.items() if split.test)
 #: the splits of :func:`~shipgym_baselines.leaderboard.tables.generalisation`, in its order
-GENERALISATION_SPLITS = ("catalogue", *TEST_SPLITS)
+GENERALISATION_SPLITS = ("catalogue", *TEST_SPLITS, UNSEEN_HULL)
+#: the splits :func:`~shipgym_baselines.leaderboard.tables.generalisation` always has
+ALWAYS_GENERALISED = ("catalogue", "heldout")
 
 
 def table_title(split: str) -> str:
@@ -70,11 +82,21 @@ def split_label(split: str) -> str:
     return found.label if found else split
 
 
-def scenario_split(scenario: str, own: Collection[str] = ()) -> str:
+def scenario_split(scenario: str, own: Collection[str] = (), unseen: Collection[str] = ()) -> str:
     """``heldout`` / ``inrange`` for named held-out / in-range test scenarios
     (``heldout:3``, ``inrange:3``), :data:`YOURS` for the suite's own scenarios (``own``:
-    their table names; a YAML path, as older records name them), else ``catalogue``."""
+    their table names; a YAML path, as older records name them), :data:`UNSEEN_HULL` for
+    the catalogue scenarios on an unseen hull (``unseen``: their names,
+    :func:`unseen_hull_scenarios`), else ``catalogue``."""
     for split in TEST_SPLITS:
         if scenario.startswith(f"{split}:"):
             return split
-    return YOURS if scenario in own or is_path(scenario) else "catalogue"
+    if scenario in own or is_path(scenario):
+        return YOURS
+    return UNSEEN_HULL if scenario in unseen else "catalogue"
+
+
+def unseen_hull_scenarios(settings: Mapping[str, Mapping[str, Any]]) -> set[str]:
+    """The scenarios of a run (name → settings, as ``run.json`` records them) whose ship is
+    an unseen hull (:data:`shipgym.models.UNSEEN_HULLS`)."""
+    return {name for name, s in settings.items() if s["ship"]["model"] in UNSEEN_HULLS}

@@ -16,6 +16,7 @@ from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
 from shipgym_baselines.leaderboard.ranking import row_intervals
 
 # the splits are defined in .splits; these names stay importable from here
+from shipgym_baselines.leaderboard.splits import ALWAYS_GENERALISED
 from shipgym_baselines.leaderboard.splits import GENERALISATION_SPLITS as GENERALISATION_SPLITS
 from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES
 from shipgym_baselines.leaderboard.splits import TEST_SPLITS as TEST_SPLITS
@@ -149,10 +150,10 @@ def rankable(
 
 
 def generalisation_splits(rows: Sequence[Mapping[str, Any]]) -> tuple[str, ...]:
-    """The splits of :func:`generalisation`: catalogue and held-out always, in-range when
-    the run has in-range rows."""
+    """The splits of :func:`generalisation`: catalogue and held-out always, in-range and
+    unseen-hull when the run has their rows."""
     present = {r["split"] for r in rows}
-    return tuple(s for s in GENERALISATION_SPLITS if s != "inrange" or s in present)
+    return tuple(s for s in GENERALISATION_SPLITS if s in ALWAYS_GENERALISED or s in present)
 
 
 def generalisation(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:

@@ -9,11 +9,13 @@ from shipgym_baselines.leaderboard.splits import (
     SPLIT_TITLES,
     SPLITS,
     TEST_SPLITS,
+    UNSEEN_HULL,
     YOURS,
     figure_title,
     scenario_split,
     split_label,
     table_title,
+    unseen_hull_scenarios,
 )
 
 
@@ -25,15 +27,30 @@ from shipgym_baselines.leaderboard.splits import (
         ("mariner_rudder_aging", (), "catalogue"),
         ("my_harbour", ("my_harbour",), YOURS),
         ("scenarios/mine.yaml", (), YOURS),
+        ("kvlcc2_rudder_aging", (), UNSEEN_HULL),
+        ("kvlcc2_rudder_aging", ("kvlcc2_rudder_aging",), YOURS),  # a suite's own file
     ],
 )
 def test_a_scenario_falls_in_its_split(scenario: str, own: tuple[str, ...], split: str) -> None:
-    assert scenario_split(scenario, own) == split
+    assert scenario_split(scenario, own, unseen={"kvlcc2_rudder_aging"}) == split
+
+
+def test_the_unseen_hull_scenarios_are_those_on_an_unseen_hull() -> None:
+    """A run's scenarios on the KVLCC2 (shipgym.models.UNSEEN_HULLS), read from their
+    recorded settings, whatever their name."""
+    from shipgym.scenarios import load_scenario
+
+    settings = {
+        name: load_scenario(name).config.model_dump(mode="json")
+        for name in ("kvlcc2_nominal", "esso_osaka_nominal", "nominal")
+    }
+    settings["renamed"] = settings["kvlcc2_nominal"]
+    assert unseen_hull_scenarios(settings) == {"kvlcc2_nominal", "renamed"}
 
 
 def test_the_test_splits_are_the_named_test_scenarios_in_order() -> None:
     assert TEST_SPLITS == ("heldout", "inrange")
-    assert GENERALISATION_SPLITS == ("catalogue", "heldout", "inrange")
+    assert GENERALISATION_SPLITS == ("catalogue", "heldout", "inrange", UNSEEN_HULL)
 
 
 def test_each_split_has_its_titles_in_one_entry() -> None:
@@ -46,5 +63,5 @@ def test_each_split_has_its_titles_in_one_entry() -> None:
 
 
 def test_an_unknown_split_is_titled_by_its_name() -> None:
-    assert table_title("unseen_hull") == figure_title("unseen_hull") == "unseen_hull"
-    assert split_label("unseen_hull") == "unseen_hull"
+    assert table_title("some_split") == figure_title("some_split") == "some_split"
+    assert split_label("some_split") == "some_split"

@@ -42,14 +42,23 @@ def test_packaged_suites_load() -> None:
 
 
 def test_default_suite_holds_the_matrix_and_every_family_held_out() -> None:
-    """The whole scenario matrix with the nomoto2 and papers' scenarios, and the
-    held-out scenarios up to heldout:15 (each 3-DOF ship's three families and a combination)."""
+    """The whole scenario matrix with the nomoto2 and papers' scenarios, the five KVLCC2
+    scenarios of the unseen-hull split, and the held-out scenarios up to heldout:15 (each
+    3-DOF ship's three families and a combination)."""
     from shipgym_baselines.studies.change_effect import matrix_scenarios
 
     default = load_suite("default")
     matrix = matrix_scenarios() + [f"{s}_nominal" for s in ("esso_osaka", "mariner", "blanke")]
     assert set(matrix) <= set(default.scenarios)
-    assert len(default.scenarios) == 31 and default.heldout_scenarios == 16
+    assert len(default.scenarios) == 36 and default.heldout_scenarios == 16
+    unseen = [s for s in default.scenarios if s.startswith("kvlcc2_")]
+    assert unseen == [
+        "kvlcc2_nominal",
+        "kvlcc2_rudder_aging",
+        "kvlcc2_current_shift",
+        "kvlcc2_maneuverability_change",
+        "kvlcc2_rudder_aging_curved",
+    ]
     assert default.seeds == 8
 
 
@@ -61,7 +70,7 @@ def test_the_in_range_split_follows_the_held_out_one() -> None:
     assert default.inrange_scenarios == 16 and default.inrange_seeds == 2
     assert default.heldout_scenarios == 16 and default.heldout_seeds == 4
     assert default.learned_trials == "shared"
-    assert default.all_scenarios()[31:] == [
+    assert default.all_scenarios()[36:] == [
         *(f"heldout:{i}" for i in range(16)),
         *(f"inrange:{i}" for i in range(16)),
     ]
