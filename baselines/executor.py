@@ -14,7 +14,8 @@ The one executor of the leaderboard's jobs, training sweeps and a tuning study's
 
 :func:`map_jobs` yields the results as the jobs finish, or in the order of the items
 (``ordered``).  It checks the backend when called (:func:`check_backend`: a
-:class:`RunError` naming a bad one).
+:class:`RunError` naming a bad one).  :func:`task_pool` is the local pool for work
+submitted task by task (the leaderboard's figures, DAgger's label rollouts).
 A job that raises, Ctrl-C, or a consumer that stops reading (``close()``) ends the rest:
 the jobs not started are cancelled, the running ones killed (Ray tasks cancelled;
 ``finish_running``: a pool's running jobs finish first), and the error propagates.
@@ -22,10 +23,11 @@ the jobs not started are cancelled, the running ones killed (Ray tasks cancelled
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from contextlib import closing
 from typing import Any, TypeVar
 
@@ -187,3 +189,30 @@ def _on_ray(fn: Callable[[T], R], items: list[T], setup: RaySetup) -> Pairs[R]:
 
 
 __all__ = ["BACKENDS", "RaySetup", "check_backend", "map_jobs"]
+
+
+class Inline:
+    """An executor that runs each task as it is submitted (a small job needs no pool)."""
+
+    def submit(self, fn: Callable[..., R], *args: Any, **kwargs: Any) -> Future:
+        future: Future = Future()
+        future.set_result(fn(*args, **kwargs))
+        return future
+
+
+@contextlib.contextmanager
+def task_pool(
+    workers: int, initializer: Callable[[], object] | None = None
+) -> Iterator[Executor | Inline]:
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes (each
+    started with ``initializer``) for tasks submitted one by one, or :class:`Inline` for
+    ``workers`` ≤ 1; on leaving, the tasks not started are cancelled and the pool waits for
+    the running ones."""
+    if workers <= 1:
+        yield Inline()
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=initializer)
+    try:
+        yield pool
+    finally:
+        pool.shutdown(cancel_futures=True)

@@ -8,8 +8,8 @@ import csv
 import io
 import json
 import os
-from collections.abc import Callable, Iterator, Mapping
-from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from collections.abc import Iterator, Mapping
+from concurrent.futures import Executor
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +19,7 @@ from shipgym.config import is_path
 from shipgym.notices import notice
 from shipgym.scenarios import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.jsonout import dumps, dumps_rows
 from shipgym_baselines.leaderboard.comparison import (
     comparison_note,
@@ -205,23 +206,11 @@ def subtitle(suite: Mapping[str, Any], results: list[EpisodeResult]) -> str:
 POOLED_FIGURES = 4
 
 
-class _Inline:
-    """An executor that runs each task as it is submitted (a small run needs no pool)."""
-
-    def submit(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Future:
-        future: Future = Future()
-        future.set_result(fn(*args, **kwargs))
-        return future
-
-
 @contextlib.contextmanager
-def _pool(workers: int, figures: int) -> Iterator[Executor | _Inline]:
+def _pool(workers: int, figures: int) -> Iterator[Executor | Inline]:
     """A process pool of ``workers`` for ``figures`` scenario figures and the ranking, or
-    :class:`_Inline` for a few or one worker."""
-    if workers <= 1 or figures < POOLED_FIGURES:
-        yield _Inline()
-        return
-    with ProcessPoolExecutor(max_workers=workers, initializer=worker_init) as pool:
+    :class:`~shipgym_baselines.executor.Inline` for a few or one worker."""
+    with task_pool(workers if figures >= POOLED_FIGURES else 1, worker_init) as pool:
         yield pool
 
 

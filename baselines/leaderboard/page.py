@@ -44,11 +44,11 @@ from shipgym_baselines.leaderboard.html_cells import packed_body as packed_body
 from shipgym_baselines.leaderboard.html_cells import sort_keys as sort_keys
 from shipgym_baselines.leaderboard.html_cells import swatch_css as swatch_css
 from shipgym_baselines.leaderboard.html_cells import unpacked_body as unpacked_body
-from shipgym_baselines.leaderboard.page_figures import REFERENCE_CSS
 from shipgym_baselines.leaderboard.page_figures import PageImage as PageImage
 from shipgym_baselines.leaderboard.page_figures import embedded_figures as embedded_figures
 from shipgym_baselines.leaderboard.page_figures import figure_sections as figure_sections
 from shipgym_baselines.leaderboard.page_figures import page_image as page_image
+from shipgym_baselines.leaderboard.page_figures import reference_css
 from shipgym_baselines.leaderboard.page_sections import ROW_METRICS as ROW_METRICS
 from shipgym_baselines.leaderboard.page_sections import headroom_html as headroom_html
 from shipgym_baselines.leaderboard.page_sections import ranking_tables as ranking_tables
@@ -186,7 +186,7 @@ def page(
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{esc(title)}</title><style>{_CSS}{swatch_css(names)}{REFERENCE_CSS}</style>"
+        f"<title>{esc(title)}</title><style>{_CSS}{swatch_css(names)}{reference_css()}</style>"
         "</head><body>"
         f"<h1>{esc(title)}</h1>{sub}"
         '<h2 id="ranking">Ranking</h2><p class="note">'

@@ -101,11 +101,18 @@ def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
 #: grey, dash-dotted: dashed here, CSS has no dash-dot), as legend swatches
 _REFERENCE_SWATCH = "kref"
 _FROZEN_SWATCH = "kfrozen"
-REFERENCE_CSS = (
-    f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
-    f".{_FROZEN_SWATCH}{{border-top-style:dashed;"
-    f"border-top-color:{controller_style(ORACLE_FROZEN).color}}}"
-)
+
+
+def reference_css() -> str:
+    """The CSS of the two reference swatches (the frozen optimum's colour read from its
+    registration when the page is written, so importing the page loads no controller)."""
+    return (
+        f".{_REFERENCE_SWATCH}{{border-top-style:dashed;border-top-color:#000}}"
+        f".{_FROZEN_SWATCH}{{border-top-style:dashed;"
+        f"border-top-color:{controller_style(ORACLE_FROZEN).color}}}"
+    )
+
+
 _REFERENCE_SWATCHES = {ORACLE: _REFERENCE_SWATCH, ORACLE_FROZEN: _FROZEN_SWATCH}
 
 

@@ -4,6 +4,7 @@ axis."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
@@ -22,14 +23,19 @@ PANEL_CONTROLLERS = 5
 
 #: the oracle's episode, drawn in every column as the reference
 ORACLE_STYLE = {"color": "black", "linestyle": (0, (4, 1.5)), "alpha": 0.75, "zorder": 1.5}
-#: the frozen optimum's episode (``oracle_frozen``: the oracle's truth frozen at the start),
-#: drawn in every column beside the oracle's: its fixed colour, dash-dotted
-FROZEN_STYLE = {
-    "color": controller_style(ORACLE_FROZEN).color,
-    "linestyle": (0, (5, 1.5, 1, 1.5)),
-    "alpha": 0.85,
-    "zorder": 1.4,
-}
+
+
+@functools.cache
+def frozen_style() -> dict[str, Any]:
+    """The frozen optimum's episode (``oracle_frozen``: the oracle's truth frozen at the
+    start), drawn in every column beside the oracle's: its registered colour (read when
+    first drawn, so importing the figures loads no controller), dash-dotted."""
+    return {
+        "color": controller_style(ORACLE_FROZEN).color,
+        "linestyle": (0, (5, 1.5, 1, 1.5)),
+        "alpha": 0.85,
+        "zorder": 1.4,
+    }
 
 
 def controller_family(name: str, kind: str | None = None) -> str:

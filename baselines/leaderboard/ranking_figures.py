@@ -16,9 +16,9 @@ from shipgym_baselines.leaderboard.figure_files import figure_stem, pyplot, save
 from shipgym_baselines.leaderboard.headroom import trial_headroom
 from shipgym_baselines.leaderboard.intervals import geometric_mean, interquartile_mean
 from shipgym_baselines.leaderboard.panels import (
-    FROZEN_STYLE,
     column_axes,
     family_panels,
+    frozen_style,
     legend_below,
     log_ratio_axis,
 )
@@ -169,7 +169,7 @@ def _frozen_line(ax: Any, x: float, key: str) -> None:
     """The frozen optimum's place ``x`` [cost ratio] on a panel: a dash-dotted vertical line
     labelled :data:`FROZEN_LABEL` in the band :func:`_plot_intervals` adds above the top row
     (clear of the bars and of the panel's title)."""
-    style = {k: v for k, v in FROZEN_STYLE.items() if k != "zorder"}
+    style = {k: v for k, v in frozen_style().items() if k != "zorder"}
     ax.axvline(x, lw=1.1, zorder=0.5, gid=f"{ORACLE_FROZEN}/{key}", **style)
     low_x, high_x = ax.get_xlim()
     ax.text(
@@ -177,7 +177,7 @@ def _frozen_line(ax: Any, x: float, key: str) -> None:
         ax.get_ylim()[1] - 0.4,
         f" {FROZEN_LABEL} ({x:.2f}) ",
         fontsize=7,
-        color=FROZEN_STYLE["color"],
+        color=frozen_style()["color"],
         va="center",
         ha="right" if x > math.sqrt(low_x * high_x) else "left",
     )

@@ -22,7 +22,6 @@ from shipgym_baselines.leaderboard.figure_files import (
     save_figure,
 )
 from shipgym_baselines.leaderboard.panels import (
-    FROZEN_STYLE,
     ORACLE_STYLE,
     PANEL_W,
     ROW_GAP,
@@ -31,6 +30,7 @@ from shipgym_baselines.leaderboard.panels import (
     column_axes,
     controller_family,
     family_panels,
+    frozen_style,
     legend_below,
 )
 from shipgym_baselines.leaderboard.style import controller_style
@@ -40,11 +40,16 @@ from shipgym_baselines.records.trajectories import DRAWN_KEYS, thin_trajectory
 _CHANGE_STYLE = {"color": "black", "linestyle": (0, (1, 1.5)), "linewidth": 0.9}
 
 
-#: the two references drawn in every column: style, legend suffix, widths (track, e, δ)
+#: the two references drawn in every column: legend suffix, widths (track, e, δ); their
+#: styles: :func:`_reference_style`
 _REFERENCE_LINES = {
-    ORACLE: (ORACLE_STYLE, ", the reference", (1.2, 1.1, 1.4)),
-    ORACLE_FROZEN: (FROZEN_STYLE, ", never adapts", (1.1, 1.0, 1.2)),
+    ORACLE: (", the reference", (1.2, 1.1, 1.4)),
+    ORACLE_FROZEN: (", never adapts", (1.1, 1.0, 1.2)),
 }
+
+
+def _reference_style(name: str) -> dict[str, Any]:
+    return ORACLE_STYLE if name == ORACLE else frozen_style()
 
 
 class DrawnEpisode(NamedTuple):
@@ -258,7 +263,8 @@ def plot_scenario(
             ax_track.plot(path[:, 0], path[:, 1], color="0.55", lw=2.2, alpha=0.5, zorder=1)
         for name in refs:  # the references in every column
             tr = lines[name]
-            style, suffix, (w_track, w_e, w_d) = _REFERENCE_LINES[name]
+            suffix, (w_track, w_e, w_d) = _REFERENCE_LINES[name]
+            style = _reference_style(name)
             label = _episode_label(name, everything[name]) + suffix
             legend.append((name, label))
             handles += ax_track.plot(

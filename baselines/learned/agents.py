@@ -127,7 +127,7 @@ class AgentConfig(StrictModel):
             if self.eval.select_on != "relative_cost":
                 raise ValueError("plateau.metric 'selection' needs eval.select_on: relative_cost")
         if self.algo == "dagger":
-            from shipgym_baselines.learned.dagger_agent import check_config
+            from shipgym_baselines.learned.dagger_config import check_config
 
             check_config(self)
         return self
@@ -173,7 +173,7 @@ def hyperparameter_names(algo: str) -> list[str] | None:
     algorithm is unknown or stable-baselines3 is not installed; for ``dagger`` the DAgger
     settings (:class:`~shipgym_baselines.learned.dagger_agent.DaggerHyperparams`)."""
     if algo == "dagger":
-        from shipgym_baselines.learned.dagger_agent import hyperparameter_names as dagger_names
+        from shipgym_baselines.learned.dagger_config import hyperparameter_names as dagger_names
 
         return dagger_names()
     try:

@@ -68,6 +68,7 @@ from pydantic import Field, field_validator
 from shipgym.config import StrictModel
 from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.records.folders import check_out_usable, clear_outputs
 from shipgym_baselines.records.locking import LOCK_FILE, out_lock
 from shipgym_baselines.records.runrecord import now, versions
@@ -563,23 +564,18 @@ def run_dagger(
             folder, settings, make_env, make_teacher, env.observation_space, env.action_space
         )
         student = state.student_after(len(rounds) - 1) if rounds else None
-        pool = None
-        try:
-            if executor is None and workers > 1:
-                pool = concurrent.futures.ProcessPoolExecutor(
-                    worker_count(workers, settings.episodes_per_round)
-                )
+        own = worker_count(workers, settings.episodes_per_round) if executor is None else 1
+        with task_pool(own) as pool:
+            # one worker: the rollouts run here one after the other, each stored as it ends
+            runner = executor or (None if isinstance(pool, Inline) else pool)
             for round_ in range(len(rounds), n_rounds):
-                found, student = state.round(round_, student, pool or executor, progress)
+                found, student = state.round(round_, student, runner, progress)
                 rounds.append(found)
                 _write_json(folder / ROUNDS_FILE, rounds)
                 if progress is not None:
                     progress(_describe_round(found))
                 if on_round is not None and not on_round(found, student):
                     break
-        finally:
-            if pool is not None:
-                pool.shutdown(cancel_futures=True)
     return DaggerRun(folder, student, rounds)
 
 

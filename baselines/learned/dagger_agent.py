@@ -55,89 +55,26 @@ import shutil
 import sys
 import time
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import Field
 
-from shipgym.config import StrictModel
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.learned.dagger_config import ENV_SEED_STRIDE as ENV_SEED_STRIDE
+from shipgym_baselines.learned.dagger_config import STUDENT_KWARGS as STUDENT_KWARGS
+from shipgym_baselines.learned.dagger_config import DaggerHyperparams as DaggerHyperparams
+from shipgym_baselines.learned.dagger_config import check_config as check_config
+from shipgym_baselines.learned.dagger_config import hyperparameter_names as hyperparameter_names
+from shipgym_baselines.learned.dagger_config import hyperparams as hyperparams
+from shipgym_baselines.learned.dagger_config import settings as settings
 from shipgym_baselines.learned.meta import training_meta
 
 #: the ``algo`` of an agent config trained by DAgger
 DAGGER_ALGO = "dagger"
 #: the DAgger run's folder inside the agent folder
 RUN_DIR = "dagger"
-#: env seeds per training seed: seed k's rollouts use env seeds k·stride, k·stride + 1, …
-ENV_SEED_STRIDE = 1000
-#: the student's ``policy_kwargs`` (JSON data the data-only loader reads)
-STUDENT_KWARGS = ("net_arch", "log_std_init")
 SELECTION_FILE = "selection.json"
-
-
-class DaggerHyperparams(StrictModel):
-    """The ``hyperparams`` block of an ``algo: dagger`` config (module doc); the fields of
-    :class:`~shipgym_baselines.learned.dagger.DaggerSettings` but the seeds and the
-    network, and the run's ``rounds`` and ``workers``."""
-
-    #: rounds at most (round 0: the teacher's own rollouts)
-    rounds: int = Field(10, ge=1)
-    episodes_per_round: int = Field(8, ge=1)
-    beta_schedule: Literal["indicator", "exponential"] = "indicator"
-    beta_decay: float = Field(0.5, gt=0, lt=1)
-    epochs: int = Field(20, ge=1)
-    batch_size: int = Field(256, ge=1)
-    learning_rate: float = Field(1e-3, gt=0)
-    warm_start: bool = True
-    #: processes labelling a round's rollouts (1: here); the data do not depend on it
-    workers: int = Field(1, ge=1)
-
-
-def hyperparameter_names() -> list[str]:
-    """The keys an ``algo: dagger`` config's ``hyperparams`` may set, sorted."""
-    return sorted(DaggerHyperparams.model_fields)
-
-
-def check_config(config: Any) -> None:
-    """A ValueError naming the key unless the ``algo: dagger`` config ``config`` can train:
-    rudder commands (the oracle's), the relative-cost selection, an ``MlpPolicy`` student
-    whose ``policy_kwargs`` are data, valid DAgger hyperparameters."""
-    if config.env.action_mode != "rudder":
-        raise ValueError(
-            "env.action_mode: the dagger student imitates the oracle's rudder commands"
-        )
-    if config.eval.select_on != "relative_cost":
-        raise ValueError(
-            "eval.select_on: a dagger agent selects its round on the relative cost "
-            "('relative_cost')"
-        )
-    if config.policy != "MlpPolicy":
-        raise ValueError(f"policy: the dagger student is an MlpPolicy, not {config.policy!r}")
-    extra = sorted(set(config.policy_kwargs) - set(STUDENT_KWARGS))
-    if extra:
-        raise ValueError(
-            f"policy_kwargs: the dagger student takes {', '.join(STUDENT_KWARGS)}, not "
-            f"{', '.join(extra)}"
-        )
-    settings(config)  # the values' types and ranges
-
-
-def hyperparams(config: Any) -> DaggerHyperparams:
-    """The config's DAgger hyperparameters, checked."""
-    return DaggerHyperparams.model_validate(config.hyperparams)
-
-
-def settings(config: Any) -> Any:
-    """The :class:`~shipgym_baselines.learned.dagger.DaggerSettings` of the config (its
-    seed, its env seeds from ``seed ×`` :data:`ENV_SEED_STRIDE`, its network)."""
-    from shipgym_baselines.learned.dagger import DaggerSettings
-
-    found = hyperparams(config).model_dump(exclude={"rounds", "workers"})
-    student = {k: config.policy_kwargs[k] for k in STUDENT_KWARGS if k in config.policy_kwargs}
-    return DaggerSettings(
-        seed=config.seed, env_seed_start=config.seed * ENV_SEED_STRIDE, **found, **student
-    )
 
 
 def make_env(
@@ -247,9 +184,9 @@ class _Selection:
     def score(self, record: dict[str, Any], student: Any, wall_s: float) -> bool:
         """Score the student of the round ``record`` describes; False when the run stops
         here (the plateau rule, or the env-step budget reached)."""
+        from shipgym_baselines.learned.agent_folder import write_best
         from shipgym_baselines.learned.dagger import student_file
         from shipgym_baselines.learned.selection import evaluate_relative
-        from shipgym_baselines.learned.train import write_best
 
         env = self.config.env
         cpu = time.process_time()
@@ -327,13 +264,13 @@ def train_dagger(
     import torch
 
     from shipgym_baselines.learned import dagger
-    from shipgym_baselines.learned.selection import reference_costs, validation_trials
-    from shipgym_baselines.learned.teachers import oracle_teacher
-    from shipgym_baselines.learned.train import (
+    from shipgym_baselines.learned.agent_folder import (
         TRAINING_OUTPUTS,
         check_agent_folder,
         check_tuned_from,
     )
+    from shipgym_baselines.learned.selection import reference_costs, validation_trials
+    from shipgym_baselines.learned.teachers import oracle_teacher
     from shipgym_baselines.records.folders import clear_outputs
 
     torch.set_num_threads(1)

@@ -43,6 +43,12 @@ from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.executor import map_jobs
+from shipgym_baselines.learned.agent_folder import BEST_FILE
+from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS as TRAINING_OUTPUTS
+from shipgym_baselines.learned.agent_folder import TUNED_FROM_FILE as TUNED_FROM_FILE
+from shipgym_baselines.learned.agent_folder import check_agent_folder as check_agent_folder
+from shipgym_baselines.learned.agent_folder import check_tuned_from as check_tuned_from
+from shipgym_baselines.learned.agent_folder import write_best as write_best
 from shipgym_baselines.learned.agents import (
     AgentConfig,
     algo_class,
@@ -52,24 +58,9 @@ from shipgym_baselines.learned.agents import (
     make_training_env,
 )
 from shipgym_baselines.learned.meta import training_meta
-from shipgym_baselines.records.folders import check_out_dir, clear_outputs
+from shipgym_baselines.records.folders import clear_outputs
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
-#: what a training run writes into its directory (``force`` clears these, and only these)
-TRAINING_OUTPUTS = (
-    "model.zip",
-    "best_model.zip",
-    "meta.json",
-    "vecnormalize.json",
-    "checkpoints",
-    "eval",
-    "tb",
-    "learning_curve.json",
-    "tuned_from.json",
-    "dagger",  # a dagger agent's DAgger run (shipgym_baselines.learned.dagger_agent)
-)
-#: the chosen settings a run was started with (``--settings tuned``; null: the config's)
-TUNED_FROM_FILE = "tuned_from.json"
 
 
 def _callbacks(
@@ -182,19 +173,6 @@ def _kept_history(steps: list[int], resumed_at: int) -> int:
             break
         kept += 1
     return kept
-
-
-#: the value of ``best_model.zip`` (the best ever evaluated, which a resumed run's history
-#: may no longer hold) and the env step it was evaluated at
-BEST_FILE = "best.json"
-
-
-def write_best(out: Path, value: float, step: int) -> None:
-    """Record in ``out/eval/`` (:data:`BEST_FILE`) the value of the model just saved as
-    ``best_model.zip`` (its mean return, or its relative cost when the run selects on it)
-    and the env step it was evaluated at."""
-    (out / "eval").mkdir(parents=True, exist_ok=True)
-    (out / "eval" / BEST_FILE).write_text(json.dumps({"value": value, "env_steps": step}))
 
 
 def _read_best(out: Path, history_best: float) -> float:
@@ -504,30 +482,6 @@ def train(
     return meta
 
 
-def check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: bool) -> None:
-    """A fresh run records the settings it starts with (``tuned_from.json``); a resumed one
-    is refused if they changed since (e.g. a study rewrote the chosen settings)."""
-    file = out / TUNED_FROM_FILE
-    record = json.loads(json.dumps(tuned_from))  # as JSON reads it back
-    if resuming and file.is_file():
-        started = json.loads(file.read_text())
-        if _substance(started) != _substance(record):
-            raise RunError(
-                f"--resume: {out} was started with other settings ({file}); train it "
-                "afresh with --force, or resume with the settings it started with"
-            )
-        return
-    file.write_text(json.dumps(record, indent=2))
-
-
-def _substance(tuned_from: dict[str, Any] | None) -> Any:
-    """What a resumed run must share with its start: the applied settings and final block
-    (not where the files lie: a moved checkout resumes)."""
-    if tuned_from is None:
-        return None
-    return {key: tuned_from.get(key) for key in ("settings", "final")}
-
-
 def save_obs_statistics(venv: Any, out: Path) -> Path | None:
     """Write the observation statistics of a training env that normalises observations as
     ``out/vecnormalize.json`` (data: :class:`~shipgym_baselines.learned.normalizer.ObsNormalizer`);
@@ -552,12 +506,6 @@ def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
     meta = json.loads(meta_file.read_text())
     done = int(meta.get("env_steps", 0)) >= n_timesteps
     return meta if done or meta.get("stopped_on_plateau_at") is not None else None
-
-
-def check_agent_folder(out: str | Path, name: str, force: bool = False) -> None:
-    """A :class:`RunError` unless ``out`` can take a fresh training run of agent ``name``:
-    usable, and empty unless ``force``."""
-    check_out_dir(out, force=force, note=f" (agent folder of {name})")
 
 
 #: the files of a policy folder (what LearnedPolicy reads, and the run's learning curve),

@@ -99,8 +99,6 @@ EXCEPTIONS = _edge_table(
 CYCLE_EXCEPTIONS = _edge_table(
     """
     registry -> classical.*: _load_builtins, lazy, loads the built-ins, which register there
-    learned.agents -> learned.dagger_agent: a config checks its DAgger block there (lazy)
-    learned.train -> learned.dagger_agent: train hands a DAgger config to its agent (lazy)
     """
 )
 
