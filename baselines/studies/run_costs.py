@@ -70,15 +70,17 @@ def profile_suite(
     """CPU seconds of ``suite``'s jobs with ``seeds`` evaluation seeds (the suite's first
     ones), optionally only ``controllers`` / ``scenarios`` (names as the suite gives them).
 
-    Returns ``cpu_s`` (all measured jobs), ``suite_cpu_s`` (the estimate for the whole suite:
-    each (controller, scenario) cell's CPU per episode × the suite's seeds × training
-    seeds; a learned agent's batch of all seeds costs less per episode than measured with
-    one), ``per_controller`` / ``per_ship`` / ``per_controller_ship`` entries of
-    ``episodes``, ``steps``, ``cpu_s``, ``act_cpu_s`` (the controller's ``act`` calls),
-    ``suite_cpu_s``, ``us_per_step``, ``act_us_per_step`` and ``other_us_per_step`` (env,
-    setup) [µs], and the machine's ``load_average`` (1 min) at the start and the end.
-    ``show_progress``: a progress bar of the jobs on stderr.
+    Returns ``cpu_s`` (all measured jobs), ``suite_cpu_s`` (the estimate for the whole
+    suite: each (controller, scenario) cell's CPU per episode × the suite's seeds ×
+    training seeds, or × 1 where the suite shares the trials, whose learned jobs are
+    measured as the suite runs them, all training seeds in one lockstep job),
+    ``per_controller`` / ``per_ship`` / ``per_controller_ship`` entries of ``episodes``,
+    ``steps``, ``cpu_s``, ``act_cpu_s`` (the controller's ``act`` calls), ``suite_cpu_s``,
+    ``us_per_step``, ``act_us_per_step`` and ``other_us_per_step`` (env, setup) [µs], and
+    the machine's ``load_average`` (1 min) at the start and the end.  ``show_progress``: a
+    progress bar of the jobs on stderr.
     """
+
     import sys
 
     import torch
@@ -107,9 +109,14 @@ def profile_suite(
     loaded = {s: suite_scenario(s) for s in chosen}
     record = suite_record(spec, names, loaded, list(range(seeds)), seeds_of)
     skip = {tuple(pair) for pair in record["does_not_apply"]}
-    measured = {label: ts[:1] for label, ts in seeds_of.items()}  # a learned agent's first
+    shared = spec.learned_trials == SHARED
+    # a suite that shares the trials: a learned agent's training seeds in one lockstep job,
+    # as the suite runs them; else its first training seed on all seeds
+    measured = seeds_of if shared else {label: ts[:1] for label, ts in seeds_of.items()}
     seed_list = [EVAL_SEED_OFFSET + i for i in range(seeds)]
-    jobs = plan_jobs(names, record["scenarios"], seed_list, measured, record["randomize"], skip)
+    jobs = plan_jobs(
+        names, record["scenarios"], seed_list, measured, record["randomize"], skip, shared=shared
+    )
     ship_of = {s: sc.model.name for s, sc in loaded.items()}
     load_start = os.getloadavg()[0]
     cells: dict[tuple[str, str], dict[str, float]] = defaultdict(_entry)
@@ -133,7 +140,7 @@ def profile_suite(
     per_pair: dict[str, dict[str, dict[str, float]]] = defaultdict(lambda: defaultdict(_entry))
     for (label, scenario), cell in cells.items():
         suite_seeds = len(spec.scenario_seeds(range(spec.seeds)).get(scenario, range(spec.seeds)))
-        runs = suite_seeds * (1 if spec.learned_trials == SHARED else len(seeds_of[label]))
+        runs = suite_seeds * (1 if shared else len(seeds_of[label]))
         cell["suite_cpu_s"] = cell["cpu_s"] / max(cell["episodes"], 1) * runs
         for target in (
             per_controller[label],
@@ -172,8 +179,9 @@ def _sorted(entries: Mapping[str, dict[str, float]]) -> dict[str, dict[str, floa
 
 #: evaluation seeds of the other controllers' measured jobs (in lockstep, as a run's)
 OTHER_SEEDS = 3
-#: evaluation seeds of a learned agent's measured batch (the default suite's: its batch size)
-LEARNED_SEEDS = 10
+#: evaluation seeds of a learned agent's measured job (the quick and default suites share
+#: them among its training seeds: one lockstep job of 8 seeds in the default suite)
+LEARNED_SEEDS = 8
 
 
 def _per_step(entry: Mapping[str, float]) -> float:

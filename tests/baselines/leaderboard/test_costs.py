@@ -22,15 +22,15 @@ from shipgym_baselines.leaderboard.costs import (
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import training_seeds
 
-#: the default suite's whole run, CPU seconds (README: 1,528 CPU s on a 2-core machine)
-DEFAULT_RUN_CPU_S = 1528.0
-#: how far the estimate may be from it, either way: the recorded costs, measured on a quiet
-#: 2-core VM, estimate 1,273 CPU s with the tables' (0.83×), and a measurement moves by
-#: ±13 % from run to run (docs/leaderboard-cost.md)
+#: the default suite's whole run, CPU seconds (README: 1,097 CPU s on a 2-core machine)
+DEFAULT_RUN_CPU_S = 1097.0
+#: how far the estimate may be from it, either way: the recorded costs, measured on a 2-core
+#: VM, estimate 921 CPU s with the tables' (0.84×), and a measurement moves by ±13 % from
+#: run to run (docs/leaderboard-cost.md)
 FACTOR = 1.25
-#: the default suite's episodes: 47 scenarios × 10 seeds and 16 in-range ones × 2 seeds for
-#: every controller, × 3 training seeds for a learned one; oracle_frozen's 502 among them
-DEFAULT_EPISODES = 20_582
+#: the default suite's episodes: 384 trials (36 scenarios × 8 seeds, 16 held-out × 4, 16
+#: in-range × 2) for each of its 25 rows, a learned agent's training seeds sharing them
+DEFAULT_EPISODES = 9_600
 
 
 def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
