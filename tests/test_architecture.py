@@ -36,6 +36,8 @@ LAYERS: dict[str, int] = {
     "shipgym.manoeuvres": 3,
     # the IMO manoeuvring criteria (MSC.137(76)) a manoeuvre is measured against
     "shipgym.manoeuvring_standards": 3,
+    # every ship's standard manoeuvres beside the published values of its hull
+    "shipgym.validation": 3,
     # 4 — identification: LS-SVM fits, online identifiers, nominal models from zig-zags
     "shipgym.identification": 4,
     # 5 — guidance laws, heading autopilots, path tracking, disturbances and sensors (and

@@ -104,6 +104,11 @@ Actuators (inside the plant; not in the papers)
   −(1 + T_shaft/667 s)/(3 T_shaft) = −1/140 s → Kp = 0.65 rps/(m/s), Ki = 0.0019 rps/m full
   scale (Kp·λ, Ki·λ^1.5 at model scale; 1/14 s closed-loop pole at λ = 100).
   ``speed_control = 0`` switches it off: n → n0 (the papers' constant-n open loop).
+* Constant revolutions (``constant_revolutions = 1``, off by default; not in the seeds): the
+  controller off and the shaft held at n = ν·U_ref/L, the straight run at U_ref, as
+  free-running model tests hold the propeller revolutions of the approach speed; the cruise
+  state is the straight-ahead equilibrium at that n (u = U_ref up to the trim rudder's drag).
+  docs/validation.md compares it with free-running tests of a 3 m Esso Osaka model.
 
 Time steps
 ----------
@@ -195,6 +200,7 @@ class EssoOsakaParams(ParameterRecord):
     T_shaft: float = 50.0  # shaft time constant, full scale [s]
     n_max: float = 1.3  # largest propeller speed, full scale [rps]
     speed_control: float = 1.0  # 1: PI speed controller on n; 0: n → n0 (open loop)
+    constant_revolutions: float = 0.0  # 1: n → ν·U_ref/L, the straight-run rps at U_ref [-]
     U_ref: float = 4.1152  # 8 kn, speed set-point (through the water), full scale [m/s]
     Kp: float = 0.65  # proportional gain, full scale [rps/(m/s)]
     Ki: float = 0.0019  # integral gain, full scale [rps/m]
@@ -230,6 +236,7 @@ class EssoOsakaParams(ParameterRecord):
     #: fields that must be 0 or 1 / 1 or 2 (switches)
     switches: ClassVar[dict[str, tuple[float, ...]]] = {
         "speed_control": (0.0, 1.0),
+        "constant_revolutions": (0.0, 1.0),
         "slip_exp": (1.0, 2.0),
     }
 
@@ -393,8 +400,11 @@ class EssoOsaka(ShipModel):
         n_sat = ops.clip(n_raw, 0.0, s.n_max)
         on = p.speed_control
         n_command = on * n_sat + (1.0 - on) * s.n0
+        # constant revolutions: the shaft held at the straight-run rps of U_ref (controller off)
+        hold = p.constant_revolutions
+        n_command = (1.0 - hold) * n_command + hold * n_ff
         n_dot = (n_command - n) / s.T_shaft
-        z_dot = on * (error + (n_sat - n_raw) / s.Kp)  # back-calculation anti-windup
+        z_dot = (1.0 - hold) * on * (error + (n_sat - n_raw) / s.Kp)  # back-calculation anti-windup
         return ops.stack(
             [
                 u_g * cos_psi - v_g * sin_psi,
@@ -417,9 +427,9 @@ class EssoOsaka(ShipModel):
 
     @property
     def nominal_speed(self) -> float:
-        """Speed set-point U_ref/√λ (u0/√λ with the speed controller off) [m/s]."""
+        """Speed set-point U_ref/√λ (u0/√λ with the speed controller off and n → n0) [m/s]."""
         p = self.params
-        speed = p.U_ref if p.speed_control else p.u0
+        speed = p.U_ref if p.speed_control or p.constant_revolutions else p.u0
         return speed / math.sqrt(p.scale)
 
     def cruise_state(self, **values: float) -> np.ndarray:
@@ -443,6 +453,8 @@ class EssoOsaka(ShipModel):
     def _cruise(self) -> np.ndarray:
         p = self.params
         root_lam = math.sqrt(p.scale)
+        if p.constant_revolutions:
+            return self._cruise_constant_revolutions()
         if not p.speed_control:
             return self.initial_state(u=p.u0 / root_lam, n=p.n0 * root_lam)
         L = self.length
@@ -469,6 +481,29 @@ class EssoOsaka(ShipModel):
         return self.initial_state(
             u=u_ref, v=v, delta=delta, n=n, speed_error_integral=(n - n_ff) / ki
         )
+
+    def _cruise_constant_revolutions(self) -> np.ndarray:
+        """Straight-ahead equilibrium at the held rps n = ν·U_ref/L: u, v, δ solved (u is
+        U_ref/√λ up to the drag of the trim rudder)."""
+        p = self.params
+        u_ref = p.U_ref / math.sqrt(p.scale)
+        n = float(_self_propulsion_ratio(p, SimpleNamespace(sqrt=math.sqrt))) * u_ref / self.length
+        pv = p.to_vector()
+        rows = [self.state_index(k) for k in ("u", "v", "r")]
+        weights = np.array([1.0, 1.0, self.length])
+
+        def residual(unknowns: np.ndarray) -> np.ndarray:
+            u, v, delta = unknowns
+            x = self.initial_state(u=u, v=v, delta=delta, n=n)
+            return self.f_numpy(x, [delta], [0.0, 0.0, 0.0], pv)[rows] * weights
+
+        sol = root(residual, [u_ref, 0.0, 0.0], tol=1e-13)
+        if np.max(np.abs(residual(sol.x))) > 1e-9 * u_ref**2 / self.length:
+            raise ParameterError(
+                f"{self.name}: no straight-ahead equilibrium at n = {n:.4g} rps ({sol.message})"
+            )
+        u, v, delta = (float(a) for a in sol.x)
+        return self.initial_state(u=u, v=v, delta=delta, n=n)
 
     @property
     def mass(self) -> float:

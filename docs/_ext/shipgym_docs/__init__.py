@@ -3,9 +3,10 @@
 At ``builder-inited`` the generators write MyST pages into ``<srcdir>/_generated/`` (ignored by
 git): one page per registered env id (:mod:`.envs`, from the env class's docstring), the
 scenario catalogue with route figures (:mod:`.scenarios`), one page per registered controller
-(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the command-line
-reference (:mod:`.cli`), the recorded measurements (:mod:`.measurements`), the API reference
-(:mod:`.api`) and the notebooks as tutorials (:mod:`.tutorials`).  A page is rewritten only
+(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the validation
+tables (:mod:`.validation`), the command-line reference (:mod:`.cli`), the recorded
+measurements (:mod:`.measurements`), the API reference (:mod:`.api`) and the notebooks as
+tutorials (:mod:`.tutorials`).  A page is rewritten only
 when its text changes, so that an incremental build rereads only what moved.
 """
 
@@ -27,10 +28,11 @@ from shipgym_docs import (
     scenarios,
     ships,
     tutorials,
+    validation,
 )
 
 GENERATED = "_generated"
-GENERATORS = (envs, scenarios, controllers, ships, cli, measurements, tutorials, api)
+GENERATORS = (envs, scenarios, controllers, ships, validation, cli, measurements, tutorials, api)
 
 
 def generate(app: Sphinx) -> None:

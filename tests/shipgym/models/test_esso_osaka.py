@@ -189,7 +189,11 @@ def test_froude_scaling_of_turning_circle(variant: str) -> None:
 @pytest.mark.parametrize("variant", VARIANTS)
 @pytest.mark.parametrize(
     "changes",
-    [{}, {"scale": 1.0, "speed_control": 0.0, "slip_exp": 1.0, "m_Xudot": 0.0188}],
+    [
+        {},
+        {"scale": 1.0, "speed_control": 0.0, "slip_exp": 1.0, "m_Xudot": 0.0188},
+        {"constant_revolutions": 1.0},
+    ],
 )
 def test_numpy_and_casadi_rhs_agree(variant: str, changes: dict[str, float]) -> None:
     model = EssoOsaka(EssoOsakaParams(**changes), variant)
@@ -327,6 +331,32 @@ def test_speed_controller_off_holds_the_propeller_at_n0() -> None:
     assert model.cruise_state()[3] == pytest.approx(0.41152)  # the source's start, u0
 
 
+def test_constant_revolutions_hold_the_straight_run_rps_of_the_set_point() -> None:
+    """constant_revolutions = 1: n → ν·U_ref/L (0.644 rps full scale at 8 kn, data file
+    §1.2), the controller integral frozen; the cruise state is the equilibrium at that n."""
+    model = EssoOsaka(EssoOsakaParams(constant_revolutions=1.0))
+    n_hold = 0.644 * 10.0
+    x = model.initial_state(u=0.3, n=5.0, speed_error_integral=2.0)
+    xdot = model.f_numpy(x, [0.0], [0, 0, 0], model.params.to_vector())
+    assert xdot[model.state_index("n")] == pytest.approx((n_hold - 5.0) / 5.0, rel=1e-3)
+    assert xdot[model.state_index("speed_error_integral")] == 0.0
+    x0 = model.cruise_state()
+    assert x0[model.state_index("n")] == pytest.approx(n_hold, rel=1e-3)
+    assert x0[model.state_index("u")] == pytest.approx(model.nominal_speed, rel=1e-4)
+    delta = x0[model.state_index("delta")]
+    xdot = model.f_numpy(x0, [delta], [0, 0, 0], model.params.to_vector())
+    np.testing.assert_allclose(xdot[2:], 0.0, atol=1e-10)
+
+
+def test_constant_revolutions_lose_speed_in_the_turn_and_turn_slower() -> None:
+    """The speed controller holds u in a 35° turn; at constant revolutions the ship slows
+    down and its yaw rate drops (docs/validation.md)."""
+    _, held = turning_circle(EssoOsaka(), 35.0)
+    _, free = turning_circle(EssoOsaka(EssoOsakaParams(constant_revolutions=1.0)), 35.0)
+    assert free["speed_loss"] > held["speed_loss"] + 0.03
+    assert free["steady_turn_rate"] < 0.75 * held["steady_turn_rate"]
+
+
 def test_model_mass_matches_the_scaled_displacement() -> None:
     """m'·½ρL³ at 1:100 in fresh water ≈ 311.6 kg (data file §1.3; m' = 0.0181 is rounded)."""
     assert EssoOsaka().mass == pytest.approx(311.6, rel=0.005)
@@ -339,7 +369,7 @@ def test_bad_parameters_raise_naming_the_field(field: str, value: float) -> None
         EssoOsakaParams(**{field: value})
 
 
-@pytest.mark.parametrize("field", ["speed_control", "slip_exp"])
+@pytest.mark.parametrize("field", ["speed_control", "slip_exp", "constant_revolutions"])
 def test_switch_parameters_accept_only_their_values(field: str) -> None:
     with pytest.raises(ParameterError, match=field):
         EssoOsakaParams(**{field: 0.5})
