@@ -28,7 +28,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.scenarios import Scenario, load_scenario
-from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
@@ -777,10 +777,8 @@ def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) 
         loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
         settings = json.dumps(loaded.config.model_dump(mode="json"), sort_keys=True)
         base = load_scenario(json.loads(settings))
-    randomization = None
-    if spec.randomize is not None:
-        randomization = TrialRandomization(**spec.randomize.model_dump(mode="json"))
-    return [trial_scenario(base, randomization, int(seed)) for seed in seeds]
+    randomize = None if spec.randomize is None else spec.randomize.model_dump(mode="json")
+    return seed_trials(base, randomize, seeds)
 
 
 def evaluate(

@@ -12,7 +12,9 @@ from typing import Any, NamedTuple
 
 from shipgym.config import is_path
 from shipgym.scenarios import Scenario, load_scenario
-from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym.scenarios.trials import TrialRandomization as TrialRandomization  # re-exported
+from shipgym.scenarios.trials import seed_trials
+from shipgym.scenarios.trials import trial_scenario as trial_scenario  # re-exported
 from shipgym_baselines import evaluation
 from shipgym_baselines.errors import BackendError as BackendError  # re-exported by the package
 from shipgym_baselines.errors import RunError
@@ -23,7 +25,7 @@ from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult, controller_failed
-from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, dealt_seeds, shares_trials
+from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, dealt_owners, shares_trials
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label
 from shipgym_baselines.signals import worker_init
@@ -123,9 +125,7 @@ def job_scenario(job: Job) -> Scenario:
 def trials(job: Job) -> list[Scenario]:
     """The job's scenario as each of its seeds draws it (the scenario itself without
     randomisation)."""
-    base = job_scenario(job)
-    randomization = None if job.randomize is None else TrialRandomization(**job.randomize)
-    return [trial_scenario(base, randomization, seed) for seed in job.seeds]
+    return seed_trials(job_scenario(job), job.randomize, job.seeds)
 
 
 def run_job(job: tuple) -> EpisodeResult:
@@ -291,7 +291,7 @@ def plan_jobs(
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job of all seeds
     per training seed (a learned agent's; with ``shared`` one job of all seeds, each played
-    by the training seed :func:`~shipgym_baselines.records.trials.dealt_seeds` deals it,
+    by the training seed :func:`~shipgym_baselines.records.trials.dealt_owners` deals it,
     :attr:`Job.dealt`) or of all seeds (a classical controller's: they run in lockstep,
     :func:`run_batch`), one job per seed for the
     privileged oracle (its reference table is looked up trial by trial).  ``scenarios``:
@@ -307,12 +307,7 @@ def plan_jobs(
                 continue
             learned = controller_kind(label) == "learned"
             if learned and shared:  # one job: each seed played by the training seed dealt it
-                owner = {
-                    s: k
-                    for k, mine in dealt_seeds(scenario, seeds, seeds_of[label]).items()
-                    for s in mine
-                }
-                dealt = tuple(owner[s] for s in seeds)
+                dealt = tuple(dealt_owners(scenario, seeds, seeds_of[label]))
                 jobs.append(Job(c, scenario, tuple(seeds), None, randomize, settings, dealt=dealt))
                 continue
             for k in seeds_of[label]:

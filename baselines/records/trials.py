@@ -27,20 +27,26 @@ LearnedTrials = Literal["all", "shared"]
 T = TypeVar("T")
 
 
-def dealt_seeds(
-    scenario: str, seeds: Sequence[int], training_seeds: Sequence[T]
-) -> dict[T, list[int]]:
-    """Training seed → the evaluation seeds of ``scenario`` it plays when they are shared:
-    ``seeds`` dealt in turn to ``training_seeds``, starting at an offset fixed by the
-    scenario's name (CRC-32), so that over many scenarios each training seed plays about as
-    many trials, and adding a scenario to a suite changes no other scenario's deal.  A
-    controller that is not trained (``[None]``) plays every seed."""
+def dealt_owners(scenario: str, seeds: Sequence[int], training_seeds: Sequence[T]) -> list[T]:
+    """The training seed that plays each of ``seeds`` of ``scenario`` when they are shared:
+    the training seeds in turn, starting at an offset fixed by the scenario's name (CRC-32),
+    so that over many scenarios each training seed plays about as many trials, and adding a
+    scenario to a suite changes no other scenario's deal.  A controller that is not trained
+    (``[None]``) plays every seed."""
     if not training_seeds:
         raise ValueError("no training seeds to deal the trials to")
     start = zlib.crc32(scenario.encode()) % len(training_seeds)
+    return [training_seeds[(start + i) % len(training_seeds)] for i in range(len(seeds))]
+
+
+def dealt_seeds(
+    scenario: str, seeds: Sequence[int], training_seeds: Sequence[T]
+) -> dict[T, list[int]]:
+    """Training seed → the evaluation seeds of ``scenario`` it plays when they are shared
+    (:func:`dealt_owners`)."""
     dealt: dict[T, list[int]] = {k: [] for k in training_seeds}
-    for i, seed in enumerate(seeds):
-        dealt[training_seeds[(start + i) % len(training_seeds)]].append(seed)
+    for seed, owner in zip(seeds, dealt_owners(scenario, seeds, training_seeds), strict=True):
+        dealt[owner].append(seed)
     return dealt
 
 
@@ -53,9 +59,7 @@ def runs_of(
     scenario: str, seeds: Sequence[int], training_seeds: Sequence[T], shared: bool
 ) -> set[tuple[T, int]]:
     """The (training seed, evaluation seed) episodes a controller plays on ``scenario``:
-    every pair, or with ``shared`` the pairs of :func:`dealt_seeds`."""
+    every pair, or with ``shared`` each seed with its :func:`dealt_owners`."""
     if not shared:
         return {(k, s) for k in training_seeds for s in seeds}
-    return {
-        (k, s) for k, mine in dealt_seeds(scenario, seeds, training_seeds).items() for s in mine
-    }
+    return set(zip(dealt_owners(scenario, seeds, training_seeds), seeds, strict=True))

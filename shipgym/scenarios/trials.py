@@ -25,6 +25,7 @@ observations, never the event schedule.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping
 from typing import Annotated, Any
 
 import numpy as np
@@ -86,6 +87,16 @@ def trial_draws(randomization: TrialRandomization, seed: int) -> dict[str, float
         if r is not None:
             out[name] = r[0] + (r[1] - r[0]) * x
     return out
+
+
+def seed_trials(
+    scenario: Any, randomize: Mapping[str, Any] | None, seeds: Iterable[int]
+) -> list[Any]:
+    """:func:`trial_scenario` of each seed, the ranges given as a dict (a
+    :class:`TrialRandomization`'s fields, as a suite or ``run.json`` holds them; None: the
+    scenario itself for every seed)."""
+    randomization = None if randomize is None else TrialRandomization(**randomize)
+    return [trial_scenario(scenario, randomization, int(seed)) for seed in seeds]
 
 
 def trial_scenario(scenario: Any, randomization: TrialRandomization | None, seed: int) -> Any:
