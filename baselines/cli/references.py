@@ -6,7 +6,9 @@ cache, and runs a reference only for a trial neither holds.  This command runs e
 reference of ``--reference`` (default: both) on every trial of the given suites (scenarios ×
 the suite's seeds, the held-out and in-range ones × its ``heldout_seeds`` and
 ``inrange_seeds``, drawn with its ``randomize``
-ranges) and, with ``--validation``, the ``oracle`` on the validation split that ``shipgym
+ranges), the ``oracle`` on the twins of the suite's changing scenarios that are no
+scenario of the suite (:mod:`shipgym_baselines.leaderboard.twins`) and, with
+``--validation``, the ``oracle`` on the validation split that ``shipgym
 tune`` scores on (:func:`~shipgym_baselines.tuning.validation.validation_trials`; tuning
 needs no other reference), that its target does not hold yet.  It writes after every
 episode, so an interrupted fill resumes where it stopped.  Without ``--suite`` and
@@ -95,7 +97,9 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
+    from shipgym_baselines.leaderboard.jobs import suite_scenarios
     from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.leaderboard.twins import plan_twins
     from shipgym_baselines.references import (
         ReferenceCache,
         ReferenceTable,
@@ -127,6 +131,17 @@ def run(args: argparse.Namespace) -> int:
                     job = Job(ref, scenario, (seed,), None, randomize, references="recompute")
                     (trial,) = trials(job)
                     candidates.append((ref, job, scenario, seed, trial))
+        if spec.twins and ORACLE in chosen:  # the oracle plays the twins, no other reference
+            scenarios = suite_scenarios(spec.all_scenarios())
+            seeds_of = {s: fewer.get(s, seeds) for s in scenarios}
+            of, new = plan_twins(scenarios, seeds_of)
+            for twin, scenario in new.items():
+                settings = scenario.config.model_dump(mode="json")
+                first = next(s for s, t in of.items() if t == twin)
+                for seed in seeds_of[first]:
+                    job = Job(ORACLE, twin, (seed,), None, randomize, settings, "recompute")
+                    (trial,) = trials(job)
+                    candidates.append((ORACLE, job, twin, seed, trial))
     if args.validation and ORACLE in chosen:
         from shipgym_baselines.tuning.validation import validation_trials
 

@@ -72,7 +72,7 @@ _DEFINED = {
         "scenario_split",
     ),
     "markdown": (
-        "GAP_HEADERS",
+        "TWIN_HEADERS",
         "generalisation_table",
         "headroom_markdown",
         "markdown_table",

@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
+from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
 from shipgym_baselines.leaderboard.ranking import BASELINE, GAIN, PROB
 
 #: how a cell reads: the row's rank in its table, the controller's name (the page: with its
@@ -29,7 +30,8 @@ class RankingColumn:
     ascending on the first click), ``digits``: the decimals of ``leaderboard.md``'s value
     and interval (the page shows 3), ``trials``: the field of the count shown beside the
     value, ``only_with``: the field without which (None in every row of a table) the
-    column is left out of that table."""
+    column is left out of that table, ``long``: shown only in the page's long ranking table
+    (every field of ``aggregate.json``), not in the main ranking."""
 
     name: str
     markdown: str | None
@@ -40,6 +42,7 @@ class RankingColumn:
     digits: int = 2
     trials: str | None = None
     only_with: str | None = None
+    long: bool = False
 
     @property
     def key(self) -> str:
@@ -77,17 +80,28 @@ RANKING_COLUMNS = (
         only_with=PROB,
     ),
     RankingColumn("failure_rate", "failure rate [95 % CI]", "failure rate", lower=True),
-    # against the frozen optimum: only where the run has oracle_frozen's episodes
-    RankingColumn(GAIN, "adaptation gain [95 % CI]", "adaptation gain", only_with=GAIN),
+    # against the changing trials' twins: only where the run has the twins' episodes
     RankingColumn(
-        "prob_beats_frozen", "P(C < C_frozen) [95 % CI]", "P(C < C_frozen)", only_with=GAIN
+        NOMINAL, "nominal ratio [95 % CI]", "nominal ratio", lower=True, only_with=NOMINAL
     ),
     RankingColumn(
+        SHARE,
+        "change share IQM [95 % CI] (trials)",
+        "change share",
+        trials="share_trials",
+        only_with=SHARE,
+    ),
+    # against the frozen optimum: only where the run has oracle_frozen's episodes; in the
+    # page's long table
+    RankingColumn(GAIN, None, "C_frozen / C", only_with=GAIN, long=True),
+    RankingColumn("prob_beats_frozen", None, "P(C < C_frozen)", only_with=GAIN, long=True),
+    RankingColumn(
         "gap_closed_iqm",
-        "gap closed IQM [95 % CI] (trials)",
+        None,
         "gap closed IQM",
         trials="gap_trials",
         only_with=GAIN,
+        long=True,
     ),
 )
 #: the columns of ``leaderboard.md``'s ranking tables, in its order
@@ -101,9 +115,8 @@ MARKDOWN_ORDER = (
     "cost_ratio_gmean",
     "prob",
     "failure_rate",
-    GAIN,
-    "prob_beats_frozen",
-    "gap_closed_iqm",
+    NOMINAL,
+    SHARE,
 )
 
 
@@ -113,9 +126,10 @@ def markdown_columns() -> list[RankingColumn]:
     return [by_name[name] for name in MARKDOWN_ORDER]
 
 
-def page_columns() -> list[RankingColumn]:
-    """The columns the page shows, in its order."""
-    return [c for c in RANKING_COLUMNS if c.page is not None]
+def page_columns(long: bool = False) -> list[RankingColumn]:
+    """The columns the page's main ranking shows, in its order; ``long``: those of its long
+    ranking table (every column)."""
+    return [c for c in RANKING_COLUMNS if c.page is not None and (long or not c.long)]
 
 
 def shown(

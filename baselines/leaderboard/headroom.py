@@ -1,7 +1,7 @@
 """What adaptation is worth: per trial the headroom C_frozen / C_oracle (the optimum that
-never adapts against the oracle), per ranking row the adaptation gain, P(C < C_frozen) and
-the gap closed with their intervals, and the headroom per ship × change family (the
-method: :mod:`.ranking`)."""
+never adapts against the oracle), per ranking row the cost against the frozen optimum
+(``cost_vs_frozen_gmean``), P(C < C_frozen) and the gap closed with their intervals, and
+the headroom per ship × change family (the method: :mod:`.ranking`)."""
 
 from __future__ import annotations
 
@@ -28,8 +28,9 @@ from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 #: the gap closed is averaged over the trials where knowing the change is worth at least
 #: this factor (headroom C_frozen / C_oracle)
 GAP_HEADROOM = 1.2
-#: an aggregate row's adaptation gain (None: no frozen optimum's episodes)
-GAIN = "adaptation_gain_gmean"
+#: an aggregate row's cost against the frozen optimum, the geometric mean of C_frozen / C
+#: (None: no frozen optimum's episodes)
+GAIN = "cost_vs_frozen_gmean"
 #: the fields of an ``aggregate.json`` object against the frozen optimum, in order
 GAP_FIELDS = (
     GAIN,
@@ -48,11 +49,7 @@ HEADROOM_EXPLAINED = (
     f"What knowing the change is worth: the cost of {ORACLE_FROZEN} (the same NMPC as "
     f"{ORACLE}, its truth frozen at the episode's start: the optimum that never adapts) "
     f"over {ORACLE}'s, geometric mean over the catalogue scenarios' trials of each ship "
-    "and change family (how many below). 1: adapting is worth nothing. In the ranking: the "
-    "adaptation gain C_frozen / C (geometric mean; above 1: better than the optimum that "
-    "never adapts), P(C < C_frozen) over the trials (ties count half) and the gap closed, "
-    "log(C_frozen / C) / log(C_frozen / C_oracle) (0 = never adapting, 1 = the oracle), "
-    f"its IQM over the trials worth {GAP_HEADROOM:g}× or more."
+    "and change family (how many below). 1: adapting is worth nothing."
 )
 
 
@@ -151,8 +148,8 @@ def gap_fields(
     point, interval = interval_estimate(m["gain"], _gain_estimates, reps, seed)
     qualified = np.isfinite(m["gap"])
     out = {
-        "adaptation_gain_gmean": finite_or_none(point[0]),
-        "adaptation_gain_gmean_ci95": finite_bounds(interval, 0),
+        GAIN: finite_or_none(point[0]),
+        f"{GAIN}_ci95": finite_bounds(interval, 0),
         "prob_beats_frozen": float(point[1]),
         "prob_beats_frozen_ci95": bounds(interval, 1),
         "gap_closed_iqm": None,

@@ -78,18 +78,51 @@ def row_intervals(
     episodes: Sequence[Mapping[str, Any]], metrics: Iterable[str], seed: int = 0
 ) -> dict[str, list[float] | None]:
     """``{f"{metric}_ci95": [low, high] | None}`` for one row's episodes (dicts with the
-    metrics and, for learned agents, ``training_seed``): stratified over training seeds."""
+    metrics and, for learned agents, ``training_seed``): stratified over training seeds
+    when every training seed played the same evaluation seeds (:func:`row_strata`), else
+    the row's episodes resampled as one pool."""
+    strata = row_strata(episodes)
+    # every metric resamples the same episodes: one draw serves them all (the same numbers)
+    indices = bootstrap_indices([len(group) for group in strata], seed=seed)
+    out: dict[str, list[float] | None] = {}
+    for metric in metrics:
+        values = [[float_or_nan(ep.get(metric)) for ep in group] for group in strata]
+        out[f"{metric}_ci95"] = stratified_bootstrap_ci(values, seed=seed, indices=indices)
+    return out
+
+
+def row_strata(episodes: Sequence[Mapping[str, Any]]) -> list[list[Mapping[str, Any]]]:
+    """The strata a row's interval resamples within: one per training seed when each
+    played the same evaluation seeds (every training seed × every trial), else one of all
+    the episodes (trials dealt among the training seeds: a stratum per training seed would
+    hold one or two episodes, and an interval of one trial has no width)."""
     by_run: dict[Any, list[Mapping[str, Any]]] = defaultdict(list)
     for ep in episodes:
         by_run[ep.get("training_seed")].append(ep)
     runs = sorted(by_run, key=lambda s: (s is None, s))
-    # every metric resamples the same episodes: one draw serves them all (the same numbers)
-    indices = bootstrap_indices([len(by_run[run]) for run in runs if by_run[run]], seed=seed)
-    out: dict[str, list[float] | None] = {}
-    for metric in metrics:
-        strata = [[float_or_nan(ep.get(metric)) for ep in by_run[run]] for run in runs]
-        out[f"{metric}_ci95"] = stratified_bootstrap_ci(strata, seed=seed, indices=indices)
-    return out
+    trials = {frozenset(int(ep["seed"]) for ep in by_run[run]) for run in runs}
+    if len(trials) > 1:
+        return [list(episodes)]
+    return [by_run[run] for run in runs]
+
+
+def pooled_bootstrap_ci(
+    values: np.ndarray,
+    statistic: Callable[[np.ndarray], float],
+    reps: int = ROW_REPS,
+    confidence: float = CONFIDENCE,
+    seed: int = 0,
+) -> list[float] | None:
+    """Percentile-bootstrap interval [low, high] of ``statistic`` over ``values`` resampled
+    with replacement as one pool; None without finite values."""
+    a = np.asarray(values, dtype=np.float64).ravel()
+    if not a.size or not np.all(np.isfinite(a)):
+        return None
+    (idx,) = bootstrap_indices([a.size], reps, seed)
+    samples = np.array([statistic(a[row]) for row in idx])
+    alpha = 0.5 * (1.0 - confidence)
+    low, high = np.quantile(samples, [alpha, 1.0 - alpha])
+    return [float(low), float(high)]
 
 
 def float_or_nan(value: Any) -> float:

@@ -22,10 +22,20 @@ from shipgym_baselines.evaluation import ACT_TIMEOUT_S
 from shipgym_baselines.executor import BACKENDS as BACKENDS  # re-exported by the package
 from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.leaderboard.suite import scenario_names
+from shipgym_baselines.leaderboard.twins import plan_twins, twin_record
 from shipgym_baselines.plugins import ControllerSpec
-from shipgym_baselines.privileged import grants_truth
+from shipgym_baselines.privileged import ORACLE, grants_truth
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult, controller_failed
-from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, dealt_owners, shares_trials
+from shipgym_baselines.records.trials import (
+    LEARNED_TRIALS,
+    SHARED,
+    TWIN_PLAYERS,
+    TWIN_SCENARIOS,
+    deal_names,
+    dealt_owners,
+    shares_trials,
+    twin_scenarios,
+)
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label
 from shipgym_baselines.signals import worker_init
@@ -242,8 +252,10 @@ def suite_record(
     the scenarios run on fewer,
     :meth:`~shipgym_baselines.leaderboard.suite.SuiteConfig.scenario_seeds`),
     the trial randomisation, controllers (table name, how the suite names it, kind, training seeds),
-    each scenario's settings (by table name), the pairs that do not apply and, when the
-    suite has its own scenarios, ``scenario_files`` (table name → the YAML file read)."""
+    each scenario's settings (by table name), the pairs that do not apply, when the
+    suite has its own scenarios ``scenario_files`` (table name → the YAML file read) and,
+    unless the suite turns them off, the no-change twins (``twins``, ``twin_scenarios``,
+    ``twin_players``: :mod:`shipgym_baselines.leaderboard.twins`)."""
     ships = {s: sc.model.name for s, sc in scenarios.items()}
     controllers = []
     for c in names:
@@ -260,6 +272,22 @@ def suite_record(
     own = {"scenario_files": {n: f for n, f in files.items() if n in scenarios}}
     fewer = {s: v for s, v in spec.scenario_seeds(seed_list).items() if s in scenarios}
     shared = {LEARNED_TRIALS: SHARED} if spec.learned_trials == SHARED else {}
+    twins: dict[str, Any] = {}
+    if spec.twins:
+        of, new = plan_twins(scenarios, {s: fewer.get(s, seed_list) for s in scenarios})
+        players = [c["name"] for c in controllers if is_twin_player(c["name"], c["kind"])]
+        twins = {**twin_record(of, new), TWIN_PLAYERS: players} if of else {}
+        for name, twin in new.items():
+            first = next(s for s, t in of.items() if t == name)
+            if first in fewer:
+                fewer[name] = fewer[first]
+            ships[name] = twin.model.name
+    skip = [
+        [s, c["name"]]
+        for s in [*scenarios, *twins.get(TWIN_SCENARIOS, {})]
+        for c in controllers
+        if not applies_to(c["name"], ships[s])
+    ]
     return {
         "name": spec.name,
         "seeds": seed_list,
@@ -268,14 +296,17 @@ def suite_record(
         "randomize": None if spec.randomize is None else spec.randomize.model_dump(mode="json"),
         "controllers": controllers,
         "scenarios": {s: sc.config.model_dump(mode="json") for s, sc in scenarios.items()},
-        "does_not_apply": [
-            [s, c["name"]]
-            for s in scenarios
-            for c in controllers
-            if not applies_to(c["name"], ships[s])
-        ],
+        "does_not_apply": skip,
         **(own if own["scenario_files"] else {}),  # absent without: older records resume
+        **twins,  # absent: a run without twins (and older records resume)
     }
+
+
+def is_twin_player(name: str, kind: str) -> bool:
+    """Whether a controller of a run plays the twins: every competitor, and the ``oracle``
+    (the other references never: the optimum that never adapts costs what the oracle does on
+    a trial without a change)."""
+    return kind != "reference" or name == ORACLE
 
 
 def plan_jobs(
@@ -288,6 +319,7 @@ def plan_jobs(
     references: str = "table",
     scenario_seeds: Mapping[str, list[int]] | None = None,
     shared: bool = False,
+    deal: Mapping[str, str] | None = None,
 ) -> list[Job]:
     """Every job of a run: per scenario and controller that applies, one job of all seeds
     per training seed (a learned agent's; with ``shared`` one job of all seeds, each played
@@ -296,7 +328,9 @@ def plan_jobs(
     :func:`run_batch`), one job per seed for the
     privileged oracle (its reference table is looked up trial by trial).  ``scenarios``:
     names, or name → recorded settings (the jobs run those); ``scenario_seeds``: the
-    scenarios run on other seeds than ``seed_list``, with theirs."""
+    scenarios run on other seeds than ``seed_list``, with theirs; ``deal``: the name each
+    scenario's trials are dealt by (default: its own;
+    :func:`~shipgym_baselines.records.trials.deal_names`)."""
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
@@ -307,7 +341,8 @@ def plan_jobs(
                 continue
             learned = controller_kind(label) == "learned"
             if learned and shared:  # one job: each seed played by the training seed dealt it
-                dealt = tuple(dealt_owners(scenario, seeds, seeds_of[label]))
+                by = (deal or {}).get(scenario, scenario)
+                dealt = tuple(dealt_owners(by, seeds, seeds_of[label]))
                 jobs.append(Job(c, scenario, tuple(seeds), None, randomize, settings, dealt=dealt))
                 continue
             for k in seeds_of[label]:
@@ -331,10 +366,9 @@ def plan_run(
 ) -> list[Job]:
     """The jobs of a run whose resolved suite is ``record`` (:func:`suite_record`, as
     ``run.json`` keeps it): :func:`plan_jobs` on its scenarios' recorded settings, seeds,
-    randomisation, the pairs that do not apply and its deal of learned trials."""
-    return plan_jobs(
-        names,
-        record["scenarios"],
+    randomisation, the pairs that do not apply and its deal of learned trials, then on the
+    twins that are no scenario of the run, by the controllers that play them."""
+    args = (
         list(record["seeds"]),
         seeds_of,
         record["randomize"],
@@ -342,7 +376,24 @@ def plan_run(
         references,
         record.get("scenario_seeds"),
         shares_trials(record),
+        deal_names(record),
     )
+    jobs = plan_jobs(names, record["scenarios"], *args)
+    twins = twin_scenarios(record)
+    if twins:
+        players = set(record.get(TWIN_PLAYERS, []))
+        jobs += plan_jobs([c for c in names if controller_label(c) in players], twins, *args)
+    return jobs
+
+
+def run_scenarios(
+    record: Mapping[str, Any], scenarios: Mapping[str, Scenario]
+) -> dict[str, Scenario]:
+    """``scenarios`` (the run's, by table name) and the twins of ``record`` that are no
+    scenario of the run, built from their recorded settings."""
+    twins = {t: _recorded_scenario(json.dumps(s, sort_keys=True)) for t, s in
+             twin_scenarios(record).items()}  # fmt: skip
+    return {**scenarios, **twins}
 
 
 def longest_first(jobs: list[Job], scenarios: Mapping[str, Scenario]) -> list[Job]:

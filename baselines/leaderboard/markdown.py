@@ -7,6 +7,12 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from shipgym_baselines.leaderboard.change_share import (
+    CHANGE_SHARE_EXPLAINED,
+    NOMINAL,
+    SHARE,
+    SHARE_GRID_EXPLAINED,
+)
 from shipgym_baselines.leaderboard.columns import (
     RankingColumn,
     count,
@@ -15,7 +21,6 @@ from shipgym_baselines.leaderboard.columns import (
 )
 from shipgym_baselines.leaderboard.escaping import md_cell
 from shipgym_baselines.leaderboard.ranking import (
-    GAIN,
     HEADROOM_EXPLAINED,
     ORACLE,
     PARTIAL,
@@ -76,8 +81,8 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
-#: the ranking tables' columns against the frozen optimum
-GAP_HEADERS = tuple(str(c.markdown) for c in markdown_columns() if c.only_with == GAIN)
+#: the ranking tables' columns against the changing trials' twins
+TWIN_HEADERS = tuple(str(c.markdown) for c in markdown_columns() if c.key in (NOMINAL, SHARE))
 
 
 def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> str:
@@ -103,6 +108,7 @@ def ranking_markdown(
     episodes: Sequence[Mapping[str, Any]] = (),
     note: str = "",
     headroom: Sequence[Mapping[str, Any]] = (),
+    shares: Mapping[str, Any] | None = None,
 ) -> str:
     """The head of ``leaderboard.md``: the score in two sentences, the ranking per split
     (and its partial tables), the resolution, the headroom per ship × change family and the
@@ -128,8 +134,10 @@ def ranking_markdown(
             f"{', '.join(unranked)}.",
             "",
         ]
+    if any(r.get(NOMINAL) is not None for r in board):
+        lines += [CHANGE_SHARE_EXPLAINED, ""]
     lines += ranking_tables(board) + resolution_lines(board) + headroom_markdown(headroom)
-    lines += scores_markdown(board, scores, scenarios)
+    lines += share_markdown(shares or {}) + scores_markdown(board, scores, scenarios)
     return "\n".join(lines)
 
 
@@ -154,6 +162,28 @@ def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
             found = cells.get((ship, family))
             row.append(f"{found['headroom_gmean']:.2f} ({found['trials']})" if found else "–")
         lines.append("| " + " | ".join(row) + " |")
+    return [*lines, ""]
+
+
+def share_markdown(shares: Mapping[str, Any]) -> list[str]:
+    """The change share per ship × change family of the top competitors and the best learned
+    agent (:func:`~shipgym_baselines.leaderboard.outputs.share_table`): a row per ship and
+    family, a column per controller; no lines without rows."""
+    if not shares or not shares["rows"]:
+        return []
+    controllers = shares["controllers"]
+    lines = [
+        "### Change share per ship and change family",
+        "",
+        f"{SHARE_GRID_EXPLAINED} ({split_label(shares['split'])} scenarios).",
+        "",
+        "| ship | family | trials | " + " | ".join(map(md_cell, controllers)) + " |",
+        "|---|---|---|" + "---|" * len(controllers),
+    ]
+    for row in shares["rows"]:
+        cells = [md_cell(row["ship"]), row["family"].replace("_", " "), str(row["trials"])]
+        cells += [_interval(row["shares"][c], None) for c in controllers]
+        lines.append("| " + " | ".join(cells) + " |")
     return [*lines, ""]
 
 

@@ -21,11 +21,19 @@ from shipgym.scenarios import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.jsonout import dumps, dumps_rows
+from shipgym_baselines.leaderboard.change_share import (
+    NO_SCENARIO_CELLS,
+    episode_costs,
+    scenario_twin_cells,
+    share_controllers,
+    share_grid,
+)
 from shipgym_baselines.leaderboard.comparison import (
     comparison_note,
 )
 from shipgym_baselines.leaderboard.costs import tables_line
 from shipgym_baselines.leaderboard.escaping import csv_cell, plain_text
+from shipgym_baselines.leaderboard.headroom import change_family, headroom_table, scenario_ships
 from shipgym_baselines.leaderboard.markdown import (
     generalisation_table,
     markdown_table,
@@ -35,13 +43,12 @@ from shipgym_baselines.leaderboard.markdown import (
 from shipgym_baselines.leaderboard.ranking import (
     PARTIAL,
     aggregate_ranking,
-    headroom_table,
     no_ranking,
     resolution_lines,
-    scenario_ships,
 )
 from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
-from shipgym_baselines.leaderboard.splits import scenario_split, unseen_hull_scenarios
+from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, scored_episodes
+from shipgym_baselines.leaderboard.splits import suite_splits
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.leaderboard.tables import (
     AGGREGATE_FILE,
@@ -51,12 +58,12 @@ from shipgym_baselines.leaderboard.tables import (
     generalisation,
     rankable,
 )
-from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name, verdict
+from shipgym_baselines.leaderboard.verdict import folder_verdict, main_table, plain_name, verdict
 from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
 from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
 from shipgym_baselines.records.runrecord import RUN_FILE, read_run
 from shipgym_baselines.records.trajectories import episode_result
-from shipgym_baselines.records.trials import shares_trials
+from shipgym_baselines.records.trials import shares_trials, twins_of
 from shipgym_baselines.signals import worker_init
 
 
@@ -101,17 +108,23 @@ def write_results(
     out = Path(out)
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     episodes = episode_rows(results)
-    own, unseen = suite.get("scenario_files", {}), unseen_hull_scenarios(suite["scenarios"])
-    splits = {s: scenario_split(s, own, unseen) for s in suite["scenarios"]}
+    splits = suite_splits(suite)
+    twins = twins_of(suite)
+    # the twins' episodes are scored against the changing trials, never shown or ranked
     ranked = rankable(episodes, suite.get("scenario_seeds"), shares_trials(suite))
+    shown_episodes = [e for e in ranked if e["scenario"] in splits]
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
-    drawn = figures.episodes_to_draw(results)
+    drawn = figures.episodes_to_draw([r for r in results if r.scenario in splits])
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
         boards = [
             pool.submit(
-                aggregate_ranking, ranked, {s: sp for s, sp in splits.items() if sp == split}, kinds
+                aggregate_ranking,
+                ranked,
+                {s: sp for s, sp in splits.items() if sp == split},
+                kinds,
+                twins=twins,
             )
             for split in sorted(set(splits.values()))
         ]
@@ -135,7 +148,7 @@ def write_results(
                 carried(figures.plot_ranking),
                 out,
                 [r for r in board if r["split"].removesuffix(PARTIAL) == split],
-                ranked,
+                shown_episodes,
                 splits,
                 kinds,
                 vector_figures,
@@ -150,20 +163,30 @@ def write_results(
             not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
             splits=splits,
         )
-        scores = score_table(ranked, splits, kinds)
+        add_twin_cells(rows, ranked, twins)
+        scores = score_table(shown_episodes, splits, kinds)
         write_text(out / AGGREGATE_FILE, dumps(board, indent=2) + "\n")
         write_text(out / SCENARIO_SCORES_FILE, dumps_rows(scores))  # one scenario a line
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         note = comparison_note(suite, out)
-        headroom = headroom_table(ranked, scenario_ships(suite["scenarios"]), splits)
+        ships = scenario_ships(suite["scenarios"])
+        headroom = headroom_table(ranked, ships, splits)
+        shares = share_table(board, ranked, ships, splits, twins)
         head = ranking_markdown(
-            board, scores, list(suite["scenarios"]), left_out, ranked, note, headroom
+            board,
+            scores,
+            list(suite["scenarios"]),
+            left_out,
+            shown_episodes,
+            note,
+            headroom,
+            shares,
         )
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
         files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
-    lead = verdict(board, ranked, plain_name)
+    lead = verdict(board, shown_episodes, plain_name, headroom)
     page.write_html(
         out,
         rows,
@@ -174,8 +197,46 @@ def write_results(
         verdict=lead,
         note=note if board else "",
         headroom=headroom,
+        shares=shares,
     )
     return rows
+
+
+def add_twin_cells(
+    rows: list[dict[str, Any]], ranked: list[dict[str, Any]], twins: Mapping[str, str]
+) -> None:
+    """Each row of a changing scenario gets its controller's nominal ratio and change share
+    there, with intervals that resample the scenario's trials
+    (:func:`~shipgym_baselines.leaderboard.change_share.scenario_twin_cells`); the other rows
+    None.  The references' rows have none."""
+    scored = scored_episodes(ranked)
+    costs = episode_costs(scored)
+    for row in rows:
+        cells = dict(NO_SCENARIO_CELLS)
+        if row["scenario"] in twins and row["applies"] and row["kind"] != REFERENCE_KIND:
+            cells = scenario_twin_cells(scored, row["controller"], row["scenario"], twins, costs)
+        row.update(cells)
+
+
+def share_table(
+    board: list[dict[str, Any]],
+    ranked: list[dict[str, Any]],
+    ships: Mapping[str, str],
+    splits: Mapping[str, str],
+    twins: Mapping[str, str],
+) -> dict[str, Any]:
+    """The change share per ship × change family of the verdict's table's top competitors
+    and best learned agent (:func:`~shipgym_baselines.leaderboard.change_share.share_grid`):
+    ``split``, ``controllers`` and ``rows``; empty without twins or a ranking."""
+    table = main_table(board)
+    if not twins or not table:
+        return {}
+    split = table[0]["split"]
+    controllers = share_controllers(table)
+    scenarios = [s for s in splits if splits[s] == split and s in table[0]["scenarios"]]
+    families = {s: change_family(s) for s in scenarios}
+    grid = share_grid(scored_episodes(ranked), controllers, ships, families, scenarios, twins)
+    return {"split": split, "controllers": controllers, "rows": grid}
 
 
 def learned_curves(kinds: Mapping[str, str]) -> dict[str, list[dict[str, Any]]]:

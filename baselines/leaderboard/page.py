@@ -1,14 +1,16 @@
 """``leaderboard.html``: the leaderboard as one self-contained page.
 
-It opens with the run's verdict in two sentences (:mod:`shipgym_baselines.leaderboard.verdict`).
+It opens with the run's verdict in four sentences (:mod:`shipgym_baselines.leaderboard.verdict`).
 No network: the style sheet and the script are inline and every figure is embedded as a
 data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
 
 1. the **ranking** per split (``aggregate.json`` rows: IQM and geometric mean of the cost
    ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
-   rate, 95 % intervals; a split's partial table below it), the resolution of each split,
-   the headroom per ship × change family (what knowing the change is worth: C_frozen /
-   C_oracle, :func:`shipgym_baselines.leaderboard.ranking.headroom_table`) and the figures
+   rate, the nominal ratio and the change share, 95 % intervals; a split's partial table
+   below it; every ``aggregate.json`` field in a collapsed long table), the resolution of
+   each split, the headroom per ship × change family (what knowing the change is worth:
+   C_frozen / C_oracle, :func:`shipgym_baselines.leaderboard.ranking.headroom_table`), the
+   change share per ship × change family of the top competitors and the figures
    (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.leaderboard.figures`);
 2. the **controller × scenario table**: the oracle's mean cost, then each controller's
    geometric-mean cost ratio with its interval (``scenario_scores.json``,
@@ -54,6 +56,7 @@ from shipgym_baselines.leaderboard.page_sections import headroom_html as headroo
 from shipgym_baselines.leaderboard.page_sections import ranking_tables as ranking_tables
 from shipgym_baselines.leaderboard.page_sections import row_table as row_table
 from shipgym_baselines.leaderboard.page_sections import score_table as score_table
+from shipgym_baselines.leaderboard.page_sections import share_html
 from shipgym_baselines.leaderboard.ranking import ORACLE_FROZEN, SCORE_EXPLAINED, no_ranking
 from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
 from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES  # re-exported
@@ -168,12 +171,15 @@ def page(
     verdict: str | None = None,
     note: str = "",
     headroom: Sequence[Mapping[str, Any]] = (),
+    shares: Mapping[str, Any] | None = None,
 ) -> str:
     """The page's HTML (module doc); ``verdict``: the run's sentences
     (:mod:`shipgym_baselines.leaderboard.verdict`), the page's first paragraph; ``note``: what the
     run is ranked against (:func:`~shipgym_baselines.leaderboard.comparison.comparison_note`),
     under it; ``headroom``: the headroom table's rows
-    (:func:`~shipgym_baselines.leaderboard.ranking.headroom_table`), after the ranking."""
+    (:func:`~shipgym_baselines.leaderboard.ranking.headroom_table`), after the ranking;
+    ``shares``: the change share per ship × change family
+    (:func:`~shipgym_baselines.leaderboard.outputs.share_table`), after the headroom."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
         figures, (r["scenario"] for r in rows)
     )
@@ -192,7 +198,7 @@ def page(
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{esc(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
         f"{ranking_tables(aggregate) if aggregate else _no_ranking(scores)}"
-        f"{headroom_html(headroom)}"
+        f"{headroom_html(headroom)}{share_html(shares or {})}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
         "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
         "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
@@ -236,6 +242,7 @@ def write_html(
     verdict: str | None = None,
     note: str = "",
     headroom: Sequence[Mapping[str, Any]] = (),
+    shares: Mapping[str, Any] | None = None,
 ) -> Path:
     """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
     ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
@@ -243,14 +250,15 @@ def write_html(
     :mod:`shipgym_baselines.leaderboard.figures`; ``subtitle``: a line under the title (e.g. the
     suite
     and seeds); ``verdict``: the paragraph the page opens with; ``note``: what the run is
-    ranked against; ``headroom``: the headroom table's rows.  Returns the page's path."""
+    ranked against; ``headroom``: the headroom table's rows; ``shares``: the change share
+    per ship × change family.  Returns the page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
     write_bytes(
         path,
-        page(rows, aggregate, scores, figures, title, subtitle, verdict, note, headroom).encode(
-            "utf-8"
-        ),
+        page(
+            rows, aggregate, scores, figures, title, subtitle, verdict, note, headroom, shares
+        ).encode("utf-8"),
     )
     return path

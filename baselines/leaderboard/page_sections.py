@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from shipgym_baselines.leaderboard.change_share import SHARE_GRID_EXPLAINED
 from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
 from shipgym_baselines.leaderboard.html_cells import (
     Td,
@@ -28,7 +29,7 @@ from shipgym_baselines.leaderboard.ranking import (
     is_partial,
     resolution_lines,
 )
-from shipgym_baselines.leaderboard.splits import table_title
+from shipgym_baselines.leaderboard.splits import split_label, table_title
 
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
@@ -54,17 +55,31 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
     parts = []
     for split in dict.fromkeys(r["split"] for r in aggregate):
         rows = [r for r in aggregate if r["split"] == split]
-        mine = shown(page_columns(), rows)
-        columns = [(c.name, esc(c.page), _sort_kind(c)) for c in mine]
-        body = [[_ranking_cell(c, r, rank) for c in mine] for rank, r in enumerate(rows, 1)]
         base = split.removesuffix(PARTIAL)
         title = table_title(base)
         if is_partial(split):
             title += ": controllers that do not apply to every scenario (each on its own)"
-        table = html_table(f"ranking-{split}", columns, body, compact=True, cls="ranking")
-        parts.append(f"<div><h3>{esc(title)}</h3>{table}</div>")
+        table = _ranking_table(f"ranking-{split}", rows, page_columns())
+        parts.append(f"<div><h3>{esc(title)}</h3>{table}")
+        if any(c.long for c in shown(page_columns(long=True), rows)):
+            long = _ranking_table(f"ranking-long-{split}", rows, page_columns(long=True))
+            parts.append(
+                "<details><summary>Every field of the ranking (against the frozen optimum: "
+                f"C_frozen / C, P(C &lt; C_frozen), gap closed)</summary>{long}</details>"
+            )
+        parts.append("</div>")
     notes = "".join(f'<p class="note">{esc(line)}</p>' for line in resolution_lines(aggregate))
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
+
+
+def _ranking_table(
+    table_id: str, rows: Sequence[Mapping[str, Any]], columns: Sequence[RankingColumn]
+) -> str:
+    """One split's ranking table of ``columns`` (those some row has)."""
+    mine = shown(columns, rows)
+    heads = [(c.name, esc(c.page), _sort_kind(c)) for c in mine]
+    body = [[_ranking_cell(c, r, rank) for c in mine] for rank, r in enumerate(rows, 1)]
+    return html_table(table_id, heads, body, compact=True, cls="ranking")
 
 
 def _sort_kind(column: RankingColumn) -> str:
@@ -192,6 +207,29 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
         '<h3 id="headroom">Headroom per ship and change family</h3>'
         f'<p class="note">{esc(HEADROOM_EXPLAINED)}</p>'
         f"{html_table('headroom', columns, body, compact=True)}"
+    )
+
+
+def share_html(shares: Mapping[str, Any]) -> str:
+    """The change share per ship × change family of the top competitors and the best learned
+    agent (:func:`~shipgym_baselines.leaderboard.outputs.share_table`), sortable; empty
+    without rows."""
+    if not shares or not shares["rows"]:
+        return ""
+    controllers = shares["controllers"]
+    columns = [("ship", "ship", "text"), ("family", "family", "text")]
+    columns += [("trials", "trials", "number")]
+    columns += [(f"share:{c}", esc(c), "number") for c in controllers]
+    body = []
+    for row in shares["rows"]:
+        tds = [text_cell(row["ship"]), text_cell(row["family"].replace("_", " "))]
+        tds += [value_cell(row["trials"])]
+        tds += [value_cell(row["shares"][c]) for c in controllers]
+        body.append(tds)
+    note = f"{SHARE_GRID_EXPLAINED} ({split_label(shares['split'])} scenarios)."
+    return (
+        '<h3 id="change-share">Change share per ship and change family</h3>'
+        f'<p class="note">{esc(note)}</p>{html_table("change-share", columns, body, compact=True)}'
     )
 
 

@@ -32,7 +32,7 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   with its truth frozen at the episode's start (the optimum that never adapts).  Per trial,
   ``headroom`` = C_frozen / C_oracle (:func:`trial_headroom`): what knowing the change is
   worth.  Per controller and split (:func:`ranking_row`, the same bootstrap as the rest):
-  the geometric mean of C_frozen / C (``adaptation_gain_gmean``: > 1, better than never
+  the geometric mean of C_frozen / C (``cost_vs_frozen_gmean``: > 1, better than never
   adapting), P(C < C_frozen) + ½ P(C = C_frozen) over the trials
   (``prob_beats_frozen``) and the IQM of the gap closed, log(C_frozen / C) /
   log(C_frozen / C_oracle), over the trials whose headroom is at least
@@ -41,6 +41,9 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   not qualify and its IQM is over the finite entries, so each bootstrap sample redraws
   the qualifying trials with the rest (the interval is None if one sample draws none).
   :func:`headroom_table`: the headroom per ship × change family.
+* **Steering and adapting, apart** (:mod:`.change_share`): with each changing trial's
+  no-change twin, the nominal ratio C(twin) / C_oracle(twin) (``nominal_cost_ratio_gmean``)
+  and the change share (``change_share_iqm``) of each row, same bootstrap.
 
 **Reproducible**: rliable 1.2's bootstraps draw from numpy's *global* generator (its
 ``update_indices`` calls ``np.random.choice``; the ``random_state`` it hands to arch is
@@ -61,6 +64,8 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
+
+from shipgym_baselines.leaderboard.change_share import TWIN_FIELDS, episode_costs, twin_fields
 
 # the statistics, the episodes' scores and what adaptation is worth have their own
 # modules (intervals, scores, headroom); their names stay importable from here
@@ -142,6 +147,7 @@ AGGREGATE_FIELDS = (
     "failure_rate",
     "failure_rate_ci95",
     *GAP_FIELDS,
+    *TWIN_FIELDS,
 )
 
 
@@ -196,10 +202,14 @@ def ranking_row(
     tasks: list[str],
     reps: int = AGGREGATE_REPS,
     seed: int = 0,
+    twins: Mapping[str, str] | None = None,
+    costs: dict | None = None,
 ) -> dict[str, Any]:
     """One ``aggregate.json`` object (:data:`AGGREGATE_FIELDS`): ``controller`` over
     ``tasks``; the probability of improvement is None for ``pid_los`` itself (no comparison
-    with itself) and where ``pid_los`` lacks a task (not ranked in this run, or not there)."""
+    with itself) and where ``pid_los`` lacks a task (not ranked in this run, or not there);
+    ``twins``: changing scenario → its twin (None: no twin fields); ``costs``: the
+    episodes' costs (:func:`~.change_share.episode_costs`, computed once per table)."""
     ratios = run_matrix(scored, controller, tasks)
     point, interval = interval_estimate(ratios, _ratio_estimates, reps, seed)
     fail_point, fail_interval = interval_estimate(
@@ -228,6 +238,7 @@ def ranking_row(
         "failure_rate": float(fail_point[0]),
         "failure_rate_ci95": bounds(fail_interval, 0),
         **gap_fields(scored, controller, tasks, reps, seed),
+        **twin_fields(scored, controller, tasks, twins or {}, reps, seed, costs),
     }
 
 
@@ -237,14 +248,17 @@ def aggregate_ranking(
     kinds: Mapping[str, str] | None = None,
     reps: int = AGGREGATE_REPS,
     seed: int = 0,
+    twins: Mapping[str, str] | None = None,
 ) -> list[dict[str, Any]]:
     """The ``aggregate.json`` rows (module doc): per split, every competing controller (kind
     not ``reference``) on the same scenarios (those with the oracle's episodes), ranked by
     the cost ratio's IQM, ascending; a competitor without ratios on some of them is ranked on
     its own in the split ``"<split>:partial"``.  ``splits``: scenario → "catalogue" |
-    "heldout" | "inrange" | "yours"; ``kinds``: controller → kind (default: the episodes').
-    Empty without the oracle's episodes."""
+    "heldout" | "inrange" | "yours"; ``kinds``: controller → kind (default: the episodes');
+    ``episodes`` may hold the twins' (``twins``: changing scenario → its twin's table name;
+    the twins are no split's).  Empty without the oracle's episodes."""
     scored = scored_episodes(episodes)
+    costs = episode_costs(scored)
     kind_of = controller_kinds(episodes, kinds)
     competitors = sorted(c for c, k in kind_of.items() if k != REFERENCE_KIND)
     rows: list[dict[str, Any]] = []
@@ -254,8 +268,9 @@ def aggregate_ranking(
             tasks = rated_scenarios(scored, controller, set(common))
             if tasks:
                 label = split if tasks == common else split + PARTIAL
+                kind = kind_of[controller]
                 rows.append(
-                    ranking_row(scored, controller, kind_of[controller], label, tasks, reps, seed)
+                    ranking_row(scored, controller, kind, label, tasks, reps, seed, twins, costs)
                 )
     rows.sort(key=lambda r: (r["split"], r["cost_ratio_iqm"], r["controller"]))
     return rows

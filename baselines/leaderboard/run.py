@@ -35,6 +35,7 @@ from shipgym_baselines.leaderboard.jobs import (
     missing,
     plan_run,
     result_key,
+    run_scenarios,
     suite_record,
     suite_scenarios,
 )
@@ -117,6 +118,7 @@ def run_leaderboard(
         record[RECORD_KEY] = references_record(suite, spec.controllers, given, added)
     references = "recompute" if recompute_references else "table"
     jobs = plan_run(names, record, seeds_of, references)
+    scenarios = run_scenarios(record, scenarios)
     jobs = [job._replace(act_timeout=act_timeout) for job in jobs]
     workers = worker_count(workers if workers is not None else os.cpu_count() or 1, len(jobs))
     n_episodes = sum(len(job.seeds) for job in jobs)

@@ -54,23 +54,17 @@ def scored_episodes(
     return out
 
 
-def run_matrix(
-    scored: Sequence[Mapping[str, Any]],
-    controller: str,
-    scenarios: Sequence[str],
-    key: str = "cost_ratio",
-) -> np.ndarray:
-    """(runs, tasks) values ``key`` of one controller's episodes that have a cost ratio: a
-    run is a (training seed, evaluation seed) pair, a task a scenario (rliable's layout);
-    each task's runs in the order (training seed, evaluation seed).  The runs of a row are
-    rliable's independent samples per task (its stratified bootstrap resamples each task on
-    its own): where the training seeds share the trials, each task has its own pairs.
+def run_keys(
+    scored: Sequence[Mapping[str, Any]], controller: str, scenarios: Sequence[str]
+) -> dict[str, list[tuple[Any, int]]]:
+    """Per scenario, the (training seed, evaluation seed) runs of ``controller``'s episodes
+    that have a cost ratio, in :func:`run_matrix`'s order (training seed, then seed).
     Raises ValueError if a scenario has more or fewer runs than another (unequal seeds)."""
-    cells: dict[str, dict[tuple[Any, int], float]] = {s: {} for s in scenarios}
+    cells: dict[str, set[tuple[Any, int]]] = {s: set() for s in scenarios}
     for ep in scored:
         if ep["controller"] == controller and ep["scenario"] in cells:
             if ep.get("cost_ratio") is not None:
-                cells[ep["scenario"]][(ep.get("training_seed"), int(ep["seed"]))] = ep[key]
+                cells[ep["scenario"]].add((ep.get("training_seed"), int(ep["seed"])))
     order = {s: sorted(cells[s], key=lambda r: (r[0] is None, r[0] or 0, r[1])) for s in cells}
     first = order[scenarios[0]]
     for s in scenarios:
@@ -79,8 +73,30 @@ def run_matrix(
                 f"{controller}: scenario {s!r} has runs {order[s]} but "
                 f"{scenarios[0]!r} has {first}: every scenario needs the same seeds"
             )
+    return order
+
+
+def run_matrix(
+    scored: Sequence[Mapping[str, Any]],
+    controller: str,
+    scenarios: Sequence[str],
+    key: str = "cost_ratio",
+) -> np.ndarray:
+    """(runs, tasks) values ``key`` of one controller's episodes that have a cost ratio: a
+    run is a (training seed, evaluation seed) pair, a task a scenario (rliable's layout);
+    each task's runs in the order (training seed, evaluation seed) (:func:`run_keys`).  The
+    runs of a row are rliable's independent samples per task (its stratified bootstrap
+    resamples each task on its own): where the training seeds share the trials, each task
+    has its own pairs.  Raises ValueError if a scenario has more or fewer runs than another
+    (unequal seeds)."""
+    values: dict[tuple[str, Any, int], Any] = {}
+    for ep in scored:
+        if ep["controller"] == controller and ep.get("cost_ratio") is not None:
+            values[(ep["scenario"], ep.get("training_seed"), int(ep["seed"]))] = ep[key]
+    order = run_keys(scored, controller, scenarios)
+    runs = len(order[scenarios[0]])
     return np.array(
-        [[cells[s][order[s][i]] for s in scenarios] for i in range(len(first))], dtype=np.float64
+        [[values[(s, *order[s][i])] for s in scenarios] for i in range(runs)], dtype=np.float64
     )
 
 

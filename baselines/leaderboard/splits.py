@@ -100,3 +100,11 @@ def unseen_hull_scenarios(settings: Mapping[str, Mapping[str, Any]]) -> set[str]
     """The scenarios of a run (name → settings, as ``run.json`` records them) whose ship is
     an unseen hull (:data:`shipgym.models.UNSEEN_HULLS`)."""
     return {name for name, s in settings.items() if s["ship"]["model"] in UNSEEN_HULLS}
+
+
+def suite_splits(suite: Mapping[str, Any]) -> dict[str, str]:
+    """Scenario → split of a resolved suite (``run.json``'s): its scenarios only, never its
+    no-change twins (:func:`scenario_split` with the suite's own files and unseen hulls)."""
+    own = suite.get("scenario_files", {})
+    unseen = unseen_hull_scenarios(suite["scenarios"])
+    return {s: scenario_split(s, own, unseen) for s in suite["scenarios"]}

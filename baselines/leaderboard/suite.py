@@ -64,7 +64,10 @@ class SuiteConfig(StrictModel):
     among them is read against the suite file's folder.  ``seeds``: evaluation seeds per
     (controller, scenario, training seed); ``learned_trials``: ``all`` (every training seed
     of a learned agent plays every seed) or ``shared`` (each seed is played by one training
-    seed, :func:`~shipgym_baselines.records.trials.dealt_seeds`).  ``randomize``: what each
+    seed, :func:`~shipgym_baselines.records.trials.dealt_seeds`).  ``twins``: every
+    competitor and the ``oracle`` also play each changing scenario's no-change twin on the
+    same trials (:mod:`shipgym_baselines.leaderboard.twins`; what steering and what the
+    change cost are apart).  ``randomize``: what each
     evaluation seed draws for its trial of a scenario
     (:class:`~shipgym.scenarios.trials.TrialRandomization`: start offset and heading
     error, jump-time jitter, current speed and direction; the sensor noise varies with the
@@ -81,6 +84,7 @@ class SuiteConfig(StrictModel):
     controllers: list[SuiteController] = Field(min_length=1)
     seeds: int = Field(5, ge=1, le=MAX_SEEDS)
     learned_trials: LearnedTrials = ALL
+    twins: bool = True
     randomize: TrialRandomization | None = None
 
     @field_validator("scenarios")

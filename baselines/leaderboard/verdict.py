@@ -1,28 +1,24 @@
-"""The verdict of a leaderboard run in two sentences (four with the frozen optimum).
+"""The verdict of a leaderboard run: at most four sentences of at most 30 words each.
 
-``leaderboard.md``, ``leaderboard.html`` and the terminal summary open with them:
+``leaderboard.md``, ``leaderboard.html`` and the terminal summary open with them, all read
+from the main ranking table (the catalogue split's; the held-out split's when a run has no
+catalogue table):
 
-1. **Who leads and by how much**: the first controller of the main ranking table (the
-   catalogue split's; the held-out split's when a run has no catalogue table), its
-   cost-ratio IQM (C / C_oracle, 1 = the oracle's cost) and 95 % interval, the gap to the
-   second and whether the two intervals overlap (then the lead is *not resolved*); and where
-   the learned agents stand: the best one's rank and its IQM over the best classical
-   controller's.
-2. **What the failures are**: the median failure rate of the table's controllers
-   (:data:`~shipgym_baselines.leaderboard.ranking.FAILED_EPISODES`), and the scenarios the failed
-   episodes come from: those on which most controllers (more than half) fail most of their
-   episodes (more than half), with their share of all failed episodes; when there are none,
-   the scenario with the most failed episodes.
+1. **Who leads**: the first controller, its cost-ratio IQM (C / C_oracle, 1 = the oracle's
+   cost) and 95 % interval, and whether its lead over the second is resolved (the two
+   intervals do not overlap).
+2. **The learned agents and the failures**: the best learned agent's rank and its IQM over
+   the leader's; the median failure rate of the table's controllers
+   (:data:`~shipgym_baselines.leaderboard.scores.FAILED_EPISODES`) and the scenario with
+   the most failed episodes.
 
-When the record has the episodes of both references (``oracle`` and ``oracle_frozen``, the
-same NMPC with its truth frozen at the episode's start), two more sentences decompose it:
+With both references' episodes (``oracle`` and ``oracle_frozen``, the same NMPC with its
+truth frozen at the episode's start):
 
-3. **What knowing the change is worth**: the geometric mean, over the table's trials, of
-   the headroom C_frozen / C_oracle (:func:`shipgym_baselines.leaderboard.ranking.trial_headroom`).
-4. **How much of it the leader captures**: its gap closed (IQM of log(C_frozen / C) /
-   log(C_frozen / C_oracle) over the trials whose headroom is at least 1.2, with its 95 %
-   interval) and how often it beats the optimum that never adapts (P(C < C_frozen)); and
-   the controller that closes most of the gap, when that is another.
+3. **What knowing the change is worth**: the geometric mean of C_frozen / C_oracle over the
+   table's trials, and its range over ship × change family.
+4. **Who copes with the change**: the change share of the leader and of the best learned
+   agent (:mod:`.change_share`; their gap closed when the run has no twins).
 
 No ranking (no ``aggregate.json`` rows): no verdict.
 """
@@ -32,25 +28,30 @@ from __future__ import annotations
 import json
 import os
 import statistics
-from collections import Counter, defaultdict
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.leaderboard.ranking import (
-    FAILED_EPISODES,
+from shipgym_baselines.leaderboard.change_share import SHARE
+from shipgym_baselines.leaderboard.headroom import (
+    CHANGE_FAMILIES,
     GAP_HEADROOM,
-    ORACLE,
-    ORACLE_FROZEN,
     gmean_headroom,
-    is_failure,
-    is_partial,
+    headroom_table,
+    scenario_ships,
     trial_headroom,
 )
-from shipgym_baselines.leaderboard.splits import split_label
+from shipgym_baselines.leaderboard.ranking import is_failure, is_partial
+from shipgym_baselines.leaderboard.splits import split_label, suite_splits
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
-#: the kinds the second half of the first sentence compares
+#: the kinds the second sentence compares
 LEARNED, CLASSICAL = "learned", "classical"
+#: the change family of the scenarios without a change (left out of the headroom's range)
+NO_CHANGE = CHANGE_FAMILIES[0]
+#: the verdict's most sentences, and a sentence's most words
+MAX_SENTENCES, MAX_WORDS = 4, 30
 #: a scenario's failures are "where most controllers fail" when more than this fraction of
 #: the table's controllers fail more than this fraction of their episodes on it
 MOST = 0.5
@@ -116,196 +117,168 @@ def _overlap(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool | None:
 
 def _scope(table: Sequence[Mapping[str, Any]]) -> str:
     n = len(table[0]["scenarios"])
-    split = table[0]["split"]
-    label = split_label(split)
+    label = split_label(table[0]["split"])
     return f"the {n} {label} scenario{'s' if n != 1 else ''}"
 
 
 def lead_sentence(table: Sequence[Mapping[str, Any]], code: Callable[[str], str]) -> str:
-    """Sentence 1: who leads ``table`` (ranked rows of one split), by how much, and where the
-    learned agents stand."""
+    """Sentence 1: who leads ``table`` (ranked rows of one split), at which IQM, and whether
+    the lead over the second is resolved."""
     first = table[0]
     leader = code(first["controller"])
     if len(table) == 1:
-        text = (
-            f"{leader} is the only ranked controller on {_scope(table)}, with a cost-ratio "
-            f"IQM of {_iqm(first)} (1 = the oracle's cost, lower is better)"
-        )
-    else:
-        second = table[1]
-        gap = second["cost_ratio_iqm"] - first["cost_ratio_iqm"]
-        head = (
-            f"{leader} leads {_scope(table)} with a cost-ratio IQM of {_iqm(first)} "
-            "(1 = the oracle's cost, lower is better), "
-        )
-        if gap < LEVEL:
-            head += f"level with {code(second['controller'])} ({_iqm(second)})"
-        else:
-            relative = gap / second["cost_ratio_iqm"] if second["cost_ratio_iqm"] else 0.0
-            head += (
-                f"{gap:.3f} ({_percent(relative)}) below {code(second['controller'])}'s "
-                f"{_iqm(second)}"
-            )
-        overlap = _overlap(first, second)
-        if overlap is True:
-            head += ": the 95 % intervals overlap, so the lead is not resolved"
-        elif overlap is False:
-            head += ": the 95 % intervals do not overlap"
-        text = head
-    return f"{text}; {_learned_clause(table, code)}."
+        return f"{leader} is the only ranked controller on {_scope(table)}, at IQM {_iqm(first)}."
+    second = table[1]
+    head = f"{leader} leads {_scope(table)} at cost-ratio IQM {_iqm(first)}"
+    other = f"{code(second['controller'])} ({_iqm(second)})"
+    if second["cost_ratio_iqm"] - first["cost_ratio_iqm"] < LEVEL:
+        return f"{head}, level with {other}."
+    overlap = _overlap(first, second)
+    if overlap is True:
+        return f"{head}, not resolved from {other}."
+    if overlap is False:
+        return f"{head}, resolved from {other}."
+    return f"{head}, ahead of {other}."
 
 
-def _learned_clause(table: Sequence[Mapping[str, Any]], code: Callable[[str], str]) -> str:
-    learned = [(rank, r) for rank, r in enumerate(table, start=1) if r["kind"] == LEARNED]
-    classical = [r for r in table if r["kind"] == CLASSICAL]
-    if not learned:
-        return "no learned agent is ranked"
-    rank, best = learned[0]
-    ranked = f"the best learned agent, {code(best['controller'])}, ranks {_ordinal(rank)} of"
-    ranked += f" {len(table)}" if rank > 1 else f" {len(table)} (the leader)"
-    if not classical:
-        return f"{ranked}, and no classical controller is ranked"
-    top = classical[0]
-    ratio = best["cost_ratio_iqm"] / top["cost_ratio_iqm"] if top["cost_ratio_iqm"] else 0.0
-    return (
-        f"{ranked} at {best['cost_ratio_iqm']:.3f}, {ratio:.2f}× the IQM of the best "
-        f"classical controller, {code(top['controller'])}"
-    )
-
-
-def failure_sentence(
+def learned_sentence(
     table: Sequence[Mapping[str, Any]],
     episodes: Sequence[Mapping[str, Any]],
     code: Callable[[str], str],
 ) -> str:
-    """Sentence 2: the median failure rate of ``table``'s rows and the scenarios the failed
-    episodes of its controllers (on its scenarios, from ``episodes``) come from."""
-    what = f"({FAILED_EPISODES})"
-    if len(table) == 1:
-        rate = f"The failure rate {what} of {code(table[0]['controller'])} is "
-        rate += _percent(table[0]["failure_rate"])
-        their, most_fail = "its", "where it fails most episodes"
+    """Sentence 2: where the best learned agent ranks, and the failures (the median failure
+    rate of ``table``'s rows and the scenario with most failed episodes, from
+    ``episodes``)."""
+    learned = [(rank, r) for rank, r in enumerate(table, start=1) if r["kind"] == LEARNED]
+    if not learned:
+        head = "No learned agent is ranked"
     else:
-        median = statistics.median(r["failure_rate"] for r in table)
-        rate = f"The median failure rate {what} over the {len(table)} ranked controllers is "
-        rate += _percent(median)
-        their, most_fail = "their", "where most controllers fail most episodes"
+        rank, best = learned[0]
+        ratio = best["cost_ratio_iqm"] / table[0]["cost_ratio_iqm"]
+        head = f"The best learned agent, {code(best['controller'])}, ranks {_ordinal(rank)} of "
+        head += f"{len(table)}" + (f" at {ratio:.2f}× the leader's IQM" if rank > 1 else "")
+    return f"{head}; {failure_clause(table, episodes, code)}."
+
+
+def failure_clause(
+    table: Sequence[Mapping[str, Any]],
+    episodes: Sequence[Mapping[str, Any]],
+    code: Callable[[str], str],
+) -> str:
+    """The median failure rate of ``table``'s rows (:data:`FAILED_EPISODES`) and the
+    scenario of the table with most of their failed episodes (from ``episodes``)."""
+    rates = [r["failure_rate"] for r in table]
+    median = statistics.median(rates)
+    text = f"the {'median ' if len(table) > 1 else ''}failure rate is {_percent(median)}"
     controllers = {r["controller"] for r in table}
     scenarios = set(table[0]["scenarios"])
-    runs: dict[tuple[str, str], list[bool]] = defaultdict(list)
-    for ep in episodes:
-        if ep["controller"] in controllers and ep["scenario"] in scenarios:
-            runs[(ep["scenario"], ep["controller"])].append(is_failure(ep))
     failed: Counter[str] = Counter()
-    for (scenario, _), outcomes in runs.items():
-        failed[scenario] += sum(outcomes)
+    for ep in episodes:
+        if ep["controller"] in controllers and ep["scenario"] in scenarios and is_failure(ep):
+            failed[ep["scenario"]] += 1
+    if not failed:
+        return text
+    top, count = min(failed.items(), key=lambda kv: (-kv[1], kv[0]))
     total = sum(failed.values())
-    if not runs:
-        return f"{rate}."
-    if total == 0:
-        return f"{rate}: none of {their} episodes failed."
-    most = [s for s in sorted(scenarios) if _most_fail(runs, s, controllers)]
-    failures = f"{total} failed episode{'s' if total != 1 else ''}"
-    if most:
-        share = sum(failed[s] for s in most) / total
-        return (
-            f"{rate}, and {_percent(share)} of {their} {failures} come from "
-            f"{_names([code(s) for s in most])}, {most_fail}."
-        )
-    ranked = sorted(((-n, s) for s, n in failed.items() if n), key=lambda t: t)
-    if len(ranked) == 1:
-        return f"{rate}; {their} {failures} are all on {code(ranked[0][1])}."
-    count, top = -ranked[0][0], ranked[0][1]
-    return (
-        f"{rate}; {their} {failures} are spread over {len(ranked)} scenarios, the most on "
-        f"{code(top)} ({_percent(count / total)} of them)."
-    )
-
-
-def _most_fail(
-    runs: Mapping[tuple[str, str], list[bool]], scenario: str, controllers: set[str]
-) -> bool:
-    """Whether more than :data:`MOST` of ``controllers`` fail more than :data:`MOST` of their
-    episodes on ``scenario``."""
-    failing = 0
-    for controller in controllers:
-        outcomes = runs.get((scenario, controller), [])
-        if outcomes and sum(outcomes) > MOST * len(outcomes):
-            failing += 1
-    return failing > MOST * len(controllers)
+    return f"{text}, {_percent(count / total)} of failures on {code(top)}"
 
 
 def _percent_interval(ci: Sequence[float] | None) -> str:
     return f" [{_percent(ci[0])}, {_percent(ci[1])}]" if ci else ""
 
 
-def gap_sentences(
+def _value(row: Mapping[str, Any], field: str) -> str:
+    """A row's value of ``field`` with its interval, 2 decimals."""
+    ci = row.get(f"{field}_ci95")
+    text = f"{row[field]:.2f}"
+    return text + (f" [{ci[0]:.2f}, {ci[1]:.2f}]" if ci else "")
+
+
+def headroom_sentence(
     table: Sequence[Mapping[str, Any]],
     episodes: Sequence[Mapping[str, Any]],
     code: Callable[[str], str],
+    headroom: Sequence[Mapping[str, Any]] = (),
 ) -> str | None:
-    """Sentences 3 and 4 (module doc) for ``table`` (ranked rows of one split) from the
-    episodes' headroom on its scenarios and the rows' gap fields; None without both
-    references' episodes on every trial there (the rows' gap fields are None then)."""
+    """Sentence 3: what knowing the change is worth on ``table``'s trials (the geometric
+    mean of C_frozen / C_oracle) and its range over ship × change family (``headroom``:
+    :func:`~shipgym_baselines.leaderboard.headroom.headroom_table`'s rows of the split;
+    the family without a change left out); None without both references' episodes."""
     if table[0].get("gap_trials") is None:
         return None
     found = gmean_headroom(trial_headroom(episodes), table[0]["scenarios"])
     if found is None:
         return None
-    headroom, trials = found
-    label = split_label(table[0]["split"])
-    worth = (
-        f"Knowing the change is worth {headroom:.2f}× here: the cost of {code(ORACLE_FROZEN)}, "
-        f"the optimum that never adapts, over {code(ORACLE)}'s (geometric mean over the "
-        f"{trials} trial{'s' if trials != 1 else ''} of the {label} scenarios)."
+    worth, trials = found
+    text = (
+        f"Knowing the change is worth {worth:.2f}× over {trials} trial"
+        f"{'s' if trials != 1 else ''} ({code(ORACLE_FROZEN)} over {code(ORACLE)}, geometric "
+        "mean)"
     )
+    cells = [r["headroom_gmean"] for r in headroom if r["family"] != NO_CHANGE]
+    if len(cells) > 1:
+        text += f", from {min(cells):.2f}× to {max(cells):.2f}× across ship × change family"
+    return f"{text}."
+
+
+def share_sentence(table: Sequence[Mapping[str, Any]], code: Callable[[str], str]) -> str | None:
+    """Sentence 4: the change share of the leader and of the best learned agent (their gap
+    closed where the run has no twins); None without either."""
     leader = table[0]
-    name = code(leader["controller"])
-    beats = leader.get("prob_beats_frozen")
-    beaten = (
-        f"beats the optimum that never adapts on {_percent(beats)}"
-        f"{_percent_interval(leader.get('prob_beats_frozen_ci95'))} of trials"
-        if beats is not None
-        else "has no comparison with the optimum that never adapts"
-    )
-    gap = leader.get("gap_closed_iqm")
-    if gap is None:
+    learned = [r for r in table if r["kind"] == LEARNED]
+    named = [leader, *([learned[0]] if learned and learned[0] is not leader else [])]
+    if leader.get(SHARE) is not None:
+        parts = [f"{code(r['controller'])} {_value(r, SHARE)}" for r in named if r.get(SHARE)
+                 is not None]  # fmt: skip
         return (
-            f"{worth} No trial is worth {GAP_HEADROOM:g}× or more, so no gap closed is "
-            f"measured; the leader, {name}, {beaten}."
+            f"Change share (0 = costs as much as never adapting, 1 = as little as the oracle): "
+            f"{_names(parts)}."
         )
+    if leader.get("gap_closed_iqm") is None:
+        return None
     n = leader.get("gap_trials")
-    closed = (
-        f"{name}, the leader, captures {_percent(gap)}"
-        f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of it (gap closed "
-        "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: "
-        f"its IQM over the {n} trials worth {GAP_HEADROOM:g}× or more) and {beaten}"
+    return (
+        f"The leader closes {_percent(leader['gap_closed_iqm'])}"
+        f"{_percent_interval(leader.get('gap_closed_iqm_ci95'))} of that gap (IQM over the {n} "
+        f"trials worth {GAP_HEADROOM:g}× or more)."
     )
-    rows = [r for r in table if r.get("gap_closed_iqm") is not None]
-    best = max(rows, key=lambda r: (r["gap_closed_iqm"], -table.index(r)))
-    if best is not leader:
-        closed += (
-            f"; {code(best['controller'])} captures the most, {_percent(best['gap_closed_iqm'])}"
-        )
-    return f"{worth} {closed}."
+
+
+def verdict_sentences(
+    board: Sequence[Mapping[str, Any]],
+    episodes: Sequence[Mapping[str, Any]],
+    code: Callable[[str], str] = md_code,
+    headroom: Sequence[Mapping[str, Any]] = (),
+) -> list[str]:
+    """The verdict's sentences (module doc; at most :data:`MAX_SENTENCES`): who leads, where
+    the learned agents stand and the failures, what knowing the change is worth and the
+    change share of the leader and the best learned agent; empty without a ranking."""
+    table = main_table(board)
+    if not table:
+        return []
+    sentences = [lead_sentence(table, code), learned_sentence(table, episodes, code)]
+    worth = headroom_sentence(table, episodes, code, headroom)
+    if worth is not None:
+        sentences.append(worth)
+        share = share_sentence(table, code)
+        if share is not None:
+            sentences.append(share)
+    return sentences
 
 
 def verdict(
     board: Sequence[Mapping[str, Any]],
     episodes: Sequence[Mapping[str, Any]],
     code: Callable[[str], str] = md_code,
+    headroom: Sequence[Mapping[str, Any]] = (),
 ) -> str | None:
-    """The two sentences (module doc) from ``board`` (``aggregate.json`` rows) and the run's
-    ``episodes`` (dicts with ``controller``, ``scenario``, ``seed``, ``termination_reason``
-    and ``cost``), and two more with both references' episodes (:func:`gap_sentences`);
-    ``code`` writes a controller or scenario name (default: a Markdown code span;
-    :func:`plain_name` for HTML).  None without a ranking."""
-    table = main_table(board)
-    if not table:
-        return None
-    text = f"{lead_sentence(table, code)} {failure_sentence(table, episodes, code)}"
-    gap = gap_sentences(table, episodes, code)
-    return f"{text} {gap}" if gap else text
+    """The verdict (:func:`verdict_sentences`) as one paragraph from ``board``
+    (``aggregate.json`` rows), the run's ``episodes`` (dicts with ``controller``,
+    ``scenario``, ``seed``, ``termination_reason`` and ``cost``) and the ``headroom``
+    table's rows; ``code`` writes a controller or scenario name (default: a Markdown code
+    span; :func:`plain_name` for HTML).  None without a ranking."""
+    sentences = verdict_sentences(board, episodes, code, headroom)
+    return " ".join(sentences) if sentences else None
 
 
 def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_code) -> str | None:
@@ -313,15 +286,22 @@ def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_co
     ``report`` folder (no episodes of its own) gives the one its ``leaderboard.md`` opens
     with (written from the merged episodes)."""
     from shipgym_baselines.records.episodes import read_episodes
+    from shipgym_baselines.records.runrecord import RUN_FILE, read_run
 
     folder = Path(folder)
     board = json.loads((folder / "aggregate.json").read_text())
-    if not main_table(board):
+    table = main_table(board)
+    if not table:
         return None
     episodes = read_episodes(folder)
-    if episodes:
-        return verdict(board, episodes, code)
-    return recorded_verdict(folder / MARKDOWN_FILE)
+    if not episodes:
+        return recorded_verdict(folder / MARKDOWN_FILE)
+    headroom: list[dict[str, Any]] = []
+    if (folder / RUN_FILE).is_file():
+        suite = read_run(folder)["suite"]
+        ships = scenario_ships(suite["scenarios"])
+        headroom = headroom_table(episodes, ships, suite_splits(suite), table[0]["split"])
+    return verdict(board, episodes, code, headroom)
 
 
 def recorded_verdict(markdown: Path) -> str | None:
@@ -336,13 +316,15 @@ def recorded_verdict(markdown: Path) -> str | None:
 
 
 __all__ = [
-    "failure_sentence",
     "folder_verdict",
-    "gap_sentences",
+    "headroom_sentence",
     "lead_sentence",
+    "learned_sentence",
     "main_table",
     "md_code",
     "plain_name",
     "recorded_verdict",
+    "share_sentence",
     "verdict",
+    "verdict_sentences",
 ]

@@ -27,7 +27,13 @@ import numpy as np
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.jsonfiles import from_plain, plain, short_json
 from shipgym_baselines.records.outfiles import open_regular
-from shipgym_baselines.records.trials import runs_of, shares_trials
+from shipgym_baselines.records.trials import (
+    TWIN_PLAYERS,
+    deal_names,
+    runs_of,
+    shares_trials,
+    twin_scenarios,
+)
 
 EPISODES_FILE = "episodes.jsonl"
 #: the keys of an ``episodes.jsonl`` object that are not metrics
@@ -189,28 +195,36 @@ def _lines(file: Path) -> list[tuple[int, str]]:
 
 
 class _SuiteKeys(NamedTuple):
-    """What a resolved suite (``run.json``'s) runs: scenarios, the (scenario, controller)
-    pairs that apply, each scenario's evaluation seeds, each controller's training seeds."""
+    """What a resolved suite (``run.json``'s) runs: scenarios and twins, the (scenario,
+    controller) pairs that apply, each scenario's evaluation seeds, each controller's
+    training seeds, the name each scenario's trials are dealt by."""
 
     scenarios: set[str]
     pairs: set[tuple[str, str]]
     seeds: dict[str, set[int]]  # scenario → its evaluation seeds
     trained: dict[str, list[int | None]]
     shared: bool  # each evaluation seed played by one training seed
+    deal: dict[str, str]  # scenario → the name its trials are dealt by
 
 
 def _suite_keys(suite: Mapping[str, Any]) -> _SuiteKeys:
     skip = {tuple(pair) for pair in suite["does_not_apply"]}
     trained = {c["name"]: list(c["training_seeds"]) for c in suite["controllers"]}
-    pairs = {(s, c) for s in suite["scenarios"] for c in trained if (s, c) not in skip}
+    twins = twin_scenarios(suite)
+    players = set(suite.get(TWIN_PLAYERS, []))
+    pairs = {(s, c) for s in suite["scenarios"] for c in trained}
+    pairs |= {(t, c) for t in twins for c in trained if c in players}
     fewer = suite.get("scenario_seeds", {})
-    seeds = {s: list(fewer.get(s, suite["seeds"])) for s in suite["scenarios"]}
-    return _SuiteKeys(set(suite["scenarios"]), pairs, seeds, trained, shares_trials(suite))
+    everything = [*suite["scenarios"], *twins]
+    seeds = {s: set(fewer.get(s, suite["seeds"])) for s in everything}
+    return _SuiteKeys(
+        set(everything), pairs - skip, seeds, trained, shares_trials(suite), deal_names(suite)
+    )
 
 
 def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
     """Why the episode ``key`` is not one of a suite's (``keys``), or None when it is."""
-    scenarios, pairs, seeds, trained, shared = keys
+    scenarios, pairs, seeds, trained, shared, deal = keys
     scenario, controller, seed, training_seed = key
     if controller not in trained:
         return f"controller {controller!r} is not in the run's suite"
@@ -223,7 +237,7 @@ def _foreign(key: Key, keys: _SuiteKeys) -> str | None:
     if training_seed not in trained[controller]:
         return f"training seed {training_seed} is not one of {controller!r}'s in the run"
     if shared and (training_seed, seed) not in runs_of(
-        scenario, seeds[scenario], trained[controller], shared
+        deal[scenario], sorted(seeds[scenario]), trained[controller], shared
     ):
         return (
             f"seed {seed} of {scenario!r} is dealt to another training seed of "

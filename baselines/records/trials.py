@@ -63,3 +63,30 @@ def runs_of(
     if not shared:
         return {(k, s) for k in training_seeds for s in seeds}
     return set(zip(dealt_owners(scenario, seeds, training_seeds), seeds, strict=True))
+
+
+#: ``run.json``'s suite keys of the no-change twins: changing scenario → its twin's table
+#: name, the settings of the twins that are no scenario of the run, and the controllers
+#: that play the twins (:mod:`shipgym_baselines.leaderboard.twins`)
+TWINS, TWIN_SCENARIOS, TWIN_PLAYERS = "twins", "twin_scenarios", "twin_players"
+
+
+def twins_of(suite: Mapping[str, Any]) -> dict[str, str]:
+    """Changing scenario → its twin's table name, as a resolved suite (``run.json``'s)
+    records them; empty for a run without twins."""
+    return dict(suite.get(TWINS) or {})
+
+
+def twin_scenarios(suite: Mapping[str, Any]) -> dict[str, Any]:
+    """The recorded settings of the twins that are no scenario of the run, by name."""
+    return dict(suite.get(TWIN_SCENARIOS) or {})
+
+
+def deal_names(suite: Mapping[str, Any]) -> dict[str, str]:
+    """Scenario or twin → the name its trials are dealt by (:func:`dealt_owners`): a
+    changing scenario's twin's, so that a trial and its twin are played by the same
+    training seed; every other scenario's own."""
+    names = {s: s for s in suite.get("scenarios", {})}
+    names.update({t: t for t in twin_scenarios(suite)})
+    names.update(twins_of(suite))
+    return names
