@@ -44,8 +44,10 @@ from shipgym_baselines.leaderboard.intervals import (
     finite_bounds,
     finite_or_none,
     float_or_nan,
+    gmean_rows,
     interquartile_mean,
     interval_estimate,
+    iqm_rows,
     pooled_bootstrap_ci,
 )
 from shipgym_baselines.leaderboard.scores import run_keys
@@ -225,12 +227,12 @@ def scenario_twin_cells(
     if m is None:
         return out
     for field, values, estimate in (
-        (NOMINAL, m["nominal"], finite_gmean),
-        (SHARE, m["share"], finite_iqm),
+        (NOMINAL, m["nominal"], gmean_rows),
+        (SHARE, m["share"], iqm_rows),
     ):
         finite = values[np.isfinite(values)]
         if finite.size:
-            out[field] = estimate(finite)
+            out[field] = float(estimate(finite))
             out[f"{field}_ci95"] = pooled_bootstrap_ci(finite, estimate, seed=seed)
     return out
 

@@ -108,18 +108,19 @@ def row_strata(episodes: Sequence[Mapping[str, Any]]) -> list[list[Mapping[str, 
 
 def pooled_bootstrap_ci(
     values: np.ndarray,
-    statistic: Callable[[np.ndarray], float],
+    statistic: Callable[[np.ndarray], np.ndarray],
     reps: int = ROW_REPS,
     confidence: float = CONFIDENCE,
     seed: int = 0,
 ) -> list[float] | None:
     """Percentile-bootstrap interval [low, high] of ``statistic`` over ``values`` resampled
-    with replacement as one pool; None without finite values."""
+    with replacement as one pool; ``statistic`` maps a (reps, n) array of resamples to
+    their (reps,) values (e.g. :func:`iqm_rows`).  None without finite values."""
     a = np.asarray(values, dtype=np.float64).ravel()
     if not a.size or not np.all(np.isfinite(a)):
         return None
     (idx,) = bootstrap_indices([a.size], reps, seed)
-    samples = np.array([statistic(a[row]) for row in idx])
+    samples = statistic(a[idx])
     alpha = 0.5 * (1.0 - confidence)
     low, high = np.quantile(samples, [alpha, 1.0 - alpha])
     return [float(low), float(high)]
@@ -139,6 +140,19 @@ def interquartile_mean(scores: np.ndarray) -> float:
     low = int(0.25 * a.size)
     high = a.size - low
     return np.mean(np.partition(a, (low, high - 1))[low:high])
+
+
+def iqm_rows(samples: np.ndarray) -> np.ndarray:
+    """The interquartile mean of each row of ``samples`` (:func:`interquartile_mean`'s trim:
+    ⌊n/4⌋ values off each end of each sorted row)."""
+    a = np.sort(np.asarray(samples, dtype=np.float64), axis=-1)
+    low = int(0.25 * a.shape[-1])
+    return a[..., low : a.shape[-1] - low].mean(axis=-1)
+
+
+def gmean_rows(samples: np.ndarray) -> np.ndarray:
+    """The geometric mean of each row of positive ``samples``."""
+    return np.exp(np.log(np.asarray(samples, dtype=np.float64)).mean(axis=-1))
 
 
 def geometric_mean(ratios: np.ndarray) -> float:
