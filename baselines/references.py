@@ -31,7 +31,9 @@ user: :class:`ReferenceCache` keeps its entry in a table of the same format at
 ``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``).  Lookups go shipped table → user
 cache → compute and store.  Several processes may store at once: each store re-reads the
 file, merges and replaces it atomically under an exclusive lock (``fcntl.lockf`` on a
-``.lock`` file beside it).  Before computing, :func:`announce` says how many and an estimate
+``.lock`` file beside it).  A cache file that cannot be read (cut short, not gzip, no table)
+is set aside as ``<file>.bad`` (:func:`set_aside_path`) with one line naming it, and the cache
+starts afresh.  Before computing, :func:`announce` says how many and an estimate
 of their CPU time (:data:`ORACLE_CPU_S_PER_STEP`).
 """
 
@@ -43,6 +45,7 @@ import fcntl
 import functools
 import gzip
 import hashlib
+import io
 import json
 import math
 import os
@@ -60,6 +63,7 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.records.jsonfiles import from_plain, plain
+from shipgym_baselines.records.outfiles import write_bytes
 
 #: the references with a table, in the order they are computed
 REFERENCES = (ORACLE, ORACLE_FROZEN)
@@ -139,6 +143,8 @@ class ReferenceTable:
             return cls({}, file, reference)
         with gzip.open(file, "rt", encoding="utf-8") as f:
             data = json.load(f)
+        if not isinstance(data, dict) or not isinstance(data.get("entries", {}), dict):
+            raise ValueError("no reference table: no JSON object of entries")
         wanted = oracle_header(reference)
         if {k: data.get(k) for k in wanted} != wanted:
             return cls({}, file, reference)
@@ -161,14 +167,11 @@ class ReferenceTable:
         file = Path(path) if path is not None else (self.path or table_path(self.reference))
         file.parent.mkdir(parents=True, exist_ok=True)
         data = {**oracle_header(self.reference), "entries": dict(sorted(self.entries.items()))}
-        staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
+        raw = io.BytesIO()
         # no file name or time in the gzip header: the same entries give the same bytes
-        with (
-            open(staged, "wb") as raw,
-            gzip.GzipFile(filename="", fileobj=raw, mode="wb", mtime=0) as f,
-        ):
+        with gzip.GzipFile(filename="", fileobj=raw, mode="wb", mtime=0) as f:
             f.write(json.dumps(data, allow_nan=False).encode())
-        os.replace(staged, file)
+        write_bytes(file, raw.getvalue())  # atomic, through no link
         return file
 
 
@@ -307,6 +310,13 @@ def _locked(file: Path) -> Iterator[None]:
         os.close(fd)  # closing releases the lock
 
 
+def set_aside_path(path: str | os.PathLike) -> Path:
+    """Where an unreadable cache file is moved: ``<file>.bad`` beside it (an earlier one
+    replaced)."""
+    file = Path(path)
+    return file.with_name(f"{file.name}.bad")
+
+
 class ReferenceCache:
     """The per-user cache (module doc) of ``reference``'s episodes: a
     :class:`ReferenceTable` file, re-read when another process replaced it, stored to under
@@ -330,12 +340,28 @@ class ReferenceCache:
             try:
                 self._table = ReferenceTable.load(self.path, self.reference)
             except (OSError, EOFError, ValueError) as exc:
-                raise RunError(
-                    f"the reference cache {self.path} is unreadable ({exc}): delete it "
-                    "(it holds only computed references, computed again when needed)"
-                ) from None
+                self._set_aside(stamp, exc)
+                return self._load()
             self._stamp = stamp
         return self._table
+
+    def _set_aside(self, stamp: tuple[int, int, int], exc: Exception) -> None:
+        """Move the unreadable file (``stamp``: as it was read) to :func:`set_aside_path`,
+        under the lock and only if no other process replaced it meanwhile, saying so in one
+        line: the cache starts afresh (it holds only computed references)."""
+        with _locked(self.path):
+            try:
+                stat = self.path.stat()
+            except FileNotFoundError:
+                return  # another process set it aside
+            if (stat.st_ino, stat.st_mtime_ns, stat.st_size) != stamp:
+                return  # another process replaced it: read that one
+            bad = set_aside_path(self.path)
+            os.replace(self.path, bad)
+        notice(
+            f"shipgym: the reference cache {self.path} is unreadable ({exc}): set aside as "
+            f"{bad}; its references are computed again when needed"
+        )
 
     def lookup(self, scenario: Scenario, seed: int) -> dict[str, Any] | None:
         return self._load().lookup(scenario, seed)

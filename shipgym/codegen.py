@@ -12,6 +12,12 @@ an ``fcntl`` lock on ``<library>.lock`` beside it while it compiles, and a proce
 waited for the lock loads the library the other one published instead of compiling it (so
 only the process that compiles announces it).  The lock files stay in the cache folder.
 
+A library is loaded only once it is checked: its size and SHA-256 are recorded at compile
+time in a sidecar ``<library>.json`` (written atomically after the library), and a library
+whose size or hash differs from the record, or that has none, is never loaded (a truncated
+shared library kills the process with SIGBUS when it is mapped).  It is compiled again,
+with one line on stderr naming the file (:func:`library_problem`).
+
 The per-user cache folder (:func:`user_cache_dir`) is ``$SHIPGYM_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/shipgym``, else ``~/.cache/shipgym``; compiled libraries sit at its top
 (``$SHIPGYM_CACHE``, if set, names their folder alone).  Deleting the folder clears it.
@@ -21,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import shutil
 import subprocess
@@ -102,7 +109,7 @@ def compiled_all(
             except (OSError, RuntimeError) as exc:
                 out[i] = _fallback(function, exc)
                 continue
-            if target.exists():
+            if library_problem(target) is None:
                 out[i] = _load(function, target)
             else:
                 todo.append((i, source, target))
@@ -116,7 +123,7 @@ def compiled_all(
             for i, source, target in todo:
                 out[i] = (
                     _load(functions[i], target)
-                    if target.exists()  # the same library twice in ``functions``
+                    if library_problem(target) is None  # the same library twice in ``functions``
                     else _build(functions[i], compiler, flags, source, target)
                 )
     return [f for f in out if f is not None]
@@ -127,15 +134,75 @@ def _published(
     todo: list[tuple[int, Path, Path]],
     out: list[ca.Function | None],
 ) -> list[tuple[int, Path, Path]]:
-    """The entries of ``todo`` whose library is still missing; the others loaded into
-    ``out``."""
+    """The entries of ``todo`` whose library is still missing or fails its check; the others
+    loaded into ``out``.  A library that is there but fails its check is named in one line
+    (:func:`library_problem`): it is compiled again."""
     missing = []
     for i, source, target in todo:
-        if target.exists():
+        problem = library_problem(target)
+        if problem is None:
             out[i] = _load(functions[i], target)
-        else:
-            missing.append((i, source, target))
+            continue
+        if target.exists():
+            notice(f"shipgym: the cached library {target} {problem}: compiling it again")
+        missing.append((i, source, target))
     return missing
+
+
+def record_path(target: Path) -> Path:
+    """The sidecar recording the size and SHA-256 of the library ``target``."""
+    return target.with_name(f"{target.name}.json")
+
+
+def _digest(file: Path) -> str:
+    """The SHA-256 of ``file``'s bytes (hex)."""
+    digest = hashlib.sha256()
+    with open(file, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+#: libraries this process checked: (path, inode, size, mtime [ns]) of each
+_CHECKED: set[tuple[str, int, int, int]] = set()
+
+
+def library_problem(target: Path) -> str | None:
+    """What keeps the library ``target`` from being loaded, in words ("is missing", "is
+    3000 bytes, 16480 recorded", "has no record of its size and SHA-256", "differs from
+    its recorded SHA-256"), or None when it matches the record written when it was
+    compiled (:func:`record_path`)."""
+    try:
+        info = target.stat()
+    except OSError:
+        return "is missing"
+    stamp = (str(target), info.st_ino, info.st_size, info.st_mtime_ns)
+    if stamp in _CHECKED:
+        return None
+    try:
+        record = json.loads(record_path(target).read_text())
+        size, sha256 = int(record["size"]), str(record["sha256"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return "has no record of its size and SHA-256"
+    if info.st_size != size:
+        return f"is {info.st_size} bytes, {size} recorded"
+    try:
+        if _digest(target) != sha256:
+            return "differs from its recorded SHA-256"
+    except OSError as exc:
+        return f"is unreadable ({exc.strerror})"
+    _CHECKED.add(stamp)
+    return None
+
+
+def _write_record(target: Path) -> None:
+    """Record the size and SHA-256 of the published library ``target`` beside it,
+    atomically."""
+    record = {"size": target.stat().st_size, "sha256": _digest(target)}
+    file = record_path(target)
+    staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
+    staged.write_text(json.dumps(record) + "\n")
+    os.replace(staged, file)
 
 
 @contextlib.contextmanager
@@ -175,7 +242,9 @@ def _build(
         # atomic publish: concurrent processes may compile the same library
         staged = target.with_suffix(f".{os.getpid()}.tmp")
         shutil.copy(partial, staged)
+        record_path(target).unlink(missing_ok=True)  # no record of a library being replaced
         os.replace(staged, target)
+        _write_record(target)
     except (OSError, subprocess.CalledProcessError, RuntimeError) as exc:
         return _fallback(function, exc)
     return _load(function, target)

@@ -21,6 +21,7 @@ from shipgym_baselines.cli.options import (
     add_json_option,
     add_out_options,
     add_progress_option,
+    add_trust_pickle_option,
     emit,
 )
 from shipgym_baselines.errors import RunError, check_count
@@ -74,6 +75,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "(with --resume, finished runs are not trained again: only exported)",
     )
     add_progress_option(p)
+    add_trust_pickle_option(p)  # --resume: checkpoints this user's shipgym did not write
     add_json_option(p, "print the training meta as JSON")
     p.set_defaults(func=run)
 

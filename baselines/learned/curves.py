@@ -26,6 +26,7 @@ from pydantic import Field
 
 from shipgym.config import StrictModel
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.records.outfiles import write_text
 
 CURVE_FILE = "learning_curve.json"
 CURVE_KEYS = ("env_steps", "mean_return", "std_return")
@@ -49,7 +50,7 @@ def write_curve(
         curve["selection"] = [float(x) for x in selection]
     check_curve(curve, str(out))
     path = Path(out) / CURVE_FILE
-    path.write_text(json.dumps(curve, indent=1))
+    write_text(path, json.dumps(curve, indent=1))  # atomic, through no link
     return path
 
 

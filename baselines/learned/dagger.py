@@ -56,7 +56,6 @@ import dataclasses
 import hashlib
 import io
 import json
-import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -69,8 +68,10 @@ from shipgym.config import StrictModel
 from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.executor import Inline, task_pool
-from shipgym_baselines.records.folders import check_out_usable, clear_outputs
+from shipgym_baselines.records.folders import check_out_usable
 from shipgym_baselines.records.locking import LOCK_FILE, out_lock
+from shipgym_baselines.records.manifest import MANIFEST_FILE, Manifest, clear_listed
+from shipgym_baselines.records.outfiles import check_no_links, make_dir, write_bytes
 from shipgym_baselines.records.runrecord import now, versions
 
 SETTINGS_FILE = "dagger.json"
@@ -559,24 +560,59 @@ def run_dagger(
         "spaces": spaces,
     }
     with out_lock(folder, now()):
-        rounds = _prepare(folder, record, resume=resume, force=force)
-        state = _Run(
-            folder, settings, make_env, make_teacher, env.observation_space, env.action_space
-        )
-        student = state.student_after(len(rounds) - 1) if rounds else None
-        own = worker_count(workers, settings.episodes_per_round) if executor is None else 1
-        with task_pool(own) as pool:
-            # one worker: the rollouts run here one after the other, each stored as it ends
-            runner = executor or (None if isinstance(pool, Inline) else pool)
-            for round_ in range(len(rounds), n_rounds):
-                found, student = state.round(round_, student, runner, progress)
-                rounds.append(found)
-                _write_json(folder / ROUNDS_FILE, rounds)
-                if progress is not None:
-                    progress(_describe_round(found))
-                if on_round is not None and not on_round(found, student):
-                    break
+        check_no_links(folder)
+        if force and _entries(folder):
+            clear_listed(folder)  # what runs wrote; refused if it holds anything else
+        manifest = Manifest(folder)
+        with manifest.recording():
+            rounds = _prepare(folder, record, resume=resume)
+            student = _rounds(
+                folder,
+                settings,
+                make_env,
+                make_teacher,
+                env,
+                rounds,
+                n_rounds,
+                workers,
+                executor,
+                on_round,
+                progress,
+            )
+        manifest.compact()
     return DaggerRun(folder, student, rounds)
+
+
+def _rounds(
+    folder: Path,
+    settings: DaggerSettings,
+    make_env: Callable[[], Any],
+    make_teacher: Callable[[], Teacher],
+    env: Any,
+    rounds: list[dict[str, Any]],
+    n_rounds: int,
+    workers: int,
+    executor: concurrent.futures.Executor | None,
+    on_round: Callable[[dict[str, Any], Any], bool] | None,
+    progress: Callable[[str], object] | None,
+) -> Any:
+    """Run rounds after ``rounds`` (appended to it) up to ``n_rounds`` in the locked run
+    folder (:func:`run_dagger`); the newest student."""
+    state = _Run(folder, settings, make_env, make_teacher, env.observation_space, env.action_space)
+    student = state.student_after(len(rounds) - 1) if rounds else None
+    own = worker_count(workers, settings.episodes_per_round) if executor is None else 1
+    with task_pool(own) as pool:
+        # one worker: the rollouts run here one after the other, each stored as it ends
+        runner = executor or (None if isinstance(pool, Inline) else pool)
+        for round_ in range(len(rounds), n_rounds):
+            found, student = state.round(round_, student, runner, progress)
+            rounds.append(found)
+            _write_json(folder / ROUNDS_FILE, rounds)
+            if progress is not None:
+                progress(_describe_round(found))
+            if on_round is not None and not on_round(found, student):
+                break
+    return student
 
 
 def _spaces(env: Any) -> dict[str, Any]:
@@ -595,18 +631,18 @@ def _spaces(env: Any) -> dict[str, Any]:
     return {"observation": list(obs.shape), "action": list(act.shape)}
 
 
-def _prepare(
-    folder: Path, record: dict[str, Any], resume: bool, force: bool
-) -> list[dict[str, Any]]:
+def _entries(folder: Path) -> list[str]:
+    """The names in the run folder, its lock file and manifest aside."""
+    return sorted(p.name for p in folder.iterdir() if p.name not in (LOCK_FILE, MANIFEST_FILE))
+
+
+def _prepare(folder: Path, record: dict[str, Any], resume: bool) -> list[dict[str, Any]]:
     """Make ``folder`` ready for the run ``record`` describes; the finished rounds'
-    records (none for a fresh run).  Refuses (:class:`RunError`) a folder holding anything
-    but a DAgger run, a run of other settings (unless ``force``), or a run without
-    ``resume`` / ``force``."""
-    entries = sorted(p.name for p in folder.iterdir() if p.name != LOCK_FILE)
+    records (none for a fresh run; ``force`` cleared the folder before).  Refuses
+    (:class:`RunError`) a folder holding anything but a DAgger run, a run of other
+    settings, or a run without ``resume``."""
+    entries = _entries(folder)
     settings_file = folder / SETTINGS_FILE
-    if entries and force:
-        clear_outputs(folder, DAGGER_OUTPUTS)
-        entries = []
     if entries and not settings_file.is_file():
         shown = ", ".join(entries[:3]) + (", …" if len(entries) > 3 else "")
         raise RunError(f"{folder} is not empty ({shown}) and holds no DAgger run ({SETTINGS_FILE})")
@@ -798,11 +834,12 @@ def student_file(out: Path, round_: int) -> Path:
 
 
 def _write_bytes(file: Path, payload: bytes) -> Path:
-    """Write ``file`` whole: staged beside it, then renamed over it."""
-    file.parent.mkdir(parents=True, exist_ok=True)
-    staged = file.with_name(f".{file.name}.part")
-    staged.write_bytes(payload)
-    os.replace(staged, file)
+    """Write ``file`` whole, through no link (:func:`~shipgym_baselines.records.outfiles.
+    write_bytes`: staged beside it, then renamed over it; listed in the run's manifest
+    first), its folder made if missing."""
+    if not file.parent.is_dir():
+        make_dir(file.parent)
+    write_bytes(file, payload)
     return file
 
 

@@ -51,7 +51,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -69,6 +68,7 @@ from shipgym_baselines.learned.dagger_config import hyperparameter_names as hype
 from shipgym_baselines.learned.dagger_config import hyperparams as hyperparams
 from shipgym_baselines.learned.dagger_config import settings as settings
 from shipgym_baselines.learned.meta import training_meta
+from shipgym_baselines.records.outfiles import write_bytes
 
 #: the ``algo`` of an agent config trained by DAgger
 DAGGER_ALGO = "dagger"
@@ -206,7 +206,8 @@ class _Selection:
         self.wall.append(float(wall_s))
         self.eval_cpu.append(time.process_time() - cpu)
         if found["selection"] <= min(self.selection):
-            shutil.copyfile(student_file(self.out / RUN_DIR, round_), self.out / "best_model.zip")
+            best = student_file(self.out / RUN_DIR, round_).read_bytes()
+            write_bytes(self.out / "best_model.zip", best)
             write_best(self.out, float(found["selection"]), int(record["labels_total"]))
         self.write()
         return self.go_on()
@@ -220,30 +221,27 @@ class _Selection:
         return not self.steps or self.steps[-1] < self.config.n_timesteps
 
     def write(self) -> None:
+        from shipgym_baselines.learned.agent_folder import write_json_file
         from shipgym_baselines.learned.curves import CURVE_FILE, write_curve
 
-        self.file.parent.mkdir(parents=True, exist_ok=True)
-        self.file.write_text(
-            json.dumps(
-                {
-                    "rounds": self.rounds,
-                    "env_steps": self.steps,
-                    "returns": self.returns,
-                    "selection": self.selection,
-                    "wall": self.wall,
-                    "eval_cpu": self.eval_cpu,
-                    "trials": [list(t) for t in self.trials],
-                    "references": self.references,
-                }
-            )
-        )
+        record = {
+            "rounds": self.rounds,
+            "env_steps": self.steps,
+            "returns": self.returns,
+            "selection": self.selection,
+            "wall": self.wall,
+            "eval_cpu": self.eval_cpu,
+            "trials": [list(t) for t in self.trials],
+            "references": self.references,
+        }
+        write_json_file(self.file, record, None)
         write_curve(self.out, self.steps, self.returns, self.selection)
         curve_file = self.out / CURVE_FILE
         curve = json.loads(curve_file.read_text())
         # every visited state is labelled: the teacher's labels are the env steps so far
         curve["teacher_labels"] = list(self.steps)
         curve["round"] = list(self.rounds)
-        curve_file.write_text(json.dumps(curve, indent=1))
+        write_json_file(curve_file, curve, 1)
 
     def best_round(self) -> int | None:
         return self.rounds[int(np.argmin(self.selection))] if self.selection else None
@@ -263,15 +261,7 @@ def train_dagger(
     ``resume`` without a started run."""
     import torch
 
-    from shipgym_baselines.learned import dagger
-    from shipgym_baselines.learned.agent_folder import (
-        TRAINING_OUTPUTS,
-        check_agent_folder,
-        check_tuned_from,
-    )
-    from shipgym_baselines.learned.selection import reference_costs, validation_trials
-    from shipgym_baselines.learned.teachers import oracle_teacher
-    from shipgym_baselines.records.folders import clear_outputs
+    from shipgym_baselines.learned.agent_folder import agent_run
 
     torch.set_num_threads(1)
     check_config(config)
@@ -286,11 +276,21 @@ def train_dagger(
         )
     if resume and not started(out):
         raise RunError(f"--resume: no DAgger run in {out / RUN_DIR}")
-    if not resume:
-        check_agent_folder(out, config.name, force)
-        if force:
-            clear_outputs(out, TRAINING_OUTPUTS)
-    out.mkdir(parents=True, exist_ok=True)
+    with agent_run(out, config.name, resume, force):
+        return _train_dagger(config, out, resume, progress, tuned_from)
+
+
+def _train_dagger(
+    config: Any, out: Path, resume: bool, progress: bool, tuned_from: dict[str, Any] | None
+) -> dict[str, Any]:
+    """:func:`train_dagger` in the agent folder ``out``, open (locked, its manifest
+    recording)."""
+    from shipgym_baselines.learned import dagger
+    from shipgym_baselines.learned.agent_folder import check_tuned_from, write_json_file
+    from shipgym_baselines.learned.selection import reference_costs, validation_trials
+    from shipgym_baselines.learned.teachers import oracle_teacher
+
+    hyper, run_settings = hyperparams(config), settings(config)
     check_tuned_from(out, tuned_from, resuming=resume)
     trials = validation_trials(config.eval.distribution, config.eval.n_episodes)
     scores = _Selection(config, out, trials, reference_costs(trials, out / "eval"))
@@ -335,7 +335,7 @@ def train_dagger(
     if not done_rounds:
         raise RunError(f"{out}: no DAgger round finished")
     newest = dagger.student_file(run_dir, int(done_rounds[-1]["round"]))
-    shutil.copyfile(newest, out / "model.zip")
+    write_bytes(out / "model.zip", newest.read_bytes())
     summary = dagger.DaggerRun(run_dir, None, done_rounds).summary()
     labels = int(done_rounds[-1]["labels_total"])
     meta = training_meta(
@@ -354,5 +354,5 @@ def train_dagger(
             "validation_cpu_s": float(sum(scores.eval_cpu)),
         },
     )
-    (out / "meta.json").write_text(json.dumps(meta, indent=2))
+    write_json_file(out / "meta.json", meta)
     return meta

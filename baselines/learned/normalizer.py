@@ -26,6 +26,7 @@ from shipgym.config import validate_model
 from shipgym.envs.core import HISTORY_WIDTH, observation_names
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.trust import pickle_trusted, refuse_unpickling
+from shipgym_baselines.records.outfiles import write_text
 
 #: the lengths an observation can have: without and with the controller-context features
 OBSERVATION_SIZES = (len(observation_names(False)), len(observation_names(True)))
@@ -105,7 +106,7 @@ class ObsNormalizer(BaseModel):
 
     def save(self, file: Path) -> Path:
         """Write the statistics as JSON (floats round-trip exactly)."""
-        file.write_text(json.dumps(self.model_dump(), indent=1) + "\n", encoding="utf-8")
+        write_text(file, json.dumps(self.model_dump(), indent=1) + "\n")  # through no link
         return file
 
 

@@ -104,8 +104,9 @@ def reference_costs(
             return data["references"]
     refs = [reference_cost(name, seed) for name, seed in trials]
     if cache is not None:
-        cache.parent.mkdir(parents=True, exist_ok=True)
-        cache.write_text(json.dumps({"trials": wanted, "references": refs, **revision}, indent=1))
+        from shipgym_baselines.learned.agent_folder import write_json_file
+
+        write_json_file(cache, {"trials": wanted, "references": refs, **revision}, indent=1)
     return refs
 
 

@@ -10,8 +10,16 @@ Output directory (default ``results/agents/<name>``)::
 ``resume=True`` continues from the newest checkpoint (model, replay buffer, reward
 normalisation and the wall-time counter) up to the config's ``n_timesteps``; a finished run
 (its ``meta.json`` has the ``n_timesteps``) is left as it is and its meta returned.
-Otherwise an output directory that is not empty is refused, unless ``force=True`` (its
-earlier outputs, :data:`TRAINING_OUTPUTS`, are removed first).
+Otherwise an output directory that is not empty is refused, unless ``force=True`` (the
+files its manifest lists are removed first; anything else in it is refused).  The folder is
+written as a run folder is (:func:`~shipgym_baselines.learned.agent_folder.agent_run`):
+locked, listed in ``manifest.txt``, through no link.
+
+A checkpoint is pickles (the SB3 zip, its replay buffer and reward statistics): a resumed
+run reads one only if this user's shipgym wrote those very bytes
+(:func:`~shipgym_baselines.learned.trust.written_here`) or ``--trust-pickle`` is given.  A
+checkpoint that is refused or cannot be read is named in one line and the next older one
+is tried (:func:`load_checkpoint`).
 
 :func:`export_policy` copies what
 :class:`~shipgym_baselines.learned.policy.LearnedPolicy` needs (the
@@ -29,6 +37,7 @@ rounds of DAgger instead of checkpoints.
 
 from __future__ import annotations
 
+import io
 import json
 import re
 import shutil
@@ -43,7 +52,7 @@ from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.executor import map_jobs
-from shipgym_baselines.learned.agent_folder import BEST_FILE
+from shipgym_baselines.learned.agent_folder import BEST_FILE, agent_run, write_json_file
 from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS as TRAINING_OUTPUTS
 from shipgym_baselines.learned.agent_folder import TUNED_FROM_FILE as TUNED_FROM_FILE
 from shipgym_baselines.learned.agent_folder import check_agent_folder as check_agent_folder
@@ -58,7 +67,14 @@ from shipgym_baselines.learned.agents import (
     make_training_env,
 )
 from shipgym_baselines.learned.meta import training_meta
-from shipgym_baselines.records.folders import clear_outputs
+from shipgym_baselines.learned.trust import (
+    TRUST_PICKLE_OPTION,
+    pickle_trusted,
+    remember_written,
+    written_here,
+)
+from shipgym_baselines.records.manifest import Manifest
+from shipgym_baselines.records.outfiles import write_bytes
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 
@@ -69,10 +85,12 @@ def _callbacks(
     n_envs: int,
     progress: bool,
     wall_offset: float,
+    manifest: Manifest,
     resumed_at: int | None = None,
 ):
     """Progress, checkpoints and the periodic validation; ``resumed_at``: the env steps of
-    the checkpoint a resumed run starts from (None: a fresh run)."""
+    the checkpoint a resumed run starts from (None: a fresh run); what SB3 writes itself
+    (checkpoints, TensorBoard logs) is listed in ``manifest`` before it is written."""
     from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 
     class _Progress(BaseCallback):
@@ -85,6 +103,11 @@ def _callbacks(
 
         def _on_training_start(self) -> None:
             from tqdm import tqdm
+
+            logs = self.model.logger.get_dir()
+            if logs:  # the TensorBoard folder SB3 just made for this run, and its files
+                folder = Path(logs).absolute()
+                manifest.record([folder, *sorted(folder.iterdir())])
 
             self.bar = tqdm(
                 total=config.n_timesteps,
@@ -109,14 +132,16 @@ def _callbacks(
 
     class _Checkpoint(CheckpointCallback):
         def _on_step(self) -> bool:
-            if self.n_calls % self.save_freq == 0:
-                state = {
-                    "num_timesteps": self.model.num_timesteps,
-                    "wall_time_s": progress_cb.wall(),
-                }
-                (out / "checkpoints").mkdir(parents=True, exist_ok=True)
-                (out / "checkpoints" / "state.json").write_text(json.dumps(state))
-            return super()._on_step()
+            if self.n_calls % self.save_freq:
+                return super()._on_step()
+            steps = self.num_timesteps
+            manifest.claim(*[f"checkpoints/{name}" for name in checkpoint_names(steps)])
+            state = {"num_timesteps": self.model.num_timesteps, "wall_time_s": progress_cb.wall()}
+            write_json_file(out / "checkpoints" / "state.json", state, None)
+            go_on = super()._on_step()
+            for file in checkpoint_files(out, steps):  # the bytes this run wrote
+                remember_written(file)
+            return go_on
 
     off_policy = config.algo in ("sac", "td3")
     checkpoint = _Checkpoint(
@@ -284,40 +309,105 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             self.steps.append(int(self.num_timesteps))
             self.returns.append(found["returns"])
             self.selection.append(found["selection"])
-            history.parent.mkdir(parents=True, exist_ok=True)
-            history.write_text(
-                json.dumps(
-                    {
-                        "env_steps": self.steps,
-                        "returns": self.returns,
-                        "selection": self.selection,
-                        "trials": [list(t) for t in trials],
-                        "references": references,
-                    }
-                )
-            )
+            record = {
+                "env_steps": self.steps,
+                "returns": self.returns,
+                "selection": self.selection,
+                "trials": [list(t) for t in trials],
+                "references": references,
+            }
+            write_json_file(history, record, None)
+            data = io.BytesIO()
             np.savez(
-                out / "eval" / "evaluations.npz",
+                data,
                 timesteps=np.array(self.steps),
                 results=np.array(self.returns),
                 ep_lengths=np.zeros_like(np.array(self.returns)),
             )
+            write_bytes(out / "eval" / "evaluations.npz", data.getvalue())
             if found["selection"] < self.best:
                 self.best = found["selection"]
-                self.model.save(str(out / "best_model.zip"))
+                save_model(self.model, out / "best_model.zip")
                 write_best(out, self.best, int(self.num_timesteps))
             return curves.after_evaluation(self.steps, self.returns, self.selection)
 
     return _RelativeCostEval()
 
 
-def latest_checkpoint(out: Path) -> tuple[Path, int] | None:
+def checkpoints(out: Path) -> list[tuple[Path, int]]:
+    """The checkpoints in ``out`` (zip, env steps), newest first."""
     found = [
         (p, int(m.group(1)))
         for p in (out / "checkpoints").glob("ckpt_*_steps.zip")
         if (m := _CKPT.search(p.name))
     ]
-    return max(found, key=lambda item: item[1]) if found else None
+    return sorted(found, key=lambda item: item[1], reverse=True)
+
+
+def latest_checkpoint(out: Path) -> tuple[Path, int] | None:
+    found = checkpoints(out)
+    return found[0] if found else None
+
+
+def checkpoint_names(steps: int) -> tuple[str, str, str]:
+    """The files of the checkpoint at ``steps`` env steps in ``checkpoints/``: the model
+    zip, its reward statistics and its replay buffer (SB3's ``CheckpointCallback`` names)."""
+    return (
+        f"ckpt_{steps}_steps.zip",
+        f"ckpt_vecnormalize_{steps}_steps.pkl",
+        f"ckpt_replay_buffer_{steps}_steps.pkl",
+    )
+
+
+def checkpoint_files(out: Path, steps: int) -> list[Path]:
+    """Those of the checkpoint's files (:func:`checkpoint_names`) that exist in ``out``."""
+    folder = out / "checkpoints"
+    return [folder / name for name in checkpoint_names(steps) if (folder / name).is_file()]
+
+
+def save_model(model: Any, file: Path) -> None:
+    """``model`` saved as the zip ``file``, atomically and through no link."""
+    data = io.BytesIO()
+    model.save(data)
+    write_bytes(file, data.getvalue())
+
+
+def load_checkpoint(
+    out: Path, config: AgentConfig, cls: Any, venv: Any
+) -> tuple[Any, Any, int] | None:
+    """(model, its env, env steps) of the newest checkpoint in ``out`` that may be read
+    and can be: its files written by this user's shipgym (or ``--trust-pickle``), then
+    loaded without error.  Each checkpoint passed over is named in one line on stderr.
+    None when there is none."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    for ckpt, steps in checkpoints(out):
+        files = checkpoint_files(out, steps)
+        foreign = [f for f in files if not (pickle_trusted() or written_here(f))]
+        if foreign:
+            sys.stderr.write(
+                f"train --resume: {foreign[0]} is not what a shipgym run of yours wrote (no "
+                "record of its SHA-256: changed since, or made elsewhere), and reading it "
+                f"means unpickling: skipped (pass {TRUST_PICKLE_OPTION} if you trust whoever "
+                "made it)\n"
+            )
+            continue
+        _, statistics, buffer = (out / "checkpoints" / name for name in checkpoint_names(steps))
+        try:
+            env = venv
+            if config.env.normalize_reward and not config.env.normalize_per_ship:
+                env = VecNormalize.load(str(statistics), venv)
+            model = cls.load(str(ckpt), env=env, device="cpu")
+            if buffer.is_file():
+                model.load_replay_buffer(str(buffer))
+        except Exception as exc:  # a damaged checkpoint: any error of its readers
+            sys.stderr.write(
+                f"train --resume: the checkpoint {ckpt} is unreadable ({type(exc).__name__}: "
+                f"{exc}): skipped\n"
+            )
+            continue
+        return model, env, steps
+    return None
 
 
 def train(
@@ -338,7 +428,6 @@ def train(
     settings applied to ``config`` (:func:`shipgym_baselines.tuning.tuned.tuned_agent`),
     recorded in the meta; a resumed run must be resumed with the settings it started with."""
     import torch
-    from stable_baselines3.common.vec_env import VecNormalize
 
     torch.set_num_threads(1)  # small networks: threads only contend with the env workers
     if not isinstance(config, AgentConfig):
@@ -362,11 +451,22 @@ def train(
                 "steps, so finished: nothing trained (--force trains it afresh)\n"
             )
         return finished
-    if not resume:
-        check_agent_folder(out, config.name, force)
-        if force:
-            clear_outputs(out, TRAINING_OUTPUTS)
-    out.mkdir(parents=True, exist_ok=True)
+    with agent_run(out, config.name, resume, force) as manifest:
+        return _train(config, out, resume, progress, tensorboard, tuned_from, manifest)
+
+
+def _train(
+    config: AgentConfig,
+    out: Path,
+    resume: bool,
+    progress: bool,
+    tensorboard: bool,
+    tuned_from: dict[str, Any] | None,
+    manifest: Manifest,
+) -> dict[str, Any]:
+    """:func:`train` in the agent folder ``out``, open (locked, ``manifest`` recording)."""
+    from stable_baselines3.common.vec_env import VecNormalize
+
     cls = algo_class(config.algo)
     previous = latest_checkpoint(out) if resume else None
     if resume and previous is None:
@@ -377,9 +477,6 @@ def train(
             f"--resume: the newest checkpoint has {previous[1]} steps, n_timesteps is "
             f"{config.n_timesteps}: nothing to train (raise --timesteps)"
         )
-    if previous is None and (out / "checkpoints").is_dir():  # a fresh run: no stale resume
-        shutil.rmtree(out / "checkpoints")
-        (out / "eval" / "evaluations.npz").unlink(missing_ok=True)
     # a resumed run continues with fresh scenario draws: the env seeds move on by n_envs per
     # checkpoint reached (still below the evaluation seeds)
     env_seed = config.seed
@@ -402,19 +499,21 @@ def train(
             gamma = env_gammas(ship_envs, config.env.gamma_seconds)
     wall_offset = 0.0
     if previous is not None:
-        ckpt, steps = previous
         if config.env.normalize_per_ship:  # its statistics are not checkpointed: re-estimated
             from shipgym_baselines.learned.per_ship import VecNormalizePerShip
 
             venv = VecNormalizePerShip(venv, groups, gamma)
-        elif config.env.normalize_reward:
-            venv = VecNormalize.load(
-                str(out / "checkpoints" / f"ckpt_vecnormalize_{steps}_steps.pkl"), venv
+        loaded = load_checkpoint(out, config, cls, venv)
+        if loaded is None:
+            venv.close()
+            raise RunError(
+                f"--resume: no checkpoint in {out / 'checkpoints'} can be read (each is named "
+                "above): train it afresh with --force"
             )
-        model = cls.load(str(ckpt), env=venv, device="cpu")
-        buffer = out / "checkpoints" / f"ckpt_replay_buffer_{steps}_steps.pkl"
-        if buffer.is_file():
-            model.load_replay_buffer(str(buffer))
+        model, venv, steps = loaded
+        if steps != previous[1]:
+            sys.stderr.write(f"train --resume: resuming from {steps} env steps\n")
+            previous = (previous[0], steps)
         state_file = out / "checkpoints" / "state.json"
         if state_file.is_file():
             wall_offset = float(json.loads(state_file.read_text())["wall_time_s"])
@@ -457,6 +556,7 @@ def train(
         config.env.n_envs,
         progress,
         wall_offset,
+        manifest,
         resumed_at=previous[1] if previous is not None else None,
     )
     remaining = config.n_timesteps - model.num_timesteps
@@ -467,7 +567,7 @@ def train(
             reset_num_timesteps=previous is None,
             tb_log_name=config.name,
         )
-    model.save(str(out / "model.zip"))
+    save_model(model, out / "model.zip")
     meta = training_meta(
         config,
         algo=config.algo,
@@ -476,7 +576,7 @@ def train(
         stopped_at=curves.stopped_at,
         tuned_from=tuned_from,
     )
-    (out / "meta.json").write_text(json.dumps(meta, indent=2))
+    write_json_file(out / "meta.json", meta)
     save_obs_statistics(venv, out)
     venv.close()
     return meta

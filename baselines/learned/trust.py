@@ -10,11 +10,19 @@ it: ``--trust-pickle`` on ``evaluate``, ``run`` and ``leaderboard``.
 
 The choice travels in the environment variable :data:`TRUST_PICKLE_ENV`, so the worker
 processes of a run (forked, spawned or a local Ray instance) see what the command said.
+
+A training checkpoint (an SB3 zip, its replay buffer and reward statistics, pickles all)
+is read by ``train --resume`` under the same rule, with one exception: a file this user's
+shipgym wrote itself.  Each checkpoint file's SHA-256 is recorded when it is written
+(:func:`remember_written`) in the per-user cache, outside the agent folder, so whoever made
+a folder cannot forge the record; a file whose bytes match a record (:func:`written_here`)
+is unpickled without ``--trust-pickle``, any other file only with it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 from collections.abc import Iterator
 from pathlib import Path
@@ -53,3 +61,36 @@ def refuse_unpickling(file: Path, why: str) -> UnsafeFileError:
         f"{file}: {why}; reading it means unpickling, which runs any code the file holds: "
         f"refused (pass {TRUST_PICKLE_OPTION} if you trust whoever made it)"
     )
+
+
+#: the per-user cache's folder of SHA-256 records of the checkpoint files shipgym wrote
+WRITTEN_DIR = "written"
+
+
+def file_sha256(file: Path) -> str:
+    """The SHA-256 of ``file``'s bytes (hex)."""
+    digest = hashlib.sha256()
+    with open(file, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _record(digest: str) -> Path:
+    from shipgym.codegen import user_cache_dir
+
+    return user_cache_dir() / WRITTEN_DIR / digest
+
+
+def remember_written(file: Path) -> None:
+    """Record that this user's shipgym wrote ``file`` as it is now (its SHA-256: an empty
+    file of that name in the per-user cache)."""
+    record = _record(file_sha256(file))
+    record.parent.mkdir(parents=True, exist_ok=True)
+    record.touch()
+
+
+def written_here(file: Path) -> bool:
+    """True when ``file``'s bytes are those of a file this user's shipgym wrote
+    (:func:`remember_written`)."""
+    return _record(file_sha256(file)).is_file()

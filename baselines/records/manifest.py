@@ -23,7 +23,7 @@ from pathlib import Path
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.locking import LOCK_FILE
-from shipgym_baselines.records.outfiles import open_regular, recording, write_text
+from shipgym_baselines.records.outfiles import announce, open_regular, recording, write_text
 
 #: the list of paths the runs in a folder wrote
 MANIFEST_FILE = "manifest.txt"
@@ -74,6 +74,9 @@ class Manifest:
         new = [p for p in dict.fromkeys(paths) if p not in self.listed]
         if not new:
             return
+        if MANIFEST_FILE not in self.listed:  # a manifest inside another run's folder is
+            self.listed.add(MANIFEST_FILE)  # listed there (its own recorder claims nothing)
+            announce(self.folder / MANIFEST_FILE)
         data = "".join(f"{p}\n" for p in new).encode("utf-8")
         fd = open_regular(self.folder / MANIFEST_FILE, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
         try:

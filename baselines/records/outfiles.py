@@ -117,8 +117,9 @@ def open_regular(path: str | os.PathLike, flags: int, mode: int = 0o644) -> int:
     return fd
 
 
-def _announce(*paths: Path) -> None:
-    """Tell this process's recorders that ``paths`` are about to be written."""
+def announce(*paths: Path) -> None:
+    """Tell this process's recorders that ``paths`` are about to be written (by a writer
+    other than :func:`write_bytes` and :func:`make_dir`, which announce their own)."""
     absolute = [Path(os.path.abspath(p)) for p in paths]
     for record in list(_RECORDERS):
         record(absolute)
@@ -164,7 +165,7 @@ def make_dir(folder: str | os.PathLike) -> Path:
     """``folder`` made if missing (announced first, its parent must exist); a
     :class:`RunError` when a link or a file is in its place."""
     path = Path(folder)
-    _announce(path)
+    announce(path)
     with contextlib.suppress(FileExistsError):
         path.mkdir()
     mode = os.lstat(path).st_mode
@@ -182,7 +183,7 @@ def write_bytes(file: str | os.PathLike, data: bytes) -> None:
     path = Path(file)
     refuse_special(path)
     tmp = temporary_name(path)
-    _announce(path, tmp)
+    announce(path, tmp)
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
         with os.fdopen(fd, "wb") as fh:
@@ -202,6 +203,7 @@ def write_text(file: str | os.PathLike, text: str) -> None:
 
 
 __all__ = [
+    "announce",
     "carried",
     "check_no_links",
     "make_dir",

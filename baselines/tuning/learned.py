@@ -16,7 +16,6 @@ runs its rounds until the part's labels are reached (:func:`dagger_part`).  Runs
 from __future__ import annotations
 
 import functools
-import shutil
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -87,19 +86,18 @@ def train_and_score(
     agent = agent.model_copy(
         update={"checkpoint_freq": part, "eval": quiet, "n_timesteps": spec.n_timesteps}
     )
-    if folder.exists():
-        shutil.rmtree(folder)  # a re-run trial (failed before) starts afresh
     fit = functools.partial(train, progress=False, tensorboard=False)
     ratios: list[float] = []
     for k in range(1, spec.evaluations + 1):
         steps = part * k if k < spec.evaluations else spec.n_timesteps
         if agent.algo == "dagger":
-            meta = fit(dagger_part(agent, steps), folder, resume=k > 1)
+            # a re-run trial (failed before) starts afresh: force deletes what its run wrote
+            meta = fit(dagger_part(agent, steps), folder, resume=k > 1, force=k == 1)
             steps = int(meta["env_steps"])
         else:
             latest = latest_checkpoint(folder) if k > 1 else None
             if latest is None or latest[1] < steps:  # a part a long rollout covered: skip
-                fit(agent, folder, n_timesteps=steps, resume=k > 1)
+                fit(agent, folder, n_timesteps=steps, resume=k > 1, force=k == 1)
         ratios = controller_ratios(str(folder / "model.zip"), {}, trials, oracle)
         if report is not None:
             report(geometric_mean(ratios), steps)

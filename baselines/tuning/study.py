@@ -27,6 +27,12 @@ the same validation trials, or with ``force`` (:mod:`~shipgym_baselines.tuning.p
 
 ``backend="ray"`` runs the trials as Ray tasks, ``workers`` at a time, each loading the
 study from the shared storage.
+
+A study's folder is locked while the study runs, as a run folder is
+(:func:`~shipgym_baselines.records.locking.out_lock`): a second process on the same study
+is refused in one line naming the holder, so two processes never draw the same trials.
+The folder holds no link (refused in one line), and the report is written through none,
+listed in the folder's manifest (:mod:`~shipgym_baselines.records.manifest`).
 """
 
 from __future__ import annotations
@@ -44,6 +50,10 @@ from typing import Any
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.executor import BACKENDS as BACKENDS  # public here too
 from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
+from shipgym_baselines.records.locking import out_lock
+from shipgym_baselines.records.manifest import Manifest
+from shipgym_baselines.records.outfiles import check_no_links, write_text
+from shipgym_baselines.records.runrecord import now
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
 from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
@@ -140,7 +150,7 @@ def _plan(
     storage: str | None,
     chosen: Path,
 ) -> StudyPlan:
-    url = storage or f"sqlite:///{(folder / STORAGE_FILE).absolute()}"
+    url = storage or default_storage(folder)
     name = f"{config.name}:{ship}" if ship else config.name
     return StudyPlan(tuning, config, ship, folder, url, name, chosen)
 
@@ -300,13 +310,19 @@ def open_study(plan: StudyPlan, resume: bool, create: bool = True, driver: bool 
     pruner = optuna.pruners.MedianPruner(n_startup_trials=plan.config.startup_trials)
     if not exists and create:
         record = study_record(plan)
-        study = optuna.create_study(
-            study_name=plan.study_name,
-            storage=plan.storage,
-            sampler=sampler,
-            pruner=pruner,
-            direction="minimize",
-        )
+        try:
+            study = optuna.create_study(
+                study_name=plan.study_name,
+                storage=plan.storage,
+                sampler=sampler,
+                pruner=pruner,
+                direction="minimize",
+            )
+        except optuna.exceptions.DuplicatedStudyError:
+            raise RunError(
+                f"study {plan.study_name!r} was just created in {plan.storage} by another "
+                "process: wait for it, or choose another --out / --storage"
+            ) from None
         study.set_user_attr(RECORD_ATTR, record)
         study.set_user_attr(DIGEST_ATTR, record_digest(record))
         return study
@@ -340,6 +356,32 @@ def run_study(
     total = int(n_trials if n_trials is not None else plan.config.budget)
     if total < 1:
         raise RunError(f"--trials {total}: at least 1")
+    with out_lock(plan.folder, now()):
+        check_no_links(plan.folder)
+        manifest = Manifest(plan.folder)
+        if plan.storage == default_storage(plan.folder):
+            manifest.claim(STORAGE_FILE)
+        with manifest.recording():
+            report = _run_locked(plan, total, resume, backend, workers, progress, force)
+        manifest.compact(keep=(REPORT_FILE,))
+        return report
+
+
+def default_storage(folder: Path) -> str:
+    """The SQLite storage URL of a study in ``folder`` (:data:`STORAGE_FILE`)."""
+    return f"sqlite:///{(folder / STORAGE_FILE).absolute()}"
+
+
+def _run_locked(
+    plan: StudyPlan,
+    total: int,
+    resume: bool,
+    backend: str,
+    workers: int,
+    progress: Progress | None,
+    force: bool,
+) -> dict[str, Any]:
+    """:func:`run_study` once the study's folder is locked."""
     study = open_study(plan, resume)
     scorer = Scorer(plan, progress)
     if "default_ratios" not in study.user_attrs:
@@ -463,9 +505,7 @@ def write_report(
             **write_chosen(plan, scorer, settings, ratios, summary, choice, force, progress),
         }
     plan.folder.mkdir(parents=True, exist_ok=True)
-    staged = plan.folder / f"{REPORT_FILE}.{os.getpid()}.tmp"
-    staged.write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
-    os.replace(staged, plan.folder / REPORT_FILE)
+    write_text(plan.folder / REPORT_FILE, json.dumps(report, indent=2, default=_jsonable) + "\n")
     return report
 
 

@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -247,3 +250,36 @@ def test_a_controller_too_slow_for_act_timeout_ends_the_episode(
     assert (doc["termination_reason"], doc["steps"]) == ("controller_timeout", 2)
     assert doc["error"].startswith("the call took 0.2")
     assert json.loads((out / "metrics.json").read_text()) == doc
+
+
+def test_a_truncated_compiled_library_is_rebuilt_and_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The nomoto2 plant's library in the per-user cache cut to 3,000 bytes (loading it
+    kills the process with SIGBUS): the next episode compiles it again, says so in one line
+    naming the file, and runs (in child processes: this one never maps the library)."""
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SHIPGYM_CACHE_DIR", str(cache))
+    monkeypatch.delenv("SHIPGYM_CACHE", raising=False)
+    monkeypatch.delenv("SHIPGYM_NO_COMPILE", raising=False)
+    monkeypatch.delenv("SHIPGYM_QUIET", raising=False)
+
+    def episode(out: str) -> subprocess.CompletedProcess[str]:
+        command = [sys.executable, "-m", "shipgym_baselines.cli", "run", "current_shift"]
+        command += ["pid_los", "--out", str(tmp_path / out), "--json"]
+        return subprocess.run(command, capture_output=True, text=True, timeout=300)
+
+    assert episode("first").returncode == 0
+    (library,) = cache.glob("nomoto2_period_50_*.so")
+    size = library.stat().st_size
+    os.truncate(library, 3000)
+    again = episode("second")
+    assert again.returncode == 0, again.stderr
+    line = (
+        f"shipgym: the cached library {library} is 3000 bytes, {size} recorded: compiling it again"
+    )
+    assert line in again.stderr.splitlines()
+    assert json.loads((tmp_path / "second" / "metrics.json").read_text()) == json.loads(
+        again.stdout
+    )
+    assert library.stat().st_size == size

@@ -150,12 +150,46 @@ def test_a_cache_of_another_revision_is_ignored_and_replaced(
     assert ReferenceTable.load(cached).lookup(trial.scenario, trial.seed) is not None
 
 
-def test_an_unreadable_cache_is_named(oracle: CountingOracle) -> None:
+@pytest.mark.parametrize("damage", ["truncated", "not gzip", "no table"])
+def test_an_unreadable_cache_is_set_aside_and_named(
+    oracle: CountingOracle, capsys: pytest.CaptureFixture[str], damage: str
+) -> None:
+    """A cache cut short, not gzip, or gzip of no table: moved to ``<file>.bad``
+    with one line naming it, and the cache starts afresh (the reference computed again)."""
+    cached = user_cache_path()
+    (trial,) = validation_trials(ship="nomoto2", per_ship=1)
+    scenario = load_scenario("nominal")
+    cache = ReferenceCache(cached)
+    for seed in range(3):
+        cache.store(scenario, CountingOracle()(None, scenario, [seed])[0])
+    if damage == "truncated":
+        cached.write_bytes(cached.read_bytes()[: cached.stat().st_size // 2])
+    else:
+        cached.write_bytes(gzip.compress(b"[]") if damage == "no table" else b"not gzip")
+    damaged = cached.read_bytes()
+    capsys.readouterr()
+    assert oracle_costs([trial]) == [1 + trial.seed / 1e5] and len(oracle.runs) == 1
+    bad = references.set_aside_path(cached)
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "unreadable" in x]
+    assert line.startswith(f"shipgym: the reference cache {cached} is unreadable (")
+    assert line.endswith(f"): set aside as {bad}; its references are computed again when needed")
+    assert bad.read_bytes() == damaged
+    assert set(ReferenceTable.load(cached).entries) == {entry_key(trial.scenario, trial.seed)}
+
+
+def test_a_link_in_place_of_the_cache_is_not_written_through(
+    oracle: CountingOracle, tmp_path: Path
+) -> None:
+    """A store replaces no file that a link in the cache's place points to: refused."""
     cached = user_cache_path()
     cached.parent.mkdir(parents=True)
-    cached.write_bytes(b"not gzip")
-    with pytest.raises(RunError, match=f"reference cache {cached} is unreadable.*delete it"):
+    victim = tmp_path / "victim.json.gz"
+    ReferenceTable({}).save(victim)
+    before = victim.read_bytes()
+    cached.symlink_to(victim)
+    with pytest.raises(RunError, match=f"{cached} is a symbolic link"):
         oracle_costs(validation_trials(ship="nomoto2", per_ship=1))
+    assert victim.read_bytes() == before and cached.is_symlink()
 
 
 def _store(args: tuple[str, list[int]]) -> None:

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 import multiprocessing
+import os
 import shutil
 import subprocess
 import sys
@@ -216,3 +219,47 @@ def test_the_estimate_grows_with_the_code_size() -> None:
     assert codegen.compile_seconds(2_460_065) == pytest.approx(50.4, abs=0.1)
     line = codegen.compile_message("the mariner plant", 26.2, Path("/c"))
     assert line == "shipgym: compiling the mariner plant to C (one-off, ≈ 26 s; cached in /c)"
+
+
+@needs_compiler
+def test_a_library_is_recorded_when_it_is_compiled(cache: Path) -> None:
+    """Beside each library: its size and SHA-256, as the check before loading reads them."""
+    codegen.compiled(_step())
+    (library,) = cache.glob("*.so")
+    record = json.loads(codegen.record_path(library).read_text())
+    assert record == {
+        "size": library.stat().st_size,
+        "sha256": hashlib.sha256(library.read_bytes()).hexdigest(),
+    }
+    assert codegen.library_problem(library) is None
+
+
+@needs_compiler
+@pytest.mark.parametrize("damage", ["truncated", "flipped", "unrecorded"])
+def test_a_damaged_library_is_compiled_again_and_named(
+    cache: Path, capfd: pytest.CaptureFixture[str], damage: str
+) -> None:
+    """A library cut to 3,000 bytes (loading it is a SIGBUS), with a byte changed, or
+    without its record is never loaded: it is compiled again, named in one line."""
+    codegen.compiled(_step())
+    (library,) = cache.glob("*.so")
+    good = library.read_bytes()
+    capfd.readouterr()
+    if damage == "truncated":
+        os.truncate(library, 3000)
+    elif damage == "flipped":
+        library.write_bytes(good[:-1] + bytes([good[-1] ^ 1]))
+    else:
+        codegen.record_path(library).unlink()
+    why = {
+        "truncated": f"is 3000 bytes, {len(good)} recorded",
+        "flipped": "differs from its recorded SHA-256",
+        "unrecorded": "has no record of its size and SHA-256",
+    }[damage]
+    assert codegen.library_problem(library) == why
+    fast = codegen.compiled(_step())
+    first = capfd.readouterr().err.splitlines()[0]
+    assert first == f"shipgym: the cached library {library} {why}: compiling it again"
+    assert library.read_bytes() == good and codegen.library_problem(library) is None
+    args = _random_inputs(np.random.default_rng(2))
+    np.testing.assert_array_equal(np.array(fast(*args)), np.array(_step()(*args)))

@@ -107,6 +107,7 @@ def test_a_killed_sweep_resumes_where_each_seed_stood(
     checkpoint = out / "seed_1" / "checkpoints" / "ckpt_128_steps.zip"
     stamp = checkpoint.stat().st_mtime_ns
     (out / "seed_2" / "eval").mkdir(parents=True)  # started, killed before a checkpoint
+    (out / "seed_2" / "manifest.txt").write_text("eval\n")  # listed as a run starts
     capsys.readouterr()
 
     argv = [*_train(tiny, chosen, "--out", str(out), "--resume", "--ship")]

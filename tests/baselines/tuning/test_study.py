@@ -17,15 +17,18 @@ from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records import chosen as chosen_reader
+from shipgym_baselines.records.manifest import read_manifest
 from shipgym_baselines.tuning import chosen
+from shipgym_baselines.tuning import study as study_module
 from shipgym_baselines.tuning.objective import controller_ratios, geometric_mean
 from shipgym_baselines.tuning.space import ParamSpec, TuningConfig, load_tuning
-from shipgym_baselines.tuning.study import open_study, plan_studies, run_study
+from shipgym_baselines.tuning.study import default_storage, open_study, plan_studies, run_study
 from shipgym_baselines.tuning.validation import (
     check_validation_split,
     oracle_costs,
     validation_trials,
 )
+from tests.baselines.records.test_locking import hold
 
 #: the packaged distributions' folder
 DISTRIBUTIONS = Path(__file__).resolve().parents[3] / "configs" / "distributions"
@@ -632,3 +635,51 @@ def test_the_chosen_settings_score_what_their_record_says(tmp_path: Path) -> Non
     study = optuna.load_study(study_name=plan.study_name, storage=plan.storage)
     again = write_report(edited, study, Scorer(edited))
     assert again["chosen"]["settings"] == settings
+
+
+def test_a_second_process_on_a_study_is_refused_in_one_line(
+    tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """While another process holds a study's folder, ``tune`` and ``tune --resume`` on it
+    are refused in one line naming the holder; nothing is added to the study."""
+    out = tmp_path / "out"
+    argv = ["tune", str(tiny), "--out", str(out), "--chosen-dir", str(tmp_path), "--trials", "1"]
+    assert main(argv) == 0
+    folder = out / "nomoto2"
+    study = optuna.load_study(study_name="pid_los_tiny:nomoto2", storage=default_storage(folder))
+    assert len(study.trials) == 1
+    assert read_manifest(folder) >= {"study.db", "tuning_report.json", "manifest.txt"}
+    capsys.readouterr()
+    holder = hold(folder)
+    try:
+        for extra in (["--resume", "--trials", "2"], []):
+            assert main([*argv, *extra]) == 2
+            (line,) = capsys.readouterr().err.strip().splitlines()
+            assert f"--out {folder} is in use by another run (process {holder.pid}," in line
+    finally:
+        holder.kill()
+        holder.wait()
+    assert len(study.trials) == 1
+
+
+def test_a_study_created_meanwhile_by_another_process_is_one_line(
+    tiny: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two fresh studies on one storage at once: the second creation is refused in one
+    line (not Optuna's DuplicatedStudyError)."""
+    storage = f"sqlite:///{tmp_path / 'shared.db'}"
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "a", storage=storage, ship="nomoto2")
+    open_study(plan, resume=False)
+    monkeypatch.setattr(study_module, "study_exists", lambda plan: False)  # the race
+    with pytest.raises(RunError, match=r"was just created in .* by another process"):
+        open_study(plan, resume=False)
+
+
+def test_a_link_in_a_study_folder_is_refused(tiny: Path, tmp_path: Path) -> None:
+    """A study writes through no link: one planted in its folder is refused, named."""
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "out", chosen_dir=tmp_path)
+    plan.folder.mkdir(parents=True)
+    (plan.folder / "tuning_report.json").symlink_to(tmp_path / "elsewhere.json")
+    with pytest.raises(RunError, match=r"tuning_report\.json is a symbolic link"):
+        run_study(plan, n_trials=1)
+    assert not (tmp_path / "elsewhere.json").exists()
