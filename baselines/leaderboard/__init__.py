@@ -94,6 +94,7 @@ _DEFINED = {
 }
 #: helpers the leaderboard module has always re-exported (their own homes are elsewhere)
 _BORROWED = {
+    "headroom": ("GAIN",),
     "jobs": (
         "ACT_TIMEOUT_S",
         "BACKENDS",
@@ -143,7 +144,6 @@ _BORROWED = {
         "row_intervals",
     ),
     "markdown": (
-        "GAIN",
         "HEADROOM_EXPLAINED",
         "ORACLE",
         "PARTIAL",

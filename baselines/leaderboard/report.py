@@ -29,7 +29,17 @@ from shipgym_baselines.records.manifest import Manifest, clear_listed
 from shipgym_baselines.records.runlog import outside_problem
 from shipgym_baselines.records.runrecord import git_commit, now, read_run, versions
 from shipgym_baselines.records.trajectories import episode_result
-from shipgym_baselines.records.trials import ALL, LEARNED_TRIALS, SHARED, shares_trials
+from shipgym_baselines.records.trials import (
+    ALL,
+    LEARNED_TRIALS,
+    SHARED,
+    TWIN_PLAYERS,
+    TWIN_SCENARIOS,
+    TWINS,
+    shares_trials,
+    twin_scenarios,
+    twins_of,
+)
 
 REPORT_FILE = "report.json"
 
@@ -40,8 +50,9 @@ def merge_runs(
     """(suite, episodes, sources) of run folders merged: scenarios and controllers in order
     of first appearance, seeds (each scenario's too: ``scenario_seeds``, when some ran on
     fewer) and "does not apply" pairs united, the deal of learned agents' trials
-    (``learned_trials``) the same in every run; ``sources`` describes each
-    run (folder, command, status, times, episodes of jobs)."""
+    (``learned_trials``) the same in every run, the no-change twins united
+    (:func:`_merge_twins`); ``sources`` describes each run (folder, command, status, times,
+    episodes of jobs)."""
     suite: dict[str, Any] = {
         "name": None,
         "seeds": [],
@@ -51,6 +62,7 @@ def merge_runs(
         "does_not_apply": [],
     }
     first_with: dict[str, str] = {}
+    twin_first: dict[str, str] = {}  # a changing scenario or a twin → the first run with it
     ran_on: dict[str, set[int]] = {}  # scenario → the seeds any run ran it on
     episode_in: dict[Key, str] = {}
     cost_of: dict[Key, Any] = {}
@@ -93,9 +105,10 @@ def merge_runs(
         suite["does_not_apply"] += [
             pair for pair in run_suite["does_not_apply"] if pair not in suite["does_not_apply"]
         ]
+        _merge_twins(suite, run_suite, folder, twin_first)
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         fewer = run_suite.get("scenario_seeds", {})
-        for name in run_suite["scenarios"]:
+        for name in [*run_suite["scenarios"], *twin_scenarios(run_suite)]:
             ran_on.setdefault(name, set()).update(fewer.get(name, run_suite["seeds"]))
         suite["name"] = suite["name"] or run_suite.get("name")
         episodes = read_episodes(folder, suite=run_suite)
@@ -128,6 +141,35 @@ def merge_runs(
     if fewer:
         suite["scenario_seeds"] = fewer
     return suite, results, sources
+
+
+def _merge_twins(
+    suite: dict[str, Any], run_suite: Mapping[str, Any], folder: str, first: dict[str, str]
+) -> None:
+    """Merge the no-change twins of ``run_suite`` (:mod:`shipgym_baselines.leaderboard.twins`)
+    into ``suite``: each changing scenario's twin and each twin's settings the same in every
+    run that has them (else RunError), the players united; ``first``: a changing scenario or
+    a twin → the first run that has it."""
+    for name, twin in twins_of(run_suite).items():
+        known = suite.setdefault(TWINS, {}).setdefault(name, twin)
+        first.setdefault(name, folder)
+        if known != twin:
+            raise RunError(
+                f"scenario {name!r} has the twin {twin!r} in {folder} but {known!r} in "
+                f"{first[name]}: report runs of one suite"
+            )
+    for name, settings in twin_scenarios(run_suite).items():
+        known = suite.setdefault(TWIN_SCENARIOS, {}).setdefault(name, settings)
+        first.setdefault(name, folder)
+        changed = differences(known, settings)
+        if changed:
+            raise RunError(
+                f"twin {name!r} has other settings in {folder} than in {first[name]}: "
+                f"{'; '.join(changed[:3])}"
+            )
+    if TWIN_PLAYERS in run_suite:
+        players = suite.setdefault(TWIN_PLAYERS, [])
+        players += [c for c in run_suite[TWIN_PLAYERS] if c not in players]
 
 
 def _same_reference(episode: Mapping[str, Any], kinds: Mapping[str, str], cost: Any) -> bool:

@@ -204,10 +204,13 @@ def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
 def keep_drawn(log: RunLog, rows: Mapping[tuple[str, str], set[tuple]], row: tuple) -> None:
     """Once every episode of ``row`` is recorded: keep the trajectory of the episode its
     figure draws (:func:`shipgym_baselines.leaderboard.figures.median_ace_episode`), remove
-    the others'."""
+    the others' (all of them on a twin that is no scenario of the run: no figure draws it)."""
     keys = rows[row]
     if not keys <= log.done:
         return
     scenario, controller = row
+    if scenario not in log.record["suite"]["scenarios"]:
+        log.drop_trajectories(keys)
+        return
     seed, training_seed = median_ace_episode([log.episodes[k] for k in keys], *row)
     log.drop_trajectories(keys - {(scenario, controller, seed, training_seed)})

@@ -10,7 +10,7 @@ import pytest
 
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard.report import write_report
+from shipgym_baselines.leaderboard.report import merge_runs, write_report
 from shipgym_baselines.records.runrecord import read_run
 from tests.baselines.records.conftest import untimed, write_suite
 
@@ -85,6 +85,35 @@ def test_report_refuses_runs_that_disagree(evaluated: dict[str, Path], tmp_path:
     with pytest.raises(RunError, match="not a run folder"):
         write_report([tmp_path], tmp_path / "out2")
     assert not (tmp_path / "out").exists()
+
+
+def test_report_keeps_the_twins_and_refuses_runs_that_disagree_on_them(
+    evaluated: dict[str, Path], tmp_path: Path
+) -> None:
+    """The merged suite keeps the runs' no-change twins (rudder_aging's is the tiny suite's
+    nominal), their players united, and refuses a run that pairs a scenario with another
+    twin or gives a twin other settings."""
+    suite, _, _ = merge_runs([evaluated["pid_los"], evaluated["zero_rudder"]])
+    assert suite["twins"] == {"rudder_aging": "nominal"}
+    assert suite["twin_players"] == ["pid_los"]  # zero_rudder, a reference, plays no twin
+    record = read_run(evaluated["pid_los"])
+    nominal = record["suite"]["scenarios"]["nominal"]
+    record["suite"]["twins"] = {"rudder_aging": "twin:rudder_aging"}
+    record["suite"]["twin_scenarios"] = {"twin:rudder_aging": nominal}
+    folders = []
+    for name in ("one", "two"):
+        folder = tmp_path / name
+        folder.mkdir()
+        (folder / "run.json").write_text(json.dumps(record))
+        (folder / "episodes.jsonl").write_text("")
+        folders.append(folder)
+        record["suite"]["twin_scenarios"]["twin:rudder_aging"] = {**nominal, "time_limit": 20.0}
+    with pytest.raises(RunError, match=r"'rudder_aging' has the twin 'twin:rudder_aging' in"):
+        merge_runs([evaluated["zero_rudder"], folders[0]])
+    with pytest.raises(RunError, match=r"twin 'twin:rudder_aging' has other settings.*time_limit"):
+        merge_runs(folders)
+    suite, _, _ = merge_runs(folders[:1])
+    assert suite["twin_scenarios"] == {"twin:rudder_aging": nominal}
 
 
 def test_evaluate_writes_a_folder_per_policy(tmp_path: Path, monkeypatch, capsys) -> None:
