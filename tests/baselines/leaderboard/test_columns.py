@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
 from shipgym_baselines.leaderboard.columns import (
     MARKDOWN_ORDER,
     RANKING_COLUMNS,
@@ -17,7 +18,16 @@ def test_markdown_shows_every_column_with_a_markdown_header() -> None:
     with_header = {c.name for c in RANKING_COLUMNS if c.markdown is not None}
     assert set(MARKDOWN_ORDER) == with_header
     assert [c.name for c in markdown_columns()] == list(MARKDOWN_ORDER)
-    assert [c.name for c in page_columns()] == [c.name for c in RANKING_COLUMNS]
+    # the page's main ranking shows every column but the long ones, its long table all
+    long = [c.name for c in RANKING_COLUMNS if c.long]
+    assert long == [GAIN, "prob_beats_frozen", "gap_closed_iqm"]
+    assert [c.name for c in page_columns()] == [
+        c.name for c in RANKING_COLUMNS if c.name not in long
+    ]
+    assert [c.name for c in page_columns(long=True)] == [c.name for c in RANKING_COLUMNS]
+    # the main tables show the twins' numbers, not those against the frozen optimum
+    assert {NOMINAL, SHARE} <= set(MARKDOWN_ORDER)
+    assert not set(long) & set(MARKDOWN_ORDER)
 
 
 def test_every_column_shows_an_aggregate_field() -> None:

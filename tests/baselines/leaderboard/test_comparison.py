@@ -124,11 +124,17 @@ def test_a_plugin_evaluated_on_smoke_gets_a_cost_ratio_and_a_rank(
 def test_the_leaderboard_announces_its_time_before_the_first_episode(
     evaluated: tuple[Path, str, str],
 ) -> None:
-    _, _, stderr = evaluated
+    out, _, stderr = evaluated
     # the first line but a cold cache's compilations (each announced on its own line)
     first = next(x for x in stderr.splitlines() if not x.startswith("shipgym: compiling"))
-    # smoke: 3 scenarios × 2 seeds × 5 controllers (the references' read from their tables)
-    assert first.startswith("leaderboard: 30 episodes on 1 worker, about ")
+    # smoke: 3 scenarios × 2 seeds × 5 controllers (the references' read from their tables),
+    # and the no-change twins of its 2 changing scenarios × 2 seeds × steer and the oracle
+    suite = read_run(out)["suite"]
+    assert list(suite["twin_scenarios"]) == ["twin:rudder_aging", "twin:heldout:0"]
+    assert suite["twin_players"] == ["steer", "oracle"]
+    episodes = 3 * 2 * 5 + 2 * 2 * 2
+    assert first.startswith(f"leaderboard: {episodes} episodes on 1 worker, about ")
+    assert len(read_episodes(out)) == episodes
     assert first.endswith(
         " (recorded costs; one-off C compilations on a new machine come on top, each announced)"
     )

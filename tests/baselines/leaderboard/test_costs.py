@@ -19,7 +19,9 @@ from shipgym_baselines.leaderboard.costs import (
     recorded_costs,
     step_cost,
 )
+from shipgym_baselines.leaderboard.jobs import run_scenarios
 from shipgym_baselines.leaderboard.suite import load_suite
+from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, TWIN_PLAYERS, TWIN_SCENARIOS
 from shipgym_baselines.registry import training_seeds
 
 #: the default suite's whole run, CPU seconds (README: 1,097 CPU s on a 2-core machine)
@@ -28,14 +30,18 @@ DEFAULT_RUN_CPU_S = 1097.0
 #: VM, estimate 921 CPU s with the tables' (0.84×), and a measurement moves by ±13 % from
 #: run to run (docs/leaderboard-cost.md)
 FACTOR = 1.25
-#: the default suite's episodes: 384 trials (36 scenarios × 8 seeds, 16 held-out × 4, 16
-#: in-range × 2) for each of its 25 rows, a learned agent's training seeds sharing them
+#: the default suite's episodes without the no-change twins (as its recorded run, before
+#: the twins): 384 trials (36 scenarios × 8 seeds, 16 held-out × 4, 16 in-range × 2) for
+#: each of its 25 rows, a learned agent's training seeds sharing them
 DEFAULT_EPISODES = 9_600
 
 
-def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
-    """The default suite's jobs and scenarios, planned as the leaderboard plans them."""
-    spec = load_suite("default")
+def default_plan(
+    controllers: list | None = None, twins: bool = True
+) -> tuple[list[Job], dict, dict]:
+    """The default suite's jobs, scenarios (its twins' too) and resolved suite, planned as
+    the leaderboard plans them; ``twins=False``: as the suite without its no-change twins."""
+    spec = load_suite("default").model_copy(update={"twins": twins})
     names = controllers or list(spec.controllers)
     labels = check_controllers(names)
     seeds_of = {label: training_seeds(c) for label, c in zip(labels, names, strict=True)}
@@ -43,11 +49,13 @@ def default_plan(controllers: list | None = None) -> tuple[list[Job], dict]:
     scenarios = {s: suite_scenario(s) for s in spec.all_scenarios()}
     record = suite_record(spec, names, scenarios, seed_list, seeds_of)
     jobs = plan_run(names, record, seeds_of)
-    return jobs, scenarios
+    return jobs, run_scenarios(record, scenarios), record
 
 
 def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
-    jobs, scenarios = default_plan()
+    # the recorded run predates the no-change twins: estimate the same plan, without them
+    jobs, scenarios, record = default_plan(twins=False)
+    assert TWIN_SCENARIOS not in record
     cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
     assert DEFAULT_RUN_CPU_S / FACTOR < cpu < DEFAULT_RUN_CPU_S * FACTOR, cpu
     total = sum(len(job.seeds) for job in jobs)
@@ -62,6 +70,32 @@ def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
     assert eta_line(half, scenarios, 1, total).startswith(
         f"leaderboard: {todo:,} of {DEFAULT_EPISODES:,} episodes on 1 worker, about "
     )
+
+
+def test_the_twins_add_one_episode_per_player_and_trial_of_each_new_twin() -> None:
+    bare, bare_scenarios, _ = default_plan(twins=False)
+    jobs, scenarios, record = default_plan()
+    new = record[TWIN_SCENARIOS]
+    assert new and set(scenarios) == set(bare_scenarios) | set(new)
+    # the suite's own scenarios: as many episodes as without the twins (dealt otherwise)
+    own = sum(len(job.seeds) for job in jobs if job.scenario not in new)
+    assert own == DEFAULT_EPISODES
+    # each new twin: every twin player (the competitors and the oracle) once on each of its
+    # seeds (a learned agent's training seeds share the trials)
+    assert record[LEARNED_TRIALS] == SHARED
+    players = set(record[TWIN_PLAYERS])
+    assert "oracle" in players and "oracle_frozen" not in players
+    skip = {tuple(pair) for pair in record["does_not_apply"]}
+    seeds = record.get("scenario_seeds", {})
+    expected = sum(
+        len(seeds.get(twin, record["seeds"]))
+        for twin in new
+        for player in players
+        if (twin, player) not in skip
+    )
+    assert sum(len(job.seeds) for job in jobs if job.scenario in new) == expected
+    assert len(jobs) > len(bare)
+    assert estimate_cpu_s(jobs, scenarios) > estimate_cpu_s(bare, bare_scenarios)
 
 
 def test_a_controller_without_recorded_costs_takes_its_kinds(tmp_path: Path) -> None:

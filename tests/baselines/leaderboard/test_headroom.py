@@ -7,7 +7,10 @@ import json
 import numpy as np
 import pytest
 
+from shipgym_baselines.leaderboard.change_share import TWIN_FIELDS
 from shipgym_baselines.leaderboard.headroom import (
+    GAIN,
+    GAP_FIELDS,
     change_family,
     gap_matrices,
     headroom_table,
@@ -66,13 +69,13 @@ def test_the_gap_fields_against_a_hand_computed_case() -> None:
     by = {r["controller"]: r for r in rows}
     for name in ("x", "agent"):
         row = by[name]
-        assert row["adaptation_gain_gmean"] == pytest.approx((4 / 11) ** 0.2, rel=1e-12)
+        assert row[GAIN] == pytest.approx((4 / 11) ** 0.2, rel=1e-12)
         assert row["prob_beats_frozen"] == 0.5
         assert row["gap_closed_iqm"] == pytest.approx(0.25, abs=1e-12)
         assert row["gap_trials"] == 4  # trials (scenario, seed), not runs
         low, high = row["gap_closed_iqm_ci95"]
         assert -1.0 - 1e-12 <= low <= 0.25 <= high <= 1.0 + 1e-12
-        low, high = row["adaptation_gain_gmean_ci95"]
+        low, high = row[f"{GAIN}_ci95"]
         assert 0.1 <= low < (4 / 11) ** 0.2 < high <= 2.0
         low, high = row["prob_beats_frozen_ci95"]
         assert 0.0 <= low < 0.5 < high <= 1.0
@@ -119,15 +122,17 @@ def test_the_gap_interval_is_rliables_bootstrap_with_nan_where_a_trial_does_not_
 
 
 def test_the_gap_fields_are_none_without_the_frozen_optimum_or_a_trial_worth_it() -> None:
-    gap_keys = AGGREGATE_FIELDS[AGGREGATE_FIELDS.index("adaptation_gain_gmean") :]
+    assert GAIN == "cost_vs_frozen_gmean"  # the JSON name of C_frozen / C's geometric mean
+    assert set(GAP_FIELDS) <= set(AGGREGATE_FIELDS)
     (row,) = aggregate_ranking(_hand_episodes(frozen=False), {"a": "catalogue"}, reps=100)
-    assert {row[k] for k in gap_keys} == {None}
+    assert {row[k] for k in GAP_FIELDS} == {None}
+    assert {row[k] for k in TWIN_FIELDS} == {None}  # no twins either
     assert row["cost_ratio_iqm"] is not None  # the ranking is the same without it
     # every headroom below 1.2: the gain and P(beats) are there, no gap closed
     flat = [(100.0, 110.0, c) for c in (90.0, 110.0, 120.0)]
     (row,) = aggregate_ranking(_hand_episodes(flat), {"a": "catalogue"}, reps=100)
     assert row["prob_beats_frozen"] == pytest.approx(0.5)  # beats, ties, loses: (1 + ½ + 0) / 3
-    assert row["adaptation_gain_gmean"] == pytest.approx((110 / 90 * 1.0 * 110 / 120) ** (1 / 3))
+    assert row[GAIN] == pytest.approx((110 / 90 * 1.0 * 110 / 120) ** (1 / 3))
     assert row["gap_closed_iqm"] is None and row["gap_closed_iqm_ci95"] is None
     assert row["gap_trials"] == 0
 

@@ -46,13 +46,19 @@ AGGREGATE_KEYS = {
     "prob_improvement_over_pid_los_ci95",
     "failure_rate",
     "failure_rate_ci95",
-    "adaptation_gain_gmean",
-    "adaptation_gain_gmean_ci95",
+    "cost_vs_frozen_gmean",
+    "cost_vs_frozen_gmean_ci95",
     "prob_beats_frozen",
     "prob_beats_frozen_ci95",
     "gap_closed_iqm",
     "gap_closed_iqm_ci95",
     "gap_trials",
+    "nominal_cost_ratio_gmean",
+    "nominal_cost_ratio_gmean_ci95",
+    "change_share_iqm",
+    "change_share_iqm_ci95",
+    "change_trials",
+    "share_trials",
 }
 #: the stand-in oracle's cost: this fraction of pid_los's on the same trial
 STAND_IN = 0.8
@@ -64,13 +70,16 @@ def run(suite: str, out: Path, **kwargs: object) -> list[dict]:
 
 def with_stand_in_oracle(run_folder: Path, out: Path) -> Path:
     """A copy of a run record (``run.json``, ``episodes.jsonl``) with a stand-in ``oracle``
-    (kind reference): each pid_los episode again, its cost × :data:`STAND_IN`; then the
-    report of it in ``out / "report"``, whose folder is returned."""
+    (kind reference, a player of the no-change twins as in a run with the oracle): each
+    pid_los episode again, its cost × :data:`STAND_IN`; then the report of it in
+    ``out / "report"``, whose folder is returned."""
     from shipgym_baselines.leaderboard.report import write_report
 
     record = json.loads((run_folder / "run.json").read_text())
     entry = {"name": "oracle", "controller": "oracle", "kind": "reference"}
     record["suite"]["controllers"].append({**entry, "training_seeds": [None]})
+    if "twin_players" in record["suite"]:
+        record["suite"]["twin_players"].append("oracle")
     copy = out / "record"
     copy.mkdir(parents=True)
     (copy / "run.json").write_text(json.dumps(record))
@@ -169,6 +178,14 @@ def test_aggregate_json_ranks_by_cost_over_the_oracle(randomised: Path, ranked: 
         assert pid[f"{key}_ci95"] == pytest.approx([1 / STAND_IN] * 2)
     assert pid["prob_improvement_over_pid_los"] is None  # no comparison with itself
     assert pid["failure_rate"] == 0.0 and pid["failure_rate_ci95"] == [0.0, 0.0]
+    # rudder_aging's no-change twin is nominal (the same trials without the change): the
+    # nominal ratio is pid_los's cost over the oracle's there, on rudder_aging's 3 trials
+    assert read_run(randomised)["suite"]["twins"] == {"rudder_aging": "nominal"}
+    assert pid["nominal_cost_ratio_gmean"] == pytest.approx(1 / STAND_IN)
+    assert pid["nominal_cost_ratio_gmean_ci95"] == pytest.approx([1 / STAND_IN] * 2)
+    assert pid["change_trials"] == 3
+    # no frozen optimum: no trial to take a change share over
+    assert pid["change_share_iqm"] is None and pid["share_trials"] == 0
     episodes = read_episodes(randomised)
     scores = {s["scenario"]: s for s in json.loads((ranked / "scenario_scores.json").read_text())}
     assert sorted(scores) == ["nominal", "rudder_aging"]
@@ -213,16 +230,14 @@ def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
 def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     randomised: Path, ranked: Path
 ) -> None:
-    """The run's two sentences (shipgym_baselines.leaderboard.verdict) first; a report folder (no
-    episodes of its own) prints those its leaderboard.md opens with; no ranking: none."""
+    """The run's sentences (shipgym_baselines.leaderboard.verdict; two without the frozen
+    optimum) first; a report folder (no episodes of its own) prints those its leaderboard.md
+    opens with; no ranking: none."""
     from shipgym_baselines.leaderboard import terminal_summary
 
     verdict = (
-        "`pid_los` is the only ranked controller on the 2 catalogue scenarios, with a "
-        "cost-ratio IQM of 1.250 [1.250, 1.250] (1 = the oracle's cost, lower is better); no "
-        "learned agent is ranked. The failure rate (episodes ending outside the corridor, "
-        "non-finite or by a controller error or timeout) of `pid_los` is 0 %: none of its "
-        "episodes failed."
+        "`pid_los` is the only ranked controller on the 2 catalogue scenarios, at IQM 1.250 "
+        "[1.250, 1.250]. No learned agent is ranked; the failure rate is 0 %."
     )
     assert (ranked / "leaderboard.md").read_text().startswith(f"# Leaderboard\n\n{verdict}\n\n")
     assert terminal_summary(ranked).startswith(f"{verdict}\n\n## Ranking")
@@ -310,13 +325,14 @@ def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
     with_agent: tuple[str, Path], tmp_path: Path
 ) -> None:
     _, clean = with_agent
+    twin = read_run(clean)["suite"]["twins"]["rudder_aging"]
+    assert twin == "twin:rudder_aging"  # no scenario of the run is rudder_aging's twin
     learned = [e for e in read_episodes(clean) if e["controller"] == "agent"]
-    assert sorted((e["training_seed"], e["seed"]) for e in learned) == [
-        (0, 10_000),
-        (0, 10_001),
-        (1, 10_000),
-        (1, 10_001),
-    ]
+    runs = [(0, 10_000), (0, 10_001), (1, 10_000), (1, 10_001)]
+    for scenario in ("rudder_aging", twin):  # the agent plays the twin as its scenario
+        mine = [e for e in learned if e["scenario"] == scenario]
+        assert sorted((e["training_seed"], e["seed"]) for e in mine) == runs
+    assert len(learned) == 2 * len(runs)
     rows = json.loads((clean / "leaderboard.json").read_text())
     (row,) = [r for r in rows if r["kind"] == "learned"]
     assert (row["seeds"], row["training_seeds"], row["training_seed_list"]) == (2, 2, [0, 1])
@@ -326,17 +342,19 @@ def test_a_learned_row_aggregates_training_seeds_times_evaluation_seeds(
     assert (board["agent"]["training_seeds"], board["agent"]["runs"]) == (2, 4)
     controllers = read_run(clean)["suite"]["controllers"]
     assert [c["training_seeds"] for c in controllers] == [[0, 1], [None], [None]]
-    # one kept trajectory per row: the episode its figure draws
+    # one kept trajectory per row: the episode its figure draws (none of the twin's rows)
     assert len(list((clean / "trajectories").iterdir())) == 3
 
 
 def test_shared_trials_give_each_seed_to_one_training_seed(agent: Path, tmp_path: Path) -> None:
     """``learned_trials: shared``: the agent's two training seeds share three evaluation
-    seeds, each played once as :func:`dealt_seeds` deals them; its row has three episodes and
-    three runs, like a classical controller's; ``run.json`` records the deal, an episode of
-    the other training seed is refused, and a run of the other deal is not reported with it."""
+    seeds, each played once as :func:`dealt_seeds` deals them by the name of the scenario's
+    no-change twin (so each trial and its twin go to one training seed); its row has three
+    episodes and three runs, like a classical controller's; ``run.json`` records the deal,
+    an episode of the other training seed is refused, and a run of the other deal is not
+    reported with it."""
     from shipgym_baselines.leaderboard.report import merge_runs
-    from shipgym_baselines.records.trials import dealt_seeds
+    from shipgym_baselines.records.trials import deal_names, dealt_seeds
 
     suite = write_suite(
         tmp_path,
@@ -350,22 +368,23 @@ def test_shared_trials_give_each_seed_to_one_training_seed(agent: Path, tmp_path
     run(suite, out)
     record = read_run(out)["suite"]
     assert record["learned_trials"] == "shared"
+    twin = deal_names(record)["rudder_aging"]  # the name rudder_aging's trials are dealt by
+    assert twin == record["twins"]["rudder_aging"] == "twin:rudder_aging"
     learned = [e for e in read_episodes(out) if e["controller"] == "agent"]
     seeds = [10_000, 10_001, 10_002]
-    dealt = dealt_seeds("rudder_aging", seeds, [0, 1])
-    assert sorted((e["training_seed"], e["seed"]) for e in learned) == sorted(
-        (k, s) for k, mine in dealt.items() for s in mine
-    )
-    assert sorted(e["seed"] for e in learned) == seeds
-    # one lockstep job for both training seeds: each episode as its training seed alone
-    (job,) = [
-        j
-        for j in plan_run([str(agent), "pid_los"], record, {"agent": [0, 1], "pid_los": [None]})
-        if j.dealt
-    ]
-    assert job.training_seed is None and sorted(job.runs()) == sorted(
-        (s, k) for k, s in [(e["training_seed"], e["seed"]) for e in learned]
-    )
+    dealt = dealt_seeds(twin, seeds, [0, 1])
+    expected = sorted((k, s) for k, mine in dealt.items() for s in mine)
+    for scenario in ("rudder_aging", twin):  # a trial and its twin: one training seed
+        mine = [e for e in learned if e["scenario"] == scenario]
+        assert sorted((e["training_seed"], e["seed"]) for e in mine) == expected
+        assert sorted(e["seed"] for e in mine) == seeds
+    # one lockstep job for both training seeds on each: each episode as its training seed alone
+    seeds_of = {"agent": [0, 1], "pid_los": [None]}
+    jobs = {j.scenario: j for j in plan_run([str(agent), "pid_los"], record, seeds_of) if j.dealt}
+    assert sorted(jobs) == ["rudder_aging", twin]
+    job = jobs["rudder_aging"]
+    assert job.training_seed is None
+    assert sorted(job.runs()) == sorted(jobs[twin].runs()) == sorted((s, k) for k, s in expected)
     for result in run_batch(job):
         alone = run_job((str(agent), "rudder_aging", result.seed, result.training_seed, RANDOMIZE))
         assert untimed([result.row()]) == untimed([alone.row()])
@@ -390,7 +409,8 @@ def test_shared_trials_give_each_seed_to_one_training_seed(agent: Path, tmp_path
     ran: list = []
     resumed = run(suite, cut, resume=True, on_episode=ran.append)
     assert "agent" in {r.controller for r in ran}
-    assert len(read_episodes(cut)) == len(read_episodes(out)) == 6
+    # rudder_aging and its twin × 3 seeds × the agent and pid_los
+    assert len(read_episodes(cut)) == len(read_episodes(out)) == 2 * 3 * 2
     assert untimed(resumed) == untimed(json.loads((out / "leaderboard.json").read_text()))
     # an episode of the training seed the seed was not dealt to
     other = tmp_path / "other"
@@ -430,7 +450,11 @@ def test_resume_with_training_seeds_equals_a_clean_run(
         suite, out_dir=out, workers=2, show_progress=False, resume=True, on_episode=ran.append
     )
     assert ("agent", 1) in [(r.controller, r.training_seed) for r in ran]
-    assert len(ran) == 5 and len(read_episodes(out)) == 8
+    # 2 seeds: the agent's 2 training seeds, pid_los and zero_rudder on rudder_aging, the
+    # agent's and pid_los's on its twin (zero_rudder, a reference, plays no twin)
+    total = 2 * (2 + 1 + 1) + 2 * (2 + 1)
+    assert len(read_episodes(clean)) == total
+    assert len(ran) == total - 3 and len(read_episodes(out)) == total
     board = json.loads((clean / "leaderboard.json").read_text())
     assert untimed(rows) == untimed(board)
     for name in ("aggregate.json", "scenario_scores.json"):
@@ -554,7 +578,14 @@ def test_a_scenario_file_is_named_by_its_name_in_the_record_and_rows(
     assert list(suite["scenarios"]) == ["rudder_aging", "my_turn"]
     assert suite["scenario_files"] == {"my_turn": str(file)}  # where its content came from
     assert suite["scenarios"]["my_turn"]["time_limit"] == 40.0
-    assert {e["scenario"] for e in read_episodes(out)} == {"rudder_aging", "my_turn"}
+    # rudder_aging's no-change twin is no scenario of the run (my_turn stops at 40 s)
+    assert suite["twins"] == {"rudder_aging": "twin:rudder_aging"}
+    assert list(suite["twin_scenarios"]) == ["twin:rudder_aging"]
+    assert {e["scenario"] for e in read_episodes(out)} == {
+        "rudder_aging",
+        "my_turn",
+        "twin:rudder_aging",
+    }
     rows = json.loads((out / "leaderboard.json").read_text())
     assert {(r["scenario"], r["split"]) for r in rows} == {
         ("rudder_aging", "catalogue"),
@@ -575,6 +606,11 @@ def test_your_scenarios_are_ranked_in_a_group_of_their_own(
         ("catalogue", "pid_los", ["rudder_aging"]),
         ("yours", "pid_los", ["my_turn"]),
     ]
+    # the report keeps the twin too: rudder_aging's nominal ratio, none on my_turn (no change)
+    catalogue, yours = board
+    assert catalogue["nominal_cost_ratio_gmean"] == pytest.approx(1 / STAND_IN)
+    assert catalogue["change_trials"] == 2
+    assert yours["nominal_cost_ratio_gmean"] is None and yours["change_trials"] is None
     scores = json.loads((ranked / "scenario_scores.json").read_text())
     assert {(s["scenario"], s["split"]) for s in scores} == {
         ("rudder_aging", "catalogue"),
@@ -658,7 +694,8 @@ FROZEN = 2.0
 
 def with_stand_in_references(run_folder: Path, out: Path) -> Path:
     """:func:`with_stand_in_oracle`'s record with a stand-in ``oracle_frozen`` too (kind
-    reference): each pid_los episode again, its cost × :data:`FROZEN`; the report of it in
+    reference): each pid_los episode again, its cost × :data:`FROZEN`, except on a twin that
+    is no scenario of the run (the frozen optimum plays no twin); the report of it in
     ``out / "gap"``, whose folder is returned."""
     from shipgym_baselines.leaderboard.report import write_report
 
@@ -669,9 +706,10 @@ def with_stand_in_references(run_folder: Path, out: Path) -> Path:
     run_json["suite"]["controllers"].append({**entry, "training_seeds": [None]})
     (record / "run.json").write_text(json.dumps(run_json))
     lines = (record / "episodes.jsonl").read_text().splitlines()
+    twins = run_json["suite"].get("twin_scenarios", {})
     for line in list(lines):
         episode = json.loads(line)
-        if episode["controller"] == "pid_los":
+        if episode["controller"] == "pid_los" and episode["scenario"] not in twins:
             frozen = {**episode, "controller": "oracle_frozen", "kind": "reference"}
             lines.append(json.dumps({**frozen, "cost": FROZEN * episode["cost"]}))
     (record / "episodes.jsonl").write_text("\n".join(lines) + "\n")
@@ -680,8 +718,9 @@ def with_stand_in_references(run_folder: Path, out: Path) -> Path:
 
 
 def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_path: Path) -> None:
-    """With both references: aggregate.json's gap fields, scenario_scores.json's headroom,
-    the headroom table after the ranking and the verdict's two more sentences."""
+    """With both references: aggregate.json's gap fields and change share,
+    scenario_scores.json's headroom, the headroom and change-share tables after the ranking,
+    the page's long ranking and the verdict's two more sentences."""
     import math
 
     from shipgym_baselines.leaderboard import terminal_summary
@@ -689,20 +728,35 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
     gap = with_stand_in_references(randomised, tmp_path)
     (pid,) = json.loads((gap / "aggregate.json").read_text())  # oracle_frozen is not ranked
     assert set(pid) == AGGREGATE_KEYS and pid["controller"] == "pid_los"
-    assert pid["adaptation_gain_gmean"] == pytest.approx(FROZEN)
-    assert pid["adaptation_gain_gmean_ci95"] == pytest.approx([FROZEN, FROZEN])
+    assert pid["cost_vs_frozen_gmean"] == pytest.approx(FROZEN)
+    assert pid["cost_vs_frozen_gmean_ci95"] == pytest.approx([FROZEN, FROZEN])
     assert pid["prob_beats_frozen"] == 1.0 and pid["gap_trials"] == 6
     closed = math.log(FROZEN) / math.log(FROZEN / STAND_IN)  # log 2 / log 2.5 = 0.756
     assert pid["gap_closed_iqm"] == pytest.approx(closed)
+    # the stand-in oracle costs STAND_IN × pid_los's on a trial and on its twin (nominal):
+    # the change raises both costs by the same factor, so pid_los's change share is 1
+    assert pid["nominal_cost_ratio_gmean"] == pytest.approx(1 / STAND_IN)
+    assert pid["change_share_iqm"] == pytest.approx(1.0)
+    assert pid["change_share_iqm_ci95"] == pytest.approx([1.0, 1.0])
+    assert pid["change_trials"] == pid["share_trials"] == 3  # rudder_aging's trials
     for entry in json.loads((gap / "scenario_scores.json").read_text()):
         assert entry["headroom"] == pytest.approx(FROZEN / STAND_IN)
         assert entry["oracle_frozen_cost"] == pytest.approx(entry["oracle_cost"] * 2.5)
     text = (gap / "leaderboard.md").read_text()
-    assert "Knowing the change is worth 2.50× here" in text.split("\n\n")[1]  # the verdict
-    assert "`pid_los`, the leader, captures 75.6 % [75.6 %, 75.6 %] of it" in text
-    assert len(text.split("\n\n")[1].split(". The ")) == 2  # only the failure sentence opens so
+    verdict = text.split("\n\n")[1]
+    assert verdict == (
+        "`pid_los` is the only ranked controller on the 2 catalogue scenarios, at IQM 1.250 "
+        "[1.250, 1.250]. No learned agent is ranked; the failure rate is 0 %. Knowing the "
+        "change is worth 2.50× over 6 trials (`oracle_frozen` over `oracle`, geometric mean). "
+        "Change share (0 = costs as much as never adapting, 1 = as little as the oracle): "
+        "`pid_los` 1.00 [1.00, 1.00]."
+    )
     ranking, _ = text.split("## Cost ratio per scenario", 1)
-    assert "| 2.00 [2.00, 2.00] | 1.00 [1.00, 1.00] | 0.76 [0.76, 0.76] (6) |" in ranking
+    # the main ranking: the nominal ratio and the change share, not the gap closed
+    assert "| 0.00 [0.00, 0.00] | 1.25 [1.25, 1.25] | 1.00 [1.00, 1.00] (3) |" in ranking
+    assert "gap closed" not in ranking and "0.76" not in ranking
+    shares = ranking.split("### Change share per ship and change family", 1)[1]
+    assert "| nomoto2 | rudder aging | 3 | 1.00 |" in shares
     headroom = ranking.split("### Headroom per ship and change family", 1)[1]
     assert (
         "| ship | nominal | rudder aging |\n|---|---|---|\n| nomoto2 | 2.50 (3) | 2.50 (3) |"
@@ -711,6 +765,9 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
     assert terminal_summary(gap).startswith(text.split("\n\n")[1])
     html = (gap / "leaderboard.html").read_text()
     assert 'id="headroom"' in html and "2.500<i>3 trials</i>" in html
+    assert 'id="change-share"' in html
+    long = html[html.index('id="ranking-long-catalogue"') :]
+    assert "0.756<i>[0.756, 0.756]</i><i>6 trials</i>" in long[: long.index("</table>")]
 
 
 def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
@@ -736,8 +793,17 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     )
     out = tmp_path / "out"
     run(suite, out)
-    assert read_run(out)["suite"]["scenario_seeds"] == {"inrange:0": [10_000]}
-    episodes = [(e["scenario"], e["seed"]) for e in read_episodes(out)]
+    record = read_run(out)["suite"]
+    # every scenario changes: each has a no-change twin of its own, the in-range one's on
+    # its seeds
+    twins = {s: f"twin:{s}" for s in ("rudder_aging", "heldout:0", "inrange:0")}
+    assert record["twins"] == twins
+    assert record["scenario_seeds"] == {"inrange:0": [10_000], "twin:inrange:0": [10_000]}
+    everything = [(e["scenario"], e["seed"]) for e in read_episodes(out)]
+    episodes = [(s, seed) for s, seed in everything if s in record["scenarios"]]
+    assert {(s, seed) for s, seed in everything if s not in record["scenarios"]} == {
+        (twins[s], seed) for s, seed in episodes
+    }
     assert sorted(set(episodes)) == [
         ("heldout:0", 10_000),
         ("heldout:0", 10_001),
@@ -754,6 +820,9 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
         read_episodes(beyond, suite=read_run(beyond)["suite"])
     board = json.loads((out / "aggregate.json").read_text())
     assert all(set(r) == AGGREGATE_KEYS for r in board)
+    for r in board:  # the oracle played the twins: every row has its nominal ratio
+        assert r["nominal_cost_ratio_gmean"] is not None
+        assert r["change_trials"] == (1 if r["split"] == "inrange" else 2)  # its trials
     assert {(r["split"], r["controller"]) for r in board} == {
         (split, controller)
         for split in ("catalogue", "heldout", "inrange")
@@ -922,7 +991,14 @@ def test_a_leaderboard_of_broken_controllers_finishes_and_ranks_each(
         for name, (rate, _) in BROKEN.items():
             assert rows[name]["failure_rate"] == rate, (split, name)
     failed = _failed(out)
-    assert len(failed) == 6 * 5 + 3  # every episode of five, one seed a scenario of raises
+    # every episode of five, one seed of two a scenario of raises; the smoke suite's 3
+    # scenarios and the no-change twins of its 2 changing ones, 2 seeds each
+    suite = read_run(out)["suite"]
+    assert list(suite["twin_scenarios"]) == ["twin:rudder_aging", "twin:heldout:0"]
+    assert set(BROKEN) <= set(suite["twin_players"])
+    episodes = (len(suite["scenarios"]) + len(suite["twin_scenarios"])) * len(suite["seeds"])
+    assert episodes == (3 + 2) * 2
+    assert len(failed) == episodes * 5 + episodes // 2
     for episode in failed:
         rate, message = BROKEN[episode["controller"]]
         reason = "controller_timeout" if episode["controller"] == "slow" else "controller_error"

@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
 from shipgym_baselines.leaderboard.figures import DrawnEpisode, plot_scenario
+from shipgym_baselines.leaderboard.headroom import GAIN
 from shipgym_baselines.leaderboard.page import PAGE_FILE, page, unpacked_body, write_html
 
 CONTROLLERS = [
@@ -330,13 +332,15 @@ def _order(keys: list[Any]) -> list[int]:
 
 
 def _with_the_frozen_optimum() -> tuple[list, list, list, list]:
-    """synthetic_tables() with the gap fields, the frozen optimum's costs and a headroom
-    table (rows as headroom_table gives them)."""
+    """synthetic_tables() with the gap fields, the twins' fields, the frozen optimum's costs
+    and a headroom table (rows as headroom_table gives them)."""
     rows, aggregate, scores = synthetic_tables()
     for i, r in enumerate(aggregate):
-        r |= {"adaptation_gain_gmean": 1.5 - 0.01 * i, "adaptation_gain_gmean_ci95": [1.3, 1.7]}
+        r |= {GAIN: 1.5 - 0.01 * i, f"{GAIN}_ci95": [1.3, 1.7]}
         r |= {"prob_beats_frozen": 0.625, "prob_beats_frozen_ci95": [0.5, 0.75]}
         r |= {"gap_closed_iqm": 0.375, "gap_closed_iqm_ci95": [0.25, 0.5], "gap_trials": 17}
+        r |= {NOMINAL: 1.25, f"{NOMINAL}_ci95": [1.125, 1.5], "change_trials": 20}
+        r |= {SHARE: 0.4375, f"{SHARE}_ci95": [0.3125, 0.5625], "share_trials": 13}
     for s in scores:
         s |= {"oracle_frozen_cost": 240.0, "oracle_frozen_cost_ci95": [200.0, 280.0]}
         s |= {"headroom": 3.0, "headroom_ci95": [2.5, 3.5]}
@@ -354,8 +358,21 @@ def _with_the_frozen_optimum() -> tuple[list, list, list, list]:
 def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
     rows, aggregate, scores, headroom = _with_the_frozen_optimum()
     text = page(rows, aggregate, scores, headroom=headroom)
-    assert "adaptation gain</th>" in text and "P(C &lt; C_frozen)" in text
-    assert "0.375<i>[0.250, 0.500]</i><i>17 trials</i>" in text  # the gap closed's cell
+    # the main ranking: the nominal ratio and the change share, nothing against C_frozen
+    main = text[text.index('id="ranking-catalogue"') :]
+    main = main[: main.index("</table>")]
+    assert ">nominal ratio</th>" in main and ">change share</th>" in main
+    assert "1.250<i>[1.125, 1.500]</i>" in main  # the nominal ratio's cell
+    assert "0.438<i>[0.312, 0.562]</i><i>13 trials</i>" in main  # the change share's
+    assert "C_frozen" not in main and "gap closed" not in main
+    # the long ranking, collapsed under it: every field, those against C_frozen too
+    long = text[text.index('id="ranking-long-catalogue"') :]
+    long = long[: long.index("</table>")]
+    assert text.index("<details>") < text.index('id="ranking-long-catalogue"')
+    assert ">C_frozen / C</th>" in long and ">P(C &lt; C_frozen)</th>" in long
+    assert ">gap closed IQM</th>" in long and ">nominal ratio</th>" in long
+    assert "1.500<i>[1.300, 1.700]</i>" in long  # pid_los's C_frozen / C
+    assert "0.375<i>[0.250, 0.500]</i><i>17 trials</i>" in long  # the gap closed's cell
     assert "oracle_frozen cost 240.000" in text  # under each scenario's name
     assert text.index('id="ranking-catalogue"') < text.index('id="headroom"')
     table = text[text.index('id="headroom"') :]
@@ -367,6 +384,7 @@ def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
     # without the frozen optimum: no gap column, no headroom table, no frozen cost
     bare = page(*synthetic_tables())
     assert "C_frozen" not in bare and 'id="headroom"' not in bare
+    assert "ranking-long-" not in bare and "nominal ratio" not in bare
     assert "oracle_frozen cost" not in bare
 
 

@@ -1,20 +1,28 @@
-"""The verdict in two sentences, from a run's aggregate rows and episodes."""
+"""The verdict in at most four sentences of at most 30 words, from a run's aggregate rows,
+episodes and headroom table."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from shipgym_baselines.leaderboard.change_share import SHARE
+from shipgym_baselines.leaderboard.headroom import GAIN
 from shipgym_baselines.leaderboard.verdict import (
+    MAX_SENTENCES,
+    MAX_WORDS,
     folder_verdict,
     main_table,
     md_code,
     plain_name,
     recorded_verdict,
+    share_sentence,
     verdict,
+    verdict_sentences,
 )
 
 SCENARIOS = ["nomoto2_a", "nomoto2_b", "mariner_c", "blanke_d"]
@@ -85,33 +93,34 @@ FAILING = {("nomoto2_b", c): 3 for c in NAMES} | {("mariner_c", "sac"): 1}
 
 
 def test_the_sentences_name_the_leader_the_gap_and_an_unresolved_lead() -> None:
-    text = verdict(BOARD, episodes(NAMES, FAILING))
-    assert text is not None
-    first, second = text.split(". The ")
-    assert first.startswith(
-        "`nmpc` leads the 4 catalogue scenarios with a cost-ratio IQM of 3.266 [3.109, 3.446]"
+    sentences = verdict_sentences(BOARD, episodes(NAMES, FAILING))
+    # nmpc's and pid_los's intervals overlap: the lead is not resolved
+    assert sentences[0] == (
+        "`nmpc` leads the 4 catalogue scenarios at cost-ratio IQM 3.266 [3.109, 3.446], "
+        "not resolved from `pid_los` (3.342 [3.168, 3.527])."
     )
-    # 3.342 - 3.266 = 0.076, 2.3 % of 3.342
-    assert "0.076 (2.3 %) below `pid_los`'s 3.342 [3.168, 3.527]" in first
-    assert "the 95 % intervals overlap, so the lead is not resolved" in first
-    # ppo ranks 4th of the 5 main-table controllers; 4.830 / 3.266 = 1.48
-    assert "the best learned agent, `ppo`, ranks 4th of 5 at 4.830, 1.48× the IQM" in first
-    assert first.endswith("the best classical controller, `nmpc`")
+    # ppo ranks 4th of the 5 main-table controllers; 4.830 / 3.266 = 1.48; the median of
+    # 0.25 × 4 and 0.3125; 15 of the 16 failed episodes on nomoto2_b
+    assert sentences[1] == (
+        "The best learned agent, `ppo`, ranks 4th of 5 at 1.48× the leader's IQM; the median "
+        "failure rate is 25 %, 93.8 % of failures on `nomoto2_b`."
+    )
+    assert len(sentences) == 2  # no frozen optimum: no headroom, no change share
+    text = verdict(BOARD, episodes(NAMES, FAILING))
+    assert text == " ".join(sentences)
     assert "oddball" not in text  # a partial table is not the verdict's
-    # the median of 0.25 × 4 and 0.3125; 15 of the 16 failed episodes on nomoto2_b
-    assert "The median failure rate" in text and "controllers is 25 %" in second
-    assert "93.8 % of their 16 failed episodes come from `nomoto2_b`" in second
-    assert second.endswith("where most controllers fail most episodes.")
-    assert text.count(". ") == 1 and text.endswith(".")  # two sentences
 
 
 def test_separated_intervals_say_so() -> None:
     board = [row("nmpc", 2.0, (1.9, 2.1)), row("pid_los", 3.0, (2.8, 3.2))]
     text = verdict(board, episodes(["nmpc", "pid_los"], {}))
     assert text is not None
-    assert "1.000 (33.3 %) below `pid_los`'s 3.000 [2.800, 3.200]" in text
-    assert ": the 95 % intervals do not overlap;" in text
+    assert ", resolved from `pid_los` (3.000 [2.800, 3.200])." in text
     assert "not resolved" not in text
+    # the second's interval missing: neither resolved nor not, just ahead
+    board[1]["cost_ratio_iqm_ci95"] = None
+    text = verdict(board, episodes(["nmpc", "pid_los"], {}))
+    assert text is not None and ", ahead of `pid_los` (3.000)." in text
 
 
 def test_a_level_lead_is_called_level() -> None:
@@ -123,18 +132,15 @@ def test_a_level_lead_is_called_level() -> None:
 def test_one_controller_no_learned_agents_no_failures() -> None:
     text = verdict([row("pid_los", 1.25, (1.2, 1.3))], episodes(["pid_los"], {}))
     assert text == (
-        "`pid_los` is the only ranked controller on the 4 catalogue scenarios, with a "
-        "cost-ratio IQM of 1.250 [1.200, 1.300] (1 = the oracle's cost, lower is better); no "
-        "learned agent is ranked. The failure rate (episodes ending outside the corridor, "
-        "non-finite or by a controller error or timeout) of `pid_los` is 0 %: none of its "
-        "episodes failed."
+        "`pid_los` is the only ranked controller on the 4 catalogue scenarios, at IQM 1.250 "
+        "[1.200, 1.300]. No learned agent is ranked; the failure rate is 0 %."
     )
     failing = {("nomoto2_a", "pid_los"): 3, ("blanke_d", "pid_los"): 1}
     board = [row("pid_los", 1.25, (1.2, 1.3), failure_rate=0.25)]
     text = verdict(board, episodes(["pid_los"], failing))
+    # 3 of its 4 failed episodes on nomoto2_a
     assert text is not None and text.endswith(
-        "of `pid_los` is 25 %, and 75 % of its 4 failed episodes come from `nomoto2_a`, where "
-        "it fails most episodes."
+        "No learned agent is ranked; the failure rate is 25 %, 75 % of failures on `nomoto2_a`."
     )
 
 
@@ -145,13 +151,21 @@ def test_a_learned_leader_and_no_classical_controller() -> None:
     ]
     text = verdict(board, episodes(["ppo", "pid_los"], {}))
     assert text is not None
-    assert "the best learned agent, `ppo`, ranks 1st of 2 (the leader) at 2.000, 0.80×" in text
+    # the leader itself: its rank, no ratio to itself
+    assert "The best learned agent, `ppo`, ranks 1st of 2; the median failure rate" in text
+    assert "leader's IQM" not in text
     only = [
-        row("ppo", 2.0, (1.9, 2.1), kind="learned"),
         row("td3", 3.0, (2.9, 3.1), kind="learned"),
+        row("ppo", 2.0, (1.9, 2.1), kind="learned"),
     ]
     text = verdict(only, episodes(["ppo", "td3"], {}))
-    assert text is not None and "and no classical controller is ranked" in text
+    assert text is not None and text.startswith("`ppo` leads")  # ranked by IQM
+    assert "The best learned agent, `ppo`, ranks 1st of 2;" in text
+    # a learned agent behind a classical leader: 3.0 / 2.0 = 1.50
+    board = [row("pid_los", 2.0, (1.9, 2.1)), row("ppo", 3.0, (2.9, 3.1), kind="learned")]
+    text = verdict(board, episodes(["ppo", "pid_los"], {}))
+    assert text is not None
+    assert "The best learned agent, `ppo`, ranks 2nd of 2 at 1.50× the leader's IQM;" in text
 
 
 def test_spread_failures_name_the_scenario_with_most() -> None:
@@ -159,12 +173,13 @@ def test_spread_failures_name_the_scenario_with_most() -> None:
     failing = {("mariner_c", "a"): 2, ("blanke_d", "a"): 1}
     text = verdict(board, episodes(["a", "b"], failing))
     assert text is not None
-    assert text.endswith(
-        "is 6.2 %; their 3 failed episodes are spread over 2 scenarios, the most on "
-        "`mariner_c` (66.7 % of them)."
-    )
+    # the median of 0.125 and 0; 2 of the 3 failed episodes on mariner_c
+    assert text.endswith("the median failure rate is 6.2 %, 66.7 % of failures on `mariner_c`.")
     text = verdict(board, episodes(["a", "b"], {("blanke_d", "a"): 1, ("blanke_d", "b"): 2}))
-    assert text is not None and text.endswith("; their 3 failed episodes are all on `blanke_d`.")
+    assert text is not None and text.endswith(", 100 % of failures on `blanke_d`.")
+    # a tie: the first scenario by name
+    text = verdict(board, episodes(["a", "b"], {("mariner_c", "a"): 1, ("blanke_d", "b"): 1}))
+    assert text is not None and text.endswith(", 50 % of failures on `blanke_d`.")
 
 
 def test_no_ranking_no_verdict() -> None:
@@ -180,10 +195,11 @@ def test_held_out_only_and_names_as_written() -> None:
     ]
     text = verdict(board, [], md_code)
     assert text is not None and text.startswith("`a|b` leads the 4 held-out scenarios")
-    assert "below `` c`d ``'s" in text
-    assert text.endswith("over the 2 ranked controllers is 0 %.")  # no episodes given
+    assert "resolved from `` c`d `` (3.000 [2.900, 3.100])." in text
+    assert text.endswith("; the median failure rate is 0 %.")  # no episodes given
     plain = verdict(board, [], plain_name)
-    assert plain is not None and plain.startswith("a|b leads") and "below c`d's" in plain
+    assert plain is not None and plain.startswith("a|b leads")
+    assert "resolved from c`d (3.000" in plain
 
 
 def test_the_catalogue_table_is_the_verdicts() -> None:
@@ -207,7 +223,7 @@ def test_a_folder_without_episodes_reads_the_recorded_verdict(tmp_path: Path) ->
 def test_percentages(rate: float, text: str) -> None:
     board = [row("a", 2.0, (1.9, 2.1), failure_rate=rate)]
     out = verdict(board, [])
-    assert out is not None and out.endswith(f"of `a` is {text}.")
+    assert out is not None and out.endswith(f"; the failure rate is {text}.")
 
 
 def _with_references(base: list[dict[str, Any]], frozen: float) -> list[dict[str, Any]]:
@@ -228,47 +244,127 @@ def _gap(board: list[dict[str, Any]], name: str, **fields: Any) -> None:
     r.update(fields)
 
 
-def test_with_the_frozen_optimum_two_more_sentences_decompose_the_gap() -> None:
+#: headroom_table's rows: the family without a change is left out of the headroom's range
+HEADROOM = [
+    {"ship": "nomoto2", "family": "nominal", "scenarios": ["nomoto2_a"], "trials": 4}
+    | {"headroom_gmean": 1.0},
+    {"ship": "nomoto2", "family": "rudder_aging", "scenarios": ["nomoto2_b"], "trials": 4}
+    | {"headroom_gmean": 2.5},
+    {"ship": "mariner", "family": "current_shift", "scenarios": ["mariner_c"], "trials": 4}
+    | {"headroom_gmean": 1.25},
+]
+
+
+def _frozen_board(shares: bool = True) -> list[dict[str, Any]]:
+    """BOARD with the fields against the frozen optimum and, with ``shares``, the change
+    share (the twins' fields)."""
     board = [dict(r) for r in BOARD]
     for r in board:
-        r |= {"adaptation_gain_gmean": 1.2, "adaptation_gain_gmean_ci95": [1.1, 1.3]}
+        r |= {GAIN: 1.2, f"{GAIN}_ci95": [1.1, 1.3]}
         r |= {"prob_beats_frozen": 0.4, "prob_beats_frozen_ci95": [0.3, 0.5]}
         r |= {"gap_closed_iqm": 0.1, "gap_closed_iqm_ci95": [0.0, 0.2], "gap_trials": 4}
-    _gap(board, "nmpc", prob_beats_frozen=0.5625, prob_beats_frozen_ci95=[0.4375, 0.6875])
+        if shares:
+            r |= {SHARE: 0.5, f"{SHARE}_ci95": [0.4, 0.6], "share_trials": 4}
     _gap(board, "nmpc", gap_closed_iqm=0.28, gap_closed_iqm_ci95=[0.2, 0.35])
-    _gap(board, "lqr", gap_closed_iqm=0.4)
-    # headroom 8 on nomoto2_a's 4 trials, 1.1 on the 12 others: (8^4 · 1.1^12)^(1/16) = 1.81
-    text = verdict(board, _with_references(episodes(NAMES, FAILING), 800.0))
-    assert text is not None
-    assert text.startswith(verdict(BOARD, episodes(NAMES, FAILING)) or "?")  # the two first
-    assert (
-        " Knowing the change is worth 1.81× here: the cost of `oracle_frozen`, the optimum that "
-        "never adapts, over `oracle`'s (geometric mean over the 16 trials of the catalogue "
-        "scenarios). `nmpc`, the leader, captures 28 % [20 %, 35 %] of it (gap closed "
-        "log(C_frozen / C) / log(C_frozen / C_oracle), 0 = never adapting, 1 = the oracle: its "
-        "IQM over the 4 trials worth 1.2× or more) and beats the optimum that never adapts on "
-        "56.2 % [43.8 %, 68.8 %] of trials; `lqr` captures the most, 40 %."
-    ) in text
-    assert text.count(". ") == 3 and text.endswith(".")  # four sentences
+    if shares:
+        _gap(board, "nmpc", change_share_iqm=0.734, change_share_iqm_ci95=[0.72, 0.751])
+        _gap(board, "ppo", change_share_iqm=0.53, change_share_iqm_ci95=[0.5, 0.56])
+    return board
+
+
+def test_with_the_frozen_optimum_two_more_sentences_decompose_the_gap() -> None:
+    eps = _with_references(episodes(NAMES, FAILING), 800.0)
+    sentences = verdict_sentences(_frozen_board(), eps, md_code, HEADROOM)
+    assert sentences[:2] == verdict_sentences(BOARD, episodes(NAMES, FAILING))  # the two first
+    # headroom 8 on nomoto2_a's 4 trials, 1.1 on the 12 others: (8^4 · 1.1^12)^(1/16) = 1.81;
+    # its range over the families with a change: 1.25 to 2.5
+    assert sentences[2] == (
+        "Knowing the change is worth 1.81× over 16 trials (`oracle_frozen` over `oracle`, "
+        "geometric mean), from 1.25× to 2.50× across ship × change family."
+    )
+    # the leader's change share, then the best learned agent's
+    assert sentences[3] == (
+        "Change share (0 = costs as much as never adapting, 1 = as little as the oracle): "
+        "`nmpc` 0.73 [0.72, 0.75] and `ppo` 0.53 [0.50, 0.56]."
+    )
+    assert len(sentences) == 4
+    assert verdict(_frozen_board(), eps, md_code, HEADROOM) == " ".join(sentences)
+    # one headroom cell with a change: no range
+    one = verdict_sentences(_frozen_board(), eps, md_code, HEADROOM[:2])
+    assert one[2].endswith("(`oracle_frozen` over `oracle`, geometric mean).")
+    # without the twins: the leader's gap closed, over the trials worth 1.2× or more
+    bare = verdict_sentences(_frozen_board(shares=False), eps, md_code, HEADROOM)
+    assert bare[:3] == sentences[:3]
+    assert bare[3] == (
+        "The leader closes 28 % [20 %, 35 %] of that gap (IQM over the 4 trials worth 1.2× "
+        "or more)."
+    )
+
+
+def test_the_change_share_of_the_leader_alone_where_it_is_the_best_learned_agent() -> None:
+    table = main_table(_frozen_board())
+    assert share_sentence(table[3:], plain_name) == (  # ppo leads what is left
+        "Change share (0 = costs as much as never adapting, 1 = as little as the oracle): "
+        "ppo 0.53 [0.50, 0.56]."
+    )
+    # a learned agent without a share is left out; a leader without either says nothing
+    table = [dict(r) for r in table]
+    table[3][SHARE] = None
+    assert share_sentence(table, md_code) == (
+        "Change share (0 = costs as much as never adapting, 1 = as little as the oracle): "
+        "`nmpc` 0.73 [0.72, 0.75]."
+    )
+    table[0] |= {SHARE: None, "gap_closed_iqm": None}
+    assert share_sentence(table, md_code) is None
 
 
 def test_no_trial_worth_the_gap_and_no_frozen_optimum() -> None:
     board = [dict(r) for r in BOARD]
     for r in board:
-        r |= {"adaptation_gain_gmean": 1.0, "prob_beats_frozen": 0.5, "gap_trials": 0}
+        r |= {GAIN: 1.0, "prob_beats_frozen": 0.5, "gap_trials": 0}
         r |= {"prob_beats_frozen_ci95": [0.25, 0.75]}
         r |= {"gap_closed_iqm": None, "gap_closed_iqm_ci95": None}
-    text = verdict(board, _with_references(episodes(NAMES, FAILING), 110.0), plain_name)
-    assert text is not None and text.endswith(
-        "Knowing the change is worth 1.10× here: the cost of oracle_frozen, the optimum that "
-        "never adapts, over oracle's (geometric mean over the 16 trials of the catalogue "
-        "scenarios). No trial is worth 1.2× or more, so no gap closed is measured; the "
-        "leader, nmpc, beats the optimum that never adapts on 50 % [25 %, 75 %] of trials."
+    sentences = verdict_sentences(
+        board, _with_references(episodes(NAMES, FAILING), 110.0), plain_name
     )
+    # no trial worth 1.2× or more: the headroom, no gap closed and no change share
+    assert sentences[2:] == [
+        "Knowing the change is worth 1.10× over 16 trials (oracle_frozen over oracle, "
+        "geometric mean)."
+    ]
     # the oracle's episodes without the frozen optimum's: the two sentences only
     eps = _with_references(episodes(NAMES, FAILING), 110.0)
     eps = [e for e in eps if e["controller"] != "oracle_frozen"]
     assert verdict(BOARD, eps) == verdict(BOARD, episodes(NAMES, FAILING))
+
+
+def _sentences_of(text: str) -> list[str]:
+    """A verdict's paragraph cut into sentences: after a full stop and a space, before a
+    capital letter or a backtick."""
+    return re.split(r"(?<=\.) (?=[A-Z`])", text)
+
+
+def test_at_most_four_sentences_of_at_most_thirty_words() -> None:
+    assert (MAX_SENTENCES, MAX_WORDS) == (4, 30)
+    eps = _with_references(episodes(NAMES, FAILING), 800.0)
+    cases = [
+        (BOARD, episodes(NAMES, FAILING), ()),
+        ([row("pid_los", 1.25, (1.2, 1.3))], episodes(["pid_los"], {}), ()),
+        (_frozen_board(), eps, HEADROOM),
+        (_frozen_board(shares=False), eps, HEADROOM),
+        ([row("a", 2.0, (1.9, 2.1)), row("b", 2.0, (1.8, 2.2))], episodes(["a", "b"], {}), ()),
+    ]
+    four = 0
+    for board, episodes_, headroom in cases:
+        for code in (md_code, plain_name):
+            sentences = verdict_sentences(board, episodes_, code, headroom)
+            assert 2 <= len(sentences) <= MAX_SENTENCES
+            four += len(sentences) == MAX_SENTENCES
+            for sentence in sentences:
+                assert len(sentence.split()) <= MAX_WORDS, sentence
+            text = verdict(board, episodes_, code, headroom)
+            assert text is not None and _sentences_of(text) == sentences
+    assert four == 4  # the two cases with the frozen optimum say all four, in both codes
 
 
 def test_a_frozen_optimum_on_some_trials_only_gives_no_gap_sentences() -> None:
@@ -277,7 +373,7 @@ def test_a_frozen_optimum_on_some_trials_only_gives_no_gap_sentences() -> None:
     happens to cover."""
     board = [dict(r) for r in BOARD]
     for r in board:
-        r |= {key: None for key in ("adaptation_gain_gmean", "prob_beats_frozen")}
+        r |= {key: None for key in (GAIN, "prob_beats_frozen")}
         r |= {"gap_closed_iqm": None, "gap_trials": None}
     eps = _with_references(episodes(NAMES, FAILING), 800.0)
     eps = [e for e in eps if e["controller"] != "oracle_frozen" or e["scenario"] == "nomoto2_a"]
