@@ -29,7 +29,17 @@ from shipgym_baselines.records.manifest import Manifest, clear_listed
 from shipgym_baselines.records.runlog import outside_problem
 from shipgym_baselines.records.runrecord import git_commit, now, read_run, versions
 from shipgym_baselines.records.trajectories import episode_result
-from shipgym_baselines.records.trials import ALL, LEARNED_TRIALS, SHARED, shares_trials
+from shipgym_baselines.records.trials import (
+    ALL,
+    LEARNED_TRIALS,
+    SHARED,
+    TWIN_PLAYERS,
+    TWIN_SCENARIOS,
+    TWINS,
+    shares_trials,
+    twin_scenarios,
+    twins_of,
+)
 
 REPORT_FILE = "report.json"
 
@@ -86,6 +96,7 @@ def merge_runs(
                     f"scenario {name!r} has other settings in {folder} than in "
                     f"{first_with[name]}: {'; '.join(changed[:3])}"
                 )
+        merge_twins(suite, run_suite, folder, first_with)
         for name, file in run_suite.get("scenario_files", {}).items():
             suite.setdefault("scenario_files", {}).setdefault(name, file)  # the first run's
         known = {c["name"] for c in suite["controllers"]}
@@ -95,7 +106,7 @@ def merge_runs(
         ]
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         fewer = run_suite.get("scenario_seeds", {})
-        for name in run_suite["scenarios"]:
+        for name in [*run_suite["scenarios"], *twin_scenarios(run_suite)]:
             ran_on.setdefault(name, set()).update(fewer.get(name, run_suite["seeds"]))
         suite["name"] = suite["name"] or run_suite.get("name")
         episodes = read_episodes(folder, suite=run_suite)
@@ -128,6 +139,34 @@ def merge_runs(
     if fewer:
         suite["scenario_seeds"] = fewer
     return suite, results, sources
+
+
+def merge_twins(
+    suite: dict[str, Any], run_suite: Mapping[str, Any], folder: str, first_with: dict[str, str]
+) -> None:
+    """Merge a run's no-change twins into ``suite`` (:mod:`.twins`): its changing scenarios'
+    twins, the twins' settings and the controllers that play them, in order of first
+    appearance; a :class:`RunError` for a scenario whose twin, or a twin whose settings,
+    differ from an earlier run's (``first_with``: where each name was first read)."""
+    for scenario, twin in twins_of(run_suite).items():
+        known = suite.setdefault(TWINS, {}).setdefault(scenario, twin)
+        first_with.setdefault(f"{TWINS}:{scenario}", folder)
+        if known != twin:
+            raise RunError(
+                f"scenario {scenario!r} has the twin {twin!r} in {folder} but {known!r} in "
+                f"{first_with[f'{TWINS}:{scenario}']}: report runs of one suite's twins"
+            )
+    for name, settings in twin_scenarios(run_suite).items():
+        kept = suite.setdefault(TWIN_SCENARIOS, {})
+        if name not in kept:
+            kept[name], first_with[name] = settings, folder
+        elif differences(kept[name], settings):
+            raise RunError(
+                f"twin {name!r} has other settings in {folder} than in {first_with[name]}: "
+                f"{'; '.join(differences(kept[name], settings)[:3])}"
+            )
+    players = suite.setdefault(TWIN_PLAYERS, []) if TWIN_PLAYERS in run_suite else []
+    players += [c for c in run_suite.get(TWIN_PLAYERS, []) if c not in players]
 
 
 def _same_reference(episode: Mapping[str, Any], kinds: Mapping[str, str], cost: Any) -> bool:

@@ -95,3 +95,23 @@ def test_a_suite_can_run_without_twins() -> None:
     assert [j.scenario for j in plan_run(["pid_los"], record, {"pid_los": [None]})] == [
         "esso_osaka_current_shift"
     ]
+
+
+def test_a_report_merges_the_runs_twins_and_refuses_other_ones() -> None:
+    import pytest
+
+    from shipgym_baselines.errors import RunError
+    from shipgym_baselines.leaderboard.report import merge_twins
+
+    settings = {"name": "twin:a", "time_limit": 90.0}
+    run = {"twins": {"a": "twin:a"}, "twin_scenarios": {"twin:a": settings}}
+    suite: dict = {}
+    first: dict = {}
+    merge_twins(suite, run | {"twin_players": ["x", "oracle"]}, "one", first)
+    merge_twins(suite, run | {"twin_players": ["y", "oracle"]}, "two", first)
+    assert suite == run | {"twin_players": ["x", "oracle", "y"]}
+    with pytest.raises(RunError, match="scenario 'a' has the twin 'nominal' in three"):
+        merge_twins(suite, {"twins": {"a": "nominal"}}, "three", first)
+    other = {"twin_scenarios": {"twin:a": settings | {"time_limit": 80.0}}}
+    with pytest.raises(RunError, match="twin 'twin:a' has other settings in four than in one"):
+        merge_twins(suite, other, "four", first)
