@@ -19,6 +19,9 @@ cross-track error).  Each is refused early, in one line naming the key and the l
 * evaluation seeds per scenario: :data:`MAX_SEEDS` (``--seeds``, a suite's ``seeds``);
 * held-out scenarios of a suite: :data:`MAX_HELDOUT_SCENARIOS` (``heldout_scenarios``);
 * in-range scenarios of a suite: :data:`MAX_INRANGE_SCENARIOS` (``inrange_scenarios``);
+* a controller's own figures of an episode (``episode_stats``): at most
+  :data:`MAX_CONTROLLER_STATS` entries, each text at most :data:`MAX_STAT_TEXT_CHARS`
+  characters;
 * trial ranges of a suite's ``randomize:``: :data:`RANDOMIZE_BOUNDS` (``randomize.<key>``);
 * local worker processes: at least 1, at most the number of jobs (more are clamped to it,
   :func:`worker_count`; ``--workers``).
@@ -56,6 +59,10 @@ MAX_SEEDS = 10_000
 MAX_HELDOUT_SCENARIOS = 1_000
 #: in-range test scenarios a suite draws (``inrange_scenarios``); the default suite: 16
 MAX_INRANGE_SCENARIOS = 1_000
+#: entries of a controller's ``episode_stats`` (the catalogue's most: 4)
+MAX_CONTROLLER_STATS = 100
+#: characters of a text value of a controller's ``episode_stats``
+MAX_STAT_TEXT_CHARS = 300
 #: the interval each trial range of a suite's ``randomize:`` block must lie in
 RANDOMIZE_BOUNDS: dict[str, tuple[float, float]] = {
     "cross_track_offset_L": (-100.0, 100.0),  # ship lengths

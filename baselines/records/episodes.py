@@ -10,6 +10,9 @@ NaN: a metric of ±inf (t_c = inf, "never converged") is the string ``"inf"`` / 
 and NaN is ``null`` (metrics ignore NaN), so a record reads back to the same numbers.  Read
 back, each value is checked by type: a metric is a finite number, null, ``"inf"`` or
 ``"-inf"``; only :data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text.
+
+A controller's own figures of the episode (its ``episode_stats``) are the one mapping,
+:data:`CONTROLLER_STATS`: they sit beside the benchmark's metrics and never replace one.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipgym.limits import MAX_CONTROLLER_STATS, MAX_NAME_CHARS, MAX_STAT_TEXT_CHARS
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.jsonfiles import from_plain, plain, short_json
 from shipgym_baselines.records.outfiles import open_regular
@@ -44,6 +48,14 @@ CONTROLLER_ERROR = "controller_error"
 CONTROLLER_TIMEOUT = "controller_timeout"
 #: the ``termination_reason`` values of an episode its controller ended
 CONTROLLER_FAILURES = (CONTROLLER_ERROR, CONTROLLER_TIMEOUT)
+
+#: the metric that holds a controller's own figures of its episode (its ``episode_stats``):
+#: name → number, true / false, null or text (:func:`stats_problem`); no other metric is
+#: the controller's to set
+CONTROLLER_STATS = "controller_stats"
+#: the metric saying why a controller's ``episode_stats`` were left out (it raised, ran over
+#: the limit or gave no mapping of figures); the episode counts as the env ended it
+STATS_ERROR = "stats_error"
 
 
 @dataclasses.dataclass
@@ -111,9 +123,33 @@ def episode_key(record: Mapping[str, Any]) -> Key:
 
 #: metrics whose value is text or null (every other metric is a number, null, "inf" or
 #: "-inf"): ``error`` is the one-line message of an episode its controller ended
-TEXT_METRICS = ("termination_reason", "error")
+TEXT_METRICS = ("termination_reason", "error", STATS_ERROR)
 #: metrics whose value is a boolean (true / false, or null)
 BOOL_METRICS = ("success",)
+
+
+def stats_problem(stats: Any) -> str | None:
+    """Why ``stats`` cannot be a controller's figures of an episode
+    (:data:`CONTROLLER_STATS`), or None: a mapping of at most
+    :data:`~shipgym.limits.MAX_CONTROLLER_STATS` names (text of at most
+    :data:`~shipgym.limits.MAX_NAME_CHARS` characters), each to a number, true / false, null
+    or text of at most :data:`~shipgym.limits.MAX_STAT_TEXT_CHARS` characters."""
+    if not isinstance(stats, Mapping):
+        return f"is a {type(stats).__name__}, not a mapping of names to numbers"
+    if len(stats) > MAX_CONTROLLER_STATS:
+        return f"has {len(stats)} entries, beyond the limit of {MAX_CONTROLLER_STATS}"
+    for key, value in stats.items():
+        if not isinstance(key, str) or not 0 < len(key) <= MAX_NAME_CHARS:
+            return f"has the key {repr(key)[:40]}, not a name of 1 to {MAX_NAME_CHARS} characters"
+        if value is None or isinstance(value, bool | int | float | np.bool_ | np.number):
+            continue
+        if isinstance(value, str) and len(value) <= MAX_STAT_TEXT_CHARS:
+            continue
+        return (
+            f"gives {key!r} a {type(value).__name__}, not a number, true / false, null or "
+            f"a text of at most {MAX_STAT_TEXT_CHARS} characters"
+        )
+    return None
 
 
 class _Constant(ValueError):
@@ -126,6 +162,9 @@ def _no_constant(token: str) -> Any:
 
 def _metric_problem(key: str, value: Any) -> str | None:
     """Why ``value`` cannot be the metric ``key`` of an episode record, or None."""
+    if key == CONTROLLER_STATS:
+        problem = stats_problem(value)
+        return None if problem is None else f"the controller's figures that {problem}"
     if key in TEXT_METRICS:
         return None if value is None or isinstance(value, str) else "not text"
     if key in BOOL_METRICS:
@@ -303,9 +342,11 @@ __all__ = [
     "BOOL_METRICS",
     "CONTROLLER_ERROR",
     "CONTROLLER_FAILURES",
+    "CONTROLLER_STATS",
     "CONTROLLER_TIMEOUT",
     "EPISODES_FILE",
     "EPISODE_KEYS",
+    "STATS_ERROR",
     "TEXT_METRICS",
     "EpisodeLabel",
     "EpisodeResult",
@@ -315,4 +356,5 @@ __all__ = [
     "episode_key",
     "episode_record",
     "read_episodes",
+    "stats_problem",
 ]
