@@ -41,6 +41,7 @@ from shipgym_baselines.leaderboard.ranking import (
     scenario_ships,
 )
 from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
+from shipgym_baselines.leaderboard.scores import refused_trials
 from shipgym_baselines.leaderboard.splits import scenario_split, unseen_hull_scenarios
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.leaderboard.tables import (
@@ -106,6 +107,8 @@ def write_results(
     ranked = rankable(episodes, suite.get("scenario_seeds"), shares_trials(suite))
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
+    for line in refused_trials(episodes):  # a reference's failure: never a denominator
+        notice(line)
     drawn = figures.episodes_to_draw(results)
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
