@@ -9,7 +9,9 @@ training_seed) and the file is read as a set keyed by it.  Strict JSON has no in
 NaN: a metric of ±inf (t_c = inf, "never converged") is the string ``"inf"`` / ``"-inf"``
 and NaN is ``null`` (metrics ignore NaN), so a record reads back to the same numbers.  Read
 back, each value is checked by type: a metric is a finite number, null, ``"inf"`` or
-``"-inf"``; only :data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text.
+``"-inf"``; only :data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text; a
+metric of :data:`NONNEGATIVE_METRICS` is never below 0, and none is beyond
+:data:`~shipgym.limits.MAX_METRIC` in magnitude.
 
 A controller's own figures of the episode (its ``episode_stats``) are the one mapping,
 :data:`CONTROLLER_STATS`: they sit beside the benchmark's metrics and never replace one.
@@ -27,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from shipgym.limits import MAX_CONTROLLER_STATS, MAX_NAME_CHARS, MAX_STAT_TEXT_CHARS
+from shipgym.limits import MAX_CONTROLLER_STATS, MAX_METRIC, MAX_NAME_CHARS, MAX_STAT_TEXT_CHARS
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.jsonfiles import from_plain, plain, short_json
 from shipgym_baselines.records.outfiles import open_regular
@@ -126,6 +128,29 @@ def episode_key(record: Mapping[str, Any]) -> Key:
 TEXT_METRICS = ("termination_reason", "error", STATS_ERROR)
 #: metrics whose value is a boolean (true / false, or null)
 BOOL_METRICS = ("success",)
+#: metrics that are never negative: distances [m], angles' magnitudes [rad], times [s, ms],
+#: step counts and the sums of costs (:func:`shipgym.metrics.compute_metrics`)
+NONNEGATIVE_METRICS = (
+    "ace",
+    "ace_L",
+    "t_c",
+    "convergence_threshold",
+    "mean_abs_cross_track",
+    "std_abs_cross_track",
+    "max_abs_cross_track",
+    "mean_abs_heading_error",
+    "std_abs_heading_error",
+    "mean_abs_rudder",
+    "std_abs_rudder",
+    "rudder_travel",
+    "rudder_command_travel",
+    "J",
+    "cost",
+    "steps",
+    "duration",
+    "compute_ms",
+    "compute_ms_max",
+)
 
 
 def stats_problem(stats: Any) -> str | None:
@@ -164,11 +189,13 @@ def _metric_problem(key: str, value: Any) -> str | None:
     """Why ``value`` cannot be the metric ``key`` of an episode record, or None."""
     if key == CONTROLLER_STATS:
         problem = stats_problem(value)
-        return None if problem is None else f"the controller's figures that {problem}"
+        return None if problem is None else f"not a controller's figures: it {problem}"
     if key in TEXT_METRICS:
         return None if value is None or isinstance(value, str) else "not text"
     if key in BOOL_METRICS:
         return None if value is None or isinstance(value, bool) else "not true or false"
+    if value == "-inf" and key in NONNEGATIVE_METRICS:
+        return "negative, which this metric never is"
     if value is None or value in ("inf", "-inf"):
         return None
     if isinstance(value, bool):
@@ -178,8 +205,19 @@ def _metric_problem(key: str, value: Any) -> str | None:
             finite = math.isfinite(value)
         except OverflowError:  # an integer beyond any float
             finite = False
-        return None if finite else "not a finite number"
+        if not finite:
+            return "not a finite number"
+        return _range_problem(key, value)
     return "not a number"
+
+
+def _range_problem(key: str, value: float) -> str | None:
+    """Why the finite number ``value`` is no plausible metric ``key``, or None."""
+    if abs(value) > MAX_METRIC:
+        return f"beyond the limit of {MAX_METRIC:g} in magnitude"
+    if value < 0 and key in NONNEGATIVE_METRICS:
+        return "negative, which this metric never is"
+    return None
 
 
 def _bad_line(file: Path, number: int, problem: str) -> RunError:
@@ -346,6 +384,7 @@ __all__ = [
     "CONTROLLER_TIMEOUT",
     "EPISODES_FILE",
     "EPISODE_KEYS",
+    "NONNEGATIVE_METRICS",
     "STATS_ERROR",
     "TEXT_METRICS",
     "EpisodeLabel",
