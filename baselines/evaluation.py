@@ -29,6 +29,7 @@ import numpy as np
 import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
+from shipgym.errors import ShipgymError
 from shipgym.notices import notice
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
@@ -425,13 +426,15 @@ def _make(
 ) -> tuple[Policy, str]:
     """:func:`~shipgym_baselines.registry.make_controller`; with a guard, a controller
     whose construction raises (any exception but Ctrl-C) is an :class:`_Unmade` named as
-    ``label`` says.  A name that is no controller is the caller's error, raised."""
+    ``label`` says.  A name that is no controller, and the benchmark's own refusals (a
+    :class:`~shipgym.errors.ShipgymError`: a model that cannot be read, a pickle not
+    trusted), are the caller's errors, raised in one line as without a guard."""
     if guard is None:
         return make_controller(controller, **settings)
     record = resolve_controller(controller)
     try:
         return make_controller(controller, **settings)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, ShipgymError):
         raise
     except BaseException as exc:  # the controller's own code: a failure of its episodes
         name = label.controller if label is not None else record.name
