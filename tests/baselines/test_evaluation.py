@@ -127,6 +127,15 @@ def _trials(scenario: str, n: int) -> list[Scenario]:
 TIMINGS = ("compute_ms", "solve_ms")
 
 
+def _untimed(metrics: dict[str, Any]) -> dict[str, Any]:
+    """The metrics and the controller's figures (as ``controller_stats.<name>``) but the
+    measured times."""
+    figures = metrics.get("controller_stats", {})
+    flat = {k: v for k, v in metrics.items() if k != "controller_stats"}
+    flat |= {f"controller_stats.{k}": v for k, v in figures.items()}
+    return {k: v for k, v in flat.items() if not k.rpartition(".")[2].startswith(TIMINGS)}
+
+
 def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[EpisodeResult]) -> None:
     """Equal metrics (measured times aside) and trajectories, bit for bit."""
     assert len(batched) == len(one_by_one)
@@ -138,9 +147,9 @@ def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[Episode
             b.seed,
             b.training_seed,
         )
-        keys = {k for k in a.metrics if not k.startswith(TIMINGS)}
-        assert keys == {k for k in b.metrics if not k.startswith(TIMINGS)}
-        differ = [k for k in keys if not _same(a.metrics[k], b.metrics[k])]
+        ma, mb = _untimed(a.metrics), _untimed(b.metrics)
+        assert ma.keys() == mb.keys()
+        differ = [k for k in ma if not _same(ma[k], mb[k])]
         assert not differ, (a.controller, a.seed, differ)
         assert a.trajectory.keys() == b.trajectory.keys()
         for key, values in a.trajectory.items():
