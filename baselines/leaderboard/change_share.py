@@ -52,7 +52,7 @@ from shipgym_baselines.leaderboard.intervals import (
     pooled_bootstrap_ci,
     stratified_nan_ci,
 )
-from shipgym_baselines.leaderboard.scores import run_keys
+from shipgym_baselines.leaderboard.scores import is_failure, run_keys
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 NOMINAL = "nominal_cost_ratio_gmean"
@@ -89,13 +89,15 @@ Costs = dict[tuple[str, str, Any, int], float]
 
 
 def episode_costs(episodes: Sequence[Mapping[str, Any]]) -> Costs:
-    """(scenario, controller, training seed, seed) → the episode's cost."""
-    return {
-        (ep["scenario"], ep["controller"], ep.get("training_seed"), int(ep["seed"])): float_or_nan(
-            ep.get("cost")
-        )
-        for ep in episodes
-    }
+    """(scenario, controller, training seed, seed) → the episode's cost; NaN for an
+    ``oracle`` episode that failed (never a denominator, :func:`~.scores.refused_trials`)."""
+    out = {}
+    for ep in episodes:
+        cost = float_or_nan(ep.get("cost"))
+        if ep["controller"] == ORACLE and is_failure(ep):
+            cost = math.nan
+        out[(ep["scenario"], ep["controller"], ep.get("training_seed"), int(ep["seed"]))] = cost
+    return out
 
 
 def _positive(*values: float) -> bool:
