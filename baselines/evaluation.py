@@ -17,6 +17,8 @@ import functools
 import json
 import math
 import os
+import signal
+import threading
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any, NamedTuple, Protocol, runtime_checkable
@@ -27,6 +29,8 @@ import numpy as np
 import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
+from shipgym.errors import ShipgymError
+from shipgym.notices import notice
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
@@ -35,11 +39,14 @@ from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
 from shipgym_baselines.records.episodes import (
     CONTROLLER_ERROR,
+    CONTROLLER_STATS,
     CONTROLLER_TIMEOUT,
+    STATS_ERROR,
     EpisodeLabel,
     EpisodeResult,
+    stats_problem,
 )
-from shipgym_baselines.registry import make_controller
+from shipgym_baselines.registry import make_controller, resolve_controller
 
 ENV_ID = "ShipPathFollow-v0"
 #: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
@@ -50,8 +57,11 @@ EVAL_SEED_OFFSET = 10_000
 _clock: Callable[[], float] = time.perf_counter
 
 
-#: the default limit [s] on the wall time of one controller call (``--act-timeout``)
+#: the default limit [s] on the CPU time of one controller call (``--act-timeout``)
 ACT_TIMEOUT_S = 10.0
+#: a call that has not returned after this many times the limit of wall time ends too
+#: (one blocked: sleeping, waiting), whatever CPU time it used
+WALL_FACTOR = 10.0
 #: the most characters of an episode's ``error`` (the one-line message of its failure)
 ERROR_CHARS = 300
 
@@ -60,23 +70,26 @@ ERROR_CHARS = 300
 class ActGuard:
     """A failing controller ends its episode, not the run.
 
-    With a guard the loop ends an episode whose controller's ``reset`` or ``act`` raises,
-    or gives an action that is not numbers of the action's shape or holds NaN or inf
-    (``termination_reason`` ``"controller_error"``), or whose ``act`` took longer than
-    ``timeout`` [s] of wall time (``"controller_timeout"``; ``reset`` has no limit: it may
-    build a solver, compiled to C once per machine); the env's ``abandon`` charges it as
-    leaving the corridor at that step, and the metric ``error`` says why in one line.
-    Without a guard (None) such an error propagates, as a debugger wants it.
+    With a guard the loop ends an episode whose controller cannot be made, whose ``reset``
+    or ``act`` raises (any exception but the user's Ctrl-C: ``SystemExit`` too), or gives
+    an action that is not numbers of the action's shape or holds NaN or inf
+    (``termination_reason`` ``"controller_error"``), or whose ``act`` runs for more than
+    ``timeout`` [s] of the process's CPU time, or for :data:`WALL_FACTOR` × ``timeout`` of
+    wall time (``"controller_timeout"``); the env's ``abandon`` charges it as leaving the
+    corridor at that step, and the metric ``error`` says why in one line.  An
+    ``episode_stats`` that fails the same ways, or gives no mapping of figures, leaves the
+    episode as it is: its figures are left out and ``stats_error`` says why.  Without a
+    guard (None) such an error propagates, as a debugger wants it.
 
-    The time limit is checked when the call returns, not by stopping it: a Python call
-    cannot be stopped safely from outside in its own process (an exception sent by a
-    signal lands in whatever code runs, perhaps a library holding a lock, and does not
-    interrupt C code), and a worker process per controller would cost a round trip and
-    a pickled observation per step, and would leave a controller's state out of reach.
-    So a slow controller holds a run for at most one slow call per episode; a call that
-    never returns holds it until the run is stopped (Ctrl-C; ``--resume`` runs that
-    episode again).  A batch policy's ``act_batch`` acts for all live episodes: the
-    whole call counts against the limit.
+    The limit is CPU time so that a first call that imports a library (torch takes seconds
+    of wall time on a loaded machine) is no timeout.  A watchdog thread
+    (:class:`_Watch`) ends a call that runs past it while it runs: a signal to the main
+    thread raises :class:`CallTimeout` in the controller's code.  Code in C that holds the
+    interpreter ends when it returns to Python; off the main thread (no signal can reach
+    it) the call is judged when it returns.  Construction and ``reset`` have no limit
+    (they may load a model or compile a solver to C, once per machine).  A batch
+    policy's ``act_batch`` acts for all live episodes: the whole call counts against the
+    limit.  ``timeout`` inf: no limit (the references, never judged as entrants).
     """
 
     timeout: float = ACT_TIMEOUT_S
@@ -93,11 +106,146 @@ class _Failure(NamedTuple):
     error: str
 
 
+class CallTimeout(BaseException):
+    """Raised in a controller's call that ran past its limit (:class:`_Watch`): a
+    BaseException, so that a controller's ``except Exception`` does not swallow it."""
+
+
+class _NotMade(Exception):
+    """The error of a controller that could not be made (:class:`_Unmade`), one line."""
+
+
 def error_line(exc: BaseException) -> str:
     """``Type: message`` of ``exc`` as one printable line of at most :data:`ERROR_CHARS`."""
-    text = "".join(c if c.isprintable() else " " for c in f"{type(exc).__name__}: {exc}")
+    text = str(exc) if isinstance(exc, _NotMade) else f"{type(exc).__name__}: {exc}"
+    text = "".join(c if c.isprintable() else " " for c in text)
     text = " ".join(text.split())
     return text if len(text) <= ERROR_CHARS else text[: ERROR_CHARS - 1] + "…"
+
+
+#: the signal the watchdog sends the main thread to end a call past its limit
+_SIGNAL = getattr(signal, "SIGUSR2", None)
+#: the watchdog looks at the running call every quarter of the limit, within these [s]
+_PERIOD_S = (0.005, 1.0)
+
+
+class _Watch:
+    """The watchdog of one guarded loop: a thread that looks at the running call every
+    :attr:`period` [s] and, once the call has used ``limit`` [s] of the process's CPU time
+    or :data:`WALL_FACTOR` × ``limit`` of wall time since it first saw it, marks it over the
+    limit and (on the main thread) interrupts it: :meth:`_interrupt` raises
+    :class:`CallTimeout` in it.  The loop marks each call with :meth:`begin` and
+    :meth:`end` (two attribute writes: no system call per step)."""
+
+    def __init__(self, limit: float) -> None:
+        self.limit = limit
+        self.period = min(max(limit / 4.0, _PERIOD_S[0]), _PERIOD_S[1])
+        self.main = (
+            _SIGNAL is not None
+            and hasattr(signal, "pthread_kill")
+            and threading.current_thread() is threading.main_thread()
+        )
+        self._call = 0  # the number of the running (or last) call
+        self._active = False
+        self._over = 0  # the last call found over the limit (0: none) and why
+        self._why = ""
+        self._requested = 0  # the call the last signal was sent to end
+        self._previous: Any = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="shipgym-watchdog", daemon=True)
+
+    def begin(self) -> None:
+        """A controller's call starts."""
+        self._call += 1
+        self._active = True
+
+    def end(self) -> str | None:
+        """The call ended: why it was over the limit, or None."""
+        self._active = False
+        return self._why if self._over == self._call else None
+
+    def _run(self) -> None:
+        seen, wall0, cpu0 = 0, 0.0, 0.0
+        main = threading.main_thread().ident
+        while not self._stop.wait(self.period):
+            call = self._call
+            if not self._active:
+                continue
+            if call != seen:  # a new call: measured from now
+                seen, wall0, cpu0 = call, time.monotonic(), time.process_time()
+                continue
+            cpu, wall = time.process_time() - cpu0, time.monotonic() - wall0
+            if cpu > self.limit:
+                why = f"the call ran {cpu:.3g} s of CPU time, over the limit of {self.limit:g} s"
+            elif wall > WALL_FACTOR * self.limit:
+                why = (
+                    f"the call had not returned after {wall:.3g} s, {WALL_FACTOR:g} times the "
+                    f"limit of {self.limit:g} s"
+                )
+            else:
+                continue
+            if self._call != call or not self._active:
+                continue  # it returned meanwhile
+            self._why, self._over = why, call
+            if self.main and main is not None:
+                self._requested = call
+                signal.pthread_kill(main, _SIGNAL)
+
+    def _interrupt(self, signum: int, frame: Any) -> None:
+        """The signal handler: end the call the watchdog asked to end, if it still runs."""
+        requested, self._requested = self._requested, 0
+        if not requested:  # not the watchdog's: the handler there was before
+            if callable(self._previous):
+                self._previous(signum, frame)
+            return
+        if requested == self._call and self._active:
+            raise CallTimeout(self._why)
+
+    def __enter__(self) -> _Watch:
+        if self.main:
+            self._previous = signal.signal(_SIGNAL, self._interrupt)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
+        if self.main:
+            previous = self._previous if self._previous is not None else signal.SIG_DFL
+            signal.signal(_SIGNAL, previous)
+
+
+#: the watchdog of the guarded loop running in this thread (None: none)
+_watching = threading.local()
+
+
+@contextlib.contextmanager
+def _watched(guard: ActGuard | None) -> Iterator[None]:
+    """A watchdog (:class:`_Watch`) for the controller calls of the ``with`` body, when
+    ``guard`` has a finite limit."""
+    if guard is None or not math.isfinite(guard.timeout):
+        yield
+        return
+    outer = getattr(_watching, "watch", None)
+    with _Watch(guard.timeout) as watch:
+        _watching.watch = watch
+        try:
+            yield
+        finally:
+            _watching.watch = outer
+
+
+def _timed_call(call: Callable[[], Any], watch: _Watch | None) -> tuple[Any, str | None]:
+    """``call()`` under ``watch``: its value and why it ran over the limit (None: it did
+    not, or no watch)."""
+    if watch is None:
+        return call(), None
+    watch.begin()
+    try:
+        value = call()
+    finally:
+        over = watch.end()
+    return value, over
 
 
 def _call(
@@ -110,15 +258,22 @@ def _call(
     if guard is None:
         value = call()
         return value, _clock() - start, None
-    wall = time.perf_counter()
+    watch = getattr(_watching, "watch", None) if timed else None
     try:
-        value = call()
-    except Exception as exc:  # the controller's, whatever it is: the episode's result
+        value, over = _timed_call(call, watch)
+    except CallTimeout as exc:
+        if watch is not None:
+            watch.end()  # the signal may land as the call returns
+        return None, _clock() - start, _Failure(CONTROLLER_TIMEOUT, str(exc))
+    except KeyboardInterrupt:  # the user's Ctrl-C (or SIGTERM): the run's, not the episode's
+        raise
+    except BaseException as exc:  # the controller's, whatever it is: the episode's result
+        if watch is not None:
+            watch.end()
         return None, _clock() - start, _Failure(CONTROLLER_ERROR, error_line(exc))
-    took, wall = _clock() - start, time.perf_counter() - wall
-    if timed and wall > guard.timeout:
-        slow = f"the call took {wall:.3g} s, over the limit of {guard.timeout:g} s"
-        return value, took, _Failure(CONTROLLER_TIMEOUT, slow)
+    took = _clock() - start
+    if over is not None:
+        return value, took, _Failure(CONTROLLER_TIMEOUT, over)
     return value, took, None
 
 
@@ -185,22 +340,22 @@ class _Record:
         policy: Policy,
         trajectory: dict[str, np.ndarray] | None = None,
         label: EpisodeLabel | None = None,
+        guard: ActGuard | None = None,
     ) -> EpisodeResult:
         """The episode's result; ``trajectory``: a record without rows (the env's);
         ``label``: its scenario, controller and training seed (None: the trial's name, the
-        policy's name and its training seed)."""
+        policy's name and its training seed); ``guard``: the loop's, for the controller's
+        ``episode_stats`` (:func:`controller_stats`)."""
         metrics = dict(self.info["episode_metrics"])
         metrics["termination_reason"] = self.info.get("termination_reason")
         if self.failure is not None:
             metrics["error"] = self.failure.error
         metrics.update(compute_time_metrics(self.act_times))
-        stats = getattr(policy, "episode_stats", None)
-        if stats is not None:  # controller-specific figures (e.g. NMPC solver failures)
-            try:
-                metrics.update(stats())
-            except Exception:
-                if self.failure is None:
-                    raise  # a failed controller's figures may fail too: left out
+        stats, problem = controller_stats(policy, guard)
+        if stats:  # controller-specific figures (e.g. NMPC solver failures): their own key
+            metrics[CONTROLLER_STATS] = stats
+        if problem is not None:
+            metrics[STATS_ERROR] = problem
         if trajectory is None:
             traj = np.array(self.rows)
             trajectory = {k: traj[:, i] for i, k in enumerate(_TRAJ_KEYS)}
@@ -215,6 +370,77 @@ class _Record:
             metrics=metrics,
             trajectory=trajectory,
             training_seed=training_seed(policy) if trained is None else trained,
+        )
+
+
+#: the controllers whose left-out figures were named on stderr in this process
+_stats_named: set[str] = set()
+
+
+def controller_stats(policy: Policy, guard: ActGuard | None) -> tuple[dict[str, Any], str | None]:
+    """The controller's own figures of its episode (its ``episode_stats()``, if it has one)
+    and why they were left out (None: they were not).  With a guard, a call that fails or
+    runs over the limit, or figures that are no mapping of names to numbers
+    (:func:`~shipgym_baselines.records.episodes.stats_problem`), are left out, with one
+    line on stderr per controller; the episode stays as the env ended it.  Without a guard
+    they raise."""
+    stats = getattr(policy, "episode_stats", None)
+    if stats is None:
+        return {}, None
+    figures, _, failure = _call(guard, stats)
+    problem = failure.error if failure is not None else stats_problem(figures)
+    if problem is None:
+        return dict(figures), None
+    why = f"episode_stats() {'raised ' if failure is not None else ''}{problem}"
+    if guard is None:
+        raise ControllerError(f"{policy.name}: {why}")
+    if policy.name not in _stats_named:
+        _stats_named.add(policy.name)
+        notice(f"shipgym: {policy.name}'s {why}: its figures are left out, the episode kept")
+    return {}, why
+
+
+class _Unmade:
+    """A controller that could not be made (with a guard): each of its episodes ends at
+    its ``reset`` with that error, a counted failure of the controller."""
+
+    def __init__(
+        self, name: str, kind: str, action_mode: str, training_seed: int | None, error: str
+    ) -> None:
+        self.name, self.kind, self.action_mode = name, kind, action_mode
+        self.training_seed = training_seed
+        self.error = f"the controller could not be made: {error}"
+
+    def reset(self, context: Any, seed: int | None = None) -> None:
+        raise _NotMade(self.error)
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        raise _NotMade(self.error)
+
+
+def _make(
+    controller: ControllerSpec,
+    guard: ActGuard | None,
+    label: EpisodeLabel | None = None,
+    **settings: Any,
+) -> tuple[Policy, str]:
+    """:func:`~shipgym_baselines.registry.make_controller`; with a guard, a controller
+    whose construction raises (any exception but Ctrl-C) is an :class:`_Unmade` named as
+    ``label`` says.  A name that is no controller, and the benchmark's own refusals (a
+    :class:`~shipgym.errors.ShipgymError`: a model that cannot be read, a pickle not
+    trusted), are the caller's errors, raised in one line as without a guard."""
+    if guard is None:
+        return make_controller(controller, **settings)
+    record = resolve_controller(controller)
+    try:
+        return make_controller(controller, **settings)
+    except (KeyboardInterrupt, ShipgymError):
+        raise
+    except BaseException as exc:  # the controller's own code: a failure of its episodes
+        name = label.controller if label is not None else record.name
+        seed = settings.get("training_seed")
+        return _Unmade(name, record.kind, record.action_mode, seed, error_line(exc)), (
+            record.action_mode
         )
 
 
@@ -250,8 +476,10 @@ class _Episode:
         self.record.failure = failure
         self.done = True
 
-    def result(self, policy: Policy, label: EpisodeLabel | None = None) -> EpisodeResult:
-        return self.record.result(policy, label=label)
+    def result(
+        self, policy: Policy, label: EpisodeLabel | None = None, guard: ActGuard | None = None
+    ) -> EpisodeResult:
+        return self.record.result(policy, label=label, guard=guard)
 
 
 def run_episode(
@@ -285,21 +513,22 @@ def run_episode(
     try:
         base, shape = episode.base, episode.env.action_space.shape
         context = base.controller_context
-        if privileged:
+        if privileged and not isinstance(policy, _Unmade):
             reset = functools.partial(reset_with_truth, policy, context, base, seed)
         else:
             reset = functools.partial(policy.reset, context, seed=seed)
-        _, _, failure = _call(guard, reset, timed=False)
-        took: float | None = None  # no act call yet
-        while failure is None and not episode.done:
-            action, took, failure = _act(
-                guard, lambda: policy.act(episode.obs, episode.info), shape
-            )
-            if failure is None:
-                episode.step(action, took)
-        if failure is not None:
-            episode.abandon(failure, took)
-        result = episode.result(policy, label)
+        with _watched(guard):
+            _, _, failure = _call(guard, reset, timed=False)
+            took: float | None = None  # no act call yet
+            while failure is None and not episode.done:
+                action, took, failure = _act(
+                    guard, lambda: policy.act(episode.obs, episode.info), shape
+                )
+                if failure is None:
+                    episode.step(action, took)
+            if failure is not None:
+                episode.abandon(failure, took)
+            result = episode.result(policy, label, guard)
         if after_episode is not None:
             after_episode(episode.base)
         return result
@@ -368,7 +597,7 @@ def evaluate_batch(
             controller, per_seed, seeds, training_seeds, action_mode, env_id, guard, label
         )
     if made:
-        policy, mode = make_controller(controller, training_seed=training_seed)
+        policy, mode = _make(controller, guard, label, training_seed=training_seed)
     elif training_seed is not None:
         raise ControllerError(
             f"training_seed={training_seed}: a Policy instance is one trained agent; give the "
@@ -384,13 +613,13 @@ def evaluate_batch(
     privileged = made and grants_truth(controller)
     if made and not privileged and seeds:
         policies = [policy] + [
-            make_controller(controller, training_seed=training_seed)[0] for _ in seeds[1:]
+            _make(controller, guard, label, training_seed=training_seed)[0] for _ in seeds[1:]
         ]
         return _run_lockstep(policies, _episodes(per_seed, seeds, mode, env_id), guard, label)
     results = []
     for i, (scenario, seed) in enumerate(zip(per_seed, seeds, strict=True)):
         if made and i > 0:
-            policy, _ = make_controller(controller, training_seed=training_seed)
+            policy, _ = _make(controller, guard, label, training_seed=training_seed)
         result = run_episode(
             policy, scenario, seed, mode, env_id, privileged=privileged, guard=guard, label=label
         )
@@ -461,20 +690,39 @@ def _evaluate_dealt(
         raise ValueError(f"{len(owners)} training seeds for {len(seeds)} seeds: give one per seed")
     if not isinstance(controller, str | ControllerEntry):
         raise ControllerError("training_seeds: give the learned controller by name, not a Policy")
-    made = {k: make_controller(controller, training_seed=k) for k in dict.fromkeys(owners)}
-    if not all(isinstance(policy, BatchPolicy) for policy, _ in made.values()):
+    made = {k: _make(controller, guard, label, training_seed=k) for k in dict.fromkeys(owners)}
+    unmade = [i for i, k in enumerate(owners) if isinstance(made[k][0], _Unmade)]
+    if not all(isinstance(p, BatchPolicy | _Unmade) for p, _ in made.values()):
         raise ControllerError(f"training_seeds: {controller!r} is not a learned agent")
-    policy = DealtPolicy({k: p for k, (p, _) in made.items()}, owners)
-    mode = action_mode or next(iter(made.values()))[1] or policy.action_mode
-    episodes = _episodes(scenarios, seeds, mode, env_id, lean=True)
+    out: dict[int, EpisodeResult] = {}
+    if unmade:  # their episodes end at reset; the other training seeds' run as dealt
+        policies = [made[owners[i]][0] for i in unmade]
+        mode = made[owners[unmade[0]]][1]
+        picked = [scenarios[i] for i in unmade], [seeds[i] for i in unmade]
+        labels = _dealt_labels(picked[0], [owners[i] for i in unmade], policies[0].name, label)
+        done = _run_lockstep(policies, _episodes(*picked, mode, env_id), guard, labels)
+        out.update(zip(unmade, done, strict=True))
+    rest = [i for i in range(len(seeds)) if i not in set(unmade)]
+    if rest:
+        dealt = [owners[i] for i in rest]
+        policy = DealtPolicy({k: made[k][0] for k in dict.fromkeys(dealt)}, dealt)
+        mode = action_mode or made[dealt[0]][1] or policy.action_mode
+        picked = [scenarios[i] for i in rest], [seeds[i] for i in rest]
+        episodes = _episodes(*picked, mode, env_id, lean=True)
+        labels = _dealt_labels(picked[0], dealt, policy.name, label)
+        out.update(zip(rest, _run_lockstep(policy, episodes, guard, labels), strict=True))
+    return [out[i] for i in range(len(seeds))]
+
+
+def _dealt_labels(
+    scenarios: list[Any], owners: list[int | None], name: str, label: EpisodeLabel | None
+) -> list[EpisodeLabel]:
+    """Each dealt episode's label: ``label`` with the episode's training seed, else as the
+    loop labels an episode (its scenario's name and the policy's)."""
     if label is not None:
-        labels = [label._replace(training_seed=k) for k in owners]
-    else:  # as the loop labels an episode: its scenario's name and the policy's
-        loaded = [load_scenario(sc) if isinstance(sc, str) else sc for sc in scenarios]
-        labels = [
-            EpisodeLabel(sc.name, policy.name, k) for sc, k in zip(loaded, owners, strict=True)
-        ]
-    return _run_lockstep(policy, episodes, guard, labels)
+        return [label._replace(training_seed=k) for k in owners]
+    loaded = [load_scenario(sc) if isinstance(sc, str) else sc for sc in scenarios]
+    return [EpisodeLabel(sc.name, name, k) for sc, k in zip(loaded, owners, strict=True)]
 
 
 class _Episodes(Protocol):
@@ -498,7 +746,9 @@ class _Episodes(Protocol):
 
     def abandon(self, i: int, failure: _Failure, act_time: float | None) -> None: ...
 
-    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult: ...
+    def result(
+        self, i: int, policy: Policy, label: EpisodeLabel | None, guard: ActGuard | None
+    ) -> EpisodeResult: ...
 
     def close(self) -> None: ...
 
@@ -562,8 +812,10 @@ class _VectorEpisodes:
         self.records[i].failure = failure
         self.done[i] = True
 
-    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult:
-        return self.records[i].result(policy, self.env.trajectory(i), label)
+    def result(
+        self, i: int, policy: Policy, label: EpisodeLabel | None, guard: ActGuard | None
+    ) -> EpisodeResult:
+        return self.records[i].result(policy, self.env.trajectory(i), label, guard)
 
     def close(self) -> None:
         self.env.close()
@@ -607,8 +859,10 @@ class _SingleEpisodes:
         self.episodes[i].abandon(failure, act_time)
         self.done[i] = True
 
-    def result(self, i: int, policy: Policy, label: EpisodeLabel | None) -> EpisodeResult:
-        return self.episodes[i].result(policy, label)
+    def result(
+        self, i: int, policy: Policy, label: EpisodeLabel | None, guard: ActGuard | None
+    ) -> EpisodeResult:
+        return self.episodes[i].result(policy, label, guard)
 
     def close(self) -> None:
         for e in self.episodes:
@@ -644,43 +898,54 @@ def _run_lockstep(
     :class:`BatchPolicy` or by its own policy of a list; ``guard``: a failing controller
     ends its episodes (:class:`ActGuard`); ``label``: every result's (:class:`EpisodeLabel`),
     or one per episode."""
-    n = len(episodes.obs)
-    batch = not isinstance(policy, list)
     try:
-        contexts = episodes.contexts()
-        if batch:
-            _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), timed=False)
-            failures = [failure] * n
-        else:
-            failures = [
-                _call(guard, functools.partial(p.reset, context, seed=seed), timed=False)[2]
-                for p, context, seed in zip(policy, contexts, episodes.seeds, strict=True)
-            ]
-        for i, failure in enumerate(failures):
-            if failure is not None:
-                episodes.abandon(i, failure, None)
-        live = [i for i in range(n) if not episodes.done[i]]
-        while live:
-            if batch:
-                stepped, actions, times = _act_batch(policy, episodes, live, guard)
-            else:
-                stepped, actions, times = [], [], []
-                for i in live:
-                    act = functools.partial(policy[i].act, episodes.obs[i], episodes.info(i))
-                    action, took, failure = _act(guard, act, episodes.shape)
-                    if failure is not None:
-                        episodes.abandon(i, failure, took)
-                        continue
-                    stepped.append(i)
-                    actions.append(action)
-                    times.append(took)
-            if stepped:
-                episodes.step(stepped, actions, times)
-            live = [i for i in live if not episodes.done[i]]
-        labels = label if isinstance(label, list) else [label] * n
-        return [episodes.result(i, _policy_of(policy, i), labels[i]) for i in range(n)]
+        with _watched(guard):
+            return _lockstep(policy, episodes, guard, label)
     finally:
         episodes.close()
+
+
+def _lockstep(
+    policy: BatchPolicy | list[Policy],
+    episodes: _Episodes,
+    guard: ActGuard | None,
+    label: EpisodeLabel | Sequence[EpisodeLabel] | None,
+) -> list[EpisodeResult]:
+    """:func:`_run_lockstep`'s body, its episodes open."""
+    n = len(episodes.obs)
+    batch = not isinstance(policy, list)
+    contexts = episodes.contexts()
+    if batch:
+        _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), timed=False)
+        failures = [failure] * n
+    else:
+        failures = [
+            _call(guard, functools.partial(p.reset, context, seed=seed), timed=False)[2]
+            for p, context, seed in zip(policy, contexts, episodes.seeds, strict=True)
+        ]
+    for i, failure in enumerate(failures):
+        if failure is not None:
+            episodes.abandon(i, failure, None)
+    live = [i for i in range(n) if not episodes.done[i]]
+    while live:
+        if batch:
+            stepped, actions, times = _act_batch(policy, episodes, live, guard)
+        else:
+            stepped, actions, times = [], [], []
+            for i in live:
+                act = functools.partial(policy[i].act, episodes.obs[i], episodes.info(i))
+                action, took, failure = _act(guard, act, episodes.shape)
+                if failure is not None:
+                    episodes.abandon(i, failure, took)
+                    continue
+                stepped.append(i)
+                actions.append(action)
+                times.append(took)
+        if stepped:
+            episodes.step(stepped, actions, times)
+        live = [i for i in live if not episodes.done[i]]
+    labels = label if isinstance(label, list) else [label] * n
+    return [episodes.result(i, _policy_of(policy, i), labels[i], guard) for i in range(n)]
 
 
 def _policy_of(policy: BatchPolicy | list[Policy], i: int) -> Policy:
@@ -808,7 +1073,7 @@ def evaluate(
     for seed, trial in zip(seeds, trials, strict=True):
         privileged = False
         if isinstance(controller, str | ControllerEntry):
-            policy, mode = make_controller(controller, **settings)
+            policy, mode = _make(controller, guard, label, **settings)
             plain = all(k == "training_seed" and v is None for k, v in settings.items())
             privileged = plain and grants_truth(controller)
         else:

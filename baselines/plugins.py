@@ -125,11 +125,20 @@ def anchored(controller: str, folder: Path) -> str:
 def load_spec(spec: Spec) -> Any:
     """The object ``spec`` names: its module imported (a file loaded), the attribute read.
 
-    A missing module, file or attribute is a :class:`ControllerError`; an exception raised
-    by the module's own code while it runs is that module's, and keeps its traceback.
+    A missing module, file or attribute is a :class:`ControllerError`, and so is a module
+    that exits while it runs (``SystemExit``); an exception raised by the module's own
+    code while it runs is that module's, and keeps its traceback.
     """
-    module = _load_file(Path(spec.target)) if spec.is_file else _import(spec.target)
+    try:
+        module = _load_file(Path(spec.target)) if spec.is_file else _import(spec.target)
+    except SystemExit as exc:
+        raise ControllerError(f"controller {str(spec)!r}: {_exited(exc)}") from None
     return _attribute(module, spec.attr, f"controller {str(spec)!r}", spec.target)
+
+
+def _exited(exc: SystemExit) -> str:
+    """What a module that called ``sys.exit`` while it was loaded did, in words."""
+    return f"its module exits while it is loaded (SystemExit: {exc.code!r:.60})"
 
 
 def _attribute(module: ModuleType, dotted: str, origin: str, where: str) -> Any:
@@ -215,6 +224,8 @@ def load_entry_point(ep: EntryPoint) -> Any:
     origin = f"entry point {ep.name!r} = {ep.value!r} ({ENTRY_POINT_GROUP})"
     try:
         module = importlib.import_module(ep.module)
+    except SystemExit as exc:
+        raise ControllerError(f"{origin}: {_exited(exc)}") from None
     except ModuleNotFoundError as exc:
         if not (exc.name and (ep.module == exc.name or ep.module.startswith(f"{exc.name}."))):
             raise  # the plug-in's module imports something missing: its error

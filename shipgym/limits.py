@@ -19,6 +19,14 @@ cross-track error).  Each is refused early, in one line naming the key and the l
 * evaluation seeds per scenario: :data:`MAX_SEEDS` (``--seeds``, a suite's ``seeds``);
 * held-out scenarios of a suite: :data:`MAX_HELDOUT_SCENARIOS` (``heldout_scenarios``);
 * in-range scenarios of a suite: :data:`MAX_INRANGE_SCENARIOS` (``inrange_scenarios``);
+* scenarios a suite lists: :data:`MAX_SUITE_SCENARIOS` (``scenarios``), refused before any
+  of them is loaded;
+* steps of history in a learned agent's observation: :data:`MAX_HISTORY_STEPS`
+  (``history_steps``);
+* a controller's own figures of an episode (``episode_stats``): at most
+  :data:`MAX_CONTROLLER_STATS` entries, each text at most :data:`MAX_STAT_TEXT_CHARS`
+  characters;
+* a metric of an ``episodes.jsonl`` record: at most :data:`MAX_METRIC` in magnitude;
 * trial ranges of a suite's ``randomize:``: :data:`RANDOMIZE_BOUNDS` (``randomize.<key>``);
 * local worker processes: at least 1, at most the number of jobs (more are clamped to it,
   :func:`worker_count`; ``--workers``).
@@ -56,6 +64,18 @@ MAX_SEEDS = 10_000
 MAX_HELDOUT_SCENARIOS = 1_000
 #: in-range test scenarios a suite draws (``inrange_scenarios``); the default suite: 16
 MAX_INRANGE_SCENARIOS = 1_000
+#: scenarios a suite lists (``scenarios``: names and YAML files); the default suite: 13
+MAX_SUITE_SCENARIOS = 1_000
+#: control steps of history a learned agent observes (``history_steps``): 1000 steps are
+#: 17 min at the catalogue's 1 s control period, and 8 values a step
+MAX_HISTORY_STEPS = 1_000
+#: entries of a controller's ``episode_stats`` (the catalogue's most: 4)
+MAX_CONTROLLER_STATS = 100
+#: characters of a text value of a controller's ``episode_stats``
+MAX_STAT_TEXT_CHARS = 300
+#: magnitude of a metric of an episode record: no episode within these limits comes near it
+#: (the corridor penalty is ≈ 10³), a value beyond is a damaged or forged record
+MAX_METRIC = 1.0e30
 #: the interval each trial range of a suite's ``randomize:`` block must lie in
 RANDOMIZE_BOUNDS: dict[str, tuple[float, float]] = {
     "cross_track_offset_L": (-100.0, 100.0),  # ship lengths

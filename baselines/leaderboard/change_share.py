@@ -24,8 +24,9 @@ much more the change cost X than the oracle.  Per competitor and split:
   is the gap closed plus log(nominal ratio) / log(C_frozen / C_oracle): a controller that
   steers the unchanged ship worse than the oracle is no longer charged for it.
 
-Each comes with rliable's stratified-bootstrap 95 % interval (runs resampled within each
-scenario, the same seed as the row's other fields).  A trial whose costs are not all
+Each comes with a stratified-bootstrap 95 % interval (rliable's scheme: each resample
+redraws every scenario's runs; :func:`~.intervals.stratified_nan_ci`, which leaves out the
+cells that do not count).  A trial whose costs are not all
 finite and positive leaves its cell out (NaN).  Without the twins' episodes, or the
 frozen optimum's for the share, the fields are None.
 """
@@ -41,16 +42,17 @@ import numpy as np
 from shipgym_baselines.leaderboard.headroom import GAP_HEADROOM
 from shipgym_baselines.leaderboard.intervals import (
     AGGREGATE_REPS,
-    finite_bounds,
     finite_or_none,
     float_or_nan,
     gmean_rows,
     interquartile_mean,
-    interval_estimate,
     iqm_rows,
+    nan_gmean_rows,
+    nan_iqm_rows,
     pooled_bootstrap_ci,
+    stratified_nan_ci,
 )
-from shipgym_baselines.leaderboard.scores import run_keys
+from shipgym_baselines.leaderboard.scores import is_failure, run_keys
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 NOMINAL = "nominal_cost_ratio_gmean"
@@ -87,13 +89,15 @@ Costs = dict[tuple[str, str, Any, int], float]
 
 
 def episode_costs(episodes: Sequence[Mapping[str, Any]]) -> Costs:
-    """(scenario, controller, training seed, seed) → the episode's cost."""
-    return {
-        (ep["scenario"], ep["controller"], ep.get("training_seed"), int(ep["seed"])): float_or_nan(
-            ep.get("cost")
-        )
-        for ep in episodes
-    }
+    """(scenario, controller, training seed, seed) → the episode's cost; NaN for an
+    ``oracle`` episode that failed (never a denominator, :func:`~.scores.refused_trials`)."""
+    out = {}
+    for ep in episodes:
+        cost = float_or_nan(ep.get("cost"))
+        if ep["controller"] == ORACLE and is_failure(ep):
+            cost = math.nan
+        out[(ep["scenario"], ep["controller"], ep.get("training_seed"), int(ep["seed"]))] = cost
+    return out
 
 
 def _positive(*values: float) -> bool:
@@ -173,14 +177,6 @@ def finite_iqm(values: np.ndarray) -> float:
     return float(interquartile_mean(a)) if a.size else math.nan
 
 
-def _nominal_estimate(nominal: np.ndarray) -> np.ndarray:
-    return np.array([finite_gmean(nominal)])
-
-
-def _share_estimate(share: np.ndarray) -> np.ndarray:
-    return np.array([finite_iqm(share)])
-
-
 def twin_fields(
     scored: Sequence[Mapping[str, Any]],
     controller: str,
@@ -196,18 +192,15 @@ def twin_fields(
     if m is None:
         return dict(NO_TWIN_FIELDS)
     out = dict(NO_TWIN_FIELDS)
-    counted = np.isfinite(m["nominal"])
-    if counted.any():
-        point, interval = interval_estimate(m["nominal"], _nominal_estimate, reps, seed)
-        out[NOMINAL] = finite_or_none(point[0])
-        out[f"{NOMINAL}_ci95"] = finite_bounds(interval, 0)
-    out["change_trials"] = int(counted.sum())
-    qualified = np.isfinite(m["share"])
-    out["share_trials"] = int(qualified.sum())
-    if qualified.any():
-        point, interval = interval_estimate(m["share"], _share_estimate, reps, seed)
-        out[SHARE] = finite_or_none(point[0])
-        out[f"{SHARE}_ci95"] = finite_bounds(interval, 0)
+    for field, values, point, rows in (
+        (NOMINAL, m["nominal"], finite_gmean, nan_gmean_rows),
+        (SHARE, m["share"], finite_iqm, nan_iqm_rows),
+    ):
+        if np.isfinite(values).any():
+            out[field] = finite_or_none(point(values))
+            out[f"{field}_ci95"] = stratified_nan_ci(values, rows, reps, seed=seed)
+    out["change_trials"] = int(np.isfinite(m["nominal"]).sum())
+    out["share_trials"] = int(np.isfinite(m["share"]).sum())
     return out
 
 

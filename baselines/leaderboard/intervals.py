@@ -142,6 +142,57 @@ def interquartile_mean(scores: np.ndarray) -> float:
     return np.mean(np.partition(a, (low, high - 1))[low:high])
 
 
+def nan_iqm_rows(samples: np.ndarray) -> np.ndarray:
+    """The interquartile mean of the finite entries of each row of ``samples``
+    (:func:`interquartile_mean`'s trim of each row's n finite values: ⌊n/4⌋ off each end);
+    NaN for a row without one."""
+    a = np.sort(np.asarray(samples, dtype=np.float64), axis=-1)  # NaN sorts last
+    n = np.isfinite(a).sum(axis=-1)
+    low = (0.25 * n).astype(np.int64)
+    high = n - low
+    sums = np.concatenate([np.zeros((*a.shape[:-1], 1)), np.cumsum(np.nan_to_num(a), -1)], -1)
+    inner = np.take_along_axis(sums, high[..., None], -1) - np.take_along_axis(
+        sums, low[..., None], -1
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, inner[..., 0] / (high - low), np.nan)
+
+
+def nan_gmean_rows(samples: np.ndarray) -> np.ndarray:
+    """The geometric mean of the finite positive entries of each row of ``samples`` (NaN
+    for a row without one)."""
+    a = np.asarray(samples, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        logs = np.where(np.isfinite(a) & (a > 0.0), np.log(np.where(a > 0.0, a, 1.0)), np.nan)
+        counts = np.isfinite(logs).sum(axis=-1)
+        return np.where(counts > 0, np.exp(np.nansum(logs, axis=-1) / counts), np.nan)
+
+
+def stratified_nan_ci(
+    matrix: np.ndarray,
+    statistic: Callable[[np.ndarray], np.ndarray],
+    reps: int = AGGREGATE_REPS,
+    confidence: float = CONFIDENCE,
+    seed: int = 0,
+) -> list[float] | None:
+    """Percentile interval [low, high] of ``statistic`` over a (runs, tasks) matrix with NaN
+    cells (those a statistic leaves out, e.g. trials not worth a gap): each resample redraws
+    every task's runs with replacement (rliable's stratified bootstrap); ``statistic`` maps
+    (reps, cells) resamples to (reps,) values ignoring NaN (:func:`nan_iqm_rows`,
+    :func:`nan_gmean_rows`).  A resample without a finite value is left out (it is rare:
+    it draws none of a task's counted runs on every task); None when every one is."""
+    m = np.asarray(matrix, dtype=np.float64)
+    runs, tasks = m.shape
+    idx = _rng(seed).integers(0, runs, size=(reps, runs, tasks))
+    values = statistic(m[idx, np.arange(tasks)].reshape(reps, -1))
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return None
+    alpha = 0.5 * (1.0 - confidence)
+    low, high = np.quantile(values, [alpha, 1.0 - alpha])
+    return [float(low), float(high)]
+
+
 def iqm_rows(samples: np.ndarray) -> np.ndarray:
     """The interquartile mean of each row of ``samples`` (:func:`interquartile_mean`'s trim:
     ⌊n/4⌋ values off each end of each sorted row)."""

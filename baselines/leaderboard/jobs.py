@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 from collections import defaultdict
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
@@ -155,7 +156,11 @@ def run_job(job: tuple) -> EpisodeResult:
 
 
 def _guard(job: Job) -> evaluation.ActGuard:
-    """How the job's episodes end when their controller fails."""
+    """How the job's episodes end when their controller fails: a privileged reference is
+    never judged as an entrant (no time limit; a failed episode of it is recorded, and
+    never a denominator: :func:`~shipgym_baselines.leaderboard.scores.scored_episodes`)."""
+    if grants_truth(job.controller):
+        return evaluation.ActGuard(math.inf)
     return evaluation.ActGuard(job.act_timeout)
 
 

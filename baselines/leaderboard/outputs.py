@@ -47,7 +47,7 @@ from shipgym_baselines.leaderboard.ranking import (
     resolution_lines,
 )
 from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
-from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, scored_episodes
+from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, refused_trials, scored_episodes
 from shipgym_baselines.leaderboard.splits import suite_splits
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.leaderboard.tables import (
@@ -115,6 +115,8 @@ def write_results(
     shown_episodes = [e for e in ranked if e["scenario"] in splits]
     if announce:
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
+    for line in refused_trials(episodes):  # a reference's failure: never a denominator
+        notice(line)
     drawn = figures.episodes_to_draw([r for r in results if r.scenario in splits])
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:

@@ -51,7 +51,7 @@ def merge_runs(
     of first appearance, seeds (each scenario's too: ``scenario_seeds``, when some ran on
     fewer) and "does not apply" pairs united, the deal of learned agents' trials
     (``learned_trials``) the same in every run, the no-change twins united
-    (:func:`_merge_twins`); ``sources`` describes each run (folder, command, status, times,
+    (:func:`merge_twins`); ``sources`` describes each run (folder, command, status, times,
     episodes of jobs)."""
     suite: dict[str, Any] = {
         "name": None,
@@ -62,7 +62,6 @@ def merge_runs(
         "does_not_apply": [],
     }
     first_with: dict[str, str] = {}
-    twin_first: dict[str, str] = {}  # a changing scenario or a twin → the first run with it
     ran_on: dict[str, set[int]] = {}  # scenario → the seeds any run ran it on
     episode_in: dict[Key, str] = {}
     cost_of: dict[Key, Any] = {}
@@ -98,6 +97,7 @@ def merge_runs(
                     f"scenario {name!r} has other settings in {folder} than in "
                     f"{first_with[name]}: {'; '.join(changed[:3])}"
                 )
+        merge_twins(suite, run_suite, folder, first_with)
         for name, file in run_suite.get("scenario_files", {}).items():
             suite.setdefault("scenario_files", {}).setdefault(name, file)  # the first run's
         known = {c["name"] for c in suite["controllers"]}
@@ -105,7 +105,6 @@ def merge_runs(
         suite["does_not_apply"] += [
             pair for pair in run_suite["does_not_apply"] if pair not in suite["does_not_apply"]
         ]
-        _merge_twins(suite, run_suite, folder, twin_first)
         suite["seeds"] = sorted({*suite["seeds"], *run_suite["seeds"]})
         fewer = run_suite.get("scenario_seeds", {})
         for name in [*run_suite["scenarios"], *twin_scenarios(run_suite)]:
@@ -143,33 +142,32 @@ def merge_runs(
     return suite, results, sources
 
 
-def _merge_twins(
-    suite: dict[str, Any], run_suite: Mapping[str, Any], folder: str, first: dict[str, str]
+def merge_twins(
+    suite: dict[str, Any], run_suite: Mapping[str, Any], folder: str, first_with: dict[str, str]
 ) -> None:
-    """Merge the no-change twins of ``run_suite`` (:mod:`shipgym_baselines.leaderboard.twins`)
-    into ``suite``: each changing scenario's twin and each twin's settings the same in every
-    run that has them (else RunError), the players united; ``first``: a changing scenario or
-    a twin → the first run that has it."""
-    for name, twin in twins_of(run_suite).items():
-        known = suite.setdefault(TWINS, {}).setdefault(name, twin)
-        first.setdefault(name, folder)
+    """Merge a run's no-change twins into ``suite`` (:mod:`.twins`): its changing scenarios'
+    twins, the twins' settings and the controllers that play them, in order of first
+    appearance; a :class:`RunError` for a scenario whose twin, or a twin whose settings,
+    differ from an earlier run's (``first_with``: where each name was first read)."""
+    for scenario, twin in twins_of(run_suite).items():
+        known = suite.setdefault(TWINS, {}).setdefault(scenario, twin)
+        first_with.setdefault(f"{TWINS}:{scenario}", folder)
         if known != twin:
             raise RunError(
-                f"scenario {name!r} has the twin {twin!r} in {folder} but {known!r} in "
-                f"{first[name]}: report runs of one suite"
+                f"scenario {scenario!r} has the twin {twin!r} in {folder} but {known!r} in "
+                f"{first_with[f'{TWINS}:{scenario}']}: report runs of one suite's twins"
             )
     for name, settings in twin_scenarios(run_suite).items():
-        known = suite.setdefault(TWIN_SCENARIOS, {}).setdefault(name, settings)
-        first.setdefault(name, folder)
-        changed = differences(known, settings)
-        if changed:
+        kept = suite.setdefault(TWIN_SCENARIOS, {})
+        if name not in kept:
+            kept[name], first_with[name] = settings, folder
+        elif differences(kept[name], settings):
             raise RunError(
-                f"twin {name!r} has other settings in {folder} than in {first[name]}: "
-                f"{'; '.join(changed[:3])}"
+                f"twin {name!r} has other settings in {folder} than in {first_with[name]}: "
+                f"{'; '.join(differences(kept[name], settings)[:3])}"
             )
-    if TWIN_PLAYERS in run_suite:
-        players = suite.setdefault(TWIN_PLAYERS, [])
-        players += [c for c in run_suite[TWIN_PLAYERS] if c not in players]
+    players = suite.setdefault(TWIN_PLAYERS, []) if TWIN_PLAYERS in run_suite else []
+    players += [c for c in run_suite.get(TWIN_PLAYERS, []) if c not in players]
 
 
 def _same_reference(episode: Mapping[str, Any], kinds: Mapping[str, str], cost: Any) -> bool:

@@ -3,6 +3,7 @@ write the tables, the ranking and the figures from the record."""
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 from collections import defaultdict
@@ -129,6 +130,7 @@ def run_leaderboard(
         jobs=n_episodes,
         resume=resume,
         force=force,
+        act_timeout=act_timeout,
     )
     with log.recording():  # holds out_dir's lock to the end
         if retry_failed:
@@ -170,9 +172,11 @@ def run_leaderboard(
 
 
 def check_failure_options(act_timeout: float, retry_failed: bool, resume: bool) -> None:
-    """A :class:`RunError` for a limit that is not a positive time [s] and for
-    ``--retry-failed`` without ``--resume``."""
+    """A :class:`RunError` for a limit that is not a positive finite time [s] (``run.json``
+    records it) and for ``--retry-failed`` without ``--resume``."""
     evaluation.ActGuard(act_timeout)
+    if not math.isfinite(act_timeout):
+        raise RunError(f"--act-timeout must be a finite time in s, got {act_timeout}")
     if retry_failed and not resume:
         raise RunError("--retry-failed runs the failed episodes of a resumed run: add --resume")
 

@@ -37,12 +37,14 @@ def scored_episodes(
 ) -> list[dict[str, Any]]:
     """Copies of the episodes with ``cost_ratio`` = C / C_oracle (the oracle's episode of the
     same scenario and seed; exactly 1 for the oracle's own) and ``failure`` (0 or 1,
-    :func:`is_failure`).  ``cost_ratio`` is None where the oracle has no episode, or where
-    either cost is not finite or the oracle's is not positive."""
+    :func:`is_failure`).  ``cost_ratio`` is None where the oracle has no episode, where its
+    episode failed (:func:`is_failure`: never a denominator, :func:`refused_trials`), or
+    where either cost is not finite or the oracle's is not positive."""
     ref: dict[tuple[str, int], float] = {}
     for ep in episodes:
         if ep["controller"] == oracle:
-            ref[(ep["scenario"], int(ep["seed"]))] = float_or_nan(ep.get("cost"))
+            cost = math.nan if is_failure(ep) else float_or_nan(ep.get("cost"))
+            ref[(ep["scenario"], int(ep["seed"]))] = cost
     out = []
     for ep in episodes:
         c_ref = ref.get((ep["scenario"], int(ep["seed"])), math.nan)
@@ -52,6 +54,26 @@ def scored_episodes(
             ratio = 1.0 if ep["controller"] == oracle else cost / c_ref
         out.append({**ep, "cost_ratio": ratio, "failure": float(is_failure(ep))})
     return out
+
+
+def refused_trials(episodes: Iterable[Mapping[str, Any]], oracle: str = ORACLE) -> list[str]:
+    """One line per trial whose reference episode failed or has no finite positive cost:
+    no episode of that trial is scored (:func:`scored_episodes`), so a reference's failure
+    is never a denominator."""
+    lines = []
+    for ep in episodes:
+        if ep["controller"] != oracle:
+            continue
+        cost = float_or_nan(ep.get("cost"))
+        if is_failure(ep) or not cost > 0.0:
+            why = ep.get("termination_reason") or "no end"
+            error = ep.get("error")
+            lines.append(
+                f"shipgym: {oracle} on {ep['scenario']} seed {ep['seed']} ended {why}"
+                f"{f' ({error})' if error else ''} with cost {cost:.6g}: that trial is "
+                "not scored"
+            )
+    return lines
 
 
 def run_keys(

@@ -27,7 +27,12 @@ from shipgym.config import (
     resolve,
 )
 from shipgym.errors import ShipgymError
-from shipgym.limits import MAX_HELDOUT_SCENARIOS, MAX_INRANGE_SCENARIOS, MAX_SEEDS
+from shipgym.limits import (
+    MAX_HELDOUT_SCENARIOS,
+    MAX_INRANGE_SCENARIOS,
+    MAX_SEEDS,
+    MAX_SUITE_SCENARIOS,
+)
 from shipgym.scenarios import Scenario, list_scenarios, load_scenario
 from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
 from shipgym.scenarios.trials import TrialRandomization
@@ -76,7 +81,7 @@ class SuiteConfig(StrictModel):
 
     name: Name
     description: str = ""
-    scenarios: list[str] = Field(default_factory=list)
+    scenarios: list[str] = Field(default_factory=list, max_length=MAX_SUITE_SCENARIOS)
     heldout_scenarios: int = Field(0, ge=0, le=MAX_HELDOUT_SCENARIOS)
     heldout_seeds: int | None = Field(None, ge=1, le=MAX_SEEDS)
     inrange_scenarios: int = Field(0, ge=0, le=MAX_INRANGE_SCENARIOS)
@@ -306,8 +311,8 @@ def check_suite_file(name_or_path: str | os.PathLike) -> list[Problem]:
 def _scenario_problems(entries: Any, anchor: Path | None) -> list[Problem]:
     """The problems of a suite's ``scenarios`` list (entries that are not strings are the
     schema's)."""
-    if not isinstance(entries, list):
-        return []
+    if not isinstance(entries, list) or len(entries) > MAX_SUITE_SCENARIOS:
+        return []  # too many: the schema names it, before any is loaded
     problems: list[Problem] = []
     good: dict[int, str] = {}  # index -> the entry as the leaderboard loads it
     for i, entry in enumerate(entries):

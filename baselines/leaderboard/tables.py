@@ -22,7 +22,7 @@ from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES
 from shipgym_baselines.leaderboard.splits import TEST_SPLITS as TEST_SPLITS
 from shipgym_baselines.leaderboard.splits import YOURS as YOURS
 from shipgym_baselines.leaderboard.splits import scenario_split as scenario_split
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import CONTROLLER_STATS, EpisodeResult
 from shipgym_baselines.registry import controller_kind
 
 #: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
@@ -92,11 +92,26 @@ def aggregate_results(
             if not group:  # the controller does not apply to this scenario's ship: shown
                 rows.append({**head, **_counts([]), **_metric_cells(COLUMNS, None, None)})
                 continue
-            keys = COLUMNS + tuple(k for k in TRAINING_COLUMNS if k in group[0].metrics)
-            agg = aggregate([r.metrics for r in group], keys)
+            metrics = [with_training_cost(r.metrics) for r in group]
+            keys = COLUMNS + tuple(k for k in TRAINING_COLUMNS if k in metrics[0])
+            agg = aggregate(metrics, keys)
             cis = row_intervals(episode_rows(group), COLUMNS)
             rows.append({**head, **_counts(group), **_metric_cells(keys, agg, cis)})
     return rows
+
+
+def with_training_cost(metrics: Mapping[str, Any]) -> dict[str, Any]:
+    """An episode's metrics with its learned agent's training cost
+    (:data:`TRAINING_COLUMNS`, which the agent reports among its own figures,
+    :data:`~shipgym_baselines.records.episodes.CONTROLLER_STATS`) beside them; a record of
+    an earlier version holds it beside them already."""
+    figures = metrics.get(CONTROLLER_STATS) or {}
+    cost = {k: figures[k] for k in TRAINING_COLUMNS if k not in metrics and _number(figures.get(k))}
+    return {**metrics, **cost}
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def _counts(group: list[EpisodeResult]) -> dict[str, Any]:

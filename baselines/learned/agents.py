@@ -17,6 +17,7 @@ from pydantic import Field, StrictInt, ValidationInfo, field_validator, model_va
 from pydantic_core import PydanticCustomError
 
 from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
+from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.learned.curves import PlateauRule
 
@@ -36,7 +37,7 @@ class AgentEnvConfig(StrictModel):
     context_features: bool = False
     #: K: append the last K control steps of (measurements, applied rudder command) to the
     #: observation (core.ObservationHistory; docs/observation.md); 0: none
-    history_steps: StrictInt = Field(0, ge=0)
+    history_steps: StrictInt = Field(0, ge=0, le=MAX_HISTORY_STEPS)
     #: discount in physical time: γ = exp(−Ts/τ) per ship with τ = gamma_seconds [s]
     #: (PPO and RecurrentPPO on vec_env batched over a distribution); None: hyperparams.gamma
     gamma_seconds: float | None = Field(None, gt=0)

@@ -59,6 +59,7 @@ from shipgym.envs.core import (
     check_history_steps,
     observation_size,
 )
+from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym_baselines.errors import ControllerError, UnsafeFileError
 from shipgym_baselines.learned.loading import load_data_only
 from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
@@ -164,7 +165,7 @@ class PolicyMeta(BaseModel):
     env_steps: int | None = Field(None, ge=0)
     wall_time_s: float | None = Field(None, ge=0)
     seed: int | None = Field(None, ge=0)
-    history_steps: StrictInt | None = Field(None, ge=0)
+    history_steps: StrictInt | None = Field(None, ge=0, le=MAX_HISTORY_STEPS)
 
     @model_validator(mode="after")
     def _cost_complete(self) -> PolicyMeta:

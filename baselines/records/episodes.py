@@ -9,7 +9,12 @@ training_seed) and the file is read as a set keyed by it.  Strict JSON has no in
 NaN: a metric of ±inf (t_c = inf, "never converged") is the string ``"inf"`` / ``"-inf"``
 and NaN is ``null`` (metrics ignore NaN), so a record reads back to the same numbers.  Read
 back, each value is checked by type: a metric is a finite number, null, ``"inf"`` or
-``"-inf"``; only :data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text.
+``"-inf"``; only :data:`BOOL_METRICS` are booleans and :data:`TEXT_METRICS` text; a
+metric of :data:`NONNEGATIVE_METRICS` is never below 0, and none is beyond
+:data:`~shipgym.limits.MAX_METRIC` in magnitude.
+
+A controller's own figures of the episode (its ``episode_stats``) are the one mapping,
+:data:`CONTROLLER_STATS`: they sit beside the benchmark's metrics and never replace one.
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipgym.limits import MAX_CONTROLLER_STATS, MAX_METRIC, MAX_NAME_CHARS, MAX_STAT_TEXT_CHARS
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.jsonfiles import from_plain, plain, short_json
 from shipgym_baselines.records.outfiles import open_regular
@@ -50,6 +56,14 @@ CONTROLLER_ERROR = "controller_error"
 CONTROLLER_TIMEOUT = "controller_timeout"
 #: the ``termination_reason`` values of an episode its controller ended
 CONTROLLER_FAILURES = (CONTROLLER_ERROR, CONTROLLER_TIMEOUT)
+
+#: the metric that holds a controller's own figures of its episode (its ``episode_stats``):
+#: name → number, true / false, null or text (:func:`stats_problem`); no other metric is
+#: the controller's to set
+CONTROLLER_STATS = "controller_stats"
+#: the metric saying why a controller's ``episode_stats`` were left out (it raised, ran over
+#: the limit or gave no mapping of figures); the episode counts as the env ended it
+STATS_ERROR = "stats_error"
 
 
 @dataclasses.dataclass
@@ -117,9 +131,56 @@ def episode_key(record: Mapping[str, Any]) -> Key:
 
 #: metrics whose value is text or null (every other metric is a number, null, "inf" or
 #: "-inf"): ``error`` is the one-line message of an episode its controller ended
-TEXT_METRICS = ("termination_reason", "error")
+TEXT_METRICS = ("termination_reason", "error", STATS_ERROR)
 #: metrics whose value is a boolean (true / false, or null)
 BOOL_METRICS = ("success",)
+#: metrics that are never negative: distances [m], angles' magnitudes [rad], times [s, ms],
+#: step counts and the sums of costs (:func:`shipgym.metrics.compute_metrics`)
+NONNEGATIVE_METRICS = (
+    "ace",
+    "ace_L",
+    "t_c",
+    "convergence_threshold",
+    "mean_abs_cross_track",
+    "std_abs_cross_track",
+    "max_abs_cross_track",
+    "mean_abs_heading_error",
+    "std_abs_heading_error",
+    "mean_abs_rudder",
+    "std_abs_rudder",
+    "rudder_travel",
+    "rudder_command_travel",
+    "J",
+    "cost",
+    "steps",
+    "duration",
+    "compute_ms",
+    "compute_ms_max",
+)
+
+
+def stats_problem(stats: Any) -> str | None:
+    """Why ``stats`` cannot be a controller's figures of an episode
+    (:data:`CONTROLLER_STATS`), or None: a mapping of at most
+    :data:`~shipgym.limits.MAX_CONTROLLER_STATS` names (text of at most
+    :data:`~shipgym.limits.MAX_NAME_CHARS` characters), each to a number, true / false, null
+    or text of at most :data:`~shipgym.limits.MAX_STAT_TEXT_CHARS` characters."""
+    if not isinstance(stats, Mapping):
+        return f"is a {type(stats).__name__}, not a mapping of names to numbers"
+    if len(stats) > MAX_CONTROLLER_STATS:
+        return f"has {len(stats)} entries, beyond the limit of {MAX_CONTROLLER_STATS}"
+    for key, value in stats.items():
+        if not isinstance(key, str) or not 0 < len(key) <= MAX_NAME_CHARS:
+            return f"has the key {repr(key)[:40]}, not a name of 1 to {MAX_NAME_CHARS} characters"
+        if value is None or isinstance(value, bool | int | float | np.bool_ | np.number):
+            continue
+        if isinstance(value, str) and len(value) <= MAX_STAT_TEXT_CHARS:
+            continue
+        return (
+            f"gives {key!r} a {type(value).__name__}, not a number, true / false, null or "
+            f"a text of at most {MAX_STAT_TEXT_CHARS} characters"
+        )
+    return None
 
 
 class _Constant(ValueError):
@@ -132,10 +193,15 @@ def _no_constant(token: str) -> Any:
 
 def _metric_problem(key: str, value: Any) -> str | None:
     """Why ``value`` cannot be the metric ``key`` of an episode record, or None."""
+    if key == CONTROLLER_STATS:
+        problem = stats_problem(value)
+        return None if problem is None else f"not a controller's figures: it {problem}"
     if key in TEXT_METRICS:
         return None if value is None or isinstance(value, str) else "not text"
     if key in BOOL_METRICS:
         return None if value is None or isinstance(value, bool) else "not true or false"
+    if value == "-inf" and key in NONNEGATIVE_METRICS:
+        return "negative, which this metric never is"
     if value is None or value in ("inf", "-inf"):
         return None
     if isinstance(value, bool):
@@ -145,8 +211,19 @@ def _metric_problem(key: str, value: Any) -> str | None:
             finite = math.isfinite(value)
         except OverflowError:  # an integer beyond any float
             finite = False
-        return None if finite else "not a finite number"
+        if not finite:
+            return "not a finite number"
+        return _range_problem(key, value)
     return "not a number"
+
+
+def _range_problem(key: str, value: float) -> str | None:
+    """Why the finite number ``value`` is no plausible metric ``key``, or None."""
+    if abs(value) > MAX_METRIC:
+        return f"beyond the limit of {MAX_METRIC:g} in magnitude"
+    if value < 0 and key in NONNEGATIVE_METRICS:
+        return "negative, which this metric never is"
+    return None
 
 
 def _bad_line(file: Path, number: int, problem: str) -> RunError:
@@ -317,9 +394,12 @@ __all__ = [
     "BOOL_METRICS",
     "CONTROLLER_ERROR",
     "CONTROLLER_FAILURES",
+    "CONTROLLER_STATS",
     "CONTROLLER_TIMEOUT",
     "EPISODES_FILE",
     "EPISODE_KEYS",
+    "NONNEGATIVE_METRICS",
+    "STATS_ERROR",
     "TEXT_METRICS",
     "EpisodeLabel",
     "EpisodeResult",
@@ -329,4 +409,5 @@ __all__ = [
     "episode_key",
     "episode_record",
     "read_episodes",
+    "stats_problem",
 ]

@@ -107,8 +107,10 @@ def plain(value: Any) -> Any:
 
 
 def from_plain(value: Any) -> Any:
-    """One value as :func:`plain` wrote it, read back: "inf" / "-inf" as ±inf, the rest as
-    it is."""
+    """One value as :func:`plain` wrote it, read back: "inf" / "-inf" as ±inf (a mapping's
+    values too), the rest as it is."""
+    if isinstance(value, dict):
+        return {k: from_plain(v) for k, v in value.items()}
     if value == "inf":
         return math.inf
     if value == "-inf":

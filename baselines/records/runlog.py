@@ -115,17 +115,20 @@ class RunLog:
         jobs: int,
         resume: bool = False,
         force: bool = False,
+        act_timeout: float | None = None,
     ) -> RunLog:
         """Lock ``out`` and start a run there (``force``: the paths its manifest lists
-        removed first) or resume the one there (its suite must equal ``suite``: else a
-        :class:`RunError` naming what differs).  Writes ``run.json`` with status
-        "running".  The lock is held until :meth:`recording` ends (or this fails)."""
+        removed first) or resume the one there (its suite must equal ``suite``, and its
+        ``act_timeout`` this one: else a :class:`RunError` naming what differs).  Writes
+        ``run.json`` with status "running" and ``act_timeout`` [s], the limit its
+        controllers' calls are judged by (None: none recorded).  The lock is held until
+        :meth:`recording` ends (or this fails)."""
         check_out_usable(out, resume=resume, force=force)
         lock = contextlib.ExitStack()
         start = now()
         folder = lock.enter_context(out_lock(out, start))
         try:
-            log = cls._start(folder, command, suite, jobs, resume, force, start)
+            log = cls._start(folder, command, suite, jobs, resume, force, start, act_timeout)
         except BaseException:
             lock.close()
             raise
@@ -142,6 +145,7 @@ class RunLog:
         resume: bool,
         force: bool,
         start: str,
+        act_timeout: float | None = None,
     ) -> RunLog:
         """:meth:`open` once the folder is locked."""
         check_out_dir(folder, resume=resume, force=force)
@@ -156,11 +160,14 @@ class RunLog:
                     f"--resume: the suite differs from {folder / RUN_FILE}'s: {shown}; run it "
                     "as it was, or use --force to start afresh"
                 )
+            check_act_timeout(record, act_timeout, folder / RUN_FILE)
             episodes = read_episodes(folder, suite=record["suite"])
             cut_partial_line(folder / EPISODES_FILE)
             resumed = {"time": now(), "command": command, "git_commit": git_commit()}
             record.setdefault("resumed", []).append({**resumed, "versions": versions()})
             record.update(status="running", end_time=None, jobs=jobs)
+            if act_timeout is not None:  # a record of an earlier version: this run's
+                record.setdefault(ACT_TIMEOUT_KEY, act_timeout)
         else:
             if force:
                 clear_listed(folder)
@@ -176,6 +183,8 @@ class RunLog:
                 "jobs": jobs,
                 "episodes": 0,
             }
+        if act_timeout is not None:
+            record[ACT_TIMEOUT_KEY] = act_timeout
         manifest = Manifest(folder)
         manifest.claim(RUN_FILE, EPISODES_FILE)
         log = cls(folder, record, episodes, manifest)
@@ -245,7 +254,8 @@ class RunLog:
             with contextlib.suppress(OSError):
                 os.fsync(file.fileno())
             file.close()
-        self._count = len(read_episodes(self.folder))  # the file's count: Ctrl-C may cut in
+        with contextlib.suppress(RunError):  # the file's count: Ctrl-C may cut in
+            self._count = len(read_episodes(self.folder))
         wall, cpu = self.elapsed()
         self.record.update(
             status=status,
@@ -318,6 +328,28 @@ class RunLog:
                     fh.truncate()
 
 
+#: the key of ``run.json`` that holds the limit [s] on one controller call (``--act-timeout``)
+ACT_TIMEOUT_KEY = "act_timeout"
+
+
+def check_act_timeout(record: Mapping[str, Any], act_timeout: float | None, file: Path) -> None:
+    """A :class:`RunError` when a resumed run's record (``file``) judged its controllers'
+    calls by another limit than ``act_timeout`` [s]: its episodes would mix two limits.  A
+    record without one (an earlier version) resumes under any."""
+    recorded = record.get(ACT_TIMEOUT_KEY)
+    if recorded is None or act_timeout is None:
+        return
+    if isinstance(recorded, bool) or not isinstance(recorded, int | float):
+        raise RunError(f"{file}: key '{ACT_TIMEOUT_KEY}' is {recorded!r:.40}, not a time in s")
+    if float(recorded) == float(act_timeout):
+        return
+    raise RunError(
+        f"--resume: {file} judged its controllers with --act-timeout {recorded:g} s, not "
+        f"{act_timeout:g} s: resume with --act-timeout {recorded:g}, or use --force to "
+        "start afresh"
+    )
+
+
 def cpu_seconds() -> float:
     """CPU seconds [s] of this process and of its finished child processes (a process
     pool's workers count once the pool has shut down), user and system."""
@@ -339,10 +371,12 @@ def outside_problem(exc: BaseException) -> str | None:
 
 
 __all__ = [
+    "ACT_TIMEOUT_KEY",
     "FSYNC_INTERVAL_S",
     "NO_ROOM",
     "RunInterrupted",
     "RunLog",
+    "check_act_timeout",
     "cpu_seconds",
     "outside_problem",
 ]

@@ -36,6 +36,7 @@ from shipgym.angles import wrap_angle
 from shipgym.autopilot import PIDGains, pid_step
 from shipgym.disturbances import Disturbances
 from shipgym.guidance import desired_heading
+from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY
@@ -166,15 +167,16 @@ class StepConstants:
 
 def check_history_steps(history_steps: Any) -> int:
     """``history_steps`` (K, control steps of history in the observation) checked: an int
-    ≥ 0 (not a bool), else a ValueError naming it."""
+    from 0 to :data:`~shipgym.limits.MAX_HISTORY_STEPS` (not a bool), else a ValueError
+    naming it."""
     if (
         isinstance(history_steps, bool)
         or not isinstance(history_steps, numbers.Integral)
-        or history_steps < 0
+        or not 0 <= history_steps <= MAX_HISTORY_STEPS
     ):
         raise ValueError(
-            f"history_steps must be an int ≥ 0 (control steps of history in the "
-            f"observation; 0: none), got {history_steps!r}"
+            f"history_steps must be an int from 0 to {MAX_HISTORY_STEPS} (control steps of "
+            f"history in the observation; 0: none), got {history_steps!r}"
         )
     return int(history_steps)
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+import threading
 import time
 from typing import Any
 
@@ -126,6 +127,15 @@ def _trials(scenario: str, n: int) -> list[Scenario]:
 TIMINGS = ("compute_ms", "solve_ms")
 
 
+def _untimed(metrics: dict[str, Any]) -> dict[str, Any]:
+    """The metrics and the controller's figures (as ``controller_stats.<name>``) but the
+    measured times."""
+    figures = metrics.get("controller_stats", {})
+    flat = {k: v for k, v in metrics.items() if k != "controller_stats"}
+    flat |= {f"controller_stats.{k}": v for k, v in figures.items()}
+    return {k: v for k, v in flat.items() if not k.rpartition(".")[2].startswith(TIMINGS)}
+
+
 def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[EpisodeResult]) -> None:
     """Equal metrics (measured times aside) and trajectories, bit for bit."""
     assert len(batched) == len(one_by_one)
@@ -137,9 +147,9 @@ def _assert_same_episodes(batched: list[EpisodeResult], one_by_one: list[Episode
             b.seed,
             b.training_seed,
         )
-        keys = {k for k in a.metrics if not k.startswith(TIMINGS)}
-        assert keys == {k for k in b.metrics if not k.startswith(TIMINGS)}
-        differ = [k for k in keys if not _same(a.metrics[k], b.metrics[k])]
+        ma, mb = _untimed(a.metrics), _untimed(b.metrics)
+        assert ma.keys() == mb.keys()
+        differ = [k for k in ma if not _same(ma[k], mb[k])]
         assert not differ, (a.controller, a.seed, differ)
         assert a.trajectory.keys() == b.trajectory.keys()
         for key, values in a.trajectory.items():
@@ -292,15 +302,88 @@ def test_a_guarded_failing_act_ends_its_episode_as_controller_error(kind: str) -
     assert math.isfinite(m["cost"]) and not m["success"]
 
 
-def test_a_call_over_the_limit_ends_its_episode_as_controller_timeout() -> None:
-    slow = GoesWrong(lambda: time.sleep(0.2) or np.zeros(1))
+def _spin(seconds: float = math.inf) -> np.ndarray:
+    """Compute (CPU time) for ``seconds`` [s] of CPU time (inf: forever), then act."""
+    end = time.process_time() + seconds
+    while time.process_time() < end:
+        pass
+    return np.zeros(1)
+
+
+def _block(seconds: float = 1e9) -> np.ndarray:
+    """Wait for ``seconds`` [s] (no CPU time), then act."""
+    time.sleep(seconds)
+    return np.zeros(1)
+
+
+@pytest.mark.parametrize(
+    ("wrong", "message"),
+    [
+        (_spin, r"the call ran 0\.\d+ s of CPU time, over the limit of 0\.05 s"),
+        (_block, r"the call had not returned after 0\.\d+ s, 10 times the limit of 0\.05 s"),
+    ],
+)
+def test_a_call_that_never_returns_ends_its_episode_as_controller_timeout(
+    wrong: Any, message: str
+) -> None:
+    """A call that computes or waits forever is ended while it runs: past the limit of CPU
+    time, or past ten times the limit of wall time; the episode ends, the loop goes on."""
     start = time.perf_counter()
-    result = run_episode(slow, "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05))
-    assert time.perf_counter() - start < 5.0  # one slow call, not a whole slow episode
+    result = run_episode(
+        GoesWrong(wrong), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05)
+    )
+    assert time.perf_counter() - start < 5.0
     m = result.metrics
     assert m["termination_reason"] == "controller_timeout" and m["steps"] == FAIL_AT
-    assert re.fullmatch(r"the call took 0\.2\d* s, over the limit of 0\.05 s", m["error"])
-    assert m["compute_ms_max"] >= 200.0  # the slow call is timed
+    assert re.fullmatch(message, m["error"]), m["error"]
+
+
+def test_a_call_that_swallows_the_timeout_still_ends_its_episode() -> None:
+    def swallow() -> np.ndarray:
+        try:
+            return _spin()
+        except BaseException:
+            return np.zeros(1)
+
+    result = run_episode(
+        GoesWrong(swallow), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05)
+    )
+    assert result.metrics["termination_reason"] == "controller_timeout"
+
+
+def test_a_call_slow_in_wall_time_but_not_in_cpu_time_is_no_timeout() -> None:
+    """A first call that imports a library waits on the disk and the machine's other
+    processes: wall time below ten times the limit, little CPU time, no timeout."""
+    result = run_episode(
+        GoesWrong(lambda: _block(0.2)), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(0.05)
+    )
+    assert result.metrics["termination_reason"] == "goal" and "error" not in result.metrics
+    assert result.metrics["compute_ms_max"] >= 200.0  # the slow call is timed
+
+
+def test_off_the_main_thread_a_call_over_the_limit_is_judged_when_it_returns() -> None:
+    """No signal reaches another thread: the call runs to its end, then counts as a
+    timeout."""
+    results: list[EpisodeResult] = []
+    slow = GoesWrong(lambda: _spin(0.3))
+    worker = threading.Thread(
+        target=lambda: results.append(
+            run_episode(slow, "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(timeout=0.05))
+        )
+    )
+    worker.start()
+    worker.join()
+    m = results[0].metrics
+    assert m["termination_reason"] == "controller_timeout" and m["steps"] == FAIL_AT
+    assert m["compute_ms_max"] >= 300.0
+
+
+def test_in_lockstep_a_hanging_call_ends_only_its_episode(scratch_registry: None) -> None:
+    register_controller("test_hangs", lambda: GoesWrong(_spin, on={EVAL_SEED_OFFSET + 1}))
+    seeds = [EVAL_SEED_OFFSET + i for i in range(3)]
+    results = evaluate_batch("test_hangs", "rudder_aging", seeds, guard=ActGuard(0.05))
+    reasons = [r.metrics["termination_reason"] for r in results]
+    assert reasons == ["goal", "controller_timeout", "goal"]
 
 
 def test_a_slow_reset_is_no_timeout() -> None:
@@ -330,15 +413,89 @@ def test_a_failing_reset_ends_the_episode_before_any_act() -> None:
     assert m["steps"] == 1 and math.isnan(m["compute_ms"])  # no act was timed
 
 
-def test_a_failed_controllers_episode_stats_that_fail_are_left_out() -> None:
+class Claims(PIDLOS):
+    """pid_los whose ``episode_stats`` gives ``figures()``."""
+
+    name = "claims"
+
+    def __init__(self, figures: Any) -> None:
+        super().__init__()
+        self.figures = figures
+
+    def episode_stats(self) -> Any:
+        return self.figures()
+
+
+def test_a_controllers_figures_never_replace_a_metric() -> None:
+    """Figures named as the benchmark's metrics stay in their own mapping: the episode's
+    cost, termination and time are the env's and the loop's."""
+    claims = {"cost": 0.001, "termination_reason": "goal", "compute_ms": 0.0, "error": None}
+    (mine,) = evaluate(Claims(lambda: claims), "rudder_aging", [EVAL_SEED_OFFSET], guard=ActGuard())
+    (twin,) = evaluate(Claims(dict), "rudder_aging", [EVAL_SEED_OFFSET], guard=ActGuard())
+    assert mine.metrics["controller_stats"] == claims
+    assert mine.metrics["cost"] == twin.metrics["cost"] > 1.0
+    assert "error" not in mine.metrics and mine.metrics["compute_ms"] > 0.0
+
+
+def _exit() -> None:
+    raise SystemExit(3)
+
+
+@pytest.mark.parametrize(
+    ("figures", "why"),
+    [
+        (lambda: _raise(), "episode_stats() raised ValueError: the gain table has no entry"),
+        (lambda: _exit(), "episode_stats() raised SystemExit: 3"),
+        (lambda: [("cost", 1.0)], "episode_stats() is a list, not a mapping of names to numbers"),
+        (lambda: {"gains": [1, 2]}, "episode_stats() gives 'gains' a list, not a number"),
+        (lambda: {f"k{i}": i for i in range(101)}, "episode_stats() has 101 entries, beyond"),
+    ],
+)
+def test_figures_that_fail_are_left_out_and_the_episode_kept(figures: Any, why: str) -> None:
+    result = run_episode(Claims(figures), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
+    m = result.metrics
+    assert m["termination_reason"] == "goal" and "controller_stats" not in m
+    assert m["stats_error"].startswith(why)
+    with pytest.raises((ValueError, SystemExit, ControllerError)):  # no guard: raised
+        run_episode(Claims(figures), "rudder_aging", EVAL_SEED_OFFSET)
+
+
+def test_a_failed_controllers_figures_that_fail_are_left_out() -> None:
     class NoStats(GoesWrong):
         def episode_stats(self) -> dict[str, Any]:
             raise RuntimeError("the stats need the last step")
 
     result = run_episode(NoStats(_raise), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
     assert result.metrics["termination_reason"] == "controller_error"
-    with pytest.raises(RuntimeError, match="the stats"):  # a controller that did not fail
-        run_episode(NoStats(_raise, on=set()), "rudder_aging", 0, guard=ActGuard())
+    assert result.metrics["stats_error"].startswith("episode_stats() raised RuntimeError")
+
+
+class Unbuildable(PIDLOS):
+    def __init__(self) -> None:
+        raise SystemExit("no licence for the solver")
+
+
+def test_a_controller_that_cannot_be_made_fails_every_episode(scratch_registry: None) -> None:
+    """With a guard, a constructor that raises (even SystemExit) fails each episode at its
+    reset, in every path of the loop; without one it raises."""
+    register_controller("test_unbuildable", lambda: Unbuildable())
+    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
+    results = [
+        *evaluate_batch("test_unbuildable", "rudder_aging", seeds, guard=ActGuard()),
+        *evaluate("test_unbuildable", "rudder_aging", seeds[:1], guard=ActGuard()),
+    ]
+    for result in results:
+        m = result.metrics
+        assert (result.controller, m["termination_reason"]) == (
+            "test_unbuildable",
+            "controller_error",
+        )
+        assert (
+            m["error"] == "the controller could not be made: SystemExit: no licence for the solver"
+        )
+        assert m["steps"] == 1
+    with pytest.raises(SystemExit):
+        evaluate("test_unbuildable", "rudder_aging", seeds[:1])
 
 
 def test_in_lockstep_only_the_failing_seeds_episode_ends(scratch_registry: None) -> None:

@@ -168,6 +168,17 @@ def test_a_user_modules_own_error_keeps_its_traceback(tmp_path: Path) -> None:
         make_controller(f"{broken}:x")
 
 
+def test_a_module_that_exits_while_it_is_loaded_is_a_clear_error(tmp_path: Path) -> None:
+    """``sys.exit`` in a plug-in's module is one line naming the spec, not a silent exit."""
+    leaves = tmp_path / "leaves.py"
+    leaves.write_text("import sys\nsys.exit(3)\n")
+    with pytest.raises(ControllerError) as refused:
+        make_controller(f"{leaves}:P")
+    assert str(refused.value) == (
+        f"controller '{leaves}:P': its module exits while it is loaded (SystemExit: 3)"
+    )
+
+
 @pytest.mark.parametrize(
     ("body", "message"),
     [

@@ -162,7 +162,7 @@ def test_user_factory_runs_through_the_loop_beside_a_builtin(scratch_registry: N
     assert (mine.controller, theirs.controller) == ("test_stiff_pid", "pid_los")
     assert mine.metrics["termination_reason"] == theirs.metrics["termination_reason"] == "goal"
     # ωn = 2 rad/s instead of 1: other gains, another episode
-    assert mine.metrics["pid_kp"] > theirs.metrics["pid_kp"]
+    assert mine.metrics["controller_stats"]["pid_kp"] > theirs.metrics["controller_stats"]["pid_kp"]
     assert mine.metrics["ace"] != theirs.metrics["ace"]
 
 
@@ -265,7 +265,7 @@ def test_the_long_form_renames_and_sets_a_registered_controller(scratch_registry
     mine = run_episode(policy, "nominal", seed=0)
     theirs = run_episode(make_controller("pid_los")[0], "nominal", seed=0)
     assert (mine.controller, theirs.controller) == ("pid_stiff", "pid_los")
-    assert mine.metrics["pid_kp"] > theirs.metrics["pid_kp"]
+    assert mine.metrics["controller_stats"]["pid_kp"] > theirs.metrics["controller_stats"]["pid_kp"]
     register_controller("test_nomoto2_only", lambda: ZeroRudder(), applies_to=["nomoto2"])
     alias = resolve_controller(ControllerEntry(controller="test_nomoto2_only", name="only_2"))
     assert alias.applies_to == ("nomoto2",) and controller_kind("only_2") == "classical"

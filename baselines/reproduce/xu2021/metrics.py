@@ -10,7 +10,7 @@ import numpy as np
 from shipgym.angles import wrap_angle
 from shipgym.tracking import PathTracker
 from shipgym_baselines.classical.l1_backstepping import high_frequency_power
-from shipgym_baselines.records.episodes import EpisodeResult
+from shipgym_baselines.records.episodes import CONTROLLER_STATS, EpisodeResult
 from shipgym_baselines.reproduce.xu2021.controllers import Recorded
 from shipgym_baselines.reproduce.xu2021.scenario import switch_time
 
@@ -142,8 +142,10 @@ def episode_figures(
                 DEG * _hf_rms(b_hat[wr], dt) if np.isfinite(b_hat).all() else math.nan
             ),
         }
+    # the adaptive figures: the L1 variants' own (their episode_stats)
+    figures = {**result.metrics.get(CONTROLLER_STATS, {}), **result.metrics}
     for key in EPISODE_METRICS + ADAPTIVE_METRICS:
-        if key in result.metrics:  # the adaptive figures: L1 variants only
-            value = result.metrics[key]
+        if key in figures:
+            value = figures[key]
             out["episode"][key] = float(value) if not isinstance(value, bool) else value
     return out

@@ -370,7 +370,7 @@ def test_the_oracle_reaches_the_goal_where_revision_1_turned_the_wrong_way(
     goal on both.  With the tail and the hard-turn starts the oracle reaches it too."""
     (result,) = evaluate("oracle", _default_trial(scenario, seed), seeds=[seed])
     assert result.metrics["termination_reason"] == "goal", result.metrics["cost"]
-    assert result.metrics["solver_failures"] == 0
+    assert result.metrics["controller_stats"]["solver_failures"] == 0
 
 
 @pytest.mark.parametrize(

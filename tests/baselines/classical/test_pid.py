@@ -188,7 +188,7 @@ def test_controllers_follow_the_nominal_path(cls: type, tuning: str) -> None:
     assert m["termination_reason"] == "goal"
     assert np.max(np.abs(result.trajectory["cross_track_error"])) < 4.0
     assert m["ace"] < 1.6
-    assert m["pid_kp"] > 0 and m["pid_kd"] > 0
+    assert m["controller_stats"]["pid_kp"] > 0 and m["controller_stats"]["pid_kd"] > 0
 
 
 @pytest.mark.parametrize("tuning", ["pole_placement", "vyshnegradsky"])

@@ -8,10 +8,16 @@ import numpy as np
 import pytest
 
 from shipgym_baselines.leaderboard.intervals import (
+    gmean_rows,
     interquartile_mean,
+    iqm_rows,
+    nan_gmean_rows,
+    nan_iqm_rows,
     probability_of_improvement,
     row_intervals,
+    row_strata,
     stratified_bootstrap_ci,
+    stratified_nan_ci,
 )
 
 
@@ -82,3 +88,60 @@ def test_the_fast_metrics_give_rliables_bits() -> None:
 #:   trial 4: headroom 10,            gain 1000/10000 = 0.1,  gap log 0.1 / log 10 = −1, loses
 #: gain: geometric mean (2 · 2 · 10/11 · 1 · 0.1)^(1/5) = (4/11)^(1/5)
 #: P(C < C_frozen): (1 + 1 + 0 + ½ + 0) / 5 = 0.5
+
+
+def _dealt(values: list[float]) -> list[dict]:
+    """A learned row whose trials are dealt: seed i played by training seed i % 3 alone."""
+    return [{"seed": 10_000 + i, "training_seed": i % 3, "cost": v} for i, v in enumerate(values)]
+
+
+def test_dealt_trials_are_resampled_as_one_pool_not_strata_of_one_episode() -> None:
+    """Three training seeds, one trial each: strata of one episode would give a point
+    interval; the row's interval resamples its trials and has the width their spread
+    gives (the pooled bootstrap's), and none where they are equal."""
+    values = [7.0, 5.0, 9.0]
+    ci = row_intervals(_dealt(values), ["cost"])["cost_ci95"]
+    assert ci is not None and ci[0] < np.mean(values) < ci[1]
+    assert ci == stratified_bootstrap_ci([values])  # one stratum: the trials
+    assert row_strata(_dealt(values)) == [_dealt(values)]
+    assert row_intervals(_dealt([4.0, 4.0, 4.0]), ["cost"])["cost_ci95"] == [4.0, 4.0]
+
+
+def test_every_training_seed_on_every_trial_stays_stratified() -> None:
+    eps = [
+        {"seed": 10_000 + i, "training_seed": k, "cost": float(k * 10 + i)}
+        for k in range(3)
+        for i in range(4)
+    ]
+    strata = [[float(k * 10 + i) for i in range(4)] for k in range(3)]
+    assert row_intervals(eps, ["cost"])["cost_ci95"] == stratified_bootstrap_ci(strata)
+    assert len(row_strata(eps)) == 3
+
+
+def test_the_vectorised_row_statistics_are_the_scalar_ones() -> None:
+    rng = np.random.default_rng(4)
+    for n in range(1, 13):
+        rows = rng.lognormal(size=(5, n))
+        rows[0, : n // 2] = np.nan  # left out by the NaN-aware ones
+        for row in rows:
+            finite = row[np.isfinite(row)]
+            if np.isfinite(row).all():
+                assert iqm_rows(row[None])[0] == pytest.approx(interquartile_mean(row))
+                assert gmean_rows(row[None])[0] == pytest.approx(np.exp(np.log(row).mean()))
+            assert nan_iqm_rows(row[None])[0] == pytest.approx(interquartile_mean(finite))
+            assert nan_gmean_rows(row[None])[0] == pytest.approx(np.exp(np.log(finite).mean()))
+    assert np.isnan(nan_iqm_rows(np.full((1, 3), np.nan))[0])
+
+
+def test_the_stratified_interval_with_cells_left_out() -> None:
+    """NaN cells are left out of each resample's statistic; the interval of a matrix
+    without NaN matches the percentile bootstrap's spread, and covers the point."""
+    rng = np.random.default_rng(5)
+    matrix = rng.normal(1.0, 0.2, size=(8, 20))
+    low, high = stratified_nan_ci(matrix, nan_iqm_rows)
+    assert low < interquartile_mean(matrix) < high
+    holed = matrix.copy()
+    holed[::2, :] = np.nan
+    low2, high2 = stratified_nan_ci(holed, nan_iqm_rows)
+    assert low2 < np.nanmean(holed) < high2 and high2 - low2 > high - low  # fewer cells
+    assert stratified_nan_ci(np.full((3, 2), np.nan), nan_iqm_rows) is None

@@ -12,6 +12,7 @@ from shipgym_baselines.leaderboard.scores import (
     is_failure,
     ranked_scenarios,
     rated_scenarios,
+    refused_trials,
     run_matrix,
     scored_episodes,
 )
@@ -60,3 +61,31 @@ def test_a_controller_is_rated_where_every_episode_has_a_cost_ratio() -> None:
     scored = scored_episodes(eps)
     assert rated_scenarios(scored, "x", {"a", "b", "c"}) == ["a"]
     assert ranked_scenarios(scored, ["c", "a"]) == ["a", "c"]
+
+
+def test_a_trial_whose_oracle_episode_failed_is_not_scored() -> None:
+    """The oracle timed out on seed 1 (a penalty cost of 1400): no episode of that trial
+    gets a cost ratio, the scenario is ranked on no controller, and one line names it."""
+    timed_out = {
+        **_episode("s", "oracle", 1, 1400.0),
+        "termination_reason": "controller_timeout",
+        "error": "the call ran 0.01 s of CPU time, over the limit of 0.002 s",
+    }
+    episodes = [
+        {**_episode("s", "oracle", 0, 20.0), "termination_reason": "goal"},
+        timed_out,
+        {**_episode("s", "pid_los", 0, 160.0), "termination_reason": "goal"},
+        {**_episode("s", "pid_los", 1, 180.0), "termination_reason": "goal"},
+    ]
+    scored = {(e["controller"], e["seed"]): e["cost_ratio"] for e in scored_episodes(episodes)}
+    assert scored == {
+        ("oracle", 0): 1.0,
+        ("oracle", 1): None,
+        ("pid_los", 0): 8.0,
+        ("pid_los", 1): None,
+    }
+    assert ranked_scenarios(scored_episodes(episodes), ["s"]) == []
+    assert refused_trials(episodes) == [
+        "shipgym: oracle on s seed 1 ended controller_timeout (the call ran 0.01 s of CPU "
+        "time, over the limit of 0.002 s) with cost 1400: that trial is not scored"
+    ]

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import pytest
 import yaml
 
 from shipgym.config import list_names
+from shipgym.limits import MAX_SUITE_SCENARIOS
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.leaderboard.suite import SuiteConfig, list_suites, load_suite
 
@@ -197,6 +199,25 @@ def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
     file = write(tmp_path, "name: s\nscenarios: [nominal, nominal]\ncontrollers: [pid_los]\n")
     with pytest.raises(ConfigError, match="more than once"):
         load_suite(file)
+
+
+def test_a_suite_of_ten_thousand_files_is_refused_within_a_second(tmp_path: Path) -> None:
+    """10,000 scenario files (none of them exists): a run refuses them by their count
+    before any is read, in one line naming the key and the limit; ``--validate`` too."""
+    from shipgym_baselines.leaderboard.suite import check_suite_file
+
+    entries = "".join(f"  - scenarios/s{i:05d}.yaml\n" for i in range(10_000))
+    file = write(tmp_path, f"name: big\ncontrollers: [pid_los]\nscenarios:\n{entries}")
+    start = time.perf_counter()
+    with pytest.raises(ConfigError) as refused:
+        load_suite(file)
+    assert time.perf_counter() - start < 1.0
+    (problem,) = check_suite_file(file)
+    assert str(refused.value) == (
+        f"{file}: key 'scenarios': List should have at most {MAX_SUITE_SCENARIOS} items after "
+        "validation, not 10000"
+    )
+    assert problem.key == "scenarios" and problem.line == 3
 
 
 # --- check_suite_file (shipgym scenarios --validate) -----------------------------------------

@@ -21,6 +21,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs import core
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym_baselines import evaluation, privileged
+from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.evaluation import evaluate, evaluate_batch
 from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
 from shipgym_baselines.learned.curves import CURVE_KEYS, load_curve
@@ -213,8 +214,21 @@ def test_the_packaged_configs() -> None:
         ({"policy_kwargs": {"activation_fn": "tanh"}}, "policy_kwargs"),
         ({"eval": {"n_episodes": 2, "select_on": "return"}}, "eval.select_on"),
         ({"env": {**TINY["env"], "action_mode": "guidance"}}, "env.action_mode"),
+        ({"env": {**TINY["env"], "history_steps": 1001}}, r"env\.history_steps\n.* 1000"),
     ],
 )
 def test_a_bad_dagger_config_names_the_key(change: dict[str, Any], message: str) -> None:
     with pytest.raises(pydantic.ValidationError, match=message):
         AgentConfig.model_validate({**TINY, **change})
+
+
+def test_a_history_beyond_the_limit_is_refused_when_the_config_is_read(tmp_path: Path) -> None:
+    """A million steps of history (gigabytes of rollouts) is refused before any work, in
+    one line naming the key and the limit."""
+    config = tmp_path / "dagger_long.yaml"
+    env = {**TINY["env"], "history_steps": 1_000_000}
+    config.write_text(json.dumps({**TINY, "env": env}))
+    with pytest.raises(ConfigError) as refused:
+        load_agent_config(config)
+    assert "key 'env.history_steps'" in str(refused.value)
+    assert "less than or equal to 1000" in str(refused.value)

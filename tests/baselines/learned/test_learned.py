@@ -190,7 +190,7 @@ def test_ppo_trains_saves_reloads_and_evaluates_like_the_leaderboard(
     first = run_job((str(shipped), "nominal", EVAL_SEED_OFFSET))
     second = run_job((str(shipped), "nominal", EVAL_SEED_OFFSET))
     assert first.kind == "learned" and first.controller == "policy"
-    assert first.metrics["train_env_steps"] == 256.0
+    assert first.metrics["controller_stats"]["train_env_steps"] == 256.0
     for key in ("ace", "return", "rudder_travel"):
         assert first.metrics[key] == second.metrics[key]
     # the same episode through the plain evaluation loop

@@ -110,7 +110,7 @@ def test_a_plain_sb3_zip_is_scored_by_its_path(
     (result,) = evaluate(str(path), "nominal", [EVAL_SEED_OFFSET])
     assert (result.controller, result.kind) == ("agent", "learned")
     assert np.isfinite(result.metrics["return"])
-    assert "train_env_steps" not in result.metrics  # no meta.json: no training cost shown
+    assert "controller_stats" not in result.metrics  # no meta.json: no training cost shown
 
 
 def test_the_policy_runs_torch_on_one_thread(trained: dict[str, Path]) -> None:
@@ -244,7 +244,10 @@ def test_a_meta_json_gives_name_and_training_cost(trained: dict[str, Path], tmp_
     assert LearnedPolicy(model.parent).name == "mine"
     (result,) = evaluate(str(model.parent), "nominal", [EVAL_SEED_OFFSET])
     assert result.controller == "agent"  # the table names a folder by its name
-    assert (result.metrics["train_env_steps"], result.metrics["train_wall_s"]) == (256.0, 1.5)
+    assert (
+        result.metrics["controller_stats"]["train_env_steps"],
+        result.metrics["controller_stats"]["train_wall_s"],
+    ) == (256.0, 1.5)
 
 
 def test_a_meta_json_names_the_algorithm_the_zip_does_not(
@@ -309,7 +312,10 @@ def test_a_folder_of_seed_folders_is_one_agent_with_its_training_seeds(
     assert (first.algo, first.training_seed) == ("ppo", 0)
     (result,) = evaluate_batch(agent, "nominal", [EVAL_SEED_OFFSET], training_seed=1)
     assert (result.controller, result.training_seed) == ("agent", 1)
-    assert (result.metrics["train_env_steps"], result.metrics["train_wall_s"]) == (200.0, 2.0)
+    assert (
+        result.metrics["controller_stats"]["train_env_steps"],
+        result.metrics["controller_stats"]["train_wall_s"],
+    ) == (200.0, 2.0)
     with pytest.raises(ControllerError, match=r"'agent' was trained with seeds 0, 1: no .* 5"):
         make_controller(agent, training_seed=5)
     with pytest.raises(ControllerError, match=r"no training seed 5; it holds seed_0, seed_1"):

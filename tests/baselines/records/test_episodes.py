@@ -149,6 +149,8 @@ def test_finding2_a_malformed_line_is_one_line_naming_file_and_line(
         ("true", "metric ace is true, not a number (only success is true or false)"),
         ("[1, 2]", "metric ace is [1, 2], not a number"),
         ('{"m": 1}', 'metric ace is {"m": 1}, not a number'),
+        ("-0.5", "metric ace is -0.5, negative, which this metric never is"),
+        ("1e308", "metric ace is 1e+308, beyond the limit of 1e+30 in magnitude"),
     ],
 )
 def test_episode_values_are_read_back_by_type(
@@ -184,3 +186,58 @@ def test_success_may_be_a_boolean_and_other_metrics_may_not(
     (out / "episodes.jsonl").write_text("\n".join(lines) + "\n")
     with pytest.raises(RunError, match=r"line 1: metric success is 1\.0, not true or false"):
         read_episodes(out)
+
+
+#: one episode record as a run writes it (a few of its metrics)
+RECORD = {
+    "scenario": "nominal",
+    "controller": "pid_los",
+    "kind": "classical",
+    "seed": 10000,
+    "training_seed": None,
+    "ace": 0.5,
+    "cost": 120.0,
+    "return": -110.0,
+    "t_c": "inf",
+    "termination_reason": "goal",
+    "controller_stats": {"pid_kp": 1.5, "note": "tuned", "converged": True, "gain": None},
+}
+
+
+@pytest.mark.parametrize(
+    ("change", "problem"),
+    [
+        ({"cost": 1e308}, "metric cost is 1e+308, beyond the limit of 1e+30 in magnitude"),
+        ({"cost": -3.0}, "metric cost is -3.0, negative, which this metric never is"),
+        ({"t_c": "-inf"}, 'metric t_c is "-inf", negative, which this metric never is'),
+        ({"return": -1e31}, "metric return is -1e+31, beyond the limit of 1e+30 in magnitude"),
+        (
+            {"controller_stats": [1, 2]},
+            "metric controller_stats is [1, 2], not a controller's figures: it is a list, "
+            "not a mapping of names to numbers",
+        ),
+        (
+            {"controller_stats": {"gains": {"kp": 1}}},
+            'metric controller_stats is {"gains": {"kp": 1}}, not a controller\'s figures: it '
+            "gives 'gains' a dict, not a number, true / false, null or a text of at most 300 "
+            "characters",
+        ),
+    ],
+)
+def test_an_implausible_value_is_refused_naming_file_line_and_metric(
+    tmp_path: Path, change: dict, problem: str
+) -> None:
+    """Physical ranges: no negative distance, time or cost, nothing beyond 1e30; a
+    controller's figures a flat mapping."""
+    file = tmp_path / "episodes.jsonl"
+    file.write_text(json.dumps(RECORD) + "\n" + json.dumps({**RECORD, **change}) + "\n")
+    with pytest.raises(RunError) as refused:
+        read_episodes(tmp_path)
+    assert str(refused.value) == f"{file}: line 2: {problem}"
+
+
+def test_a_plausible_record_reads_back_with_its_figures(tmp_path: Path) -> None:
+    (tmp_path / "episodes.jsonl").write_text(json.dumps(RECORD) + "\n")
+    (record,) = read_episodes(tmp_path)
+    assert record["controller_stats"] == RECORD["controller_stats"]
+    assert record["t_c"] == float("inf") and record["cost"] == 120.0

@@ -16,6 +16,7 @@ from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.envs.randomized import ShipPathFollowRandomizedEnv
 from shipgym.envs.ship_batch import ShipTrialsVectorEnv
 from shipgym.envs.vector import ShipPathFollowVectorEnv
+from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym.scenarios import load_scenario
 from shipgym.scenarios.sampling import train_scenario_seed
 
@@ -236,7 +237,7 @@ def test_window_function_layout() -> None:
 
 
 # ------------------------------------------------------------------------- (d) bad K
-BAD = [-1, 1.5, 2.0, "3", True, None]
+BAD = [-1, 1.5, 2.0, "3", True, None, MAX_HISTORY_STEPS + 1, 10**6]
 
 
 @pytest.mark.parametrize("bad", BAD)

@@ -1,0 +1,215 @@
+"""What an entrant can do to a leaderboard run: report figures, fail to be made, fail in
+``episode_stats``, hang.  None of it changes another controller's score, the references are
+never judged as entrants, and the run always ends with its record complete."""
+
+from __future__ import annotations
+
+import io
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+from shipgym_baselines.records.episodes import read_episodes
+from shipgym_baselines.records.runrecord import read_run
+
+#: the plug-ins: twins of one PID (an unregistered name: the same default tuning), one
+#: claiming a cost; one whose figures are a list; one that cannot be made; one that hangs
+PLUGINS = """
+import os
+
+import numpy as np
+
+from shipgym_baselines.classical.pid import PIDLOS
+
+
+class Twin(PIDLOS):
+    name = "twin"
+
+
+class Claims(PIDLOS):
+    name = "claims"
+
+    def episode_stats(self):
+        return {"cost": 0.001, "termination_reason": "goal"}
+
+
+class Listing(PIDLOS):
+    name = "listing"
+
+    def episode_stats(self):
+        return [1.0, 2.0]
+
+
+class Unbuildable(PIDLOS):
+    name = "unbuildable"
+
+    def __init__(self, **settings):
+        if not os.environ.get("FIXED"):
+            raise SystemExit("no licence for the solver")
+        super().__init__(**settings)
+
+
+class Hangs(PIDLOS):
+    name = "hangs"
+
+    def reset(self, context, seed=None):
+        super().reset(context, seed=seed)
+        self.calls = 0
+
+    def act(self, obs, info):
+        self.calls += 1
+        while self.calls == 3 and not os.environ.get("FIXED"):
+            pass  # computes forever
+        return super().act(obs, info)
+"""
+CLASSES = ("Twin", "Claims", "Listing", "Unbuildable", "Hangs")
+#: a tiny limit: the computed oracle's calls take far longer, the PIDs' far less
+ACT_TIMEOUT = "0.002"
+
+
+def _suite(root: Path) -> Path:
+    """A suite of one own scenario (so the oracle is computed, not read from its table),
+    the plug-ins and the oracle, one seed."""
+    scenario = Path(__file__).resolve().parents[3] / "configs" / "scenarios" / "rudder_aging.yaml"
+    text = scenario.read_text().replace("name: rudder_aging", "name: mine")
+    (root / "mine.yaml").write_text(text.replace("time_limit: 90.0", "time_limit: 60.0"))
+    (root / "plugins.py").write_text(PLUGINS)
+    controllers = ", ".join(f"plugins.py:{c}" for c in CLASSES)
+    suite = root / "suite.yaml"
+    suite.write_text(f"name: mine\nscenarios: [mine.yaml]\ncontrollers: [{controllers}, oracle]\n")
+    return suite
+
+
+def _argv(suite: Path, out: Path, *extra: str) -> list[str]:
+    return [
+        "leaderboard",
+        "--suite",
+        str(suite),
+        "--seeds",
+        "1",
+        "--act-timeout",
+        ACT_TIMEOUT,
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--no-progress",
+        *extra,
+    ]
+
+
+def _main(argv: list[str], monkeypatch: pytest.MonkeyPatch) -> tuple[int, str]:
+    from shipgym_baselines.cli import main
+
+    monkeypatch.delenv("SHIPGYM_QUIET", raising=False)
+    stderr = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", stderr)
+    code = main(argv)
+    monkeypatch.undo()
+    return code, stderr.getvalue()
+
+
+@pytest.fixture(scope="module")
+def entrants_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, str]:
+    """The suite run once: (the suite file, the run folder, what stderr said)."""
+    root = tmp_path_factory.mktemp("entrants")
+    suite = _suite(root)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("FIXED", raising=False)
+        code, stderr = _main(_argv(suite, root / "out"), mp)
+    assert code == 0, stderr
+    return suite, root / "out", stderr
+
+
+def _episodes(out: Path) -> dict[str, dict]:
+    return {e["controller"]: e for e in read_episodes(out)}
+
+
+def _ratios(out: Path) -> dict[str, float]:
+    board = json.loads((out / "aggregate.json").read_text())
+    return {row["controller"]: row["cost_ratio_iqm"] for row in board}
+
+
+def test_a_plugin_that_claims_a_cost_ranks_as_its_twin(entrants_run: tuple) -> None:
+    _, out, _ = entrants_run
+    episodes = _episodes(out)
+    assert episodes["claims"]["controller_stats"] == {"cost": 0.001, "termination_reason": "goal"}
+    assert episodes["claims"]["cost"] == episodes["twin"]["cost"] > 1.0
+    ratios = _ratios(out)
+    assert ratios["claims"] == ratios["twin"] > 1.0
+
+
+def test_the_oracle_is_never_timed_out_as_an_entrant(entrants_run: tuple) -> None:
+    """Computed afresh under a 2 ms limit (its solver's calls take longer), the oracle's
+    episode is its own, so the ratios are against its true cost."""
+    _, out, _ = entrants_run
+    episodes = _episodes(out)
+    assert episodes["oracle"]["termination_reason"] == "goal"
+    assert _ratios(out)["twin"] == pytest.approx(
+        episodes["twin"]["cost"] / episodes["oracle"]["cost"]
+    )
+
+
+def test_figures_that_are_a_list_are_left_out_and_the_run_completes(entrants_run: tuple) -> None:
+    _, out, stderr = entrants_run
+    listing = _episodes(out)["listing"]
+    assert listing["termination_reason"] == "goal" and "controller_stats" not in listing
+    assert listing["stats_error"] == "episode_stats() is a list, not a mapping of names to numbers"
+    assert "shipgym: listing's episode_stats() is a list" in stderr
+    assert read_run(out)["status"] == "complete"
+
+
+def test_a_plugin_that_cannot_be_made_fails_every_trial(entrants_run: tuple) -> None:
+    _, out, stderr = entrants_run
+    unbuildable = _episodes(out)["unbuildable"]
+    assert unbuildable["termination_reason"] == "controller_error"
+    assert unbuildable["error"] == (
+        "the controller could not be made: SystemExit: no licence for the solver"
+    )
+    assert "shipgym: unbuildable failed on mine seed 10000" in stderr
+
+
+def test_a_hanging_act_ends_its_episode_and_the_run_finishes(entrants_run: tuple) -> None:
+    _, out, _ = entrants_run
+    hangs = _episodes(out)["hangs"]
+    assert (hangs["termination_reason"], hangs["steps"]) == ("controller_timeout", 3)
+    assert hangs["error"].startswith("the call ran ")
+    record = read_run(out)
+    assert record["status"] == "complete" and record["act_timeout"] == float(ACT_TIMEOUT)
+
+
+def test_resume_after_the_fix_runs_the_failed_entrants_again(
+    entrants_run: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    suite, source, _ = entrants_run
+    out = tmp_path / "out"
+    shutil.copytree(source, out)
+    monkeypatch.setenv("FIXED", "1")
+    code, _ = _main(_argv(suite, out, "--resume", "--retry-failed"), monkeypatch)
+    assert code == 0 and read_run(out)["status"] == "complete"
+    episodes = _episodes(out)
+    assert episodes["unbuildable"]["termination_reason"] == "goal"
+    assert episodes["hangs"]["termination_reason"] == "goal"
+
+
+def test_resume_under_another_limit_is_refused_in_one_line(
+    entrants_run: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys
+) -> None:
+    from shipgym_baselines.cli import main
+
+    suite, source, _ = entrants_run
+    out = tmp_path / "out"
+    shutil.copytree(source, out)
+    argv = _argv(suite, out, "--resume")
+    argv[argv.index(ACT_TIMEOUT)] = "0.5"
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"shipgym leaderboard: error: --resume: {out / 'run.json'} judged its controllers "
+        f"with --act-timeout {ACT_TIMEOUT} s, not 0.5 s: resume with --act-timeout "
+        f"{ACT_TIMEOUT}, or use --force to start afresh"
+    )
+    assert read_run(out)["status"] == "complete"
