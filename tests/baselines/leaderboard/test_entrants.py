@@ -125,7 +125,9 @@ def entrants_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, 
 
 
 def _episodes(out: Path) -> dict[str, dict]:
-    return {e["controller"]: e for e in read_episodes(out)}
+    """Each controller's episode of the suite's scenario (not of its no-change twin)."""
+    scenarios = json.loads((out / "run.json").read_text())["suite"]["scenarios"]
+    return {e["controller"]: e for e in read_episodes(out) if e["scenario"] in scenarios}
 
 
 def _ratios(out: Path) -> dict[str, float]:

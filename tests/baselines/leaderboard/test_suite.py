@@ -203,15 +203,16 @@ def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
 
 def test_a_suite_of_ten_thousand_files_is_refused_within_a_second(tmp_path: Path) -> None:
     """10,000 scenario files (none of them exists): a run refuses them by their count
-    before any is read, in one line naming the key and the limit; ``--validate`` too."""
+    before any is read (within a second of CPU), in one line naming the key and the limit;
+    ``--validate`` too."""
     from shipgym_baselines.leaderboard.suite import check_suite_file
 
     entries = "".join(f"  - scenarios/s{i:05d}.yaml\n" for i in range(10_000))
     file = write(tmp_path, f"name: big\ncontrollers: [pid_los]\nscenarios:\n{entries}")
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: a loaded machine does not make it slower
     with pytest.raises(ConfigError) as refused:
         load_suite(file)
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
     (problem,) = check_suite_file(file)
     assert str(refused.value) == (
         f"{file}: key 'scenarios': List should have at most {MAX_SUITE_SCENARIOS} items after "
