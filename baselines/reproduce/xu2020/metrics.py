@@ -38,6 +38,7 @@ def episode_figures(result: EpisodeResult, desired: list[float]) -> dict[str, fl
     ``desired``: ψd [rad] at each control step (the controller's log).
     """
     tr, m = result.trajectory, result.metrics
+    gains = m.get("controller_stats") or {}  # the controller's own figures: its PID gains
     e = tr["cross_track_error"][1:]
     delta = np.degrees(tr["rudder_angle"][1:])
     n = len(desired)
@@ -59,6 +60,6 @@ def episode_figures(result: EpisodeResult, desired: list[float]) -> dict[str, fl
         "max_abs_cross_track": float(m["max_abs_cross_track"]),
         "duration": float(m["duration"]),
         "success": float(bool(m["success"])),
-        "pid_kp": float(m["pid_kp"]),
-        "pid_kd": float(m["pid_kd"]),
+        "pid_kp": float(gains["pid_kp"]),
+        "pid_kd": float(gains["pid_kd"]),
     }
