@@ -5,8 +5,9 @@ Cost of a step = −reward without the goal bonus (the corridor penalty included
 episode cost C is the sum of the step costs and C / steps its cost per step.  For a
 scenario with a change (a parameter event or a two-phase current's switch, at time t*) and
 one trial (the suite's ``randomize`` draw of a seed), :func:`change_effect` runs the
-controller on the trial and on its **twin**: the same trial with the events removed and no
-current (for the straight-route matrix scenarios that is ``{ship}_nominal``'s trial).  It
+controller on the trial and on its **twin**: the same trial without its change
+(:func:`shipgym.scenarios.twins.nominal_twin`, as the leaderboard plays it; for the
+straight-route matrix scenarios that is ``{ship}_nominal``'s trial).  It
 reports the cost per step over the steps that start at or after t* on the changed plant,
 the same on the twin over the same time window, the cost per step before t*, and the
 whole episodes' costs per step.  The change *matters* when the mean over seeds of the
@@ -31,6 +32,7 @@ import numpy as np
 
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym.scenarios.twins import nominal_twin
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import make_controller
@@ -65,8 +67,9 @@ def change_time(scenario: Scenario) -> float | None:
 
 
 def twin(scenario: Scenario) -> Scenario:
-    """The scenario without its events and its current (the nominal twin)."""
-    return scenario.with_overrides(name=scenario.name, drop=("events", "disturbances.current"))
+    """The scenario without its change (:func:`shipgym.scenarios.twins.nominal_twin`: no
+    events, a two-phase current's first phase; the scenario itself when nothing changes)."""
+    return nominal_twin(scenario) or scenario
 
 
 def step_costs(
