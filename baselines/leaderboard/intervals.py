@@ -120,10 +120,7 @@ def pooled_bootstrap_ci(
     if not a.size or not np.all(np.isfinite(a)):
         return None
     (idx,) = bootstrap_indices([a.size], reps, seed)
-    samples = statistic(a[idx])
-    alpha = 0.5 * (1.0 - confidence)
-    low, high = np.quantile(samples, [alpha, 1.0 - alpha])
-    return [float(low), float(high)]
+    return percentile_interval(statistic(a[idx]), confidence)
 
 
 def float_or_nan(value: Any) -> float:
@@ -185,11 +182,16 @@ def stratified_nan_ci(
     runs, tasks = m.shape
     idx = _rng(seed).integers(0, runs, size=(reps, runs, tasks))
     values = statistic(m[idx, np.arange(tasks)].reshape(reps, -1))
-    values = values[np.isfinite(values)]
-    if not values.size:
+    return percentile_interval(values[np.isfinite(values)], confidence)
+
+
+def percentile_interval(samples: np.ndarray, confidence: float = CONFIDENCE) -> list[float] | None:
+    """The central ``confidence`` interval [low, high] of bootstrap ``samples`` (None:
+    none)."""
+    if not np.size(samples):
         return None
     alpha = 0.5 * (1.0 - confidence)
-    low, high = np.quantile(values, [alpha, 1.0 - alpha])
+    low, high = np.quantile(samples, [alpha, 1.0 - alpha])
     return [float(low), float(high)]
 
 
