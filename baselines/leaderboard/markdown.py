@@ -116,8 +116,9 @@ def ranking_markdown(
     scenarios without the oracle's); ``note``: what the run is ranked against
     (:func:`~shipgym_baselines.leaderboard.comparison.comparison_note`), under the score's
     sentences; ``headroom``: :func:`~shipgym_baselines.leaderboard.ranking.headroom_table`'s
-    rows."""
-    lead = verdict(board, episodes)
+    rows; ``shares``: the change share per ship × change family
+    (:func:`~shipgym_baselines.leaderboard.outputs.share_table`)."""
+    lead = verdict(board, episodes, headroom=headroom)
     lines = ["# Leaderboard", "", *([lead, ""] if lead else []), "## Ranking", ""]
     if not board:
         return "\n".join([*lines, no_ranking(scores), ""])

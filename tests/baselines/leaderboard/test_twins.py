@@ -30,8 +30,8 @@ def test_the_default_suites_twins_are_shared_where_the_same_task() -> None:
     # a current shift's time limit is longer than the nominal's: its twin is its own
     assert twins["esso_osaka_current_shift"] == "twin:esso_osaka_current_shift"
     # every held-out and in-range scenario has its own route
-    assert all(twins[f"{split}:{i}"] == f"twin:{split}:{i}" for split in ("heldout", "inrange")
-               for i in range(16))  # fmt: skip
+    assert all(twins[f"heldout:{i}"] == f"twin:heldout:{i}" for i in range(16))
+    assert all(twins[f"inrange:{i}"] == f"twin:inrange:{i}" for i in range(8))
     assert "nominal" not in twins and "esso_osaka_nominal" not in twins  # no change
     assert set(new) == {t for t in twins.values() if t.startswith("twin:")}
 
