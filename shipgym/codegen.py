@@ -154,7 +154,7 @@ def record_path(target: Path) -> Path:
     return target.with_name(f"{target.name}.json")
 
 
-def _digest(file: Path) -> str:
+def file_sha256(file: Path) -> str:
     """The SHA-256 of ``file``'s bytes (hex)."""
     digest = hashlib.sha256()
     with open(file, "rb") as f:
@@ -187,7 +187,7 @@ def library_problem(target: Path) -> str | None:
     if info.st_size != size:
         return f"is {info.st_size} bytes, {size} recorded"
     try:
-        if _digest(target) != sha256:
+        if file_sha256(target) != sha256:
             return "differs from its recorded SHA-256"
     except OSError as exc:
         return f"is unreadable ({exc.strerror})"
@@ -198,7 +198,7 @@ def library_problem(target: Path) -> str | None:
 def _write_record(target: Path) -> None:
     """Record the size and SHA-256 of the published library ``target`` beside it,
     atomically."""
-    record = {"size": target.stat().st_size, "sha256": _digest(target)}
+    record = {"size": target.stat().st_size, "sha256": file_sha256(target)}
     file = record_path(target)
     staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
     staged.write_text(json.dumps(record) + "\n")

@@ -42,10 +42,11 @@ import numpy as np
 from shipgym_baselines.leaderboard.headroom import GAP_HEADROOM
 from shipgym_baselines.leaderboard.intervals import (
     AGGREGATE_REPS,
+    finite_gmean,
+    finite_iqm,
     finite_or_none,
     float_or_nan,
     gmean_rows,
-    interquartile_mean,
     iqm_rows,
     nan_gmean_rows,
     nan_iqm_rows,
@@ -161,20 +162,6 @@ def twin_matrices(
                 return None
             nominal[i, j], share[i, j] = cells
     return {"nominal": nominal, "share": share}
-
-
-def finite_gmean(ratios: np.ndarray) -> float:
-    """The geometric mean over the finite positive entries (NaN: none)."""
-    a = np.asarray(ratios, dtype=np.float64).ravel()
-    a = a[np.isfinite(a) & (a > 0.0)]
-    return float(np.exp(np.mean(np.log(a)))) if a.size else math.nan
-
-
-def finite_iqm(values: np.ndarray) -> float:
-    """The interquartile mean over the finite entries (NaN: none)."""
-    a = np.asarray(values, dtype=np.float64).ravel()
-    a = a[np.isfinite(a)]
-    return float(interquartile_mean(a)) if a.size else math.nan
 
 
 def twin_fields(

@@ -16,10 +16,10 @@ from shipgym_baselines.leaderboard.intervals import (
     AGGREGATE_REPS,
     bounds,
     finite_bounds,
+    finite_iqm,
     finite_or_none,
     float_or_nan,
     geometric_mean,
-    interquartile_mean,
     interval_estimate,
 )
 from shipgym_baselines.leaderboard.scores import run_matrix
@@ -88,13 +88,6 @@ def gmean_headroom(
     return float(geometric_mean(np.array(values))), len(values)
 
 
-def _finite_iqm(scores: np.ndarray) -> float:
-    """:func:`interquartile_mean` over the finite entries (NaN: none)."""
-    a = np.asarray(scores, dtype=np.float64)
-    a = a[np.isfinite(a)]
-    return interquartile_mean(a) if a.size else math.nan
-
-
 def _gain_estimates(gains: np.ndarray) -> np.ndarray:
     """[geometric mean of C_frozen / C, P(C < C_frozen) + ½ P(C = C_frozen)]: for positive
     finite costs C_frozen / C > 1 exactly when C < C_frozen and = 1 exactly when equal
@@ -104,7 +97,7 @@ def _gain_estimates(gains: np.ndarray) -> np.ndarray:
 
 
 def _gap_estimate(gaps: np.ndarray) -> np.ndarray:
-    return np.array([_finite_iqm(gaps)])
+    return np.array([finite_iqm(gaps)])
 
 
 def gap_matrices(

@@ -208,6 +208,20 @@ def gmean_rows(samples: np.ndarray) -> np.ndarray:
     return np.exp(np.log(np.asarray(samples, dtype=np.float64)).mean(axis=-1))
 
 
+def finite_iqm(values: np.ndarray) -> float:
+    """:func:`interquartile_mean` over the finite entries (NaN: none)."""
+    a = np.asarray(values, dtype=np.float64).ravel()
+    a = a[np.isfinite(a)]
+    return float(interquartile_mean(a)) if a.size else math.nan
+
+
+def finite_gmean(ratios: np.ndarray) -> float:
+    """The geometric mean over the finite positive entries (NaN: none)."""
+    a = np.asarray(ratios, dtype=np.float64).ravel()
+    a = a[np.isfinite(a) & (a > 0.0)]
+    return float(np.exp(np.mean(np.log(a)))) if a.size else math.nan
+
+
 def geometric_mean(ratios: np.ndarray) -> float:
     """exp(mean(log r)) over all runs and tasks (the mean of ratios on a log scale)."""
     with np.errstate(divide="ignore"):

@@ -165,7 +165,8 @@ def write_results(
             not_applicable={tuple(pair) for pair in suite["does_not_apply"]},
             splits=splits,
         )
-        add_twin_cells(rows, ranked, twins)
+        scored = scored_episodes(ranked)  # C / C_oracle of each: the twins' numbers read it
+        add_twin_cells(rows, scored, twins)
         scores = score_table(shown_episodes, splits, kinds)
         write_text(out / AGGREGATE_FILE, dumps(board, indent=2) + "\n")
         write_text(out / SCENARIO_SCORES_FILE, dumps_rows(scores))  # one scenario a line
@@ -173,7 +174,7 @@ def write_results(
         note = comparison_note(suite, out)
         ships = scenario_ships(suite["scenarios"])
         headroom = headroom_table(ranked, ships, splits)
-        shares = share_table(board, ranked, ships, splits, twins)
+        shares = share_table(board, scored, ships, splits, twins)
         head = ranking_markdown(
             board,
             scores,
@@ -205,13 +206,13 @@ def write_results(
 
 
 def add_twin_cells(
-    rows: list[dict[str, Any]], ranked: list[dict[str, Any]], twins: Mapping[str, str]
+    rows: list[dict[str, Any]], scored: list[dict[str, Any]], twins: Mapping[str, str]
 ) -> None:
     """Each row of a changing scenario gets its controller's nominal ratio and change share
     there, with intervals that resample the scenario's trials
     (:func:`~shipgym_baselines.leaderboard.change_share.scenario_twin_cells`); the other rows
-    None.  The references' rows have none."""
-    scored = scored_episodes(ranked)
+    None.  The references' rows have none.  ``scored``: the ranked episodes with their cost
+    ratios (:func:`~shipgym_baselines.leaderboard.scores.scored_episodes`)."""
     costs = episode_costs(scored)
     for row in rows:
         cells = dict(NO_SCENARIO_CELLS)
@@ -222,14 +223,15 @@ def add_twin_cells(
 
 def share_table(
     board: list[dict[str, Any]],
-    ranked: list[dict[str, Any]],
+    scored: list[dict[str, Any]],
     ships: Mapping[str, str],
     splits: Mapping[str, str],
     twins: Mapping[str, str],
 ) -> dict[str, Any]:
     """The change share per ship × change family of the verdict's table's top competitors
     and best learned agent (:func:`~shipgym_baselines.leaderboard.change_share.share_grid`):
-    ``split``, ``controllers`` and ``rows``; empty without twins or a ranking."""
+    ``split``, ``controllers`` and ``rows``; empty without twins or a ranking.  ``scored``:
+    as :func:`add_twin_cells` reads them."""
     table = main_table(board)
     if not twins or not table:
         return {}
@@ -237,7 +239,7 @@ def share_table(
     controllers = share_controllers(table)
     scenarios = [s for s in splits if splits[s] == split and s in table[0]["scenarios"]]
     families = {s: change_family(s) for s in scenarios}
-    grid = share_grid(scored_episodes(ranked), controllers, ships, families, scenarios, twins)
+    grid = share_grid(scored, controllers, ships, families, scenarios, twins)
     return {"split": split, "controllers": controllers, "rows": grid}
 
 

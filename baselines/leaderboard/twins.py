@@ -40,14 +40,14 @@ def plan_twins(
     ``scenarios`` (table name → scenario, in the suite's order; module doc).  A twin is
     shared with a scenario or another twin only when both are the same task and run on the
     same evaluation seeds (``seeds_of``: each scenario's)."""
+    drawn = {name: nominal_twin(sc, name=f"{TWIN_PREFIX}{name}") for name, sc in scenarios.items()}
     by_task: dict[tuple[str, tuple[int, ...]], str] = {}
     for name, scenario in scenarios.items():
-        if nominal_twin(scenario) is None:
+        if drawn[name] is None:
             by_task.setdefault(_task(scenario, seeds_of[name]), name)
     twins: dict[str, str] = {}
     new: dict[str, Scenario] = {}
-    for name, scenario in scenarios.items():
-        twin = nominal_twin(scenario, name=f"{TWIN_PREFIX}{name}")
+    for name, twin in drawn.items():
         if twin is None:
             continue
         key = _task(twin, seeds_of[name])

@@ -46,8 +46,8 @@ from shipgym_baselines.leaderboard.ranking import is_failure, is_partial
 from shipgym_baselines.leaderboard.splits import split_label, suite_splits
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
-#: the kinds the second sentence compares
-LEARNED, CLASSICAL = "learned", "classical"
+#: the kind whose best row the second sentence names
+LEARNED = "learned"
 #: the change family of the scenarios without a change (left out of the headroom's range)
 NO_CHANGE = CHANGE_FAMILIES[0]
 #: the verdict's most sentences, and a sentence's most words

@@ -22,7 +22,6 @@ is unpickled without ``--trust-pickle``, any other file only with it.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import os
 from collections.abc import Iterator
 from pathlib import Path
@@ -67,25 +66,17 @@ def refuse_unpickling(file: Path, why: str) -> UnsafeFileError:
 WRITTEN_DIR = "written"
 
 
-def file_sha256(file: Path) -> str:
-    """The SHA-256 of ``file``'s bytes (hex)."""
-    digest = hashlib.sha256()
-    with open(file, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+def _record(file: Path) -> Path:
+    """The record of ``file``'s bytes as they are now (named by their SHA-256)."""
+    from shipgym.codegen import file_sha256, user_cache_dir
 
-
-def _record(digest: str) -> Path:
-    from shipgym.codegen import user_cache_dir
-
-    return user_cache_dir() / WRITTEN_DIR / digest
+    return user_cache_dir() / WRITTEN_DIR / file_sha256(file)
 
 
 def remember_written(file: Path) -> None:
     """Record that this user's shipgym wrote ``file`` as it is now (its SHA-256: an empty
     file of that name in the per-user cache)."""
-    record = _record(file_sha256(file))
+    record = _record(file)
     record.parent.mkdir(parents=True, exist_ok=True)
     record.touch()
 
@@ -93,4 +84,4 @@ def remember_written(file: Path) -> None:
 def written_here(file: Path) -> bool:
     """True when ``file``'s bytes are those of a file this user's shipgym wrote
     (:func:`remember_written`)."""
-    return _record(file_sha256(file)).is_file()
+    return _record(file).is_file()
