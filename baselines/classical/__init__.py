@@ -8,7 +8,7 @@ registry.
 
 # the import order is the registration order (CONTROLLERS and the docs' index list it)
 # isort: off
-from shipgym_baselines.classical import pid, lqr, l1_backstepping, nmpc, reference, oracle
+from shipgym_baselines.classical import pid, lqr, l1_backstepping, nmpc, reference, oracle, nmpc_ekf
 # isort: on
 
-__all__ = ["l1_backstepping", "lqr", "nmpc", "oracle", "pid", "reference"]
+__all__ = ["l1_backstepping", "lqr", "nmpc", "nmpc_ekf", "oracle", "pid", "reference"]

@@ -807,20 +807,15 @@ def predicted_disturbances(
     return rows
 
 
-# its look colours its name in the page's tables; the scenario figures draw its episode black
-# and dashed, the reference (shipgym_baselines.leaderboard.figures)
-@register_controller("oracle", family="references", look=Style("#17becf", "-", "s"))
-class Oracle:
-    """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
+class PlantNMPC:
+    """The oracle's NMPC (module doc) on a plant handed to it at every step: the truth for
+    the references, an estimate for a controller that estimates the plant
+    (``nmpc_ekf``).  :meth:`start` at an episode's start, :meth:`steer` at every step."""
 
     name: ClassVar[str]  # set by the registration
-    kind: ClassVar[str] = "reference"
-    #: predict with the truth of the episode's start (``oracle_frozen``) instead of now
-    frozen: ClassVar[bool] = False
 
     def __init__(self, settings: OracleSettings | None = None) -> None:
         self.settings = settings if settings is not None else OracleSettings()
-        self._start: PlantTruth | None = None  # the truth at the episode's first step
         for field, allowed in (
             ("tail_speed", TAIL_SPEEDS),
             ("tail_terms", TAIL_TERMS),
@@ -830,22 +825,10 @@ class Oracle:
                 raise ValueError(
                     f"{field} must be one of {allowed}, got {getattr(self.settings, field)!r}"
                 )
-        self._truth = None
 
-    def reset(self, context: ControllerContext, seed: int | None = None) -> None:
-        raise ControllerError(
-            f"{self.name} reads the true plant through the evaluation loop's privileged "
-            f"channel, which only the built-in references run by their own names receive; it "
-            "cannot run as an instance, a spec or under another name"
-        )
-
-    def reset_privileged(
-        self, context: ControllerContext, truth: Any, seed: int | None = None
-    ) -> None:
-        """Start an episode; ``truth()`` returns the :class:`PlantTruth` now."""
+    def start(self, context: ControllerContext) -> None:
+        """An episode's start: the solver of ``context``'s ship, a new tracker, no plan."""
         self.ctx = context
-        self._truth = truth
-        self._start = None  # a new episode: its first truth is captured at the first step
         reward = context.reward
         self.weights = (reward.heading_weight, reward.rudder_weight, reward.rudder_rate_weight)
         self.solver = get_solver(context, self.settings, self.weights)
@@ -857,25 +840,9 @@ class Oracle:
         self.solve_times: list[float] = []  # wall clock [s]
         self.solve_cpu_times: list[float] = []  # this thread's CPU time [s]
 
-    def predicted_plant(self, truth: PlantTruth) -> PlantTruth:
-        """The truth the prediction uses: the plant now (``oracle``), or its parameters and
-        disturbances as at the episode's start with the true state now
-        (``oracle_frozen``)."""
-        if self._start is None:
-            self._start = truth
-        if not self.frozen:
-            return truth
-        return dataclasses.replace(
-            truth,
-            params=self._start.params,
-            disturbance_now=self._start.disturbance_now,
-            wave_now=self._start.wave_now,
-        )
-
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        if self._truth is None:
-            raise ControllerError(f"{self.name}: reset_privileged() first (the privileged channel)")
-        plant = self.predicted_plant(self._truth())
+    def steer(self, plant: PlantTruth) -> np.ndarray:
+        """The action of one step: the plan's first command over the horizon predicted
+        with ``plant``'s state, parameters and disturbances now (module doc)."""
         ctx, grid = self.ctx, self.solver.grid
         model = ctx.nominal_model
         px = float(plant.state[model.state_index("x")])
@@ -918,6 +885,57 @@ class Oracle:
             "solve_ms_median": 1e3 * float(np.median(times)),
             "solve_ms_p99": 1e3 * float(np.percentile(times, 99)),
         }
+
+
+# its look colours its name in the page's tables; the scenario figures draw its episode black
+# and dashed, the reference (shipgym_baselines.leaderboard.figures)
+@register_controller("oracle", family="references", look=Style("#17becf", "-", "s"))
+class Oracle(PlantNMPC):
+    """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
+
+    kind: ClassVar[str] = "reference"
+    #: predict with the truth of the episode's start (``oracle_frozen``) instead of now
+    frozen: ClassVar[bool] = False
+
+    def __init__(self, settings: OracleSettings | None = None) -> None:
+        super().__init__(settings)
+        self._start: PlantTruth | None = None  # the truth at the episode's first step
+        self._truth = None
+
+    def reset(self, context: ControllerContext, seed: int | None = None) -> None:
+        raise ControllerError(
+            f"{self.name} reads the true plant through the evaluation loop's privileged "
+            f"channel, which only the built-in references run by their own names receive; it "
+            "cannot run as an instance, a spec or under another name"
+        )
+
+    def reset_privileged(
+        self, context: ControllerContext, truth: Any, seed: int | None = None
+    ) -> None:
+        """Start an episode; ``truth()`` returns the :class:`PlantTruth` now."""
+        self._truth = truth
+        self._start = None  # a new episode: its first truth is captured at the first step
+        self.start(context)
+
+    def predicted_plant(self, truth: PlantTruth) -> PlantTruth:
+        """The truth the prediction uses: the plant now (``oracle``), or its parameters and
+        disturbances as at the episode's start with the true state now
+        (``oracle_frozen``)."""
+        if self._start is None:
+            self._start = truth
+        if not self.frozen:
+            return truth
+        return dataclasses.replace(
+            truth,
+            params=self._start.params,
+            disturbance_now=self._start.disturbance_now,
+            wave_now=self._start.wave_now,
+        )
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        if self._truth is None:
+            raise ControllerError(f"{self.name}: reset_privileged() first (the privileged channel)")
+        return self.steer(self.predicted_plant(self._truth()))
 
 
 @register_controller("oracle_frozen", family="references", look=Style("#525252", "-.", "x"))
