@@ -94,8 +94,9 @@ _BUILTINS_LOADED = False
 
 
 def _load_builtins() -> None:
-    """Import :mod:`shipgym_baselines.classical`, whose modules register the built-in
-    controllers, once per process.
+    """Import :mod:`shipgym_baselines.classical` and the learned controllers that register
+    by name (:mod:`shipgym_baselines.learned.plant_id.controller`), whose modules register
+    the built-in controllers, once per process.
 
     The one import of the controllers by the registry, lazy (inside this function) because
     they import the registry to register: a reader calls it before reading the records.
@@ -106,6 +107,7 @@ def _load_builtins() -> None:
     _BUILTINS_LOADED = True  # set first: the package's modules register while it imports
     try:
         import shipgym_baselines.classical  # noqa: F401
+        import shipgym_baselines.learned.plant_id.controller  # noqa: F401
     except BaseException:
         _BUILTINS_LOADED = False
         raise
@@ -207,6 +209,7 @@ def register_controller(
         action_mode=action_mode,
         applies_to=_ships(f"controller {name!r}", applies_to),
         kind=getattr(factory, "kind", "classical"),
+        training_seeds=tuple(getattr(factory, "training_seeds", (None,))),
         family=family,
         look=look,
     )

@@ -82,6 +82,9 @@ class NmpcEkf(PlantNMPC):
         FilterSettings(**filter_settings)  # an invalid value is an error here, not at reset
         self.preset = preset
         self.explicit = {k: float(v) for k, v in filter_settings.items()}
+        #: per step (t [s], state, parameter vector, disturbances): the plant it predicts
+        #: with (:mod:`shipgym_baselines.studies.estimation` scores it against the truth)
+        self.estimate_log: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
 
     def filter_settings(self, ship: str) -> FilterSettings:
         """The filter's settings on ``ship``: the chosen ones (``preset="tuned"``) under the
@@ -125,6 +128,7 @@ class NmpcEkf(PlantNMPC):
             )
         self._filtering = False
         self.estimates: list[np.ndarray] = []  # η per step (ln factors)
+        self.estimate_log = []
 
     def _fit_servo(self, info: dict[str, Any]) -> None:
         """The servo fit over the period just ended, handed to the filter (ln factors)."""
@@ -148,14 +152,15 @@ class NmpcEkf(PlantNMPC):
         else:
             self._fit_servo(info)
             self.ekf.step(float(info["rudder_command"]), y)
-        record = type(self.ctx.nominal_params).from_vector(self.ekf.params())
-        self.estimates.append(self.ekf.eta.copy())
+        theta = self.ekf.params()
         plant = PlantTruth(
             t=float(info["t"]),
             state=self.ekf.state.copy(),
-            params=record,
+            params=type(self.ctx.nominal_params).from_vector(theta),
             disturbance_now=self.ekf.disturbances.copy(),
         )
+        self.estimates.append(self.ekf.eta.copy())
+        self.estimate_log.append((plant.t, plant.state, theta, plant.disturbance_now))
         return self.steer(plant)
 
     def episode_stats(self) -> dict[str, float]:

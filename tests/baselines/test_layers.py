@@ -62,6 +62,7 @@ LAYERS: dict[str, int] = {
     f"{B}.learned.selection": 4,
     f"{B}.learned.dagger_agent": 4,
     f"{B}.learned.meta": 4,
+    f"{B}.learned.plant_id.train": 4,
     f"{B}.reproduce": 4,
     # 5 — the leaderboard
     f"{B}.leaderboard": 5,
@@ -99,6 +100,7 @@ EXCEPTIONS = _edge_table(
 CYCLE_EXCEPTIONS = _edge_table(
     """
     registry -> classical.*: _load_builtins, lazy, loads the built-ins, which register there
+    registry -> learned.plant_id.controller: _load_builtins, lazy, as the classical ones
     """
 )
 

@@ -45,13 +45,17 @@ BUILTINS = {
     "nmpc_lambda_lssvm": ("rudder", None),
     "nmpc_wlssvm_svf": ("rudder", None),
     "nmpc_lambda_lssvm_svf": ("rudder", None),
+    "nmpc_ekf": ("rudder", None),
     "zero_rudder": ("rudder", None),
     "random": ("rudder", None),
     "oracle": ("rudder", None),
     "oracle_frozen": ("rudder", None),
+    "nmpc_learned_id": ("rudder", None),
 }
 #: the references: shown on every scenario, never ranked
 REFERENCES = {"zero_rudder", "random", "oracle", "oracle_frozen"}
+#: the built-ins that are learned (registered by name, trained estimators shipped)
+LEARNED = {"nmpc_learned_id"}
 
 
 def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
@@ -61,7 +65,10 @@ def _without_compute_time(metrics: dict[str, Any]) -> dict[str, Any]:
 def test_builtin_controllers_keep_their_names_modes_and_ships() -> None:
     table = {name: (r.action_mode, r.applies_to) for name, r in CONTROLLERS.items()}
     assert table == BUILTINS
-    assert {controller_kind(name) for name in BUILTINS.keys() - REFERENCES} == {"classical"}
+    assert {controller_kind(name) for name in BUILTINS.keys() - REFERENCES - LEARNED} == {
+        "classical"
+    }
+    assert {controller_kind(name) for name in LEARNED} == {"learned"}
     assert {controller_kind(name) for name in REFERENCES} == {"reference"}
 
 

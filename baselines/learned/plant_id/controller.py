@@ -1,0 +1,149 @@
+"""``nmpc_learned_id``: the oracle's NMPC fed by the learned estimator φ.
+
+RMA's architecture (Kumar, Fu, Pathak & Malik 2021, "RMA: Rapid Motor Adaptation for
+Legged Robots"): an adaptation module φ reads a window of the recent history and estimates
+what the base policy needs of the plant; here the base policy is the oracle's NMPC on the
+ship's own model (:class:`~shipgym_baselines.classical.oracle.PlantNMPC`), and φ estimates
+the adapted quantities, the current and the yaw bias (:mod:`.labels`).  At every step:
+
+1. φ(window) = (μ, σ²) per slot (:mod:`.network`).
+2. **Where φ is unsure it falls back towards the nominal ship**: each slot is the posterior
+   mean under a prior N(0, s²) centred on the nominal ship (s = ``prior_std``):
+   μ·s²/(s² + σ²).  A confident φ (σ ≪ s) is used as it is; an unsure one is pulled to 0,
+   the nominal ship and no disturbance.
+3. The unmeasured states (surge and sway, a model's internal states) come from a
+   one-period prediction of the ship's model with the previous estimate, the measured
+   ones (position, heading, yaw rate, rudder angle) from ``info``.
+
+It reads ``info`` and the controller context only: φ learned from the truth at training
+time (:mod:`.train`), never at evaluation.  The shipped estimators are the folders
+``seeds/seed_<k>`` beside this module (``estimator.pt``, weights only, and ``meta.json``).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from shipgym.envs.context import ControllerContext
+from shipgym.envs.truth import PlantTruth
+from shipgym.identification.ekf import full_rudder_bias
+from shipgym_baselines.classical.nmpc_ekf import measurement
+from shipgym_baselines.classical.oracle import OracleSettings, PlantNMPC
+from shipgym_baselines.errors import ControllerError
+from shipgym_baselines.learned.plant_id.features import Window
+from shipgym_baselines.learned.plant_id.labels import SLOTS, plant_of, slot_mask
+from shipgym_baselines.learned.plant_id.network import WEIGHTS_FILE, Estimator
+from shipgym_baselines.policy import Style
+from shipgym_baselines.registry import register_controller
+
+#: the shipped estimators: ``seed_<k>`` folders
+SHIPPED = Path(__file__).parent / "seeds"
+_SEED = re.compile(r"seed_(\d+)")
+
+
+def shipped_seeds(folder: Path = SHIPPED) -> tuple[int, ...]:
+    """The training seeds of the estimators in ``folder`` (``seed_<k>`` with weights)."""
+    if not folder.is_dir():
+        return ()
+    return tuple(
+        sorted(
+            int(m.group(1))
+            for p in folder.iterdir()
+            if (m := _SEED.fullmatch(p.name)) and (p / WEIGHTS_FILE).is_file()
+        )
+    )
+
+
+@register_controller("nmpc_learned_id", family="learned", look=Style("#9467bd", "-", "P"))
+class NmpcLearnedId(PlantNMPC):
+    """``nmpc_learned_id`` (module doc).  ``training_seed``: which shipped estimator (None:
+    the first); ``folder``: an estimator's folder instead of a shipped one; ``prior_std``:
+    s of the fallback (ln-factor and slot units)."""
+
+    kind: ClassVar[str] = "learned"
+    training_seeds: ClassVar[tuple[int | None, ...]] = shipped_seeds() or (None,)
+
+    def __init__(
+        self,
+        training_seed: int | None = None,
+        folder: str | Path | None = None,
+        prior_std: float = 0.5,
+        settings: OracleSettings | None = None,
+    ) -> None:
+        super().__init__(settings)
+        if not prior_std > 0:
+            raise ValueError(f"prior_std must be > 0, got {prior_std!r}")
+        if folder is None:
+            seeds = shipped_seeds()
+            if not seeds:
+                raise ControllerError(
+                    "nmpc_learned_id: no shipped estimator in "
+                    f"{SHIPPED}; train one (python -m shipgym_baselines.learned.plant_id.train)"
+                )
+            seed = seeds[0] if training_seed is None else training_seed
+            if seed not in seeds:
+                raise ControllerError(f"nmpc_learned_id: no training seed {seed}; shipped {seeds}")
+            folder = SHIPPED / f"seed_{seed}"
+            self.training_seed = seed
+        else:
+            self.training_seed = training_seed
+        self.estimator = Estimator.load(Path(folder))
+        self.prior_var = prior_std**2
+        self.estimate_log: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def reset(self, context: ControllerContext, seed: int | None = None) -> None:
+        self.start(context)
+        model = context.nominal_model
+        self.window = Window(context)
+        self.mask = slot_mask(context.ship)
+        self.bias_scale = full_rudder_bias(model, context.rudder_limit)
+        self.substep = context.control_period / self.solver.grid.substeps
+        self.state: np.ndarray | None = None
+        self.theta = context.nominal_params.to_vector()
+        self.w = np.zeros(model.n_disturbances)
+        self.measured = np.array([model.state_index(n) for n in ("x", "y", "psi", "r", "delta")])
+        self.estimate_log = []
+        self.slot_log: list[tuple[np.ndarray, np.ndarray]] = []  # (μ, σ²) per step
+
+    def _state(self, info: dict[str, Any]) -> np.ndarray:
+        """The state now: the model's one-period prediction from the previous estimate with
+        the applied command, the measured entries from ``info``."""
+        model = self.ctx.nominal_model
+        if self.state is None:
+            x = model.cruise_state()
+            if "u" in model.state_names:
+                x[model.state_index("u")] = self.ctx.nominal_speed
+        else:
+            x = self.state
+            command = [float(info["rudder_command"])]
+            for _ in range(self.solver.grid.substeps):
+                x = model.step_numpy(x, command, self.w, self.theta, self.substep)
+            if not np.isfinite(x).all():
+                x = model.cruise_state()
+        x = np.array(x, dtype=float)
+        x[self.measured] = measurement(info)
+        return x
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        self.state = self._state(info)
+        self.window.add(info)
+        mean, var = self.estimator.predict(self.window.input())
+        slots = mean * self.prior_var / (self.prior_var + var) * self.mask
+        self.theta, self.w = plant_of(self.ctx, slots, self.bias_scale)
+        self.slot_log.append((mean, var))
+        t = float(info["t"])
+        self.estimate_log.append((t, self.state.copy(), self.theta.copy(), self.w.copy()))
+        plant = PlantTruth(
+            t=t,
+            state=self.state.copy(),
+            params=type(self.ctx.nominal_params).from_vector(self.theta),
+            disturbance_now=self.w,
+        )
+        return self.steer(plant)
+
+
+__all__ = ["SLOTS", "NmpcLearnedId", "shipped_seeds"]
