@@ -106,7 +106,7 @@ def _load_builtins() -> None:
         return
     _BUILTINS_LOADED = True  # set first: the package's modules register while it imports
     try:
-        import shipgym_baselines.classical  # noqa: F401
+        import shipgym_baselines.classical
         import shipgym_baselines.learned.plant_id.controller  # noqa: F401
     except BaseException:
         _BUILTINS_LOADED = False

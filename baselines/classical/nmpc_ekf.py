@@ -55,6 +55,40 @@ def measurement(info: dict[str, Any]) -> np.ndarray:
     return np.array([px, py, info["heading"], info["yaw_rate"], info["rudder_angle"]], dtype=float)
 
 
+def servo_fit(context: ControllerContext) -> ServoFit:
+    """The windowed servo fit of ``context``'s ship: from the nominal servo, over the last
+    yaw time constant T of fine samples (at least one period), bounded as the adapted
+    quantities ``servo`` and ``rate`` are."""
+    model = context.nominal_model
+    _, time_constant = first_order_nomoto(model, context.nominal_params)
+    nominal_t, nominal_rate = servo_constants(
+        model, context.nominal_params.to_vector(), context.rudder_limit
+    )
+    bounds = {
+        q.name: (q.low, q.high) for q in Adaptation(context.ship, context.nominal_params).quantities
+    }
+    window = round(time_constant / context.fine_step)
+    return ServoFit(
+        nominal_t,
+        nominal_rate,
+        context.fine_step,
+        max(window, round(context.control_period / context.fine_step)),
+        context.rudder_limit,
+        (bounds["servo"], bounds.get("rate", (1.0, 1.0))),
+    )
+
+
+def servo_factors(fit: ServoFit) -> dict[str, float]:
+    """The fit's estimate as ln factors on the nominal servo: ``servo`` and, where the
+    servo has a rate limit, ``rate``."""
+    t, rate = fit.fit()
+    nominal_t, nominal_rate = fit.nominal
+    factors = {"servo": math.log(t / nominal_t)}
+    if math.isfinite(nominal_rate):
+        factors["rate"] = math.log(rate / nominal_rate)
+    return factors
+
+
 @register_controller("nmpc_ekf", family="NMPC", look=Style("#d62728", "-", "P"))
 class NmpcEkf(PlantNMPC):
     """``nmpc_ekf`` (module doc).  ``preset``: "tuned" (default) reads the ship's chosen
@@ -111,21 +145,7 @@ class NmpcEkf(PlantNMPC):
             self.filter_settings(context.ship),
             given=tuple(q for q in SERVO_QUANTITIES if fitted and q in adaptation.names),
         )
-        self.servo_fit: ServoFit | None = None
-        if fitted:
-            nominal_t, nominal_rate = servo_constants(
-                model, context.nominal_params.to_vector(), context.rudder_limit
-            )
-            bounds = {q.name: (q.low, q.high) for q in adaptation.quantities}
-            window = round(time_constant / context.fine_step)  # one yaw time constant
-            self.servo_fit = ServoFit(
-                nominal_t,
-                nominal_rate,
-                context.fine_step,
-                max(window, round(context.control_period / context.fine_step)),
-                context.rudder_limit,
-                (bounds["servo"], bounds.get("rate", (1.0, 1.0))),
-            )
+        self.servo_fit = servo_fit(context) if fitted else None
         self._filtering = False
         self.estimates: list[np.ndarray] = []  # η per step (ln factors)
         self.estimate_log = []
@@ -137,14 +157,10 @@ class NmpcEkf(PlantNMPC):
         if fit is None or samples is None:
             return
         fit.add(samples["delta"], samples["delta_c"], float(info["rudder_angle"]))
-        t, rate = fit.fit()
-        nominal_t, nominal_rate = fit.nominal
-        given = {"servo": math.log(t / nominal_t)}
-        if math.isfinite(nominal_rate):
-            given["rate"] = math.log(rate / nominal_rate)
-        self.ekf.set_given(given)
+        self.ekf.set_given(servo_factors(fit))
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        self.mark()
         y = measurement(info)
         if not self._filtering:
             self.ekf.start(y, self.ctx.nominal_speed)

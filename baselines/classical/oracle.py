@@ -839,6 +839,15 @@ class PlantNMPC:
         self.failures = 0
         self.solve_times: list[float] = []  # wall clock [s]
         self.solve_cpu_times: list[float] = []  # this thread's CPU time [s]
+        #: a whole step's times (estimate and solve) of a controller that estimates the
+        #: plant: from :meth:`mark` to the end of :meth:`steer` [s]
+        self.step_times: list[float] = []
+        self.step_cpu_times: list[float] = []
+        self._mark: tuple[float, float] | None = None
+
+    def mark(self) -> None:
+        """The start of a step whose whole time :meth:`steer` records (``step_times``)."""
+        self._mark = (time.perf_counter(), time.thread_time())
 
     def steer(self, plant: PlantTruth) -> np.ndarray:
         """The action of one step: the plan's first command over the horizon predicted
@@ -876,6 +885,10 @@ class PlantNMPC:
             self.failures += 1
             self.plan = np.clip(guess, self.solver.lb, self.solver.ub)
         self.command = float(self.plan[0])
+        if self._mark is not None:
+            self.step_times.append(time.perf_counter() - self._mark[0])
+            self.step_cpu_times.append(time.thread_time() - self._mark[1])
+            self._mark = None
         return np.array([np.clip(self.command / ctx.rudder_limit, -1.0, 1.0)], dtype=np.float32)
 
     def episode_stats(self) -> dict[str, float]:

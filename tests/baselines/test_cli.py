@@ -224,6 +224,12 @@ def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
     monkeypatch.setattr(benchmarks, "NMPC_FAMILY", ("nmpc", "nmpc_lambda_lssvm_svf"))
     monkeypatch.setattr(benchmarks, "PER_SHIP_MAX_STEPS", 40)
     monkeypatch.setattr(benchmarks, "ORACLE_MAX_STEPS", 30)  # past the jumps (12 s)
+    monkeypatch.setattr(benchmarks, "ESTIMATING", ("nmpc_ekf",))
+    monkeypatch.setattr(
+        benchmarks,
+        "ESTIMATING_SCENARIOS",
+        {"nomoto2": ("rudder_aging",), "kvlcc2": ("kvlcc2_nominal",)},
+    )
     assert main(["bench", "nmpc", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)
     assert 0 < figures["nmpc_median_ms"] <= figures["nmpc_p99_ms"]
@@ -240,6 +246,11 @@ def test_cli_bench_nmpc_json(capsys, monkeypatch) -> None:
         # the privileged oracle, through its channel as in a run
         assert 0 < entry["oracle_median_ms"] <= entry["oracle_p99_ms"], ship
         assert entry["oracle_solves"] == (3 * 30 if ship == "nomoto2" else 30)
+    # the estimating controllers' whole steps (estimate and solve), KVLCC2 included
+    assert set(figures["estimating_per_ship"]) == {"nomoto2", "kvlcc2"}
+    for entry in figures["estimating_per_ship"].values():
+        assert 0 < entry["nmpc_ekf_step_cpu_median_ms"] <= entry["nmpc_ekf_step_cpu_p99_ms"]
+        assert entry["nmpc_ekf_steps"] == 30
 
 
 def test_cli_reproduce_liu2019_json(tmp_path, capsys) -> None:

@@ -7,10 +7,13 @@ ship's own model (:class:`~shipgym_baselines.classical.oracle.PlantNMPC`), and �
 the adapted quantities, the current and the yaw bias (:mod:`.labels`).  At every step:
 
 1. φ(window) = (μ, σ²) per slot (:mod:`.network`).
-2. **Where φ is unsure it falls back towards the nominal ship**: each slot is the posterior
-   mean under a prior N(0, s²) centred on the nominal ship (s = ``prior_std``):
-   μ·s²/(s² + σ²).  A confident φ (σ ≪ s) is used as it is; an unsure one is pulled to 0,
-   the nominal ship and no disturbance.
+2. **Where φ is unsure it falls back** towards the nominal ship, or for the servo towards
+   a model-based fit inside the window: each slot is the posterior mean of φ's N(μ, σ²)
+   under a prior N(m, s²), (μ/σ² + m/s²)/(1/σ² + 1/s²).  The prior is the nominal ship and
+   no disturbance (m = 0, s = ``prior_std``), but for the servo's time constant and rate
+   limit the windowed fit of the measured rudder (:class:`shipgym.identification.servo.
+   ServoFit`, m its ln factors, s = ``fit_std``) once it has samples.  A confident φ
+   (σ ≪ s) is used as it is; an unsure one gives way to the prior.
 3. The unmeasured states (surge and sway, a model's internal states) come from a
    one-period prediction of the ship's model with the previous estimate, the measured
    ones (position, heading, yaw rate, rudder angle) from ``info``.
@@ -31,11 +34,11 @@ import numpy as np
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
 from shipgym.identification.ekf import full_rudder_bias
-from shipgym_baselines.classical.nmpc_ekf import measurement
+from shipgym_baselines.classical.nmpc_ekf import measurement, servo_factors, servo_fit
 from shipgym_baselines.classical.oracle import OracleSettings, PlantNMPC
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.plant_id.features import Window
-from shipgym_baselines.learned.plant_id.labels import SLOTS, plant_of, slot_mask
+from shipgym_baselines.learned.plant_id.labels import SLOTS, UNLEARNED, plant_of, slot_mask
 from shipgym_baselines.learned.plant_id.network import WEIGHTS_FILE, Estimator
 from shipgym_baselines.policy import Style
 from shipgym_baselines.registry import register_controller
@@ -72,11 +75,13 @@ class NmpcLearnedId(PlantNMPC):
         training_seed: int | None = None,
         folder: str | Path | None = None,
         prior_std: float = 0.5,
+        fit_std: float = 0.1,
         settings: OracleSettings | None = None,
     ) -> None:
         super().__init__(settings)
-        if not prior_std > 0:
-            raise ValueError(f"prior_std must be > 0, got {prior_std!r}")
+        for key, value in (("prior_std", prior_std), ("fit_std", fit_std)):
+            if not value > 0:
+                raise ValueError(f"{key} must be > 0, got {value!r}")
         if folder is None:
             seeds = shipped_seeds()
             if not seeds:
@@ -93,6 +98,7 @@ class NmpcLearnedId(PlantNMPC):
             self.training_seed = training_seed
         self.estimator = Estimator.load(Path(folder))
         self.prior_var = prior_std**2
+        self.fit_var = fit_std**2
         self.estimate_log: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
@@ -100,6 +106,7 @@ class NmpcLearnedId(PlantNMPC):
         model = context.nominal_model
         self.window = Window(context)
         self.mask = slot_mask(context.ship)
+        self.unlearned = np.array([s in UNLEARNED for s in SLOTS])
         self.bias_scale = full_rudder_bias(model, context.rudder_limit)
         self.substep = context.control_period / self.solver.grid.substeps
         self.state: np.ndarray | None = None
@@ -108,6 +115,9 @@ class NmpcLearnedId(PlantNMPC):
         self.measured = np.array([model.state_index(n) for n in ("x", "y", "psi", "r", "delta")])
         self.estimate_log = []
         self.slot_log: list[tuple[np.ndarray, np.ndarray]] = []  # (μ, σ²) per step
+        self.servo_fit = servo_fit(context)
+        self.prior_mean = np.zeros(len(SLOTS))
+        self.prior_vars = np.full(len(SLOTS), self.prior_var)
 
     def _state(self, info: dict[str, Any]) -> np.ndarray:
         """The state now: the model's one-period prediction from the previous estimate with
@@ -128,11 +138,25 @@ class NmpcLearnedId(PlantNMPC):
         x[self.measured] = measurement(info)
         return x
 
+    def _prior(self, info: dict[str, Any]) -> None:
+        """The servo's slots' prior from the windowed fit of the period just ended."""
+        samples = info.get("samples")
+        if samples is None:
+            return
+        self.servo_fit.add(samples["delta"], samples["delta_c"], float(info["rudder_angle"]))
+        for name, value in servo_factors(self.servo_fit).items():
+            self.prior_mean[SLOTS.index(name)] = value
+            self.prior_vars[SLOTS.index(name)] = self.fit_var
+
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        self.mark()
         self.state = self._state(info)
         self.window.add(info)
+        self._prior(info)
         mean, var = self.estimator.predict(self.window.input())
-        slots = mean * self.prior_var / (self.prior_var + var) * self.mask
+        var[self.unlearned] = np.inf  # the prior alone: φ does not estimate them
+        precision = 1.0 / var + 1.0 / self.prior_vars
+        slots = (mean / var + self.prior_mean / self.prior_vars) / precision * self.mask
         self.theta, self.w = plant_of(self.ctx, slots, self.bias_scale)
         self.slot_log.append((mean, var))
         t = float(info["t"])

@@ -36,13 +36,25 @@ from shipgym.identification.ekf import full_rudder_bias
 QUANTITY_SLOTS = ("servo", "rate", "rudder", "draught", "gain", "time")
 #: every slot (module doc)
 SLOTS = (*QUANTITY_SLOTS, "current_x", "current_y", "bias")
+#: the slots φ does not estimate: the training distribution never moves a rate limit
+#: (its rudder aging slows the servo's time constant only), so φ would learn a constant 0
+#: with full confidence; the controller takes them from the servo's fit
+UNLEARNED = ("rate",)
 assert {q.name for qs in QUANTITIES.values() for q in qs} <= set(QUANTITY_SLOTS)
 
 
-def slot_mask(ship: str) -> np.ndarray:
-    """(len(SLOTS),) 1 where ``ship`` has the slot, else 0."""
+def slot_mask(ship: str, learned: bool = False) -> np.ndarray:
+    """(len(SLOTS),) 1 where ``ship`` has the slot, else 0; ``learned``: only where φ
+    estimates it (not :data:`UNLEARNED`: the loss's mask)."""
     names = {q.name for q in QUANTITIES[ship]}
-    return np.array([1.0 if s in names or s not in QUANTITY_SLOTS else 0.0 for s in SLOTS])
+    return np.array(
+        [
+            1.0
+            if (s in names or s not in QUANTITY_SLOTS) and not (learned and s in UNLEARNED)
+            else 0.0
+            for s in SLOTS
+        ]
+    )
 
 
 class Labeller:

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing
 import shutil
 import time
 from collections.abc import Sequence
@@ -37,6 +36,7 @@ from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.scenarios import load_scenario
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import load_distribution, train_rng
+from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.learned.plant_id.features import STEP_FEATURES, WINDOW, step_row
 from shipgym_baselines.learned.plant_id.labels import SLOTS, Labeller, slot_mask
 from shipgym_baselines.learned.plant_id.network import Estimator, build, nll, one_thread
@@ -72,7 +72,7 @@ def rollout(scenario: Any, policy: Any, seed: int) -> dict[str, np.ndarray]:
             "rows": np.array(rows, dtype=np.float32),
             "context": np.tile(ctx.feature_row, (n, 1)).astype(np.float32),
             "labels": np.array(labels, dtype=np.float32),
-            "mask": np.tile(slot_mask(ctx.ship), (n, 1)).astype(np.float32),
+            "mask": np.tile(slot_mask(ctx.ship, learned=True), (n, 1)).astype(np.float32),
         }
     finally:
         env.close()
@@ -98,11 +98,7 @@ def _episode(job: tuple[str, dict, int, str | None]) -> dict[str, np.ndarray]:
 def collect(jobs: Sequence[tuple], workers: int) -> dict[str, np.ndarray]:
     """The episodes of ``jobs`` (in order), concatenated, with ``starts`` (each episode's
     first row)."""
-    if workers > 1:
-        with multiprocessing.get_context("spawn").Pool(workers) as pool:
-            episodes = pool.map(_episode, jobs, chunksize=1)
-    else:
-        episodes = [_episode(job) for job in jobs]
+    episodes = list(map_jobs(_episode, jobs, "local", workers, ordered=True))
     lengths = [len(e["rows"]) for e in episodes]
     data = {k: np.concatenate([e[k] for e in episodes]) for k in episodes[0]}
     data["starts"] = np.cumsum([0, *lengths[:-1]]).astype(np.int64)

@@ -160,3 +160,32 @@ def test_the_learned_controller_reads_no_truth(
     result = run_episode(policy, load_scenario("rudder_aging"), seed=10_000)
     assert calls == []
     assert np.isfinite(result.metrics["cost"])
+
+
+def test_training_writes_its_rounds_and_resumes_without_collecting_again(tmp_path: Path) -> None:
+    """A tiny run: per round its data and φ, the error curve and data cost in the final
+    meta; a resumed run whose last φ was lost refits it from the kept data (no new
+    episodes: the shards are untouched) and a finished run resumed trains nothing."""
+    from shipgym_baselines.learned.plant_id import train as trainer
+
+    out = tmp_path / "phi"
+    kwargs = dict(
+        first=2, later=1, rounds=2, updates=5, later_updates=3, workers=1, validation_trials=1
+    )
+    meta = trainer.train(0, out, False, **kwargs)
+    assert [c["round"] for c in meta["error_curve"]] == [0, 1]
+    assert set(meta["error_curve"][0]["validation_rmse"]) == set(SLOTS)
+    assert [c["episodes"] for c in meta["data_cost"]] == [2, 1]
+    assert meta["data_cost"][1]["behaviour"] == "nmpc_learned_id"
+    shards = {p.name: p.stat().st_mtime_ns for p in (out / "data").iterdir()}
+    with pytest.raises(FileExistsError):
+        trainer.train(0, out, False, **kwargs)
+    import shutil
+
+    shutil.rmtree(out / "round_001")
+    again = trainer.train(0, out, True, **kwargs)
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "data").iterdir()} == shards
+    assert again["error_curve"][0] == meta["error_curve"][0]
+    assert (out / "estimator" / "estimator.pt").is_file()
+    policy = NmpcLearnedId(folder=out / "estimator")
+    assert policy.estimator.meta["round"] == 1
