@@ -693,7 +693,17 @@ def _evaluate_dealt(
     made = {k: _make(controller, guard, label, training_seed=k) for k in dict.fromkeys(owners)}
     unmade = [i for i, k in enumerate(owners) if isinstance(made[k][0], _Unmade)]
     if not all(isinstance(p, BatchPolicy | _Unmade) for p, _ in made.values()):
-        raise ControllerError(f"training_seeds: {controller!r} is not a learned agent")
+        first = next(p for p, _ in made.values())
+        if first.kind != "learned":
+            raise ControllerError(f"training_seeds: {controller!r} is not a learned agent")
+        # a learned controller that acts per episode (nmpc_learned_id): each episode its own
+        # instance of its owner's training seed, all in lockstep
+        policies = [made[owners[0]][0]] + [
+            _make(controller, guard, label, training_seed=k)[0] for k in owners[1:]
+        ]
+        mode = action_mode or made[owners[0]][1] or first.action_mode
+        labels = _dealt_labels(scenarios, owners, first.name, label)
+        return _run_lockstep(policies, _episodes(scenarios, seeds, mode, env_id), guard, labels)
     out: dict[int, EpisodeResult] = {}
     if unmade:  # their episodes end at reset; the other training seeds' run as dealt
         policies = [made[owners[i]][0] for i in unmade]

@@ -24,7 +24,8 @@ change.
 ``python -m shipgym_baselines.studies.estimation [--controllers C …] [--trials N] [--out DIR]``
 plays the first N trials per ship of the validation split (default 8: all of them) and
 writes ``estimation.json`` and the figures ``estimation_families.png`` (the error ratio per
-family) and ``estimation_trial.png`` (one trial's estimate against the truth) into DIR.
+family) and ``estimation_trial.png`` (a rudder-aging trial's servo time constant and a
+current-shift trial's current speed, estimated against the truth) into DIR.
 """
 
 from __future__ import annotations
@@ -107,6 +108,8 @@ def score_episode(policy: Any, scenario: Scenario, disturbances: dict[str, np.nd
     ts, h = scenario.control_period, scenario.fine_step
     ends, w_true = period_means(disturbances, model.disturbance_names, ts)
     log = policy.estimate_log
+    servo = next(q.params[0] for q in QUANTITIES[model.name] if q.name == "servo")
+    i_servo = type(nominal).names().index(servo)
     picks = (
         np.unique(np.linspace(1, len(log) - 1, SCORED_STEPS).astype(int)) if len(log) > 1 else []
     )
@@ -126,11 +129,21 @@ def score_episode(policy: Any, scenario: Scenario, disturbances: dict[str, np.nd
                 t,
                 float(np.hypot(*(ends_xy[1] - ends_xy[0])) / length),
                 float(np.hypot(*(ends_xy[2] - ends_xy[0])) / length),
+                float(theta[i_servo]),
+                float(truth[i_servo]),
+                float(np.hypot(*w[:2])),
+                float(np.hypot(*w_true[period][:2])),
             )
         )
     times = np.array([r[0] for r in rows])
     error = np.array([r[1] for r in rows])
     frozen = np.array([r[2] for r in rows])
+    series = {
+        "servo_estimate_s": [r[3] for r in rows],
+        "servo_true_s": [r[4] for r in rows],
+        "current_estimate_m_s": [r[5] for r in rows],
+        "current_true_m_s": [r[6] for r in rows],
+    }
     change = change_time(scenario)
     family = change_family(scenario, float(times[-1]) if times.size else 0.0, w_true[0], w_true[-1])
     after = times >= (change if change is not None else math.inf)
@@ -143,6 +156,7 @@ def score_episode(policy: Any, scenario: Scenario, disturbances: dict[str, np.nd
         "t": times.tolist(),
         "error_L": error.tolist(),
         "nominal_error_L": frozen.tolist(),
+        **series,
     }
     if after.any():
         out["error_after_L"] = float(error[after].mean())
@@ -221,21 +235,32 @@ def draw(rows: Sequence[dict], summaries: dict, out: Path) -> None:
     fig.tight_layout()
     fig.savefig(out / "estimation_families.png", dpi=120)
     plt.close(fig)
-    changing = [r for r in rows if r.get("error_share") is not None]
-    if not changing:
-        return
-    trial = max(changing, key=lambda r: r["nominal_after_L"])
-    fig, ax = plt.subplots(figsize=(6.4, 3.2))
-    t = np.array(trial["t"])
-    for r in rows:
-        if r["scenario"] == trial["scenario"]:
-            ax.plot(t, r["error_L"], label=f"{r['controller']} (estimate)")
-    ax.plot(t, trial["nominal_error_L"], color="0.4", ls="--", label="nominal ship")
-    ax.axvline(trial["change_time"], color="k", lw=0.8)
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("probe error [L]")
-    ax.set_title(f"{trial['scenario']} ({trial['ship']}, {trial['family'].replace('_', ' ')})")
-    ax.legend(frameon=False)
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.2))
+    for ax, family, key, unit in (
+        (axes[0], "rudder_aging", "servo", "servo time constant [s]"),
+        (axes[1], "current_shift", "current", "current speed [m/s]"),
+    ):
+        trials = [r for r in rows if r["family"] == family and r.get("error_share") is not None]
+        if not trials:
+            ax.set_visible(False)
+            continue
+        trial = trials[0]["scenario"]
+        estimate, true = (
+            ("servo_estimate_s", "servo_true_s")
+            if key == "servo"
+            else ("current_estimate_m_s", "current_true_m_s")
+        )
+        first = None
+        for r in rows:
+            if r["scenario"] == trial:
+                first = first or r
+                ax.plot(r["t"], r[estimate], label=r["controller"])
+        assert first is not None
+        ax.plot(first["t"], first[true], color="k", ls="--", label="truth")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(unit)
+        ax.set_title(f"{trial} ({first['ship']})")
+        ax.legend(frameon=False)
     fig.tight_layout()
     fig.savefig(out / "estimation_trial.png", dpi=120)
     plt.close(fig)

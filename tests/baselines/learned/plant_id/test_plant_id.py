@@ -189,3 +189,21 @@ def test_training_writes_its_rounds_and_resumes_without_collecting_again(tmp_pat
     assert (out / "estimator" / "estimator.pt").is_file()
     policy = NmpcLearnedId(folder=out / "estimator")
     assert policy.estimator.meta["round"] == 1
+
+
+@pytest.mark.skipif(len(NmpcLearnedId.training_seeds) < 2, reason="needs two shipped seeds")
+def test_dealt_trials_are_each_seeds_own_episode() -> None:
+    """A shared-trials row deals its trials among the shipped estimators: each dealt
+    episode is the one its training seed plays alone (lockstep changes nothing), labelled
+    with that seed."""
+    from shipgym_baselines.evaluation import evaluate_batch
+
+    first, second = NmpcLearnedId.training_seeds[:2]
+    seeds = [10_000, 10_001]
+    dealt = evaluate_batch("nmpc_learned_id", "rudder_aging", seeds, training_seeds=[first, second])
+    alone = [
+        run_episode(NmpcLearnedId(training_seed=k), load_scenario("rudder_aging"), seed=s)
+        for k, s in zip((first, second), seeds, strict=True)
+    ]
+    assert [r.training_seed for r in dealt] == [first, second]
+    assert [r.metrics["cost"] for r in dealt] == [r.metrics["cost"] for r in alone]
