@@ -89,7 +89,7 @@ def servo_factors(fit: ServoFit) -> dict[str, float]:
     return factors
 
 
-@register_controller("nmpc_ekf", family="NMPC", look=Style("#d62728", "-", "P"))
+@register_controller("nmpc_ekf", family="NMPC", look=Style("#e31a1c", "-", "v"))
 class NmpcEkf(PlantNMPC):
     """``nmpc_ekf`` (module doc).  ``preset``: "tuned" (default) reads the ship's chosen
     filter settings (``configs/tuning/chosen/nmpc_ekf.yaml``) under the ones given here;

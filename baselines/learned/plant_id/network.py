@@ -25,7 +25,11 @@ LOG_VAR_MIN, LOG_VAR_MAX = -12.0, 4.0
 
 
 def one_thread() -> Any:
-    """torch, set to one thread."""
+    """torch, set to one thread (a :class:`~shipgym_baselines.extras.MissingExtra` naming
+    the ``rl`` extra when torch is not installed)."""
+    from shipgym_baselines.extras import require
+
+    require("torch", "rl", "nmpc_learned_id")
     import torch
 
     torch.set_num_threads(1)
