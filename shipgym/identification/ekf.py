@@ -38,6 +38,11 @@ disturbance covariance is reset to its initial value (covariance resetting, Good
 1984, §6.7): the filter believes the nominal ship no more than at the start and learns the
 new one from the next measurements.  A prediction that leaves the finite numbers (an
 estimate the model cannot integrate) restarts η and w from the nominal ship.
+
+**Given quantities.**  A quantity estimated elsewhere (``given``: ``nmpc_ekf`` fits the servo
+from the measured rudder, :mod:`shipgym.identification.servo`) is set before each
+prediction (:meth:`ShipEKF.set_given`) and has no walk and no covariance: the filter
+predicts with it and never updates it.
 """
 
 from __future__ import annotations

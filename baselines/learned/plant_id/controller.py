@@ -64,8 +64,9 @@ def shipped_seeds(folder: Path = SHIPPED) -> tuple[int, ...]:
 @register_controller("nmpc_learned_id", family="learned", look=Style("#9467bd", "-", "P"))
 class NmpcLearnedId(PlantNMPC):
     """``nmpc_learned_id`` (module doc).  ``training_seed``: which shipped estimator (None:
-    the first); ``folder``: an estimator's folder instead of a shipped one; ``prior_std``:
-    s of the fallback (ln-factor and slot units)."""
+    the first); ``folder``: an estimator's folder instead of a shipped one; ``prior_std``
+    and ``fit_std``: s of the fallback to the nominal ship and to the servo's fit (ln-factor
+    and slot units)."""
 
     kind: ClassVar[str] = "learned"
     training_seeds: ClassVar[tuple[int | None, ...]] = shipped_seeds() or (None,)
@@ -170,4 +171,4 @@ class NmpcLearnedId(PlantNMPC):
         return self.steer(plant)
 
 
-__all__ = ["SLOTS", "NmpcLearnedId", "shipped_seeds"]
+__all__ = ["NmpcLearnedId", "shipped_seeds"]
