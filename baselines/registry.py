@@ -94,9 +94,9 @@ _BUILTINS_LOADED = False
 
 
 def _load_builtins() -> None:
-    """Import :mod:`shipgym_baselines.classical` and the learned controllers that register
-    by name (:mod:`shipgym_baselines.learned.plant_id.controller`), whose modules register
-    the built-in controllers, once per process.
+    """Import the modules that register the built-in controllers, once per process:
+    :mod:`shipgym_baselines.classical` and the learned controller registered by name,
+    :mod:`shipgym_baselines.learned.plant_id.controller`.
 
     The one import of the controllers by the registry, lazy (inside this function) because
     they import the registry to register: a reader calls it before reading the records.

@@ -43,7 +43,8 @@ from shipgym_baselines.registry import register_controller
 FILTER_KEYS = tuple(f.name for f in dataclasses.fields(FilterSettings))
 #: where the servo's time constant and rate limit come from: the windowed fit of the
 #: measured rudder (:mod:`shipgym.identification.servo`, the default) or the EKF's own
-#: augmented state ("filter", the issue's literal design: trapped by the rate limit)
+#: augmented state ("filter": a slowed servo's prediction is rate-limited, so the filter
+#: explains it by the rate limit alone and never sees the time constant)
 SERVO_ESTIMATES = ("fit", "filter")
 #: the adapted quantities the servo fit gives
 SERVO_QUANTITIES = ("servo", "rate")

@@ -114,6 +114,16 @@ def state_scales(model: ShipModel, length: float, speed: float, rudder_limit: fl
     )
 
 
+def measured_start(model: ShipModel, measurement: np.ndarray, speed: float) -> np.ndarray:
+    """The state at a first measurement y = (x, y, ψ, r, δ): the ship at cruise, its surge
+    at ``speed`` [m/s] where the model has one, the measured entries as measured."""
+    x0 = np.array(model.cruise_state(), dtype=float)
+    if "u" in model.state_names:
+        x0[model.state_index("u")] = speed
+    x0[[model.state_index(name) for name in MEASURED]] = measurement
+    return x0
+
+
 def full_rudder_bias(model: ShipModel, rudder_limit: float) -> float:
     """b: the yaw bias whose effect equals full rudder's on the state row the bias drives
     (|∂f/∂δ|·δmax/|∂f/∂w_ψ| at cruise; module doc)."""
@@ -258,10 +268,7 @@ class ShipEKF:
         """The estimate at the first measurement y = (x, y, ψ, r, δ): the ship at cruise
         with the measured entries, the nominal ship and no disturbance; covariance from
         the measurement noise and the initial σ's (module doc)."""
-        x0 = self.model.cruise_state()
-        x0[self.measured] = measurement
-        if "u" in self.model.state_names:
-            x0[self.model.state_index("u")] = speed
+        x0 = measured_start(self.model, measurement, speed)
         self.z = np.concatenate([x0, np.zeros(self.m + self.nw)])
         diag = np.concatenate([self.q[: self.nx] * 100.0, self.p0_extra])
         diag[self.measured] = self.r

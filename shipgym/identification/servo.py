@@ -28,23 +28,19 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
-from shipgym.models.base import ShipModel
+from shipgym.models.base import ShipModel, rk4_step
 
 
 def servo_step(
     delta: np.ndarray, target: np.ndarray, time_constant: float, rate: float, h: float
 ) -> np.ndarray:
-    """δ after one RK4 step of h [s] of δ̇ = clip((target − δ)/T, ±rate) (rad, s, rad/s;
-    ``rate`` inf: no limit), elementwise."""
+    """δ after one RK4 step (:func:`shipgym.models.base.rk4_step`, the env's) of h [s] of
+    δ̇ = clip((target − δ)/T, ±rate) (rad, s, rad/s; ``rate`` inf: no limit), elementwise."""
 
-    def f(d: np.ndarray) -> np.ndarray:
-        return np.clip((target - d) / time_constant, -rate, rate)
+    def f(d: np.ndarray, u: np.ndarray, w: object, p: object) -> np.ndarray:
+        return np.clip((u - d) / time_constant, -rate, rate)
 
-    k1 = f(delta)
-    k2 = f(delta + 0.5 * h * k1)
-    k3 = f(delta + 0.5 * h * k2)
-    k4 = f(delta + h * k3)
-    return delta + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return rk4_step(f, delta, target, None, None, h)
 
 
 class ServoFit:

@@ -44,3 +44,31 @@ def copy_folder(source: Path, target: Path) -> Path:
     """A copy of a run folder, every file of it (its manifest included)."""
     shutil.copytree(source, target)
     return target
+
+
+@pytest.fixture
+def truth_calls(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Spies on every way to the truth: the training-time teacher channel, the evaluation
+    loop's privileged reset and the env's ``plant_truth``.  The list holds the name of each
+    call made while the test runs (the originals still answer)."""
+    from shipgym.envs.path_follow import ShipPathFollowEnv
+    from shipgym_baselines import evaluation, privileged
+
+    calls: list[str] = []
+
+    def spy(name: str, original: object) -> object:
+        def recorded(*args: object, **kwargs: object) -> object:
+            calls.append(name)
+            return original(*args, **kwargs)  # type: ignore[operator]
+
+        return recorded
+
+    monkeypatch.setattr(privileged, "teacher_truth", spy("teacher_truth", privileged.teacher_truth))
+    for module in (privileged, evaluation):
+        monkeypatch.setattr(
+            module, "reset_with_truth", spy("reset_with_truth", privileged.reset_with_truth)
+        )
+    monkeypatch.setattr(
+        ShipPathFollowEnv, "plant_truth", spy("plant_truth", ShipPathFollowEnv.plant_truth)
+    )
+    return calls

@@ -33,7 +33,8 @@ import numpy as np
 
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
-from shipgym.identification.ekf import full_rudder_bias
+from shipgym.identification.adaptation import Adaptation
+from shipgym.identification.ekf import MEASURED, full_rudder_bias, measured_start
 from shipgym_baselines.classical.nmpc_ekf import measurement, servo_factors, servo_fit
 from shipgym_baselines.classical.oracle import OracleSettings, PlantNMPC
 from shipgym_baselines.errors import ControllerError
@@ -107,13 +108,14 @@ class NmpcLearnedId(PlantNMPC):
         model = context.nominal_model
         self.window = Window(context)
         self.mask = slot_mask(context.ship)
+        self.adaptation = Adaptation(context.ship, context.nominal_params)
         self.unlearned = np.array([s in UNLEARNED for s in SLOTS])
         self.bias_scale = full_rudder_bias(model, context.rudder_limit)
         self.substep = context.control_period / self.solver.grid.substeps
         self.state: np.ndarray | None = None
         self.theta = context.nominal_params.to_vector()
         self.w = np.zeros(model.n_disturbances)
-        self.measured = np.array([model.state_index(n) for n in ("x", "y", "psi", "r", "delta")])
+        self.measured = np.array([model.state_index(n) for n in MEASURED])
         self.estimate_log = []
         self.slot_log: list[tuple[np.ndarray, np.ndarray]] = []  # (μ, σ²) per step
         self.servo_fit = servo_fit(context)
@@ -124,19 +126,17 @@ class NmpcLearnedId(PlantNMPC):
         """The state now: the model's one-period prediction from the previous estimate with
         the applied command, the measured entries from ``info``."""
         model = self.ctx.nominal_model
+        y = measurement(info)
         if self.state is None:
-            x = model.cruise_state()
-            if "u" in model.state_names:
-                x[model.state_index("u")] = self.ctx.nominal_speed
-        else:
-            x = self.state
-            command = [float(info["rudder_command"])]
-            for _ in range(self.solver.grid.substeps):
-                x = model.step_numpy(x, command, self.w, self.theta, self.substep)
-            if not np.isfinite(x).all():
-                x = model.cruise_state()
+            return measured_start(model, y, self.ctx.nominal_speed)
+        x = self.state
+        command = [float(info["rudder_command"])]
+        for _ in range(self.solver.grid.substeps):
+            x = model.step_numpy(x, command, self.w, self.theta, self.substep)
+        if not np.isfinite(x).all():
+            return measured_start(model, y, self.ctx.nominal_speed)
         x = np.array(x, dtype=float)
-        x[self.measured] = measurement(info)
+        x[self.measured] = y
         return x
 
     def _prior(self, info: dict[str, Any]) -> None:
@@ -158,7 +158,7 @@ class NmpcLearnedId(PlantNMPC):
         var[self.unlearned] = np.inf  # the prior alone: φ does not estimate them
         precision = 1.0 / var + 1.0 / self.prior_vars
         slots = (mean / var + self.prior_mean / self.prior_vars) / precision * self.mask
-        self.theta, self.w = plant_of(self.ctx, slots, self.bias_scale)
+        self.theta, self.w = plant_of(self.ctx, self.adaptation, slots, self.bias_scale)
         self.slot_log.append((mean, var))
         t = float(info["t"])
         self.estimate_log.append((t, self.state.copy(), self.theta.copy(), self.w.copy()))

@@ -40,7 +40,6 @@ SLOTS = (*QUANTITY_SLOTS, "current_x", "current_y", "bias")
 #: (its rudder aging slows the servo's time constant only), so φ would learn a constant 0
 #: with full confidence; the controller takes them from the servo's fit
 UNLEARNED = ("rate",)
-assert {q.name for qs in QUANTITIES.values() for q in qs} <= set(QUANTITY_SLOTS)
 
 
 def slot_mask(ship: str, learned: bool = False) -> np.ndarray:
@@ -109,11 +108,11 @@ class Labeller:
 
 
 def plant_of(
-    ctx: ControllerContext, slots: np.ndarray, bias_scale: float
+    ctx: ControllerContext, adaptation: Adaptation, slots: np.ndarray, bias_scale: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(parameter vector, disturbances) of an estimate in slots (the inverse of the labels:
-    nomoto2's bias goes to its yaw_disturbance)."""
-    adaptation = Adaptation(ctx.ship, ctx.nominal_params)
+    """(parameter vector, disturbances) of an estimate in slots, through ``ctx``'s ship's
+    ``adaptation`` map (the inverse of the labels: nomoto2's bias goes to its
+    yaw_disturbance)."""
     eta = np.array([slots[SLOTS.index(n)] for n in adaptation.names])
     theta = adaptation.params(adaptation.clip(eta))
     model = ctx.nominal_model

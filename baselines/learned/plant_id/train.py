@@ -225,7 +225,7 @@ def train(
         folder = out / f"round_{r:03d}"
         if not shard.exists():
             behaviour = None if r == 0 else str(out / f"round_{r - 1:03d}")
-            start, cpu = time.perf_counter(), time.process_time()
+            start = time.perf_counter()
             data = collect(round_jobs(seed, r, first if r == 0 else later, behaviour), workers)
             save_data(shard, data)
             cost["rounds"] = [c for c in cost["rounds"] if c["round"] != r] + [
@@ -238,7 +238,6 @@ def train(
                 }
             ]
             cost_file.write_text(json.dumps(cost, indent=1))
-            del cpu
         parts.append(load_data(shard))
         if (folder / "meta.json").exists():
             estimator = Estimator.load(folder)

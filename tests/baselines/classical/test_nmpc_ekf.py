@@ -4,14 +4,11 @@ oracle where the ship does not change, and recovers a change it was not told of.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import pytest
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.scenarios import load_scenario
-from shipgym_baselines import evaluation, privileged
 from shipgym_baselines.classical.nmpc_ekf import NmpcEkf
 from shipgym_baselines.evaluation import evaluate, run_episode
 from shipgym_baselines.registry import resolve_controller
@@ -23,26 +20,10 @@ def test_it_is_a_classical_competitor_of_the_nmpc_family() -> None:
     assert NmpcEkf.kind == "classical"
 
 
-def test_the_spies_see_no_read_of_the_truth(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_spies_see_no_read_of_the_truth(truth_calls: list[str]) -> None:
     """Neither the privileged channel nor the env's truth is called while it plays; the
     same spies see the oracle read both."""
-    calls: list[str] = []
-
-    def spy(name: str, original: Any) -> Any:
-        def recorded(*args: Any, **kwargs: Any) -> Any:
-            calls.append(name)
-            return original(*args, **kwargs)
-
-        return recorded
-
-    monkeypatch.setattr(privileged, "teacher_truth", spy("teacher_truth", privileged.teacher_truth))
-    for module in (privileged, evaluation):
-        monkeypatch.setattr(
-            module, "reset_with_truth", spy("reset_with_truth", privileged.reset_with_truth)
-        )
-    monkeypatch.setattr(
-        ShipPathFollowEnv, "plant_truth", spy("plant_truth", ShipPathFollowEnv.plant_truth)
-    )
+    calls = truth_calls
     (result,) = evaluate("nmpc_ekf", "rudder_aging", seeds=[10_000])
     assert calls == []
     assert result.metrics["termination_reason"] == "goal"

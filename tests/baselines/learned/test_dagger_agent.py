@@ -19,8 +19,6 @@ import yaml
 
 import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs import core
-from shipgym.envs.path_follow import ShipPathFollowEnv
-from shipgym_baselines import evaluation, privileged
 from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.evaluation import evaluate, evaluate_batch
 from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
@@ -99,7 +97,7 @@ def test_the_agent_folder_holds_what_every_agent_writes(trained: dict[str, Any])
 
 
 def test_the_selected_student_ships_loads_as_data_and_is_scored_without_truth(
-    trained: dict[str, Any], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    trained: dict[str, Any], tmp_path: Path, truth_calls: list[str]
 ) -> None:
     """Exported as every agent is; its zip read by the data-only loader has the selected
     round's weights; the adapter (K from meta.json) evaluates it on the plain env, and no
@@ -129,23 +127,7 @@ def test_the_selected_student_ships_loads_as_data_and_is_scored_without_truth(
         True,
     )
 
-    calls: list[str] = []
-
-    def spy(name: str, original: Any) -> Any:
-        def recorded(*args: Any, **kwargs: Any) -> Any:
-            calls.append(name)
-            return original(*args, **kwargs)
-
-        return recorded
-
-    monkeypatch.setattr(privileged, "teacher_truth", spy("teacher_truth", privileged.teacher_truth))
-    for module in (privileged, evaluation):
-        monkeypatch.setattr(
-            module, "reset_with_truth", spy("reset_with_truth", privileged.reset_with_truth)
-        )
-    monkeypatch.setattr(
-        ShipPathFollowEnv, "plant_truth", spy("plant_truth", ShipPathFollowEnv.plant_truth)
-    )
+    calls = truth_calls
     policy = LearnedPolicy(target)
     assert policy.history_steps == K
     seeds = [10_000, 10_001]

@@ -15,7 +15,6 @@ from shipgym.envs.context import ControllerContext
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.envs.truth import PlantTruth
 from shipgym.scenarios import load_scenario
-from shipgym_baselines import evaluation, privileged
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.learned.plant_id.controller import NmpcLearnedId
 from shipgym_baselines.learned.plant_id.features import Window, episode_windows, step_row
@@ -61,7 +60,7 @@ def test_the_labels_of_a_catalogue_change_are_its_size(
     for other in names:
         if other != slot and not (other == "rate" and moved_rate):
             assert labels[SLOTS.index(other)] == pytest.approx(0.0, abs=1e-4), other
-    theta, w = plant_of(ctx, labels, labeller.bias_scale)
+    theta, w = plant_of(ctx, labeller.adaptation, labels, labeller.bias_scale)
     np.testing.assert_allclose(theta, after.to_vector(), rtol=1e-3)
     np.testing.assert_allclose(w, 0.0, atol=1e-12)
 
@@ -76,8 +75,15 @@ def test_nomoto2_d0_shift_is_its_yaw_bias() -> None:
     labels = labeller(truth)
     shift = after.d0 - ctx.nominal_params.d0
     assert labels[SLOTS.index("bias")] == pytest.approx(shift / labeller.bias_scale, rel=1e-9)
-    _, w = plant_of(ctx, labels, labeller.bias_scale)
+    _, w = plant_of(ctx, labeller.adaptation, labels, labeller.bias_scale)
     assert w[2] == pytest.approx(shift, rel=1e-9)
+
+
+def test_every_adapted_quantity_has_a_slot() -> None:
+    from shipgym.identification.adaptation import QUANTITIES
+    from shipgym_baselines.learned.plant_id.labels import QUANTITY_SLOTS
+
+    assert {q.name for qs in QUANTITIES.values() for q in qs} == set(QUANTITY_SLOTS)
 
 
 def test_a_ship_has_its_own_slots() -> None:
@@ -132,30 +138,12 @@ def test_training_windows_are_the_acting_windows(tmp_path: Path) -> None:
     np.testing.assert_allclose(window.input(), acting[1], rtol=1e-6)
 
 
-def test_the_learned_controller_reads_no_truth(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_the_learned_controller_reads_no_truth(tmp_path: Path, truth_calls: list[str]) -> None:
     """nmpc_learned_id (any φ) plays without a call of the privileged channel or the env's
     truth; it is a learned row."""
     folder = _tiny_estimator(tmp_path / "phi", 32 * 9 + 7)
     assert resolve_controller("nmpc_learned_id").kind == "learned"
-    calls: list[str] = []
-
-    def spy(name: str, original: Any) -> Any:
-        def recorded(*args: Any, **kwargs: Any) -> Any:
-            calls.append(name)
-            return original(*args, **kwargs)
-
-        return recorded
-
-    monkeypatch.setattr(privileged, "teacher_truth", spy("teacher_truth", privileged.teacher_truth))
-    for module in (privileged, evaluation):
-        monkeypatch.setattr(
-            module, "reset_with_truth", spy("reset_with_truth", privileged.reset_with_truth)
-        )
-    monkeypatch.setattr(
-        ShipPathFollowEnv, "plant_truth", spy("plant_truth", ShipPathFollowEnv.plant_truth)
-    )
+    calls = truth_calls
     policy = NmpcLearnedId(folder=folder)
     result = run_episode(policy, load_scenario("rudder_aging"), seed=10_000)
     assert calls == []
