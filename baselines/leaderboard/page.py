@@ -69,6 +69,7 @@ color:#1b1f24;background:#fff}
 h1{font-size:24px;margin:0 0 4px}h2{font-size:19px;margin:28px 0 8px;border-bottom:1px solid
 #d0d7de;padding-bottom:4px}h3{font-size:16px;margin:18px 0 6px}
 p.note{color:#57606a;margin:4px 0 10px;max-width:75em}
+.flag{color:#b15928;cursor:help;white-space:nowrap}
 .scroll{overflow-x:auto;max-width:100%;border:1px solid #d0d7de;border-radius:4px}
 table{border-collapse:collapse;font-variant-numeric:tabular-nums}
 th,td{padding:3px 8px;border-bottom:1px solid #eaeef2;text-align:right;white-space:nowrap}
