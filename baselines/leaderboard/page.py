@@ -82,6 +82,7 @@ text-align:left}
 td i{color:#57606a;display:block;font-size:11px;font-style:normal}
 table.compact td i{display:inline;margin-left:6px}
 .splits{display:flex;flex-wrap:wrap;gap:8px 24px;align-items:flex-start}
+.splits>div{min-width:0;max-width:100%}
 td.na{color:#8c959f;font-style:italic}
 td:first-child span{display:inline-block;width:22px;height:0;border-top-width:3px;
 margin-right:6px;vertical-align:middle}
