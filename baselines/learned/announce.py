@@ -45,7 +45,7 @@ def start_line(config: AgentConfig, steps: int, seed: int | None, out: str) -> s
         else (
             f"validation every {every:,} env steps on {config.eval.n_episodes} episodes"
             if steps >= every
-            else f"no validation: it runs every {every:,} env steps (eval.freq), more than {steps:,}"
+            else f"no validation: it runs every {every:,} env steps (eval.freq), over {steps:,}"
         )
     )
     return (
