@@ -119,8 +119,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             config = self.distribution.sample(
                 train_rng(scenario_seed), name=f"{self.distribution.name}:train-{scenario_seed}"
             )
-        self._env.close()
-        self._env = self._make_env(config)
+        self._env.use_scenario(build_scenario(config, config.name))
         episode_seed = int(self.np_random.integers(0, 2**31 - 1))
         # the scenario's name identifies its schedule: an attribute for logging, never in
         # info or the observation (which controllers read)
