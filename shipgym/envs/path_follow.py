@@ -167,10 +167,17 @@ class ShipPathFollowEnv(gym.Env):
     .. rubric:: Starting state
 
     The scenario's ``initial_state`` (x, y [m], heading [deg], other states SI; default: the
-    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.  A
-    suite's ``randomize:`` block (:class:`shipgym.scenarios.trials.TrialRandomization`) moves
-    it per evaluation seed; the env's seed draws sensor noise and stochastic currents and
-    waves.
+    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.
+
+    With ``randomize=True`` (what ``gym.make(ENV_ID)`` passes) every reset first draws a
+    trial of the scenario from the env's ``np_random``, with the default suite's
+    ``randomize:`` ranges (:func:`shipgym.scenarios.trials.env_randomization`): the start
+    moved off the first leg and turned, the jump times shifted, the current scaled and
+    turned.  ``reset(seed=s)`` gives one trial per seed; ``reset()`` goes on with the
+    env's stream (a new trial).  ``scenario`` is the episode's trial, ``base_scenario`` the
+    scenario given.  ``randomize=False`` (the class's default) runs the scenario itself,
+    as the leaderboard plays the trials it draws from its evaluation seeds.  The env's seed
+    also draws the sensor noise and the stochastic currents and waves.
 
     .. rubric:: Episode end
 
@@ -179,10 +186,15 @@ class ShipPathFollowEnv(gym.Env):
     plant state is not finite (``"non_finite_state"``).  Truncated: the scenario's
     ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last
     step ``info`` also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).
+    Each id's spec states its default scenario's ceil(time_limit/Ts) as
+    ``max_episode_steps`` (:data:`shipgym.MAX_EPISODE_STEPS`); ``gym.make`` wraps the env in
+    a ``TimeLimit`` of that many steps, which ends the episode at the same step as the
+    env.  With a longer ``scenario`` pass ``max_episode_steps=-1`` (the env's own limit).
 
     .. rubric:: Arguments
 
-    ``gym.make(ENV_ID, scenario=..., action_mode="rudder", render_mode=None, compile=True)``
+    ``gym.make(ENV_ID, scenario=..., action_mode="rudder", render_mode=None, compile=True,
+    randomize=True)``
 
     * ``scenario``: a catalogue name (``shipgym scenarios``), a held-out test scenario
       (``"heldout:3"``), a path to a YAML file or a :class:`shipgym.scenarios.Scenario`;
@@ -195,9 +207,12 @@ class ShipPathFollowEnv(gym.Env):
     * ``history_steps``: K ≥ 0, append the last K control steps of (measurements, applied
       rudder command), 7 entries each, oldest first, zeros before the episode's start
       (default 0: the observation above, unchanged; docs/observation.md).
+    * ``randomize``: draw a trial of ``scenario`` at every reset (see Starting state); True
+      in every id's registration, False in the class.
 
     ``gym.make_vec(ENV_ID, num_envs=N)`` returns the batched
-    :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit).
+    :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit, env i
+    seeded ``seed + i``: N different trials).
     Processes that have not imported ``shipgym`` use ``gym.make("shipgym:ENV_ID")``.
 
     .. rubric:: Version history
@@ -211,6 +226,9 @@ class ShipPathFollowEnv(gym.Env):
       exists).
     * ``-v1`` (EssoOsaka, Mariner, Blanke): the same env, defaulting to the ship's
       ``{ship}_rudder_aging`` (a changing plant).
+    * Every id, in place: ``randomize=True`` (a trial per reset) and ``max_episode_steps``
+      in the spec.  Before, ``gym.make(id)`` ran the scenario itself whatever the seed;
+      ``gym.make(id, randomize=False)`` is that env.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}

@@ -58,9 +58,13 @@ class ShipPathFollowRandomizedEnv(gym.Env):
     ``reset(options={"index": i})`` picks the i-th test scenario.  ``context_features`` and
     ``history_steps`` as the single env's (each reset starts a new history window).
 
+    The spec's ``max_episode_steps`` is the longest episode the ``train`` distribution can
+    draw (:meth:`~shipgym.scenarios.sampling.ScenarioDistribution.max_episode_steps`); each
+    episode ends at its own scenario's time limit first.
+
     .. rubric:: Version history
 
-    ``-v0``: the only version.
+    ``-v0``: the only version (``max_episode_steps`` added to its spec, in place).
     """
 
     metadata: ClassVar[dict[str, Any]] = ShipPathFollowEnv.metadata

@@ -18,7 +18,10 @@ resets only the masked envs).  ``info`` holds the scalar keys of the single env 
 in SyncVectorEnv's layout (``episode_metrics`` as a dict of arrays with ``_``-masks, present
 at the steps where an episode ended, with SyncVectorEnv's dtypes), except: ``position`` is
 an (N, 2) float array, there is no ``samples`` (online identification runs on the single
-env).  It is what
+env).  With ``randomize=True`` (the registered ids' default) each env's reset draws its trial
+from its own generator as the single env does (:attr:`trials`: the scenarios of the
+episodes; a per-env copy of the disturbance processes then carries each trial's current).
+It is what
 ``gym.make_vec("ShipPathFollow-v0", num_envs=N)`` returns by default (Gymnasium prefers a
 registered vector entry point); pass ``vectorization_mode="sync"`` for N single envs.
 """
