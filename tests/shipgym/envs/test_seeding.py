@@ -147,9 +147,7 @@ def test_make_vec_seeds_its_envs_apart(mode: str) -> None:
     obs, _ = envs.reset(seed=7)
     base = envs if mode == "vector_entry_point" else None
     trials = (
-        base.trials
-        if base is not None
-        else [e.unwrapped.scenario for e in envs.unwrapped.envs]  # type: ignore[attr-defined]
+        base.trials if base is not None else [e.unwrapped.scenario for e in envs.unwrapped.envs]  # type: ignore[attr-defined]
     )
     starts = {t.config.initial_state.y for t in trials}
     assert len(starts) == 3 and len({tuple(o) for o in obs.tolist()}) == 3
