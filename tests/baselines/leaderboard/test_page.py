@@ -201,6 +201,19 @@ def built_page(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return write_html(out, rows, aggregate, scores, figs, subtitle="synthetic: 18 controllers")
 
 
+def test_the_written_page_links_its_scenario_figures_beside_it(built_page: Path) -> None:
+    """The scenario figures (most of a run page's bytes) are the PNG files beside the page,
+    cropped above their legends (written as text); everything else stays inside the page."""
+    text = built_page.read_text(encoding="utf-8")
+    figure = re.search(r'<figure id="fig-scenario_nominal">(.*?)</figure>', text, re.S)
+    assert figure is not None
+    (src,) = re.findall(r'src="([^"]+)"', figure.group(1))
+    assert src == "fig/scenario_nominal.png" and (built_page.parent / src).is_file()
+    assert 'class="crop"' in figure.group(1) and 'class="legend"' in figure.group(1)
+    others = [a for a in re.findall(r'(?:src|href)="([^"]+)"', text) if a != src]
+    assert others and all(a.startswith(("data:", "#")) for a in others)
+
+
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
 def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page: Path) -> None:
     assert built_page.name == PAGE_FILE
