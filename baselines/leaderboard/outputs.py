@@ -327,6 +327,15 @@ def _note_lines(folder: str | os.PathLike) -> list[str]:
     return [note, ""] if note else []
 
 
+def _csv_value(key: str, value: Any) -> Any:
+    """A row's value as its CSV cell holds it: a learned row's flagged seeds in words."""
+    if key == "seed_flags" and isinstance(value, list):
+        from shipgym_baselines.learned.curves import flag_text
+
+        return "; ".join(flag_text(f) for f in value)
+    return value
+
+
 def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     """``leaderboard.{json,csv,md}`` and ``generalisation.json``; ``head``: the markdown
     before the rows (the ranking)."""
@@ -335,7 +344,7 @@ def write_tables(rows: list[dict[str, Any]], out: Path, head: str = "") -> None:
     table = io.StringIO(newline="")
     writer = csv.DictWriter(table, fieldnames=keys, restval="")
     writer.writeheader()
-    writer.writerows([{k: csv_cell(v) for k, v in r.items()} for r in rows])
+    writer.writerows([{k: csv_cell(_csv_value(k, v)) for k, v in r.items()} for r in rows])
     write_text(out / "leaderboard.csv", table.getvalue())
     rows_part = "## All rows\n\n" + markdown_table(rows) if head else markdown_table(rows)
     write_text(
