@@ -39,7 +39,14 @@ from shipgym_baselines.leaderboard.verdict import folder_verdict
 #: the summary's layout; bump when a field changes meaning
 SUMMARY_VERSION = 1
 #: the fields of a ranked row the summary keeps (each ``*_ci95`` beside its estimate)
-ROW_FIELDS = ("cost_ratio_iqm", "cost_ratio_gmean", NOMINAL, SHARE, "gap_closed_iqm", "failure_rate")
+ROW_FIELDS = (
+    "cost_ratio_iqm",
+    "cost_ratio_gmean",
+    NOMINAL,
+    SHARE,
+    "gap_closed_iqm",
+    "failure_rate",
+)
 #: the rows of the main split the README shows
 README_ROWS = 8
 #: the split whose ranking the README shows, and the one beside it
