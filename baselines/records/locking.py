@@ -15,7 +15,8 @@ its place is refused in one line, and whatever it points to is left as it was (t
 empty" check and ``--force`` see it, too).
 
 A single file that a command fills over a long time (``shipgym references --table`` /
-``--packaged``) is locked the same way by :func:`file_lock`, on ``<file>.lock`` beside it.
+``--packaged``) or reads, changes and writes back (a study's chosen settings) is locked the
+same way by :func:`file_lock`, on ``<file>.lock`` beside it.
 """
 
 from __future__ import annotations
@@ -68,13 +69,16 @@ def _acquire(folder: Path, start_time: str) -> int:
     return _acquire_file(folder / LOCK_FILE, start_time, lambda who: in_use(folder, who))
 
 
-def _acquire_file(file: Path, start_time: str, busy: Callable[[str], RunError]) -> int:
+def _acquire_file(
+    file: Path, start_time: str, busy: Callable[[str], RunError], wait: bool = False
+) -> int:
     """The descriptor of the lock file ``file``, locked, the holder written into it;
-    ``busy(holder)``: the refusal raised when another process holds it."""
+    ``busy(holder)``: the refusal raised when another process holds it (``wait``: wait
+    for it to end instead)."""
     while True:
         fd = open_regular(file, os.O_RDWR | os.O_CREAT)
         try:
-            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.lockf(fd, fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
             os.close(fd)
             if exc.errno in (errno.EACCES, errno.EAGAIN):
@@ -156,12 +160,15 @@ def lock_file_of(file: str | os.PathLike) -> Path:
 
 
 @contextlib.contextmanager
-def file_lock(file: str | os.PathLike, start_time: str, option: str) -> Iterator[Path]:
+def file_lock(
+    file: str | os.PathLike, start_time: str, option: str, wait: bool = False
+) -> Iterator[Path]:
     """Hold the exclusive lock of the single file ``file`` (:func:`lock_file_of`; its
     folder made if missing) for the ``with`` body: another process filling it is refused at
     once, in one line naming ``option`` (the command's option that named the file) and the
-    holder.  The lock file stays (another process may be waiting to take it); a link or
-    anything but a regular file in its place is refused in one line."""
+    holder; ``wait``: wait for the other process instead (a short read-modify-write).  A
+    link or anything but a regular file in the lock file's place is refused in one line;
+    the lock file is removed at the end, as :func:`out_lock` removes its own."""
     path = Path(file)
     key = Path(os.path.abspath(lock_file_of(path)))
     if key in _HELD:
@@ -170,12 +177,14 @@ def file_lock(file: str | os.PathLike, start_time: str, option: str) -> Iterator
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise RunError(f"{option} {path}: cannot create its folder ({exc.strerror})") from None
-    fd = _acquire_file(key, start_time, lambda who: _file_in_use(path, option, who))
+    fd = _acquire_file(key, start_time, lambda who: _file_in_use(path, option, who), wait)
     _HELD.add(key)
     try:
         yield path
     finally:
         _HELD.discard(key)
+        with contextlib.suppress(OSError):
+            key.unlink()  # while locked: the next holder finds a fresh file
         os.close(fd)
 
 
