@@ -39,8 +39,9 @@ from __future__ import annotations
 
 import io
 import json
+import os
+import pickle
 import re
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -74,7 +75,7 @@ from shipgym_baselines.learned.trust import (
     written_here,
 )
 from shipgym_baselines.records.manifest import Manifest
-from shipgym_baselines.records.outfiles import write_bytes
+from shipgym_baselines.records.outfiles import make_dir, refuse_special, write_bytes
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 
@@ -104,11 +105,6 @@ def _callbacks(
         def _on_training_start(self) -> None:
             from tqdm import tqdm
 
-            logs = self.model.logger.get_dir()
-            if logs:  # the TensorBoard folder SB3 just made for this run, and its files
-                folder = Path(logs).absolute()
-                manifest.record([folder, *sorted(folder.iterdir())])
-
             self.bar = tqdm(
                 total=config.n_timesteps,
                 initial=self.model.num_timesteps,
@@ -131,17 +127,31 @@ def _callbacks(
     progress_cb = _Progress()
 
     class _Checkpoint(CheckpointCallback):
+        """SB3's checkpoint files (:func:`checkpoint_names`), each written atomically
+        through no link (:func:`~shipgym_baselines.records.outfiles.write_bytes`), listed
+        before it is written, its SHA-256 recorded after (:func:`remember_written`)."""
+
+        def _init_callback(self) -> None:
+            make_dir(out / "checkpoints")  # a link in its place is refused
+
         def _on_step(self) -> bool:
             if self.n_calls % self.save_freq:
-                return super()._on_step()
+                return True
             steps = self.num_timesteps
             manifest.claim(*[f"checkpoints/{name}" for name in checkpoint_names(steps)])
             state = {"num_timesteps": self.model.num_timesteps, "wall_time_s": progress_cb.wall()}
             write_json_file(out / "checkpoints" / "state.json", state, None)
-            go_on = super()._on_step()
+            model, statistics, buffer = (out / "checkpoints" / n for n in checkpoint_names(steps))
+            save_model(self.model, model)
+            replay = getattr(self.model, "replay_buffer", None)
+            if self.save_replay_buffer and replay is not None:  # SB3's pickles, as it saves them
+                write_bytes(buffer, pickle.dumps(replay, protocol=pickle.HIGHEST_PROTOCOL))
+            normalizer = self.model.get_vec_normalize_env()
+            if self.save_vecnormalize and normalizer is not None:
+                write_bytes(statistics, pickle.dumps(normalizer))
             for file in checkpoint_files(out, steps):  # the bytes this run wrote
                 remember_written(file)
-            return go_on
+            return True
 
     off_policy = config.algo in ("sac", "td3")
     checkpoint = _Checkpoint(
@@ -215,15 +225,28 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
 
     curves = _Curves(config, out)
 
+    class _Evaluation(EvalCallback):
+        """SB3's EvalCallback, its files written through no link: its history
+        (``np.savez``) into memory, written by :class:`_AfterEval`; the best model by
+        :class:`_NewBest`."""
+
+        def _init_callback(self) -> None:
+            super()._init_callback()  # no folder made: no path given
+            make_dir(out / "eval")  # a link in its place is refused
+            self.log_path = io.BytesIO()
+
     class _AfterEval(BaseCallback):
         def _on_step(self) -> bool:
             parent = self.parent
+            write_bytes(out / "eval" / "evaluations.npz", parent.log_path.getvalue())
+            parent.log_path = io.BytesIO()  # the next evaluation's history
             return curves.after_evaluation(
                 parent.evaluations_timesteps, parent.evaluations_results, None
             )
 
-    class _NewBest(BaseCallback):  # best_model.zip was just saved: record its value
+    class _NewBest(BaseCallback):  # a new best: save it, and record its value
         def _on_step(self) -> bool:
+            save_model(self.model, out / "best_model.zip")
             write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
             return True
 
@@ -235,12 +258,10 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
         history_steps=config.env.history_steps,
     )
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
-    evaluation = EvalCallback(
+    evaluation = _Evaluation(
         eval_env,
         callback_after_eval=_AfterEval(),
         callback_on_new_best=_NewBest(),
-        best_model_save_path=str(out),
-        log_path=str(out / "eval"),
         eval_freq=max(config.eval.freq // n_envs, 1),
         n_eval_episodes=config.eval.n_episodes,
         deterministic=True,
@@ -332,6 +353,44 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             return curves.after_evaluation(self.steps, self.returns, self.selection)
 
     return _RelativeCostEval()
+
+
+#: the folder of a run's TensorBoard logs, one ``<name>_<k>`` folder per fresh start
+TB_FOLDER = "tb"
+
+
+def training_logger(out: Path, name: str, tensorboard: bool, manifest: Manifest, resumed: bool):
+    """SB3's logger of a training run: TensorBoard's events in ``tb/<name>_<k>/`` (``k``:
+    the next number on a fresh run, the newest on a resumed one, as SB3 numbers them), or
+    no output at all (``tensorboard`` False, or TensorBoard not installed).  The folders
+    are made through no link (:func:`~shipgym_baselines.records.outfiles.make_dir`) and the
+    events file gets a random suffix, so no link can be waiting in its place; it is listed
+    in the manifest as soon as it exists."""
+    from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
+    from stable_baselines3.common.utils import get_latest_run_id
+
+    if tensorboard:
+        try:
+            from torch.utils.tensorboard import SummaryWriter
+        except ImportError:
+            sys.stderr.write("tensorboard not installed: no TensorBoard logs\n")
+            tensorboard = False
+    if not tensorboard:
+        return Logger(folder=None, output_formats=[])
+    latest = get_latest_run_id(str(out / TB_FOLDER), name)
+    folder = out / TB_FOLDER / f"{name}_{max(latest, 1) if resumed else latest + 1}"
+    make_dir(folder.parent)
+    make_dir(folder)
+    suffix = f".{os.urandom(8).hex()}"
+
+    class _TensorBoard(TensorBoardOutputFormat):
+        def __init__(self) -> None:
+            self.writer = SummaryWriter(log_dir=str(folder), filename_suffix=suffix)
+            self._is_closed = False
+
+    output = _TensorBoard()
+    manifest.record([p.absolute() for p in folder.iterdir() if p.name.endswith(suffix)])
+    return Logger(folder=str(folder), output_formats=[output])
 
 
 def checkpoints(out: Path) -> list[tuple[Path, int]]:
@@ -525,27 +584,18 @@ def _train(
         elif config.env.normalize_reward:
             # an array γ (gamma_seconds) broadcasts over the envs in VecNormalize's returns
             venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
-        tb = None
-        if tensorboard:
-            try:
-                import tensorboard
-
-                tb = str(out / "tb")
-            except ImportError:
-                sys.stderr.write("tensorboard not installed: no TensorBoard logs\n")
         model = cls(
             config.policy,
             venv,
             seed=config.seed,
             device="cpu",
-            tensorboard_log=tb,
             verbose=0,
             **build_hyperparams(config, venv.action_space.shape[0]),
         )
-    if model.tensorboard_log is None:  # else SB3 makes an empty SB3-<time> folder in /tmp
-        from stable_baselines3.common.logger import Logger
-
-        model.set_logger(Logger(folder=None, output_formats=[]))
+    # the run's own logger (SB3 would make an empty SB3-<time> folder in /tmp without
+    # TensorBoard, and write where a resumed zip says with it)
+    logger = training_logger(out, config.name, tensorboard, manifest, resumed=previous is not None)
+    model.set_logger(logger)
     if config.env.gamma_seconds is not None:
         # the rollout buffer's GAE broadcasts an (n_envs,) γ: each env its ship's
         # exp(−Ts/τ); SB3's time-limit bootstrap keeps the scalar hyperparams γ
@@ -567,6 +617,7 @@ def _train(
             reset_num_timesteps=previous is None,
             tb_log_name=config.name,
         )
+    logger.close()  # the TensorBoard events flushed
     save_model(model, out / "model.zip")
     meta = training_meta(
         config,
@@ -623,7 +674,8 @@ POLICY_FILES = (
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     """Copy the best model (else the final one) as ``model.zip``, ``meta.json`` and the
     run's ``vecnormalize.json`` (if any) into ``dest`` (a policy dir); nothing else (no
-    pickle: a stale ``vecnormalize.pkl`` there is removed)."""
+    pickle: a stale ``vecnormalize.pkl`` there is removed).  Each file is written through
+    no link: a link in place of one is refused in one line, before any is written."""
     src = Path(out_dir)
     model = src / "best_model.zip"
     if not model.is_file():
@@ -632,13 +684,15 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
         raise RunError(f"{src}: no trained model (model.zip / meta.json) to export")
     target = Path(dest)
     target.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(model, target / "model.zip")
-    shutil.copyfile(src / "meta.json", target / "meta.json")
+    for name in POLICY_FILES:  # written through no link: refused before any is written
+        refuse_special(target / name)
+    write_bytes(target / "model.zip", model.read_bytes())
+    write_bytes(target / "meta.json", (src / "meta.json").read_bytes())
     for name in POLICY_FILES[2:]:
         (target / name).unlink(missing_ok=True)  # not a stale one
     for name in POLICY_FILES[2:4]:  # the observation statistics and the learning curve
         if (src / name).is_file():
-            shutil.copyfile(src / name, target / name)
+            write_bytes(target / name, (src / name).read_bytes())
     return target
 
 
