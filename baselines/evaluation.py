@@ -30,7 +30,6 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.errors import ShipgymError
-from shipgym.notices import notice
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
@@ -404,17 +403,14 @@ class _Record:
         )
 
 
-#: the controllers whose left-out figures were named on stderr in this process
-_stats_named: set[str] = set()
-
-
 def controller_stats(policy: Policy, guard: ActGuard | None) -> tuple[dict[str, Any], str | None]:
     """The controller's own figures of its episode (its ``episode_stats()``, if it has one)
     and why they were left out (None: they were not).  With a guard, a call that fails or
     runs over the limit, or figures that are no mapping of names to numbers
-    (:func:`~shipgym_baselines.records.episodes.stats_problem`), are left out, with one
-    line on stderr per controller; the episode stays as the env ended it.  Without a guard
-    they raise."""
+    (:func:`~shipgym_baselines.records.episodes.stats_problem`), are left out (the
+    result's ``stats_error`` says why; a run names it once per controller on stderr:
+    :func:`shipgym_baselines.leaderboard.run.announce_failure`); the episode stays as the
+    env ended it.  Without a guard they raise."""
     stats = getattr(policy, "episode_stats", None)
     if stats is None:
         return {}, None
@@ -430,9 +426,6 @@ def controller_stats(policy: Policy, guard: ActGuard | None) -> tuple[dict[str, 
         why = f"episode_stats() raised {problem}"
     if guard is None:
         raise ControllerError(f"{policy.name}: {why}")
-    if policy.name not in _stats_named:
-        _stats_named.add(policy.name)
-        notice(f"shipgym: {policy.name}'s {why}: its figures are left out, the episode kept")
     return {}, why
 
 
@@ -501,6 +494,26 @@ def _make(
     seed = settings.get("training_seed")
     unmade = _Unmade(name, record.kind, record.action_mode, seed, error, reason)
     return unmade, record.action_mode
+
+
+def failed_episode(
+    controller: ControllerSpec,
+    scenario: Any,
+    seed: int,
+    reason: str,
+    error: str,
+    guard: ActGuard,
+    label: EpisodeLabel,
+) -> EpisodeResult:
+    """The episode of ``controller`` (its kind and action mode; nothing of it is made)
+    that ended at its reset with ``reason`` and ``error`` (one line), as a controller's that
+    could not be made: a job whose process ended or was killed before it gave its results
+    (:mod:`shipgym_baselines.isolation`)."""
+    record = resolve_controller(controller)
+    policy = _Unmade(
+        label.controller, record.kind, record.action_mode, label.training_seed, error, reason, ""
+    )
+    return run_episode(policy, scenario, seed, record.action_mode, guard=guard, label=label)
 
 
 class _Episode:
