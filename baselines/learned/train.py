@@ -38,12 +38,12 @@ rounds of DAgger instead of checkpoints.
 from __future__ import annotations
 
 import io
-import json
 import os
 import pickle
 import re
 import sys
 import time
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -53,7 +53,12 @@ from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.executor import map_jobs
-from shipgym_baselines.learned.agent_folder import BEST_FILE, agent_run, write_json_file
+from shipgym_baselines.learned.agent_folder import (
+    BEST_FILE,
+    agent_run,
+    read_record,
+    write_json_file,
+)
 from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS as TRAINING_OUTPUTS
 from shipgym_baselines.learned.agent_folder import TUNED_FROM_FILE as TUNED_FROM_FILE
 from shipgym_baselines.learned.agent_folder import check_agent_folder as check_agent_folder
@@ -214,7 +219,7 @@ def _read_best(out: Path, history_best: float) -> float:
     """The value of the saved best model: from :data:`BEST_FILE`, else (a run from before
     the file) the best of the history on disk."""
     file = out / "eval" / BEST_FILE
-    return float(json.loads(file.read_text())["value"]) if file.is_file() else history_best
+    return float(read_record(file, "value")) if file.is_file() else history_best
 
 
 def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: int | None):
@@ -272,12 +277,20 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
     if resumed_at is not None and previous.is_file():  # keep the history and the best
         import numpy as np
 
-        data = np.load(previous)
-        keep = _kept_history(data["timesteps"].tolist(), resumed_at)
-        evaluation.evaluations_timesteps = data["timesteps"].tolist()[:keep]
-        evaluation.evaluations_results = data["results"].tolist()[:keep]
-        evaluation.evaluations_length = data["ep_lengths"].tolist()[:keep]
-        history_best = float(np.max(np.mean(data["results"], axis=1)))
+        try:
+            with np.load(previous, allow_pickle=False) as data:
+                steps, results = data["timesteps"].tolist(), data["results"].tolist()
+                lengths = data["ep_lengths"].tolist()
+                history_best = float(np.max(np.mean(data["results"], axis=1)))
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise RunError(
+                f"{previous}: unreadable ({exc}): a damaged record of the run (--force trains "
+                "it afresh)"
+            ) from None
+        keep = _kept_history(steps, resumed_at)
+        evaluation.evaluations_timesteps = steps[:keep]
+        evaluation.evaluations_results = results[:keep]
+        evaluation.evaluations_length = lengths[:keep]
         evaluation.best_mean_reward = _read_best(out, history_best)
     return evaluation
 
@@ -309,8 +322,8 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             self.selection: list[float] = []
             self.best = float("inf")
             if resumed_at is not None and history.is_file():
-                data = json.loads(history.read_text())
-                keep = _kept_history(data["env_steps"], resumed_at)
+                data = read_record(history)
+                keep = _kept_history(read_record(history, "env_steps"), resumed_at)
                 self.steps, self.returns = data["env_steps"][:keep], data["returns"][:keep]
                 self.selection = data["selection"][:keep]
                 self.best = _read_best(out, min(data["selection"], default=float("inf")))
@@ -575,7 +588,7 @@ def _train(
             previous = (previous[0], steps)
         state_file = out / "checkpoints" / "state.json"
         if state_file.is_file():
-            wall_offset = float(json.loads(state_file.read_text())["wall_time_s"])
+            wall_offset = float(read_record(state_file, "wall_time_s"))
     else:
         if config.env.normalize_per_ship:
             from shipgym_baselines.learned.per_ship import VecNormalizePerShip
@@ -654,7 +667,7 @@ def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
     meta_file = Path(out) / "meta.json"
     if not (meta_file.is_file() and (Path(out) / "model.zip").is_file()):
         return None
-    meta = json.loads(meta_file.read_text())
+    meta = read_record(meta_file)
     done = int(meta.get("env_steps", 0)) >= n_timesteps
     return meta if done or meta.get("stopped_on_plateau_at") is not None else None
 
@@ -706,7 +719,7 @@ def ship_policy(out_dir: str | Path, root: str | Path | None = None) -> Path:
     meta_file = Path(out_dir) / "meta.json"
     if not meta_file.is_file():
         raise RunError(f"{out_dir}: no trained model (model.zip / meta.json) to export")
-    meta = json.loads(meta_file.read_text())
+    meta = read_record(meta_file)
     if not isinstance(meta.get("name"), str) or not isinstance(meta.get("seed"), int):
         raise RunError(f"{meta_file}: a shipped policy needs its 'name' and its 'seed'")
     agent = Path(root if root is not None else POLICY_DIR) / meta["name"]

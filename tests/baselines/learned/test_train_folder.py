@@ -239,3 +239,28 @@ def test_another_users_checkpoints_need_trust_pickle(
     with trusting_pickle(True):
         meta = train(_tiny(), out_dir=out, n_timesteps=384, resume=True, progress=False)
     assert meta["env_steps"] == 384
+
+
+@pytest.mark.parametrize(
+    "damaged",
+    [
+        "meta.json",
+        "checkpoints/state.json",
+        "eval/best.json",
+        "tuned_from.json",
+        "eval/evaluations.npz",
+    ],
+)
+def test_a_damaged_record_of_the_run_is_one_line(
+    damaged: str, trained: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--resume`` on a folder whose record of the run (not a checkpoint) is damaged: one
+    line naming the file and that ``--force`` trains it afresh, not a traceback."""
+    same_user(trained, monkeypatch)
+    out = _copy(trained, tmp_path / "run")
+    (out / damaged).write_text("{not json")
+    with pytest.raises(RunError) as refused:
+        train(_tiny(), out_dir=out, n_timesteps=384, resume=True, progress=False)
+    line = str(refused.value)
+    assert line.startswith(str(out / damaged)) and "\n" not in line
+    assert line.endswith("a damaged record of the run (--force trains it afresh)")
