@@ -236,7 +236,7 @@ def fill_tables(
     tables: dict[str, ReferenceTable] = {}
     replaced = []
     for path in files.values():  # written through no link: refused before any work
-        refuse_special(path)
+        refuse_special(path, "--table")
     for ref, path in files.items():
         why = foreign(path, ref)
         if why is None:

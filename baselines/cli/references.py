@@ -161,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
     with contextlib.ExitStack() as locks:
         if args.table is not None or args.packaged:
             files = {r: args.table if args.table is not None else table_path(r) for r in chosen}
-            option = "--table" if args.table is not None else "--packaged:"
+            option = "--table" if args.table is not None else "--packaged"
             for file in files.values():  # one fill per file: a second is refused in one line
                 locks.enter_context(file_lock(file, now(), option))
             filled = fill_tables(files, args.replace)

@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import functools
 import json
 import os
 import sys
@@ -70,13 +71,17 @@ def _acquire(folder: Path, start_time: str) -> int:
 
 
 def _acquire_file(
-    file: Path, start_time: str, busy: Callable[[str], RunError], wait: bool = False
+    file: Path,
+    start_time: str,
+    busy: Callable[[str], RunError],
+    wait: bool = False,
+    elsewhere: str = "--out",
 ) -> int:
     """The descriptor of the lock file ``file``, locked, the holder written into it;
     ``busy(holder)``: the refusal raised when another process holds it (``wait``: wait
-    for it to end instead)."""
+    for it to end instead); ``elsewhere``: the option a link's refusal names."""
     while True:
-        fd = open_regular(file, os.O_RDWR | os.O_CREAT)
+        fd = open_regular(file, os.O_RDWR | os.O_CREAT, elsewhere=elsewhere)
         try:
             fcntl.lockf(fd, fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
@@ -177,7 +182,8 @@ def file_lock(
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise RunError(f"{option} {path}: cannot create its folder ({exc.strerror})") from None
-    fd = _acquire_file(key, start_time, lambda who: _file_in_use(path, option, who), wait)
+    busy = functools.partial(_file_in_use, path, option)
+    fd = _acquire_file(key, start_time, busy, wait, elsewhere=option)
     _HELD.add(key)
     try:
         yield path

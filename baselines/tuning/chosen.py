@@ -57,7 +57,7 @@ def write_chosen(
     both sections) and written through no link (a link in its place is refused in one
     line): :mod:`shipgym_baselines.records.locking`, :mod:`~shipgym_baselines.records.outfiles`."""
     file = chosen_file(controller, folder)
-    with file_lock(file, now(), "the chosen settings", wait=True):
+    with file_lock(file, now(), "--chosen-dir", wait=True):
         return _write_chosen(controller, section, settings, study, folder, file)
 
 
@@ -70,7 +70,7 @@ def _write_chosen(
     file: Path,
 ) -> tuple[Path, dict[str, Any] | None]:
     """:func:`write_chosen` once the file is locked."""
-    refuse_special(file)  # before the study's result is merged into what a link points to
+    refuse_special(file, "--chosen-dir")  # before the result is merged into what it points to
     data = read_chosen(controller, folder)
     ships = dict(data.get("ships") or {})
     studies = dict(data.get("studies") or {})
