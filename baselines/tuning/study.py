@@ -54,7 +54,7 @@ from shipgym_baselines.executor import BACKENDS as BACKENDS  # public here too
 from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
 from shipgym_baselines.records.locking import file_lock, out_lock
 from shipgym_baselines.records.manifest import Manifest
-from shipgym_baselines.records.outfiles import check_no_links, write_text
+from shipgym_baselines.records.outfiles import check_no_links, refuse_special, write_text
 from shipgym_baselines.records.runrecord import now
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
@@ -357,6 +357,7 @@ def run_study(
     total = int(n_trials if n_trials is not None else plan.config.budget)
     if total < 1:
         raise RunError(f"--trials {total}: at least 1")
+    check_chosen(plan)  # before any trial, not after the last
     with out_lock(plan.folder, now()), storage_lock(plan):
         check_no_links(plan.folder)
         manifest = Manifest(plan.folder)
@@ -366,6 +367,17 @@ def run_study(
             report = _run_locked(plan, total, resume, backend, workers, progress, force)
         manifest.compact(keep=(REPORT_FILE,))
         return report
+
+
+def check_chosen(plan: StudyPlan) -> None:
+    """A :class:`RunError` in one line, before the study's first trial, when the chosen
+    settings it will write cannot be: a link or no regular file in the file's place, or a
+    file that is no chosen-settings document."""
+    if plan.chosen_dir is None:
+        return
+    file = chosen_settings.chosen_file(plan.config.controller, plan.chosen_dir)
+    refuse_special(file, "--chosen-dir")
+    chosen_settings.read_chosen(plan.config.controller, plan.chosen_dir)
 
 
 @contextlib.contextmanager

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -725,3 +726,25 @@ def test_a_second_process_on_a_shared_storage_is_refused_in_one_line(
     assert len(study.trials) == 1
     assert main([*argv, "--out", str(tmp_path / "b"), "--resume", "--trials", "2"]) == 0
     assert not (tmp_path / "shared.db.lock").exists()
+
+
+@pytest.mark.parametrize("planted", ["link", "not chosen settings"])
+def test_chosen_settings_that_cannot_be_written_are_refused_before_any_trial(
+    planted: str, tiny: Path, tmp_path: Path
+) -> None:
+    """A link in place of the chosen file, or a file that is no chosen settings: refused
+    in one line before the study's first trial (not after its last), the file untouched."""
+    chosen_dir = tmp_path / "chosen"
+    chosen_dir.mkdir()
+    victim = tmp_path / "victim.yaml"
+    victim.write_text("untouched\n")
+    target = chosen_dir / "pid_los.yaml"
+    if planted == "link":
+        target.symlink_to(victim)
+    else:
+        target.write_text("untouched\n")
+    (plan,) = plan_studies(str(tiny), out=tmp_path / "out", chosen_dir=chosen_dir)
+    with pytest.raises(RunError, match=re.escape(str(target))) as refused:
+        run_study(plan, n_trials=1)
+    assert "\n" not in str(refused.value)
+    assert victim.read_text() == "untouched\n" and not (plan.folder / "study.db").exists()
