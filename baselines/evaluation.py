@@ -521,7 +521,14 @@ class _Episode:
     stepped with the policy's actions and the time each took, then its result."""
 
     def __init__(self, env_id: str, scenario: Any, seed: int, action_mode: str) -> None:
-        self.env = gym.make(env_id, scenario=scenario, action_mode=action_mode)
+        # the given trial itself (no trial drawn at reset), truncated at its own time limit
+        self.env = gym.make(
+            env_id,
+            scenario=scenario,
+            action_mode=action_mode,
+            randomize=False,
+            max_episode_steps=-1,
+        )
         self.seed = seed
         try:
             self.obs, info = self.env.reset(seed=seed)

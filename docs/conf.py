@@ -36,7 +36,6 @@ exclude_patterns = [
     ".DS_Store",
     "**.ipynb_checkpoints",
     "_generated/ships",
-    "_generated/validation",
 ]
 myst_enable_extensions = ["colon_fence", "dollarmath", "deflist"]
 myst_heading_anchors = 3

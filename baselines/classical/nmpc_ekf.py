@@ -5,7 +5,9 @@ The certainty-equivalent adaptive design of the marine-control literature (Fosse
 controller on the estimates of an augmented-state observer) on the true model structure:
 
 * **Controller.** The oracle's NMPC (:class:`~shipgym_baselines.classical.oracle.PlantNMPC`:
-  its cost, horizon, grid, tail and solver) on the ship's own equations.  Where the oracle
+  its cost, horizon, grid, tail and solver) on the ship's own equations, one solver
+  iteration a control step (a real-time iteration:
+  :data:`~shipgym_baselines.classical.oracle.REAL_TIME_SETTINGS`).  Where the oracle
   reads the true plant now, this one predicts with the filter's estimate: its state, its
   parameters and its current and yaw bias (no wave load: the filter does not resolve it).
 * **Estimator.** :class:`shipgym.identification.ekf.ShipEKF` on the same model: it starts
@@ -34,7 +36,7 @@ from shipgym.identification import first_order_nomoto
 from shipgym.identification.adaptation import Adaptation
 from shipgym.identification.ekf import FilterSettings, ShipEKF
 from shipgym.identification.servo import ServoFit, servo_constants
-from shipgym_baselines.classical.oracle import OracleSettings, PlantNMPC
+from shipgym_baselines.classical.oracle import REAL_TIME_SETTINGS, OracleSettings, PlantNMPC
 from shipgym_baselines.policy import Style
 from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
@@ -97,6 +99,7 @@ class NmpcEkf(PlantNMPC):
     "default" reads none.  Keywords: the fields of :class:`FilterSettings`."""
 
     kind: ClassVar[str] = "classical"
+    default_settings: ClassVar[OracleSettings] = REAL_TIME_SETTINGS
 
     def __init__(
         self,

@@ -22,6 +22,7 @@ from shipgym_baselines.cli import (
     reproduce,
     run,
     scenarios,
+    summary,
     train,
     tune,
 )
@@ -37,6 +38,7 @@ SUBCOMMANDS: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     leaderboard.add_evaluate_parser,
     run.add_parser,
     report.add_parser,
+    summary.add_parser,
     manoeuvre.add_parser,
     scenarios.add_parser,
     bench.add_parser,

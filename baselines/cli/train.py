@@ -14,6 +14,7 @@ unfinished ones from their checkpoint and starts the ones that reached none afre
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from shipgym_baselines.cli.options import (
@@ -134,9 +135,19 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.extras import require
 
     require("stable_baselines3", "rl", "shipgym train")
+    from shipgym_baselines.learned.announce import start_line, too_short_line
     from shipgym_baselines.learned.train import train_sweep
 
-    metas = train_sweep(training_jobs(args), backend=args.backend, workers=args.workers)
+    jobs = training_jobs(args)
+    for job in jobs:
+        config = job["config"]
+        steps = job["n_timesteps"] or config.n_timesteps
+        sys.stderr.write(start_line(config, steps, job["seed"], job["out_dir"]) + "\n")
+    metas = train_sweep(jobs, backend=args.backend, workers=args.workers)
+    for job, meta in zip(jobs, metas, strict=True):
+        line = too_short_line(job["config"], meta)
+        if line is not None:
+            sys.stderr.write(line + "\n")
     text = "\n".join(
         f"{m['name']} (seed {m['seed']}): {m['env_steps']} env steps in "
         f"{m['wall_time_s']:.0f} s -> {m['out_dir']}"

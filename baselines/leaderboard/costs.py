@@ -35,9 +35,10 @@ COSTS_FILE = Path(__file__).parents[1] / "reference_data" / "leaderboard_costs.j
 #: the kinds whose fallback a controller without a recorded cost takes
 FALLBACK_KINDS = ("classical", "learned")
 #: CPU seconds of the tables, ranking and figures per scenario of a run, after its episodes
-#: (measured: 4.3 s for the smoke suite's 3 scenarios, ``write_results`` in one process; the
-#: default run's 47 scenarios took 47 s wall on 2 workers, ≈ 2 s each)
-TABLES_CPU_S_PER_SCENARIO = 1.5
+#: (measured: ``shipgym report`` of a default run, 60 scenarios, 24 controllers and 5,760
+#: episodes with their twins: 284 CPU s and 224 s wall on 2 cores shared with a test run;
+#: the scenario figures of two dozen controllers each are most of it)
+TABLES_CPU_S_PER_SCENARIO = 4.7
 
 
 @functools.lru_cache(maxsize=1)

@@ -2,11 +2,12 @@
 
 Every figure uses :func:`shipgym_baselines.leaderboard.style.controller_style` (one colour and line
 style per controller, the same in every figure), labels its axes with units, keeps legends
-outside the data and is written twice (:func:`save_figure`): drawn at
-:data:`~shipgym_baselines.leaderboard.style.FIGURE_DPI` (200 dpi), as a palette PNG of at most
-:data:`PAGE_WIDTH` pixels (the page's image), and as a vector copy beside it (SVG; the
-scenario figures, which hold the long trajectories, as gzip-compressed SVGZ).  Matplotlib runs
-on the Agg backend.
+outside the data and is written by :func:`save_figure`: drawn at
+:data:`~shipgym_baselines.leaderboard.style.FIGURE_DPI` (200 dpi) and written as a palette PNG
+of at most :data:`PAGE_WIDTH` pixels (the page's image); only when asked (``vector``, the
+``--vector-figures`` option), also as a vector copy beside it (SVG; the scenario figures,
+which hold the long trajectories, as gzip-compressed SVGZ).  Matplotlib runs on the Agg
+backend.
 
 What a run hands in:
 
@@ -20,7 +21,7 @@ What a run hands in:
   (:func:`shipgym_baselines.leaderboard.ranking.aggregate_ranking`);
   ``episodes``: the ``episodes.jsonl`` records; ``splits``: scenario → split.
 
-Functions (each returns the written files, PNG then SVG):
+Functions (each returns the written files, the PNG then any vector copy):
 
 * :func:`plot_scenario` ``(out_dir, scenario, drawn, change_time, path_xy=None,
   ship_length=None, kinds=None, chosen_by="median-ACE")`` — one scenario: a grid with one

@@ -167,6 +167,8 @@ def write_results(
         )
         scored = scored_episodes(ranked)  # C / C_oracle of each: the twins' numbers read it
         add_twin_cells(rows, scored, twins)
+        curves = learned_curves(kinds)
+        add_seed_flags([*board, *rows], curves)
         scores = score_table(shown_episodes, splits, kinds)
         write_text(out / AGGREGATE_FILE, dumps(board, indent=2) + "\n")
         write_text(out / SCENARIO_SCORES_FILE, dumps_rows(scores))  # one scenario a line
@@ -188,7 +190,7 @@ def write_results(
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
-        files += figures.plot_learning_curves(out, learned_curves(kinds), vector_figures)
+        files += figures.plot_learning_curves(out, curves, vector_figures)
     lead = verdict(board, shown_episodes, plain_name, headroom)
     page.write_html(
         out,
@@ -241,6 +243,18 @@ def share_table(
     families = {s: change_family(s) for s in scenarios}
     grid = share_grid(scored, controllers, ships, families, scenarios, twins)
     return {"split": split, "controllers": controllers, "rows": grid}
+
+
+def add_seed_flags(rows: list[dict[str, Any]], curves: Mapping[str, list[dict[str, Any]]]) -> None:
+    """Each row of a learned agent with shipped learning curves gets ``seed_flags``: its
+    flagged training seeds (:func:`~shipgym_baselines.learned.curves.seed_flags`, the rule
+    :data:`~shipgym_baselines.learned.curves.SEED_FLAG_RULE`; [] when none is)."""
+    from shipgym_baselines.learned.curves import seed_flags
+
+    flags = {name: seed_flags(found) for name, found in curves.items() if found}
+    for row in rows:
+        if row["controller"] in flags:
+            row["seed_flags"] = flags[row["controller"]]
 
 
 def learned_curves(kinds: Mapping[str, str]) -> dict[str, list[dict[str, Any]]]:

@@ -1,8 +1,11 @@
-"""``leaderboard.html``: the leaderboard as one self-contained page.
+"""``leaderboard.html``: the leaderboard as one page in its run's folder.
 
 It opens with the run's verdict in four sentences (:mod:`shipgym_baselines.leaderboard.verdict`).
-No network: the style sheet and the script are inline and every figure is embedded as a
-data URI (the SVG copy where there is one, else the PNG).  The page holds, in order:
+No network: the style sheet and the script are inline.  The ranking figures are embedded as
+data URIs (a light WebP or PNG, else the SVG); the scenario figures, one per scenario and
+most of a page's bytes (4 of 4.8 MB on the default run), are the PNG files beside the page,
+linked (the page stays within 3 MB; copied alone, it shows their captions only).  The page
+holds, in order:
 
 1. the **ranking** per split (``aggregate.json`` rows: IQM and geometric mean of the cost
    ratio C / C_oracle, the probability of improvement over ``pid_los`` and the failure
@@ -69,6 +72,7 @@ color:#1b1f24;background:#fff}
 h1{font-size:24px;margin:0 0 4px}h2{font-size:19px;margin:28px 0 8px;border-bottom:1px solid
 #d0d7de;padding-bottom:4px}h3{font-size:16px;margin:18px 0 6px}
 p.note{color:#57606a;margin:4px 0 10px;max-width:75em}
+.flag{color:#b15928;cursor:help;white-space:nowrap}
 .scroll{overflow-x:auto;max-width:100%;border:1px solid #d0d7de;border-radius:4px}
 table{border-collapse:collapse;font-variant-numeric:tabular-nums}
 th,td{padding:3px 8px;border-bottom:1px solid #eaeef2;text-align:right;white-space:nowrap}
@@ -81,10 +85,12 @@ text-align:left}
 td i{color:#57606a;display:block;font-size:11px;font-style:normal}
 table.compact td i{display:inline;margin-left:6px}
 .splits{display:flex;flex-wrap:wrap;gap:8px 24px;align-items:flex-start}
+.splits>div{min-width:0;max-width:100%}
 td.na{color:#8c959f;font-style:italic}
 td:first-child span{display:inline-block;width:22px;height:0;border-top-width:3px;
 margin-right:6px;vertical-align:middle}
 figure{margin:10px 0 22px}figure img{max-width:100%;height:auto;border:1px solid #eaeef2}
+.crop{overflow:hidden;border:1px solid #eaeef2}.crop img{width:100%;display:block;border:0}
 figcaption{color:#57606a;font-size:12px}
 .legend{display:flex;flex-wrap:wrap;gap:2px 18px;font-size:12px;margin:4px 0}
 .legend ul{list-style:none;margin:0;padding:0}.legend b{font-weight:600}
@@ -172,8 +178,11 @@ def page(
     note: str = "",
     headroom: Sequence[Mapping[str, Any]] = (),
     shares: Mapping[str, Any] | None = None,
+    folder: str | Path | None = None,
 ) -> str:
-    """The page's HTML (module doc); ``verdict``: the run's sentences
+    """The page's HTML (module doc); ``folder``: where the page is written (its scenario
+    figures are then linked as the files beside it, the other figures embedded; None:
+    every figure embedded); ``verdict``: the run's sentences
     (:mod:`shipgym_baselines.leaderboard.verdict`), the page's first paragraph; ``note``: what the
     run is ranked against (:func:`~shipgym_baselines.leaderboard.comparison.comparison_note`),
     under it; ``headroom``: the headroom table's rows
@@ -181,7 +190,7 @@ def page(
     ``shares``: the change share per ship × change family
     (:func:`~shipgym_baselines.leaderboard.outputs.share_table`), after the headroom."""
     ranking_figs, scenario_figs, legend_names = figure_sections(
-        figures, (r["scenario"] for r in rows)
+        figures, (r["scenario"] for r in rows), folder
     )
     names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
     names += [c["controller"] for s in scores for c in s["controllers"]]
@@ -258,7 +267,17 @@ def write_html(
     write_bytes(
         path,
         page(
-            rows, aggregate, scores, figures, title, subtitle, verdict, note, headroom, shares
+            rows,
+            aggregate,
+            scores,
+            figures,
+            title,
+            subtitle,
+            verdict,
+            note,
+            headroom,
+            shares,
+            folder=out,
         ).encode("utf-8"),
     )
     return path

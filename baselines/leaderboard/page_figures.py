@@ -7,9 +7,11 @@ from __future__ import annotations
 import base64
 import io
 import json
+import os
 from collections.abc import Iterable
 from pathlib import Path
 from typing import NamedTuple
+from urllib.parse import quote
 
 from shipgym_baselines.leaderboard.curve_figures import LEARNING_CURVES_STEM
 from shipgym_baselines.leaderboard.figure_files import LEGEND_KEY, LEGEND_TOP_KEY, figure_stem
@@ -33,6 +35,19 @@ class PageImage(NamedTuple):
     mime: str
     data: bytes
     legends: list[tuple[str, list[tuple[str, str]]]] | None = None
+
+
+def png_legends(png: Path) -> tuple[list[tuple[str, list[tuple[str, str]]]] | None, float]:
+    """A scenario figure's legends (:data:`LEGEND_KEY`) and the fraction of its height
+    above them (:data:`LEGEND_TOP_KEY`); (None, 1.0) for a figure without."""
+    from PIL import Image
+
+    with Image.open(png) as image:
+        text = dict(getattr(image, "text", {}))
+    if LEGEND_KEY not in text or LEGEND_TOP_KEY not in text:
+        return None, 1.0
+    legends = [(t, [tuple(e) for e in entries]) for t, entries in json.loads(text[LEGEND_KEY])]
+    return legends, float(text[LEGEND_TOP_KEY])
 
 
 def page_image(png: Path) -> PageImage:
@@ -73,9 +88,31 @@ class _Embedded(NamedTuple):
     uri: str
     file: str
     legends: list[tuple[str, list[tuple[str, str]]]] | None
+    #: a linked figure: its (width, height) [px] and the fraction of the height shown (the
+    #: page hides the legends drawn below it; they are text under it)
+    size: tuple[int, int] | None = None
+    shown: float = 1.0
 
 
-def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
+#: the figures the page links as files beside it (the page's folder) rather than embeds:
+#: one per scenario, 60 in the default run, 4 of its 4.8 MB when embedded
+LINKED_KINDS = ("scenario",)
+
+
+def _linked(f: Path, folder: Path) -> _Embedded:
+    """A PNG beside the page, as the page links it: its path from ``folder``."""
+    from PIL import Image
+
+    legends, top = png_legends(f)
+    with Image.open(f) as image:
+        size = image.size
+    uri = Path(os.path.relpath(f.resolve(), folder.resolve())).as_posix()
+    return _Embedded(quote(uri), f.name, legends, size, top)
+
+
+def embedded_figures(
+    figures: Iterable[str | Path], folder: str | Path | None = None
+) -> dict[str, _Embedded]:
     """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
     page-sized palette PNG, :func:`shipgym_baselines.leaderboard.figures.write_page_png`, embedded
     as :func:`page_image` gives it: the page stays light), else the SVG; in the
@@ -88,6 +125,10 @@ def embedded_figures(figures: Iterable[str | Path]) -> dict[str, _Embedded]:
             by_stem[f.stem] = f
     out = {}
     for stem, f in by_stem.items():
+        linked = folder is not None and stem.partition("_")[0] in LINKED_KINDS
+        if linked and f.suffix.lower() == ".png":
+            out[stem] = _linked(f, Path(folder))
+            continue
         if f.suffix.lower() == ".png":
             image = page_image(f)
         else:
@@ -137,28 +178,39 @@ def _legend_html(legends: list[tuple[str, list[tuple[str, str]]]]) -> str:
 
 def _figure(stem: str, fig: _Embedded, caption: str) -> str:
     legend = _legend_html(fig.legends) if fig.legends else ""
+    image = f'<img src="{fig.uri}" alt="{esc(caption)}" loading="lazy">'
+    if fig.size is not None:  # a file beside the page, its legends (drawn below) hidden
+        width, height = fig.size
+        image = (
+            f'<div class="crop" style="aspect-ratio:{width}/{max(1, round(height * fig.shown))};'
+            f'max-width:{width}px">{image}</div>'
+        )
     return (
-        f'<figure id="fig-{esc(stem)}"><img src="{fig.uri}" alt="{esc(caption)}" loading="lazy">'
+        f'<figure id="fig-{esc(stem)}">{image}'
         f"{legend}<figcaption>{esc(caption)} — <code>{esc(fig.file)}</code></figcaption></figure>"
     )
 
 
 def figure_sections(
-    figures: Iterable[str | Path], scenarios: Iterable[str] = ()
+    figures: Iterable[str | Path], scenarios: Iterable[str] = (), folder: str | Path | None = None
 ) -> tuple[str, str, list[str]]:
     """(ranking figures, scenario figures, the controllers their legends name) as HTML: per
     split its interval estimates, then its performance profiles; the scenario figures in
     the order of ``figures``, captioned with the scenario's name where ``scenarios`` has
-    it."""
+    it.  ``folder``: the page's; the scenario figures are then linked as the files beside
+    it (:data:`LINKED_KINDS`), else every figure is embedded."""
     names = {anchor(s): s for s in scenarios}
     ranking: list[tuple[str, int, str]] = []
     drawn = []
     legend_names: list[str] = []
-    for stem, fig in embedded_figures(figures).items():
+    for stem, fig in embedded_figures(figures, folder).items():
         kind, _, split = stem.partition("_")
         legend_names += [n for _, entries in fig.legends or () for n, _ in entries]
         if stem == LEARNING_CURVES_STEM:  # after the ranking figures of every split
-            caption = "learning curves of the learned agents (validation return per seed)"
+            caption = (
+                "learning curves of the learned agents: per training seed, the validation cost "
+                "over the oracle's (or the validation return, for an agent without that metric)"
+            )
             ranking.append(("~", True, _figure(stem, fig, caption)))
         elif kind in ("ranking", "profile"):
             what = "interval estimates" if kind == "ranking" else "performance profiles"

@@ -30,6 +30,7 @@ from shipgym_baselines.leaderboard.ranking import (
     resolution_lines,
 )
 from shipgym_baselines.leaderboard.splits import split_label, table_title
+from shipgym_baselines.learned.curves import SEED_FLAG_RULE, flag_text
 
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {
@@ -68,8 +69,21 @@ def ranking_tables(aggregate: Sequence[Mapping[str, Any]]) -> str:
                 f"C_frozen / C, P(C &lt; C_frozen), gap closed)</summary>{long}</details>"
             )
         parts.append("</div>")
-    notes = "".join(f'<p class="note">{esc(line)}</p>' for line in resolution_lines(aggregate))
+    lines = resolution_lines(aggregate) + flag_lines(aggregate)
+    notes = "".join(f'<p class="note">{esc(line)}</p>' for line in lines)
     return '<div class="splits">' + "".join(parts) + "</div>" + notes
+
+
+def flag_lines(aggregate: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The note on the learned rows' flagged training seeds (⚑ in the ranking), with the
+    rule; none without a flagged seed."""
+    flagged = {r["controller"]: r["seed_flags"] for r in aggregate if r.get("seed_flags")}
+    if not flagged:
+        return []
+    named = "; ".join(
+        f"{name}: " + ", ".join(flag_text(f) for f in flags) for name, flags in flagged.items()
+    )
+    return [f"⚑ flagged training seeds ({SEED_FLAG_RULE}): {named}."]
 
 
 def _ranking_table(
@@ -96,7 +110,13 @@ def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> T
     if column.cell == "rank":
         return Td(str(rank), -rank, rank)  # best-first on the first click
     if column.cell == "name":
-        return name_cell(row["controller"])
+        td = name_cell(row["controller"])
+        flags = row.get("seed_flags")
+        if not flags:
+            return td
+        title = "; ".join(flag_text(f) for f in flags)
+        mark = f' <span class="flag" title="{esc(title)}">⚑{len(flags)}</span>'
+        return td._replace(html=td.html + mark)
     if column.cell == "text":
         return text_cell(row.get(column.key, ""))
     if column.cell == "count":

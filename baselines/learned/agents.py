@@ -229,12 +229,15 @@ def _single_env_factory(
         import shipgym
 
         if source.get("scenario") is not None:
+            # the configured scenario itself, truncated at its own time limit
             return gym.make(
                 "ShipPathFollow-v0",
                 scenario=source["scenario"],
                 action_mode=action_mode,
                 context_features=context_features,
                 history_steps=history_steps,
+                randomize=False,
+                max_episode_steps=-1,
             )
         return gym.make(
             shipgym.RANDOMIZED_ENV_ID,
@@ -242,6 +245,7 @@ def _single_env_factory(
             action_mode=action_mode,
             context_features=context_features,
             history_steps=history_steps,
+            max_episode_steps=-1,  # each drawn scenario's own time limit
         )
 
     return make

@@ -83,6 +83,57 @@ def load_curve(folder: str | Path) -> dict[str, list[float]] | None:
     return check_curve(curve, str(path))
 
 
+#: a training seed "never improved" when the best of its selection metric is less than this
+#: fraction below its first evaluation's (the shipped model is then as good as untrained)
+NEVER_IMPROVED_GAIN = 0.10
+#: a training seed is "unstable" when its last evaluation's selection metric is at least this
+#: factor over its best (training went on far past the model it ships)
+UNSTABLE_FACTOR = 2.0
+#: what the flags say, for the page's note and the docs
+SEED_FLAG_RULE = (
+    f"a training seed is flagged 'never improved' when its best validation cost ratio is less "
+    f"than {NEVER_IMPROVED_GAIN:.0%} below its first evaluation's, and 'unstable' when its "
+    f"last evaluation's is {UNSTABLE_FACTOR:g}× its best or more (its learning_curve.json's "
+    "selection metric; a curve without one is not judged)"
+)
+
+
+def seed_flag(curve: dict[str, Any]) -> dict[str, Any] | None:
+    """The flag of one training seed's learning curve (:data:`SEED_FLAG_RULE`): ``flag``
+    ("never improved" or "unstable") with the curve's ``first``, ``best`` and ``final``
+    selection values; None when neither applies or the curve has no selection metric."""
+    selection = curve.get("selection")
+    if not selection:
+        return None
+    first, best, final = float(selection[0]), float(min(selection)), float(selection[-1])
+    values = {"first": first, "best": best, "final": final}
+    if best > (1.0 - NEVER_IMPROVED_GAIN) * first:
+        return {"flag": "never improved", **values}
+    if final >= UNSTABLE_FACTOR * best:
+        return {"flag": "unstable", **values}
+    return None
+
+
+def seed_flags(curves: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The flags of an agent's training seeds (:func:`agent_curves`' curves, each with its
+    ``seed``): one entry per flagged seed, ``training_seed`` first."""
+    flags = []
+    for curve in curves:
+        flag = seed_flag(curve)
+        if flag is not None:
+            flags.append({"training_seed": curve["seed"], **flag})
+    return flags
+
+
+def flag_text(flag: dict[str, Any]) -> str:
+    """One flagged seed in words: "seed 1 never improved (first 33.63, best 33.62, last
+    33.62)" (validation cost ratios)."""
+    return (
+        f"seed {flag['training_seed']} {flag['flag']} (first {flag['first']:.2f}, best "
+        f"{flag['best']:.2f}, last {flag['final']:.2f})"
+    )
+
+
 class PlateauRule(StrictModel):
     """Stop when the best of the metric improved by under ``min_gain`` (relative) over the
     last ``window`` fraction of the env steps so far, after ``min_evaluations`` and not

@@ -92,9 +92,21 @@ def make_env(
         "context_features": context_features,
         "history_steps": history_steps,
     }
+    # the scenario itself or each drawn scenario, truncated at its own time limit
     if source.get("scenario") is not None:
-        return gym.make("ShipPathFollow-v0", scenario=source["scenario"], **options)
-    return gym.make(shipgym.RANDOMIZED_ENV_ID, distribution=source["distribution"], **options)
+        return gym.make(
+            "ShipPathFollow-v0",
+            scenario=source["scenario"],
+            randomize=False,
+            max_episode_steps=-1,
+            **options,
+        )
+    return gym.make(
+        shipgym.RANDOMIZED_ENV_ID,
+        distribution=source["distribution"],
+        max_episode_steps=-1,
+        **options,
+    )
 
 
 def env_factory(config: Any) -> functools.partial:

@@ -159,6 +159,8 @@ def identification_log(
     env = gym.make(
         "ShipPathFollow-v0",
         scenario=_jump_case(scenario) if isinstance(scenario, str) else scenario,
+        randomize=False,
+        max_episode_steps=-1,  # the scenario's own time limit
     )
     obs, info = env.reset(seed=seed)
     ctx = env.unwrapped.controller_context

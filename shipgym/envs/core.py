@@ -287,14 +287,7 @@ class EnvParts:
             batch=1 if batch is None else batch,
             threads=threads,
         )
-        disturbances = Disturbances(
-            sc.config.disturbances,
-            model.disturbance_names,
-            k.fine_step,
-            k.substeps,
-            batch=1 if batch is None else batch,
-            time_limit=sc.config.time_limit,
-        )
+        disturbances = scenario_disturbances(sc, 1 if batch is None else batch)
         tracker = PathTracker(sc.path, sc.acceptance_radius, sc.config.path.switching, batch)
         gains = None
         if action_mode == "guidance":
@@ -314,6 +307,18 @@ class EnvParts:
             metric_settings=metric_settings(sc),
             autopilot_gains=gains,
         )
+
+
+def scenario_disturbances(scenario: Scenario, batch: int = 1) -> Disturbances:
+    """The disturbance processes of ``scenario`` for ``batch`` ships."""
+    return Disturbances(
+        scenario.config.disturbances,
+        scenario.model.disturbance_names,
+        scenario.fine_step,
+        scenario.substeps,
+        batch=batch,
+        time_limit=scenario.config.time_limit,
+    )
 
 
 # ---------------------------------------------------------------------------------- action

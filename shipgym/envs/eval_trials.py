@@ -2,10 +2,11 @@
 
 :class:`EvaluationTrialsVectorEnv` runs N episodes of one ship as the rows of one env (the
 row machinery of :mod:`shipgym.envs.trial_rows`): row i is the episode of
-``gym.make(ENV_ID, scenario=scenarios[i], action_mode=…)`` reset with ``seeds[i]``, bit for
-bit (observations, rewards, ends, ``info`` and ``episode_metrics``; tested), with the plant
-of all rows stepped in one call of the compiled period function.  There is no autoreset: a
-finished row stays done (:attr:`finished`), its action is ignored and it is not stepped.
+``gym.make(ENV_ID, scenario=scenarios[i], action_mode=…, randomize=False)`` reset with
+``seeds[i]``, bit for bit (observations, rewards, ends, ``info`` and ``episode_metrics``;
+tested), with the plant of all rows stepped in one call of the compiled period function.
+There is no autoreset: a finished row stays done (:attr:`finished`), its action is ignored
+and it is not stepped.
 
 ``info`` holds ``"rows"``: per row the single env's ``info`` dict of that step (every key:
 ``t``, ``cross_track_error``, …, ``samples``; ``termination_reason`` and

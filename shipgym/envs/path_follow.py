@@ -56,6 +56,7 @@ from shipgym.envs.truth import PlantTruth
 from shipgym.metrics import EpisodeLog, compute_metrics
 from shipgym.numerics import SCALAR
 from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.trials import apply_trial, draw_trial, env_randomization
 from shipgym.tracking import TrackFrame
 
 __all__ = ["GUIDANCE_OFFSET_MAX", "OBS_NAMES", "ShipPathFollowEnv"]
@@ -166,10 +167,17 @@ class ShipPathFollowEnv(gym.Env):
     .. rubric:: Starting state
 
     The scenario's ``initial_state`` (x, y [m], heading [deg], other states SI; default: the
-    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.  A
-    suite's ``randomize:`` block (:class:`shipgym.scenarios.trials.TrialRandomization`) moves
-    it per evaluation seed; the env's seed draws sensor noise and stochastic currents and
-    waves.
+    origin, heading 0°), cruising at the nominal speed with zero yaw rate and rudder.
+
+    With ``randomize=True`` (what ``gym.make(ENV_ID)`` passes) every reset first draws a
+    trial of the scenario from the env's ``np_random``, with the default suite's
+    ``randomize:`` ranges (:func:`shipgym.scenarios.trials.env_randomization`): the start
+    moved off the first leg and turned, the jump times shifted, the current scaled and
+    turned.  ``reset(seed=s)`` gives one trial per seed; ``reset()`` goes on with the
+    env's stream (a new trial).  ``scenario`` is the episode's trial, ``base_scenario`` the
+    scenario given.  ``randomize=False`` (the class's default) runs the scenario itself,
+    as the leaderboard plays the trials it draws from its evaluation seeds.  The env's seed
+    also draws the sensor noise and the stochastic currents and waves.
 
     .. rubric:: Episode end
 
@@ -178,10 +186,15 @@ class ShipPathFollowEnv(gym.Env):
     plant state is not finite (``"non_finite_state"``).  Truncated: the scenario's
     ``time_limit`` (``"time_limit"``; in control periods: ceil(time_limit/Ts)).  At the last
     step ``info`` also holds ``termination_reason`` and ``episode_metrics`` (ACE, t_c, J, …).
+    Each id's spec states its default scenario's ceil(time_limit/Ts) as
+    ``max_episode_steps`` (:data:`shipgym.MAX_EPISODE_STEPS`); ``gym.make`` wraps the env in
+    a ``TimeLimit`` of that many steps, which ends the episode at the same step as the
+    env.  With a longer ``scenario`` pass ``max_episode_steps=-1`` (the env's own limit).
 
     .. rubric:: Arguments
 
-    ``gym.make(ENV_ID, scenario=..., action_mode="rudder", render_mode=None, compile=True)``
+    ``gym.make(ENV_ID, scenario=..., action_mode="rudder", render_mode=None, compile=True,
+    randomize=True)``
 
     * ``scenario``: a catalogue name (``shipgym scenarios``), a held-out test scenario
       (``"heldout:3"``), a path to a YAML file or a :class:`shipgym.scenarios.Scenario`;
@@ -194,9 +207,12 @@ class ShipPathFollowEnv(gym.Env):
     * ``history_steps``: K ≥ 0, append the last K control steps of (measurements, applied
       rudder command), 7 entries each, oldest first, zeros before the episode's start
       (default 0: the observation above, unchanged; docs/observation.md).
+    * ``randomize``: draw a trial of ``scenario`` at every reset (see Starting state); True
+      in every id's registration, False in the class.
 
     ``gym.make_vec(ENV_ID, num_envs=N)`` returns the batched
-    :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit).
+    :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (N single envs bit for bit, env i
+    seeded ``seed + i``: N different trials).
     Processes that have not imported ``shipgym`` use ``gym.make("shipgym:ENV_ID")``.
 
     .. rubric:: Version history
@@ -210,6 +226,9 @@ class ShipPathFollowEnv(gym.Env):
       exists).
     * ``-v1`` (EssoOsaka, Mariner, Blanke): the same env, defaulting to the ship's
       ``{ship}_rudder_aging`` (a changing plant).
+    * Every id, in place: ``randomize=True`` (a trial per reset) and ``max_episode_steps``
+      in the spec.  Before, ``gym.make(id)`` ran the scenario itself whatever the seed;
+      ``gym.make(id, randomize=False)`` is that env.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
@@ -222,6 +241,7 @@ class ShipPathFollowEnv(gym.Env):
         compile: bool = True,
         context_features: bool = False,
         history_steps: int = 0,
+        randomize: bool = False,
     ) -> None:
         history_steps = core.check_history_steps(history_steps)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -229,15 +249,13 @@ class ShipPathFollowEnv(gym.Env):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
-        self.scenario: Scenario = load_scenario(scenario)
-        parts = core.EnvParts.build(
-            self.scenario,
-            action_mode,
-            compile,
-            context_features=context_features,
-            history_steps=history_steps,
-        )
-        self._parts = parts
+        if not isinstance(randomize, bool):
+            raise ValueError(f"randomize must be True or False, got {randomize!r}")
+        #: the scenario as given; with ``randomize`` each reset draws a trial of it
+        self.base_scenario: Scenario = load_scenario(scenario)
+        #: draw a trial of ``base_scenario`` at every reset (the default suite's ranges)
+        self.randomize = randomize
+        self._randomization = env_randomization() if randomize else None
         #: the observation ends with the controller-context features (core.CONTEXT_NAMES)
         self.context_features = context_features
         #: K: the observation ends with the last K control steps (core.ObservationHistory)
@@ -245,21 +263,39 @@ class ShipPathFollowEnv(gym.Env):
         self._history = core.ObservationHistory(1, history_steps) if history_steps else None
         self.action_mode = action_mode
         self.render_mode = render_mode
-        self.model = self.scenario.model
+        self._compile = compile
+        self._fig = None
+        self.use_scenario(self.base_scenario)
+        self.action_space = self._parts.action_space
+        self.observation_space = self._parts.observation_space
+
+    def use_scenario(self, scenario: Scenario) -> None:
+        """Run ``scenario`` from the next reset on (its model, integrator, disturbances,
+        path tracker and sensors); the observation and action spaces do not depend on it.
+        The trial of a ``randomize`` reset and the randomised env's drawn scenarios come in
+        through here."""
+        parts = core.EnvParts.build(
+            scenario,
+            self.action_mode,
+            self._compile,
+            context_features=self.context_features,
+            history_steps=self.history_steps,
+        )
+        #: the scenario of the episode (with ``randomize``: the trial drawn at reset)
+        self.scenario: Scenario = scenario
+        self._parts = parts
+        self.model = scenario.model
         self._k = k = parts.constants
         self._integrator = parts.integrator
         self._disturbances = parts.disturbances
         self._tracker = parts.tracker
-        self._sensor = SensorModel(self.scenario.config.sensors)
+        self._sensor = SensorModel(scenario.config.sensors)
         # per-substep disturbance and parameter blocks (rows = substeps); disturbances: the
         # mean current, refilled every period when time-varying
         self._w_block = np.zeros((k.substeps, self.model.n_disturbances))
         self._w_block[:] = self._disturbances.constant_row()
         self._p_block = np.zeros((k.substeps, self.model.n_params))
         self._sample_offsets = k.fine_step * np.arange(k.substeps)
-        self.action_space = parts.action_space
-        self.observation_space = parts.observation_space
-        self._fig = None
         self._state: np.ndarray | None = None
 
     # ------------------------------------------------------------------ public helpers
@@ -273,6 +309,9 @@ class ShipPathFollowEnv(gym.Env):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
+        if self._randomization is not None:  # the trial first, from the env's own stream
+            draws = draw_trial(self._randomization, self.np_random)
+            self.use_scenario(apply_trial(self.base_scenario, draws))
         sc, k = self.scenario, self._k
         self._state = x = sc.initial_state()
         self._step_count = 0

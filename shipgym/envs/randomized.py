@@ -58,9 +58,13 @@ class ShipPathFollowRandomizedEnv(gym.Env):
     ``reset(options={"index": i})`` picks the i-th test scenario.  ``context_features`` and
     ``history_steps`` as the single env's (each reset starts a new history window).
 
+    The spec's ``max_episode_steps`` is the longest episode the ``train`` distribution can
+    draw (:meth:`~shipgym.scenarios.sampling.ScenarioDistribution.max_episode_steps`); each
+    episode ends at its own scenario's time limit first.
+
     .. rubric:: Version history
 
-    ``-v0``: the only version.
+    ``-v0``: the only version (``max_episode_steps`` added to its spec, in place).
     """
 
     metadata: ClassVar[dict[str, Any]] = ShipPathFollowEnv.metadata
@@ -119,8 +123,7 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             config = self.distribution.sample(
                 train_rng(scenario_seed), name=f"{self.distribution.name}:train-{scenario_seed}"
             )
-        self._env.close()
-        self._env = self._make_env(config)
+        self._env.use_scenario(build_scenario(config, config.name))
         episode_seed = int(self.np_random.integers(0, 2**31 - 1))
         # the scenario's name identifies its schedule: an attribute for logging, never in
         # info or the observation (which controllers read)

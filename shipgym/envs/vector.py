@@ -18,7 +18,10 @@ resets only the masked envs).  ``info`` holds the scalar keys of the single env 
 in SyncVectorEnv's layout (``episode_metrics`` as a dict of arrays with ``_``-masks, present
 at the steps where an episode ended, with SyncVectorEnv's dtypes), except: ``position`` is
 an (N, 2) float array, there is no ``samples`` (online identification runs on the single
-env).  It is what
+env).  With ``randomize=True`` (the registered ids' default) each env's reset draws its trial
+from its own generator as the single env does (:attr:`trials`: the scenarios of the
+episodes; a per-env copy of the disturbance processes then carries each trial's current).
+It is what
 ``gym.make_vec("ShipPathFollow-v0", num_envs=N)`` returns by default (Gymnasium prefers a
 registered vector entry point); pass ``vectorization_mode="sync"`` for N single envs.
 """
@@ -32,12 +35,14 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from shipgym.angles import wrap_angle
-from shipgym.disturbances import SensorModel
+from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs import core
 from shipgym.envs.core import LOG_FIELDS
 from shipgym.metrics import compute_metrics
 from shipgym.numerics import ARRAY
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.events import EVENT_TIME_EPS as _EVENT_EPS
+from shipgym.scenarios.trials import apply_trial, draw_trial, env_randomization
 
 
 class ShipPathFollowVectorEnv(VectorEnv):
@@ -59,8 +64,11 @@ class ShipPathFollowVectorEnv(VectorEnv):
         max_episode_steps: int | None = None,
         context_features: bool = False,
         history_steps: int = 0,
+        randomize: bool = False,
     ) -> None:
         history_steps = core.check_history_steps(history_steps)
+        if not isinstance(randomize, bool):
+            raise ValueError(f"randomize must be True or False, got {randomize!r}")
         if num_envs < 1:
             raise ValueError(f"num_envs must be ≥ 1, got {num_envs}")
         if max_episode_steps is not None and not (
@@ -85,7 +93,14 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self.history_steps = history_steps
         self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
         self.num_envs = num_envs
+        #: the scenario as given (with ``randomize`` each env's reset draws a trial of it)
         self.scenario = sc
+        #: draw a trial of ``scenario`` at every env's reset, from its generator (as the
+        #: single env: the default suite's ranges)
+        self.randomize = randomize
+        self._randomization = env_randomization() if randomize else None
+        #: each env's scenario this episode (``scenario`` itself without ``randomize``)
+        self.trials: list[Scenario] = [sc] * num_envs
         self.action_mode = action_mode
         self.render_mode = None
         #: compute info["episode_metrics"] for finished envs (≈ 0.2 ms each; training loops
@@ -103,6 +118,11 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._tracker = parts.tracker
         self._integrator = parts.integrator
         self._disturbances = parts.disturbances
+        #: with ``randomize``: each env's own processes (its trial's current), else None
+        self._row_disturbances: list[Disturbances] | None = None
+        if randomize:
+            self._row_disturbances = [parts.disturbances] * num_envs  # replaced at reset
+        self._event_start, self._event_end = _event_bounds([sc] * num_envs)
         self._w_block = self._integrator.disturbance_buffer  # filled in place, never copied
         self._w_block[:] = self._disturbances.constant_row()
         self._p_block = self._integrator.parameter_buffer
@@ -172,9 +192,15 @@ class ShipPathFollowVectorEnv(VectorEnv):
         # order), the processes over all advancing ships at once
         if self._disturbances.time_varying and np.any(live):
             rows = np.flatnonzero(live)
-            dist = self._disturbances
-            noise = [dist.draw(self._rngs[i]) for i in rows] if dist.n_noise else None
-            dist.fill(self._w_block, t0[rows], None if noise is None else np.stack(noise), rows)
+            if self._row_disturbances is not None:  # each env's trial has its own current
+                for i in rows.tolist():
+                    self._row_disturbances[i].fill_one(
+                        self._w_block[i], float(t0[i]), self._rngs[i]
+                    )
+            else:
+                dist = self._disturbances
+                noise = [dist.draw(self._rngs[i]) for i in rows] if dist.n_noise else None
+                dist.fill(self._w_block, t0[rows], None if noise is None else np.stack(noise), rows)
         # --- plant: one call for all ships
         # states at t0 + h … t0 + Ts (the integrator's buffer, valid until the next step)
         traj = self._integrator.substep_states(self._state, delta_c, self._w_block, self._p_block)
@@ -249,12 +275,16 @@ class ShipPathFollowVectorEnv(VectorEnv):
     # ------------------------------------------------------------------ pieces
     def _reset_envs(self, mask: np.ndarray) -> None:
         sc, k = self.scenario, self._k
-        self._state[mask] = sc.initial_state()
+        if self._randomization is None:
+            self._state[mask] = sc.initial_state()
+            self._p_block[mask] = sc.schedule.vector_at(0.0)
+        else:
+            for i in np.flatnonzero(mask).tolist():
+                self._install_trial(i)
         self._steps[mask] = 0
         self._t[mask] = 0.0
         self._delta_c[mask] = 0.0
         self._integral[mask] = 0.0
-        self._p_block[mask] = sc.schedule.vector_at(0.0)
         self._p_dirty[mask] = False
         self._speed[mask] = k.nominal_speed
         self._log[:, mask] = 0.0
@@ -262,7 +292,10 @@ class ShipPathFollowVectorEnv(VectorEnv):
             self._history.restart(mask)
         for i in np.flatnonzero(mask):
             sensor = self._sensors[i]
-            self._disturbances.reset(i, self._rngs[i])  # before the sensor's draws
+            if self._row_disturbances is None:
+                self._disturbances.reset(i, self._rngs[i])  # before the sensor's draws
+            else:
+                self._row_disturbances[i].reset(0, self._rngs[i])
             sensor.reset()
             x = self._state[i]
             if self._ideal:
@@ -272,15 +305,38 @@ class ShipPathFollowVectorEnv(VectorEnv):
                 self._psi_m[i], self._r_m[i] = p_i[0], r_i[0]
         self._tracker.reset(self._state[:, k.ix], self._state[:, k.iy], mask)
 
+    def _install_trial(self, i: int) -> None:
+        """Env i's next trial, drawn from its generator (the single env's reset): its
+        scenario, start, parameters, event times and current."""
+        rng = self._rngs[i]
+        trial = apply_trial(self.scenario, draw_trial(self._randomization, rng))
+        self.trials[i] = trial
+        self._state[i] = trial.initial_state()
+        self._p_block[i] = trial.schedule.vector_at(0.0)
+        start, end = _event_bounds([trial])
+        self._event_start[i], self._event_end[i] = start[0], end[0]
+        dist = self._row_disturbances[i] = core.scenario_disturbances(trial)
+        self._w_block[i] = dist.constant_row()
+
     def _refresh_parameters(self, t0: np.ndarray, live: np.ndarray) -> None:
-        """Parameter rows of the period [t0, t0 + Ts] per env (core.refresh_parameters)."""
-        schedule = self.scenario.schedule
-        if not schedule.events:
+        """Parameter rows of the period [t0, t0 + Ts] per env (core.refresh_parameters);
+        an env's events act on it when one starts or ramps within it (as
+        ParameterSchedule.changing_on, with each env's event times)."""
+        if not self._event_start.shape[1]:
             return
-        changing = schedule.changing_on(t0, t0 + self._k.control_period)
+        t1 = t0 + self._k.control_period
+        changing = np.any(
+            (self._event_end >= (t0 - _EVENT_EPS)[:, None])
+            & (self._event_start <= (t1 + _EVENT_EPS)[:, None]),
+            axis=1,
+        )
         for i in np.flatnonzero(live & (changing | self._p_dirty)):
             self._p_dirty[i] = core.refresh_parameters(
-                schedule, float(t0[i]), self._k, self._p_block[i], bool(self._p_dirty[i])
+                self.trials[i].schedule,
+                float(t0[i]),
+                self._k,
+                self._p_block[i],
+                bool(self._p_dirty[i]),
             )
 
     def _observation(self) -> np.ndarray:
@@ -326,5 +382,14 @@ class ShipPathFollowVectorEnv(VectorEnv):
     def _episode_metrics(self, i: int, reached: bool) -> dict[str, Any]:
         n = int(self._steps[i])
         columns = {name: self._log[j, i, :n].copy() for j, name in enumerate(LOG_FIELDS)}
-        log = core.episode_log(columns, self.scenario, reached)
+        log = core.episode_log(columns, self.trials[i], reached)
         return compute_metrics(log, self._parts.metric_settings)
+
+
+def _event_bounds(scenarios: list[Scenario]) -> tuple[np.ndarray, np.ndarray]:
+    """(start, end) times [s] of each scenario's events, (n, n_events) arrays (the
+    scenarios are trials of one scenario: as many events each)."""
+    start = np.array([[e.time for e in sc.schedule.events] for sc in scenarios])
+    end = np.array([[e.end_time() for e in sc.schedule.events] for sc in scenarios])
+    n = len(scenarios[0].schedule.events)
+    return start.reshape(len(scenarios), n), end.reshape(len(scenarios), n)

@@ -28,8 +28,9 @@ The current and the yaw bias are disturbances (the model's ``current_x``, ``curr
 ``yaw_disturbance``), estimated beside these; nomoto2's current shift moves d0, which
 enters its yaw equation exactly as the yaw bias does (eq. (4): K(δ + T3δ̇) + d0 + w_ψ).
 
-Bounds keep an estimate physical: a factor in [1/2, 100] on a servo time constant (aging
-only slows a servo; the catalogue's rudder aging is ×3–×60), [1/10, 2] on a rate limit,
+Bounds keep an estimate physical: a factor in [1/2, 400] on a servo time constant (aging
+only slows a servo; the catalogue's rudder aging is ×3–×60 on four ships and ×200 on the
+KVLCC2), [1/10, 2] on a rate limit,
 [1/3, 3] on rudder effectiveness and nomoto2's K (the catalogue's manoeuvrability change
 is K × 12: [1/3, 20] there), [1/2, 3] on T1, and a draught of ×0.3–×1.6 (the catalogue's
 loading changes are ×0.4 and ×1.35).
@@ -64,7 +65,7 @@ class Quantity:
 
 
 def _servo(name: str) -> Quantity:
-    return Quantity("servo", (name,), 0.5, 100.0)
+    return Quantity("servo", (name,), 0.5, 400.0)
 
 
 def _rate(name: str) -> Quantity:

@@ -9,7 +9,9 @@ import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord
 
-_EPS = 1e-9  # s, tolerance on event times against accumulated float time
+#: [s] tolerance on event times against accumulated float time
+EVENT_TIME_EPS = 1e-9
+_EPS = EVENT_TIME_EPS
 
 
 @dataclasses.dataclass(frozen=True)

@@ -372,6 +372,22 @@ def _shortest_time_limit(path: PathSampling, ship: ShipSampling, model: Any) -> 
     return path.time_factor * route / model.nominal_speed + ship.time_margin
 
 
+def _max_episode_steps(ship: ShipSampling, path: PathSampling) -> int:
+    """Control periods of the ship's longest episode: its time limit (as
+    :meth:`ScenarioDistribution.sample` sets it) on the longest route (most, longest legs)
+    against the strongest current it can draw (background or shift), over its Ts."""
+    from shipgym.models import MODELS
+
+    model = MODELS[ship.model].from_config(ship.params, ship.unit_reading, ship.variant)
+    route = (path.legs[1] * path.leg_length_L[1] + 1.0) * model.length
+    currents = [ship.current.speed[1]]
+    currents += [k.current.speed[1] for k in ship.jumps.kinds.values() if k.current is not None]
+    # the relative 1e-9: the drawn legs' float sum may round above the product
+    over = path.time_factor * route / (model.nominal_speed - max(currents)) * (1.0 + 1e-9)
+    time_limit = math.ceil(over + ship.time_margin)
+    return math.ceil(time_limit / model.control_period - 1e-9)  # as StepConstants.max_steps
+
+
 def _check_param(ship: ShipSampling, where: str, pname: str, params_key: str) -> None:
     """A parameter of the ship's model with a known nominal value (factor and add modes)."""
     from shipgym.models import MODELS
@@ -465,6 +481,14 @@ class ScenarioDistribution:
         for j in range(max(counts)):
             layout += [(k, j) for k, count in enumerate(counts) if j < count]
         return layout
+
+    def max_episode_steps(self) -> int:
+        """The most control periods an episode of this distribution can last: the longest
+        time limit any ship can draw (its longest route against its strongest current,
+        module doc) over that ship's control period."""
+        return max(
+            _max_episode_steps(ship, ship.path or self.config.path) for ship in self.config.ships
+        )
 
     def sample(
         self, rng: np.random.Generator, name: str | None = None, ship_index: int | None = None

@@ -15,15 +15,20 @@ states the ranges, :func:`trial_scenario` draws one trial from a seed:
 * the sensor-noise realisation (and that of any stochastic current or wave) varies with
   the env seed itself, as always.
 
-Every range is drawn on every trial, in this order, from its own stream
-``numpy.random.default_rng([TRIAL_STREAM, seed])`` (independent of the env's generator),
-so a trial is reproducible from its seed and adding one range does not change the others'
-draws.  Controllers see a trial as they see any scenario: the start through their
-observations, never the event schedule.
+A trial is two pure steps: :func:`draw_trial` draws the values from a
+``numpy.random.Generator``, :func:`apply_trial` applies them to a scenario.  Every range is
+drawn on every trial, in this order, so adding one range does not change the others' draws.
+An evaluation seed's generator is its own stream
+``numpy.random.default_rng([TRIAL_STREAM, seed])`` (independent of the env's generator), so
+a leaderboard trial is reproducible from its seed (:func:`trial_scenario`).  The registered
+env ids draw from the env's own ``np_random`` at ``reset(seed=…)`` instead
+(:data:`ENV_RANDOMIZE_SUITE`'s ranges).  Controllers see a trial as they see any scenario:
+the start through their observations, never the event schedule.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable, Mapping
 from typing import Annotated, Any
@@ -31,7 +36,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import AfterValidator, ValidationInfo, field_validator
 
-from shipgym.config import StrictModel
+from shipgym.config import StrictModel, read_yaml, resolve
 from shipgym.limits import RANDOMIZE_BOUNDS
 
 #: the trial draws' stream, apart from the env's own seeding
@@ -68,6 +73,18 @@ class TrialRandomization(StrictModel):
         return r
 
 
+#: the suite whose ``randomize:`` ranges the registered env ids draw at ``reset(seed=…)``:
+#: the leaderboard's trials, so that an agent trains on the distribution it is ranked on
+ENV_RANDOMIZE_SUITE = "default"
+
+
+@functools.cache
+def env_randomization() -> TrialRandomization:
+    """The ranges the registered env ids draw (:data:`ENV_RANDOMIZE_SUITE`'s ``randomize:``)."""
+    data = read_yaml(resolve("suites", ENV_RANDOMIZE_SUITE))
+    return TrialRandomization(**data["randomize"])
+
+
 _ORDER = (
     "cross_track_offset_L",
     "heading_error_deg",
@@ -77,9 +94,9 @@ _ORDER = (
 )
 
 
-def trial_draws(randomization: TrialRandomization, seed: int) -> dict[str, float]:
-    """The values one seed draws for the ranges that are set (module doc)."""
-    rng = np.random.default_rng([TRIAL_STREAM, int(seed)])
+def draw_trial(randomization: TrialRandomization, rng: np.random.Generator) -> dict[str, float]:
+    """The values ``rng`` draws for the ranges that are set (module doc): one uniform per
+    range, set or not, in the module's order."""
     u = rng.random(len(_ORDER))
     out = {}
     for name, x in zip(_ORDER, u.tolist(), strict=True):
@@ -87,6 +104,11 @@ def trial_draws(randomization: TrialRandomization, seed: int) -> dict[str, float
         if r is not None:
             out[name] = r[0] + (r[1] - r[0]) * x
     return out
+
+
+def trial_draws(randomization: TrialRandomization, seed: int) -> dict[str, float]:
+    """The values evaluation seed ``seed`` draws (its own stream, module doc)."""
+    return draw_trial(randomization, np.random.default_rng([TRIAL_STREAM, int(seed)]))
 
 
 def seed_trials(
@@ -105,7 +127,12 @@ def trial_scenario(scenario: Any, randomization: TrialRandomization | None, seed
     is a scenario over its trials)."""
     if randomization is None:
         return scenario
-    draws = trial_draws(randomization, seed)
+    return apply_trial(scenario, trial_draws(randomization, seed))
+
+
+def apply_trial(scenario: Any, draws: Mapping[str, float]) -> Any:
+    """``scenario`` with the drawn values of :func:`draw_trial` applied (module doc); the
+    scenario itself when nothing was drawn.  The name is kept."""
     if not draws:
         return scenario
     cfg = scenario.config

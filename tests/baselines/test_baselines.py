@@ -236,7 +236,9 @@ def test_guidance_mode_with_zero_action_is_pid_los() -> None:
     import gymnasium as gym
 
     pid = run_episode(PIDLOS(preset="paper"), "rudder_aging", seed=3)
-    env = gym.make("ShipPathFollow-v0", scenario="rudder_aging", action_mode="guidance")
+    env = gym.make(
+        "ShipPathFollow-v0", scenario="rudder_aging", action_mode="guidance", randomize=False
+    )
     env.reset(seed=3)
     commands = []
     while True:

@@ -40,6 +40,7 @@ def test_every_subcommand_is_listed() -> None:
         "evaluate",
         "run",
         "report",
+        "summary",
         "manoeuvre",
         "scenarios",
         "bench",

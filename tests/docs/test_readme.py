@@ -81,3 +81,19 @@ def test_the_evaluate_example_gives_the_leaderboards_episodes(
     expected = str([round(recorded[s]["ace"], 3) for s in seeds])
     assert printed == expected
     assert f"# {expected}" in block  # the numbers the README shows
+
+
+def test_the_ranking_table_is_the_shipped_run_summarys() -> None:
+    """The README's ranking is :func:`readme_table` of ``docs/run_summary.json`` (written by
+    ``shipgym summary RUN_DIR --out docs/run_summary.json``), and the run's CPU time it
+    quotes is the summary's."""
+    import json
+
+    from shipgym_baselines.leaderboard.summary import readme_table
+
+    summary = json.loads((REPO / "docs" / "run_summary.json").read_text(encoding="utf-8"))
+    assert readme_table(summary) in README
+    assert summary["suite"] == "default" and summary["status"] == "complete"
+    assert f"{summary['cpu_s']:,.0f} CPU s" in README
+    assert f"{summary['wall_s']:,.0f} s wall" in README
+    assert f"{summary['episodes']:,} episodes" in README

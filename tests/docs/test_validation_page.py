@@ -1,10 +1,12 @@
-"""docs/validation.md: the generated tables hold every ship's figures and every published
-value with its source, and the page includes each of them."""
+"""docs/validation.md holds its tables in its Markdown source: every ship's figures and every
+published value with its source, as the code computes them now."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
+
+import pytest
 
 from shipgym.models import MODELS
 from shipgym.validation import published
@@ -15,14 +17,26 @@ sys.path.insert(0, str(REPO / "docs" / "_ext"))
 from shipgym_docs import validation  # noqa: E402
 
 
-def test_every_ship_has_a_table_with_its_sources_and_the_page_includes_it(
-    tmp_path: Path,
-) -> None:
-    written = {p.name: p.read_text(encoding="utf-8") for p in validation.write(tmp_path)}
-    page = (REPO / "docs" / "validation.md").read_text(encoding="utf-8")
-    for name in [f"{ship}.inc.md" for ship in MODELS] + ["esso_osaka_options.inc.md"]:
-        assert f"_generated/validation/{name}" in page
-        assert name in written
+@pytest.fixture(scope="module")
+def tables() -> dict[str, str]:
+    return validation.tables()
+
+
+def test_the_pages_tables_are_what_the_code_computes_now(tables: dict[str, str]) -> None:
+    page = validation.PAGE.read_text(encoding="utf-8")
+    assert validation.inline(page, tables) == page, (
+        "the tables of docs/validation.md differ from what shipgym.validation computes now: "
+        f"run `{validation.COMMAND}` from the checkout and commit the page"
+    )
+
+
+def test_every_ship_has_a_table_with_its_sources(tables: dict[str, str]) -> None:
+    assert list(tables) == [*MODELS, "esso_osaka_options"]
     for ship in MODELS:
         for ref in published(ship):
-            assert ref.source.split(" (")[0] in written[f"{ship}.inc.md"]
+            assert ref.source.split(" (")[0] in tables[ship]
+
+
+def test_a_table_without_its_markers_is_named() -> None:
+    with pytest.raises(ValueError, match="'mariner'"):
+        validation.inline("# a page\n", {"mariner": "| a |\n|---|\n"})

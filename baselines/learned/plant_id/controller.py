@@ -3,7 +3,9 @@
 RMA's architecture (Kumar, Fu, Pathak & Malik 2021, "RMA: Rapid Motor Adaptation for
 Legged Robots"): an adaptation module φ reads a window of the recent history and estimates
 what the base policy needs of the plant; here the base policy is the oracle's NMPC on the
-ship's own model (:class:`~shipgym_baselines.classical.oracle.PlantNMPC`), and φ estimates
+ship's own model (:class:`~shipgym_baselines.classical.oracle.PlantNMPC`, one solver
+iteration a step as ``nmpc_ekf``'s:
+:data:`~shipgym_baselines.classical.oracle.REAL_TIME_SETTINGS`), and φ estimates
 the adapted quantities, the current and the yaw bias (:mod:`.labels`).  At every step:
 
 1. φ(window) = (μ, σ²) per slot (:mod:`.network`).
@@ -36,7 +38,7 @@ from shipgym.envs.truth import PlantTruth
 from shipgym.identification.adaptation import Adaptation
 from shipgym.identification.ekf import MEASURED, full_rudder_bias, measured_start
 from shipgym_baselines.classical.nmpc_ekf import measurement, servo_factors, servo_fit
-from shipgym_baselines.classical.oracle import OracleSettings, PlantNMPC
+from shipgym_baselines.classical.oracle import REAL_TIME_SETTINGS, OracleSettings, PlantNMPC
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.plant_id.features import Window
 from shipgym_baselines.learned.plant_id.labels import SLOTS, UNLEARNED, plant_of, slot_mask
@@ -71,6 +73,7 @@ class NmpcLearnedId(PlantNMPC):
 
     kind: ClassVar[str] = "learned"
     training_seeds: ClassVar[tuple[int | None, ...]] = shipped_seeds() or (None,)
+    default_settings: ClassVar[OracleSettings] = REAL_TIME_SETTINGS
 
     def __init__(
         self,

@@ -51,7 +51,7 @@ def linear_analysis(scenario: Any) -> dict[str, dict[str, float]]:
     share is zero at exact estimates and C(s) drops out of the loop.  PID: its gains on its
     first-order Nomoto design model, L = K(Kd·s² + Kp·s + Ki)/(s²(Ts + 1)).
     """
-    env = gym.make("ShipPathFollow-v0", scenario=scenario)
+    env = gym.make("ShipPathFollow-v0", scenario=scenario, randomize=False)
     try:
         env.reset(seed=0)
         ctx = env.unwrapped.controller_context

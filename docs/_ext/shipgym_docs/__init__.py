@@ -3,11 +3,13 @@
 At ``builder-inited`` the generators write MyST pages into ``<srcdir>/_generated/`` (ignored by
 git): one page per registered env id (:mod:`.envs`, from the env class's docstring), the
 scenario catalogue with route figures (:mod:`.scenarios`), one page per registered controller
-(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the validation
-tables (:mod:`.validation`), the command-line reference (:mod:`.cli`), the recorded
+(:mod:`.controllers`), the ship models' parameter tables (:mod:`.ships`), the command-line
+reference (:mod:`.cli`), the recorded
 measurements (:mod:`.measurements`), the API reference (:mod:`.api`) and the notebooks as
 tutorials (:mod:`.tutorials`).  A page is rewritten only
-when its text changes, so that an incremental build rereads only what moved.
+when its text changes, so that an incremental build rereads only what moved.  The validation
+tables (:mod:`.validation`) are not written at build time: they live in ``docs/validation.md``
+itself, and a test checks them.
 """
 
 from __future__ import annotations
@@ -28,11 +30,10 @@ from shipgym_docs import (
     scenarios,
     ships,
     tutorials,
-    validation,
 )
 
 GENERATED = "_generated"
-GENERATORS = (envs, scenarios, controllers, ships, validation, cli, measurements, tutorials, api)
+GENERATORS = (envs, scenarios, controllers, ships, cli, measurements, tutorials, api)
 
 
 def generate(app: Sphinx) -> None:

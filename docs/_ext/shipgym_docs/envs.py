@@ -69,6 +69,7 @@ def page(env_id: str) -> str:
         ("entry point", f"`{spec.entry_point}`"),
         ("vector entry point", f"`{spec.vector_entry_point}`"),
         ("`gym.make` defaults", f"`{spec.kwargs}`"),
+        ("`max_episode_steps`", f"{spec.max_episode_steps}"),
         ("other versions", _versions(env_id)),
     ]
     if "scenario" in spec.kwargs:

@@ -201,6 +201,19 @@ def built_page(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return write_html(out, rows, aggregate, scores, figs, subtitle="synthetic: 18 controllers")
 
 
+def test_the_written_page_links_its_scenario_figures_beside_it(built_page: Path) -> None:
+    """The scenario figures (most of a run page's bytes) are the PNG files beside the page,
+    cropped above their legends (written as text); everything else stays inside the page."""
+    text = built_page.read_text(encoding="utf-8")
+    figure = re.search(r'<figure id="fig-scenario_nominal">(.*?)</figure>', text, re.S)
+    assert figure is not None
+    (src,) = re.findall(r'src="([^"]+)"', figure.group(1))
+    assert src == "fig/scenario_nominal.png" and (built_page.parent / src).is_file()
+    assert 'class="crop"' in figure.group(1) and 'class="legend"' in figure.group(1)
+    others = [a for a in re.findall(r'(?:src|href)="([^"]+)"', text) if a != src]
+    assert others and all(a.startswith(("data:", "#")) for a in others)
+
+
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
 def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page: Path) -> None:
     assert built_page.name == PAGE_FILE
@@ -225,6 +238,40 @@ def test_the_page_renders_in_a_headless_browser_with_every_controller(built_page
     assert shown == [(r["controller"], r["scenario"]) for r in rows]
     # the scenario figure's legends as text under its image, the oracle's swatch aside
     assert "pid_los (seed 10000)" in dom and 'class="legend"' in dom
+
+
+#: a script appended to a copy of the page: the document's width after layout, in the DOM
+WIDTH_PROBE = (
+    "<script>addEventListener('load', () => document.body.setAttribute('data-widths', "
+    "document.documentElement.scrollWidth + ' ' + innerWidth))</script>"
+)
+
+
+def page_widths(page: Path, tmp: Path, width: int) -> tuple[int, int]:
+    """(the page's scroll width, the window's inner width) [px] in a ``width``-px window."""
+    probe = tmp / "probed.html"
+    probe.write_text(page.read_text(encoding="utf-8").replace("</body>", WIDTH_PROBE + "</body>"))
+    dom = chromium(
+        probe.as_uri(),
+        tmp,
+        f"--window-size={width},2000",
+        "--virtual-time-budget=5000",
+        "--dump-dom",
+    )
+    found = re.search(r'data-widths="(\d+) (\d+)"', dom)
+    assert found is not None, dom[:300]
+    return int(found.group(1)), int(found.group(2))
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")
+@pytest.mark.parametrize("width", [1400, 800])
+def test_the_page_fits_its_window_wide_tables_scroll_in_their_boxes(
+    built_page: Path, width: int
+) -> None:
+    """18 controllers' ranking with every column: nothing runs off a 1400-px window, nor an
+    800-px one, narrower than the ranking (a table wider than its box scrolls inside it)."""
+    scroll_width, inner = page_widths(built_page, built_page.parent, width)
+    assert inner == width and scroll_width <= inner
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (.ci/run installs it)")

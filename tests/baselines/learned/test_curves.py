@@ -194,3 +194,67 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
     assert list(lines["oracle = 1"].get_ydata()) == [1.0, 1.0]
     rings = [ln for ln in by_cost.get_lines() if ln.get_marker() == "o"]
     assert [(float(r.get_xdata()[0]), float(r.get_ydata()[0])) for r in rings] == [(20.0, 2.0)]
+
+
+def _curve(selection: list[float], seed: int = 0) -> dict:
+    steps = [100 * (i + 1) for i in range(len(selection))]
+    return {"env_steps": steps, "selection": selection, "seed": seed}
+
+
+@pytest.mark.parametrize(
+    ("selection", "flag"),
+    [
+        ([33.63, 33.62, 33.62], "never improved"),  # best 0.03 % under the first
+        ([5.91, 6.5, 44.27], "never improved"),  # the first is the best
+        ([17.5, 7.39, 19.36], "unstable"),  # ends at 2.6× its best
+        ([29.4, 1.27, 1.67], None),  # ends at 1.3× its best
+        ([10.0, 9.0, 9.0], None),  # 10 % under the first: improved, just
+    ],
+)
+def test_the_seed_flag_rule(selection: list[float], flag: str | None) -> None:
+    from shipgym_baselines.learned.curves import seed_flag
+
+    found = seed_flag(_curve(selection))
+    assert (found or {}).get("flag") == flag
+    if found is not None:
+        assert (found["first"], found["best"], found["final"]) == (
+            selection[0],
+            min(selection),
+            selection[-1],
+        )
+
+
+def test_the_shipped_agents_flagged_seeds() -> None:
+    """The shipped curves flag recurrent_ppo's seed 1 (flat at 33.6× the oracle), sac's
+    three seeds and td3's seed 2; ppo's and dagger's none."""
+    from shipgym_baselines.learned.curves import agent_curves, seed_flags
+
+    flagged = {name: [f["training_seed"] for f in seed_flags(agent_curves(name))] for name in (
+        "recurrent_ppo", "sac", "td3", "ppo", "dagger")}  # fmt: skip
+    assert flagged["recurrent_ppo"] == [0, 1]
+    assert flagged["sac"] == [0, 1, 2]
+    assert flagged["td3"] == [2]
+    assert flagged["ppo"] == flagged["dagger"] == []
+
+
+def test_flagged_seeds_are_marked_in_the_ranking_with_the_rule() -> None:
+    from shipgym_baselines.leaderboard.outputs import add_seed_flags
+    from shipgym_baselines.leaderboard.page_sections import flag_lines, ranking_tables
+
+    head = {"split": "catalogue", "runs": 4}
+    rows = [
+        {**head, "controller": "agent", "kind": "learned", "cost_ratio_iqm": 2.0},
+        {**head, "controller": "pid_los", "kind": "classical", "cost_ratio_iqm": 3.0},
+    ]
+    for row in rows:
+        row["cost_ratio_iqm_ci95"] = [row["cost_ratio_iqm"] - 0.1, row["cost_ratio_iqm"] + 0.1]
+    add_seed_flags(rows, {"agent": [_curve([4.0, 4.0], seed=1), _curve([4.0, 1.0], seed=2)]})
+    assert rows[0]["seed_flags"] == [
+        {"training_seed": 1, "flag": "never improved", "first": 4.0, "best": 4.0, "final": 4.0}
+    ]
+    assert "seed_flags" not in rows[1]
+    (line,) = flag_lines(rows)
+    assert "agent: seed 1 never improved (first 4.00, best 4.00, last 4.00)" in line
+    assert "never improved' when" in line
+    html = ranking_tables(rows)
+    assert 'class="flag"' in html and "⚑1" in html

@@ -138,7 +138,8 @@ def test_batched_env_windows_equal_the_single_envs_through_autoreset_and_reset()
     kwargs = {"scenario": "rudder_aging", "history_steps": k, "context_features": True}
     batched = ShipPathFollowVectorEnv(N, max_episode_steps=limit, **kwargs)
     single = gym.vector.SyncVectorEnv(
-        [lambda: gym.make("ShipPathFollow-v0", max_episode_steps=limit, **kwargs)] * N
+        [lambda: gym.make("ShipPathFollow-v0", max_episode_steps=limit, randomize=False, **kwargs)]
+        * N
     )
     assert batched.single_observation_space == single.single_observation_space
     rng = np.random.default_rng(0)

@@ -14,10 +14,14 @@ from shipgym.scenarios.loader import scenario_from_dict
 N = 4
 
 
-def sync_twin(scenario: str | Scenario, mode: str) -> gym.vector.SyncVectorEnv:
+def sync_twin(
+    scenario: str | Scenario, mode: str, randomize: bool = False
+) -> gym.vector.SyncVectorEnv:
     return gym.vector.SyncVectorEnv(
         [
-            lambda: gym.make("ShipPathFollow-v0", scenario=scenario, action_mode=mode)
+            lambda: gym.make(
+                "ShipPathFollow-v0", scenario=scenario, action_mode=mode, randomize=randomize
+            )
             for _ in range(N)
         ]
     )
@@ -170,13 +174,15 @@ def stochastic_disturbance_scenario() -> Scenario:
     return scenario_from_dict(data)
 
 
-def test_batched_env_equals_single_envs_with_stochastic_disturbances() -> None:
+@pytest.mark.parametrize("randomize", [False, True])
+def test_batched_env_equals_single_envs_with_stochastic_disturbances(randomize: bool) -> None:
     """Gauss–Markov current (hitting its bounds), waves and sensor noise: each env's noise is
     drawn from its generator in the single env's order, the processes advance over all
-    ships at once; equal bit for bit, disturbance blocks included, through autoresets."""
+    ships at once; equal bit for bit, disturbance blocks included, through autoresets.  With
+    ``randomize`` each env's trial has its own current (its own processes)."""
     scenario = stochastic_disturbance_scenario()
-    batched = ShipPathFollowVectorEnv(N, scenario)
-    single = sync_twin(scenario, "rudder")
+    batched = ShipPathFollowVectorEnv(N, scenario, randomize=randomize)
+    single = sync_twin(scenario, "rudder", randomize)
     np.testing.assert_array_equal(batched.reset(seed=5)[0], single.reset(seed=5)[0])
     rng = np.random.default_rng(1)
     resets = 0
@@ -217,7 +223,7 @@ def test_sb3_adapter_gives_each_env_the_single_env_info_keys() -> None:
     )
     env.seed(0)
     env.reset()
-    single = gym.make("ShipPathFollow-v0", scenario="nominal")
+    single = gym.make("ShipPathFollow-v0", scenario="nominal", randomize=False)
     _, single_info = single.reset(seed=0)
     for _ in range(400):
         env.step_async(np.ones((N, 1), dtype=np.float32))

@@ -224,7 +224,7 @@ def heading_keeper(info: dict[str, Any]) -> float:
 
 
 def record_actions(scenario: Scenario, n_steps: int, seed: int) -> list[np.ndarray]:
-    env = gym.make("ShipPathFollow-v0", scenario=scenario)
+    env = gym.make("ShipPathFollow-v0", scenario=scenario, randomize=False)
     _, info = env.reset(seed=seed)
     actions = []
     for _ in range(n_steps):
@@ -237,7 +237,7 @@ def record_actions(scenario: Scenario, n_steps: int, seed: int) -> list[np.ndarr
 
 
 def rollout(scenario: Scenario, actions: list[np.ndarray], seed: int) -> list[tuple]:
-    env = gym.make("ShipPathFollow-v0", scenario=scenario)
+    env = gym.make("ShipPathFollow-v0", scenario=scenario, randomize=False)
     obs, info = env.reset(seed=seed)
     out = [(obs, 0.0, False, False, info)]
     for a in actions:
@@ -310,7 +310,7 @@ def test_ramp_event_through_the_env_matches_an_independent_simulation() -> None:
 
     events = [{"time": 3.0, "kind": "ramp", "duration": 2.2, "params": {"Tc": 0.8, "K": 1.5}}]
     sc = scenario_from_dict(minimal_config(time_limit=10.0, events=events))
-    env = gym.make("ShipPathFollow-v0", scenario=sc)
+    env = gym.make("ShipPathFollow-v0", scenario=sc, randomize=False)
     env.reset(seed=0)
     model = Nomoto2()
     h, n_sub, ts = sc.fine_step, sc.substeps, sc.control_period

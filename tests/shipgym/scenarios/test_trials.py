@@ -4,11 +4,19 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from shipgym.paths import segment_frame
 from shipgym.scenarios import load_scenario
-from shipgym.scenarios.trials import TrialRandomization, trial_draws, trial_scenario
+from shipgym.scenarios.trials import (
+    TRIAL_STREAM,
+    TrialRandomization,
+    apply_trial,
+    draw_trial,
+    trial_draws,
+    trial_scenario,
+)
 
 FULL = TrialRandomization(
     cross_track_offset_L=(-0.5, 0.5),
@@ -92,3 +100,17 @@ def test_jitter_keeps_events_inside_the_episode() -> None:
 def test_bad_ranges_are_refused() -> None:
     with pytest.raises(ValueError, match="low ≤ high"):
         TrialRandomization(heading_error_deg=(5.0, -5.0))
+
+
+def test_an_evaluation_seed_is_a_draw_from_its_stream_then_its_application() -> None:
+    """trial_scenario = apply_trial(draw_trial(the seed's own stream)): the two pure parts
+    the envs reuse with their own generator."""
+    base = load_scenario("blanke_current_shift")
+    for seed in (0, 5):
+        draws = draw_trial(FULL, np.random.default_rng([TRIAL_STREAM, seed]))
+        assert draws == trial_draws(FULL, seed)
+        assert apply_trial(base, draws).config == trial_scenario(base, FULL, seed).config
+    assert apply_trial(base, {}) is base
+    rng = np.random.default_rng(3)
+    first, second = draw_trial(FULL, rng), draw_trial(FULL, rng)
+    assert first != second  # a generator's stream goes on
