@@ -606,12 +606,13 @@ class OracleSolver:
         """Plan (one command per interval, rad), success flag, iterations; ``tail``: the
         control steps still to go after the horizon (:meth:`set_tail`)."""
         self._p[:] = p
+        self._fresh = False  # _z was computed at another p
         self.set_tail(tail)
 
         def direction(u: np.ndarray) -> np.ndarray | None:
+            self._fresh = False  # _z is about to hold the sensitivity function's residuals
             self._u[:] = u
             self._both[1]()
-            self._fresh = False  # _z now holds the sensitivity function's residuals
             z, jac = self._z, self._j.T
             if not (np.all(np.isfinite(z)) and np.all(np.isfinite(jac))):
                 return None

@@ -15,7 +15,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "summary",
         help="a finished leaderboard run's summary: the numbers the README quotes",
     )
-    p.add_argument("run", metavar="DIR", help="a leaderboard output folder")
+    p.add_argument(
+        "run", metavar="DIR", help="a finished leaderboard run's folder (not a report's)"
+    )
     p.add_argument(
         "--out",
         metavar="FILE",
@@ -42,7 +44,10 @@ def run(args: argparse.Namespace) -> int:
         out = Path(args.out)
         if out.exists() and not args.force:
             raise RunError(f"--out {out}: exists; --force replaces it")
-        write_text(out, dumps(summary, indent=2) + "\n")
+        try:
+            write_text(out, dumps(summary, indent=2) + "\n")
+        except OSError as exc:
+            raise RunError(f"--out {out}: cannot write it ({exc.strerror})") from None
         if not args.json:
             sys.stderr.write(f"wrote {out}\n")
     has_catalogue = "catalogue" in summary["splits"]

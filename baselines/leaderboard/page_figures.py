@@ -1,4 +1,5 @@
-"""The page's figures: each embedded as a data URI (a light WebP or PNG, else the SVG),
+"""The page's figures: the ranking figures embedded as data URIs (a light WebP or PNG, else
+the SVG), the scenario figures linked as the files beside the page (:data:`LINKED_KINDS`),
 a scenario figure's legends as text below it, the ranking and the scenario figures'
 sections (:mod:`.page`)."""
 
@@ -116,7 +117,8 @@ def embedded_figures(
     """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
     page-sized palette PNG, :func:`shipgym_baselines.leaderboard.figures.write_page_png`, embedded
     as :func:`page_image` gives it: the page stays light), else the SVG; in the
-    order of ``figures``."""
+    order of ``figures``.  ``folder``: the page's; a scenario figure's PNG is then linked
+    by its path from there (:func:`_linked`) instead of embedded."""
     by_stem: dict[str, Path] = {}
     for f in map(Path, figures):
         if f.suffix.lower() not in (".svg", ".png"):

@@ -8,7 +8,10 @@
   with its 95 % interval, and the failure rate), in the ranking's order;
 * per split, what knowing the change is worth (C_frozen / C_oracle, geometric mean) and
   its value per ship × change family;
-* the verdict.
+* the verdict, as the run's page and ``leaderboard.md`` open with it.
+
+A ``shipgym report`` folder (no ``run.json``) is refused: its runs' own folders are the
+ones to summarise.
 
 The repository ships the default run's summary as ``docs/run_summary.json``.  The README's
 ranking table is :func:`readme_table` of it, and a test fails when the two differ.
@@ -31,7 +34,7 @@ from shipgym_baselines.leaderboard.headroom import (
 )
 from shipgym_baselines.leaderboard.ranking import is_partial
 from shipgym_baselines.leaderboard.splits import suite_splits
-from shipgym_baselines.leaderboard.verdict import verdict
+from shipgym_baselines.leaderboard.verdict import folder_verdict
 
 #: the summary's layout; bump when a field changes meaning
 SUMMARY_VERSION = 1
@@ -121,7 +124,7 @@ def run_summary(folder: str | os.PathLike) -> dict[str, Any]:
             }
             for split, rows in splits.items()
         },
-        "verdict": verdict(board, episodes),
+        "verdict": folder_verdict(folder),
     }
 
 

@@ -45,7 +45,7 @@ def start_line(config: AgentConfig, steps: int, seed: int | None, out: str) -> s
         else (
             f"validation every {every:,} env steps on {config.eval.n_episodes} episodes"
             if steps >= every
-            else f"no validation: it runs every {every:,} env steps (eval.freq), over {steps:,}"
+            else f"likely no validation: it runs every {every:,} env steps (eval.freq)"
         )
     )
     return (
@@ -56,9 +56,14 @@ def start_line(config: AgentConfig, steps: int, seed: int | None, out: str) -> s
 
 def too_short_line(config: AgentConfig, meta: dict[str, Any]) -> str | None:
     """After a run: why it has no ``best_model.zip`` and no learning curve when it ended
-    before its first validation; None when it validated."""
+    before its first validation (its folder, ``meta["out_dir"]``, has no curve); None when
+    it validated."""
+    from shipgym_baselines.learned.curves import CURVE_FILE
+
     steps, every = int(meta.get("env_steps", 0)), config.eval.freq
-    if config.algo == "dagger" or steps >= every:
+    folder = meta.get("out_dir")
+    validated = folder is not None and (Path(folder) / CURVE_FILE).is_file()
+    if config.algo == "dagger" or validated:
         return None
     return (
         f"note: {config.name} seed {meta.get('seed')}: {steps:,} env steps, fewer than the "

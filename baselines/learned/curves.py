@@ -84,17 +84,18 @@ def load_curve(folder: str | Path) -> dict[str, list[float]] | None:
 
 
 #: a training seed "never improved" when the best of its selection metric is less than this
-#: fraction below its first evaluation's (the shipped model is then as good as untrained)
+#: fraction below its first evaluation's (after eval.freq env steps: training moved it no
+#: further)
 NEVER_IMPROVED_GAIN = 0.10
 #: a training seed is "unstable" when its last evaluation's selection metric is at least this
 #: factor over its best (training went on far past the model it ships)
 UNSTABLE_FACTOR = 2.0
 #: what the flags say, for the page's note and the docs
 SEED_FLAG_RULE = (
-    f"a training seed is flagged 'never improved' when its best validation cost ratio is less "
-    f"than {NEVER_IMPROVED_GAIN:.0%} below its first evaluation's, and 'unstable' when its "
-    f"last evaluation's is {UNSTABLE_FACTOR:g}× its best or more (its learning_curve.json's "
-    "selection metric; a curve without one is not judged)"
+    f"a training seed is flagged 'unstable' when its last validation cost ratio is "
+    f"{UNSTABLE_FACTOR:g}× its best or more, else 'never improved' when its best is less than "
+    f"{NEVER_IMPROVED_GAIN:.0%} below its first evaluation's (its learning_curve.json's "
+    "selection metric; a curve without one, or with one evaluation, is not judged)"
 )
 
 
@@ -103,14 +104,14 @@ def seed_flag(curve: dict[str, Any]) -> dict[str, Any] | None:
     ("never improved" or "unstable") with the curve's ``first``, ``best`` and ``final``
     selection values; None when neither applies or the curve has no selection metric."""
     selection = curve.get("selection")
-    if not selection:
+    if not selection or len(selection) < 2:
         return None
     first, best, final = float(selection[0]), float(min(selection)), float(selection[-1])
     values = {"first": first, "best": best, "final": final}
-    if best > (1.0 - NEVER_IMPROVED_GAIN) * first:
-        return {"flag": "never improved", **values}
     if final >= UNSTABLE_FACTOR * best:
         return {"flag": "unstable", **values}
+    if best > (1.0 - NEVER_IMPROVED_GAIN) * first:
+        return {"flag": "never improved", **values}
     return None
 
 

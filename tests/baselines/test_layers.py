@@ -60,6 +60,7 @@ LAYERS: dict[str, int] = {
     f"{B}.tuning": 4,
     f"{B}.learned.agents": 4,
     f"{B}.learned.train": 4,
+    f"{B}.learned.announce": 4,
     f"{B}.learned.selection": 4,
     f"{B}.learned.dagger_agent": 4,
     f"{B}.learned.meta": 4,

@@ -71,3 +71,30 @@ def test_bad_settings_are_refused_at_construction() -> None:
         NmpcEkf(process_noise=1.0)
     with pytest.raises(ValueError, match="servo"):
         NmpcEkf(servo="guess")
+
+
+def test_the_solvers_objective_is_never_read_at_another_parameter_vector() -> None:
+    """The objective of a plan just evaluated is reused only at the same parameters: after
+    ``solve`` with new parameters, the first objective of the same plan is the one computed
+    afresh (a stale value would be the line search's reference)."""
+    import numpy as np
+
+    from shipgym_baselines.classical.oracle import get_solver
+
+    policy = NmpcEkf(preset="default")
+    run_episode(policy, load_scenario("rudder_aging"), seed=10_000)
+    solver = get_solver(policy.ctx, policy.settings, policy.weights)
+    p1 = solver._p.copy()
+    p2 = p1.copy()
+    p2[1] += 0.5  # another state: the ship half a metre to the side
+    plan = np.zeros(solver.n_u)
+    solver.cost(plan, p1)
+    firsts: list[float] = []
+    cost = solver.cost
+    solver.cost = lambda u, p: firsts.append(cost(u, p)) or firsts[-1]  # type: ignore[method-assign]
+    try:
+        solver.solve(p2, plan)
+    finally:
+        del solver.cost
+    solver._fresh = False
+    assert firsts[0] == solver.cost(plan, p2) != solver.cost(plan, p1)
