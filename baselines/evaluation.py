@@ -30,7 +30,6 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.errors import ShipgymError
-from shipgym.notices import notice
 from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
@@ -62,6 +61,11 @@ ACT_TIMEOUT_S = 10.0
 #: a call that has not returned after this many times the limit of wall time ends too
 #: (one blocked: sleeping, waiting), whatever CPU time it used
 WALL_FACTOR = 10.0
+#: construction and ``reset`` may take this many times the limit of one ``act`` call
+#: (they may load a model or compile a solver to C, once per machine) …
+SETUP_FACTOR = 30.0
+#: … and at least this many seconds of CPU time
+SETUP_MIN_S = 60.0
 #: the most characters of an episode's ``error`` (the one-line message of its failure)
 ERROR_CHARS = 300
 
@@ -86,8 +90,13 @@ class ActGuard:
     (:class:`_Watch`) ends a call that runs past it while it runs: a signal to the main
     thread raises :class:`CallTimeout` in the controller's code.  Code in C that holds the
     interpreter ends when it returns to Python; off the main thread (no signal can reach
-    it) the call is judged when it returns.  Construction and ``reset`` have no limit
-    (they may load a model or compile a solver to C, once per machine).  A batch
+    it) the call is judged when it returns.  A controller whose code is not the
+    benchmark's own runs in a process of its own in a run
+    (:mod:`shipgym_baselines.isolation`), which is killed when a call outlives the wall
+    limit by :data:`~shipgym_baselines.isolation.GRACE_S`: code in C that never returns,
+    a controller that ignores the signal or swallows the timeout, one that ends its
+    process.  Construction and ``reset`` have a limit too, :attr:`setup_timeout` (they
+    may load a model or compile a solver to C, once per machine).  A batch
     policy's ``act_batch`` acts for all live episodes: the whole call counts against the
     limit.  ``timeout`` inf: no limit (the references, never judged as entrants).
     """
@@ -97,6 +106,13 @@ class ActGuard:
     def __post_init__(self) -> None:
         if not self.timeout > 0.0:  # NaN too
             raise RunError(f"--act-timeout must be a positive time in s, got {self.timeout}")
+
+    @property
+    def setup_timeout(self) -> float:
+        """The limit [s] of CPU time on a controller's construction and on each ``reset``:
+        :data:`SETUP_FACTOR` × :attr:`timeout`, at least :data:`SETUP_MIN_S` (inf with
+        no limit); the wall limit is :data:`WALL_FACTOR` times it, as an act's."""
+        return max(SETUP_FACTOR * self.timeout, SETUP_MIN_S)
 
 
 class _Failure(NamedTuple):
@@ -128,6 +144,11 @@ _SIGNAL = getattr(signal, "SIGUSR2", None)
 #: the watchdog looks at the running call every quarter of the limit, within these [s]
 _PERIOD_S = (0.005, 1.0)
 
+#: in a controller's own process (:mod:`shipgym_baselines.isolation`): the shared slots
+#: where each guarded call posts when it started [s, ``time.monotonic``; 0: no call runs]
+#: and its limit [s], which the process's supervisor reads (None: not in such a process)
+BEACON: Any = None
+
 
 class _Watch:
     """The watchdog of one guarded loop: a thread that looks at the running call every
@@ -138,7 +159,7 @@ class _Watch:
     :meth:`end` (two attribute writes: no system call per step)."""
 
     def __init__(self, limit: float) -> None:
-        self.limit = limit
+        self.limit = limit  # the running call's (an act's, or a setup call's)
         self.period = min(max(limit / 4.0, _PERIOD_S[0]), _PERIOD_S[1])
         self.main = (
             _SIGNAL is not None
@@ -154,33 +175,39 @@ class _Watch:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="shipgym-watchdog", daemon=True)
 
-    def begin(self) -> None:
-        """A controller's call starts."""
+    def begin(self, limit: float) -> None:
+        """A controller's call starts, held to ``limit`` [s]."""
+        self.limit = limit
         self._call += 1
         self._active = True
+        if BEACON is not None:  # the supervisor of this process sees it too
+            BEACON[1] = limit
+            BEACON[0] = time.monotonic()
 
     def end(self) -> str | None:
         """The call ended: why it was over the limit, or None."""
         self._active = False
+        if BEACON is not None:
+            BEACON[0] = 0.0
         return self._why if self._over == self._call else None
 
     def _run(self) -> None:
-        seen, wall0, cpu0 = 0, 0.0, 0.0
+        seen, wall0, cpu0, limit = 0, 0.0, 0.0, self.limit
         main = threading.main_thread().ident
         while not self._stop.wait(self.period):
             call = self._call
             if not self._active:
                 continue
             if call != seen:  # a new call: measured from now
-                seen, wall0, cpu0 = call, time.monotonic(), time.process_time()
+                seen, wall0, cpu0, limit = call, time.monotonic(), time.process_time(), self.limit
                 continue
             cpu, wall = time.process_time() - cpu0, time.monotonic() - wall0
-            if cpu > self.limit:
-                why = f"the call ran {cpu:.3g} s of CPU time, over the limit of {self.limit:g} s"
-            elif wall > WALL_FACTOR * self.limit:
+            if cpu > limit:
+                why = f"the call ran {cpu:.3g} s of CPU time, over the limit of {limit:g} s"
+            elif wall > WALL_FACTOR * limit:
                 why = (
                     f"the call had not returned after {wall:.3g} s, {WALL_FACTOR:g} times the "
-                    f"limit of {self.limit:g} s"
+                    f"limit of {limit:g} s"
                 )
             else:
                 continue
@@ -235,12 +262,14 @@ def _watched(guard: ActGuard | None) -> Iterator[None]:
             _watching.watch = outer
 
 
-def _timed_call(call: Callable[[], Any], watch: _Watch | None) -> tuple[Any, str | None]:
-    """``call()`` under ``watch``: its value and why it ran over the limit (None: it did
-    not, or no watch)."""
+def _timed_call(
+    call: Callable[[], Any], watch: _Watch | None, limit: float = math.inf
+) -> tuple[Any, str | None]:
+    """``call()`` under ``watch``, held to ``limit`` [s]: its value and why it ran over
+    the limit (None: it did not, or no watch)."""
     if watch is None:
         return call(), None
-    watch.begin()
+    watch.begin(limit)
     try:
         value = call()
     finally:
@@ -249,18 +278,19 @@ def _timed_call(call: Callable[[], Any], watch: _Watch | None) -> tuple[Any, str
 
 
 def _call(
-    guard: ActGuard | None, call: Callable[[], Any], timed: bool = True
+    guard: ActGuard | None, call: Callable[[], Any], setup: bool = False
 ) -> tuple[Any, float, _Failure | None]:
     """``call()`` (a controller's), its time on the act clock [s] and, with a guard, why
-    the controller failed (None: it did not; :class:`ActGuard`); ``timed``: held to the
-    guard's time limit (an act, not a reset)."""
+    the controller failed (None: it did not; :class:`ActGuard`); held to the guard's
+    limit of an act, or with ``setup`` (a ``reset``) to its :attr:`ActGuard.setup_timeout`."""
     start = _clock()
     if guard is None:
         value = call()
         return value, _clock() - start, None
-    watch = getattr(_watching, "watch", None) if timed else None
+    watch = getattr(_watching, "watch", None)
+    limit = guard.setup_timeout if setup else guard.timeout
     try:
-        value, over = _timed_call(call, watch)
+        value, over = _timed_call(call, watch, limit)
     except CallTimeout as exc:
         if watch is not None:
             watch.end()  # the signal may land as the call returns
@@ -373,17 +403,14 @@ class _Record:
         )
 
 
-#: the controllers whose left-out figures were named on stderr in this process
-_stats_named: set[str] = set()
-
-
 def controller_stats(policy: Policy, guard: ActGuard | None) -> tuple[dict[str, Any], str | None]:
     """The controller's own figures of its episode (its ``episode_stats()``, if it has one)
     and why they were left out (None: they were not).  With a guard, a call that fails or
     runs over the limit, or figures that are no mapping of names to numbers
-    (:func:`~shipgym_baselines.records.episodes.stats_problem`), are left out, with one
-    line on stderr per controller; the episode stays as the env ended it.  Without a guard
-    they raise."""
+    (:func:`~shipgym_baselines.records.episodes.stats_problem`), are left out (the
+    result's ``stats_error`` says why; a run names it once per controller on stderr:
+    :func:`shipgym_baselines.leaderboard.run.announce_failure`); the episode stays as the
+    env ended it.  Without a guard they raise."""
     stats = getattr(policy, "episode_stats", None)
     if stats is None:
         return {}, None
@@ -391,31 +418,45 @@ def controller_stats(policy: Policy, guard: ActGuard | None) -> tuple[dict[str, 
     problem = failure.error if failure is not None else stats_problem(figures)
     if problem is None:
         return dict(figures), None
-    why = f"episode_stats() {'raised ' if failure is not None else ''}{problem}"
+    if failure is None:
+        why = f"episode_stats() {problem}"
+    elif failure.reason == CONTROLLER_TIMEOUT:
+        why = f"episode_stats() ran over its limit ({problem})"
+    else:
+        why = f"episode_stats() raised {problem}"
     if guard is None:
         raise ControllerError(f"{policy.name}: {why}")
-    if policy.name not in _stats_named:
-        _stats_named.add(policy.name)
-        notice(f"shipgym: {policy.name}'s {why}: its figures are left out, the episode kept")
     return {}, why
 
 
 class _Unmade:
-    """A controller that could not be made (with a guard): each of its episodes ends at
-    its ``reset`` with that error, a counted failure of the controller."""
+    """A controller that could not be made (with a guard), or whose episodes could not be
+    played: each of its episodes ends at its ``reset`` with ``error`` (after ``prefix``),
+    a counted failure of the controller (``reason``: ``controller_error``, or
+    ``controller_timeout`` for a construction over its limit)."""
 
     def __init__(
-        self, name: str, kind: str, action_mode: str, training_seed: int | None, error: str
+        self,
+        name: str,
+        kind: str,
+        action_mode: str,
+        training_seed: int | None,
+        error: str,
+        reason: str = CONTROLLER_ERROR,
+        prefix: str = "the controller could not be made: ",
     ) -> None:
         self.name, self.kind, self.action_mode = name, kind, action_mode
         self.training_seed = training_seed
-        self.error = f"the controller could not be made: {error}"
+        self.error = f"{prefix}{error}"
+        self.reason = reason
 
     def reset(self, context: Any, seed: int | None = None) -> None:
+        if self.reason == CONTROLLER_TIMEOUT:
+            raise CallTimeout(self.error)
         raise _NotMade(self.error)
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        raise _NotMade(self.error)
+        self.reset(None)
 
 
 def _make(
@@ -425,23 +466,54 @@ def _make(
     **settings: Any,
 ) -> tuple[Policy, str]:
     """:func:`~shipgym_baselines.registry.make_controller`; with a guard, a controller
-    whose construction raises (any exception but Ctrl-C) is an :class:`_Unmade` named as
-    ``label`` says.  A name that is no controller, and the benchmark's own refusals (a
+    whose construction raises (any exception but Ctrl-C) or runs over the guard's
+    :attr:`~ActGuard.setup_timeout` is an :class:`_Unmade` named as ``label`` says.  A
+    name that is no controller, and the benchmark's own refusals (a
     :class:`~shipgym.errors.ShipgymError`: a model that cannot be read, a pickle not
     trusted), are the caller's errors, raised in one line as without a guard."""
     if guard is None:
         return make_controller(controller, **settings)
     record = resolve_controller(controller)
+    reason = CONTROLLER_ERROR
     try:
-        return make_controller(controller, **settings)
+        with _watched(guard):
+            watch = getattr(_watching, "watch", None)
+            made, over = _timed_call(
+                lambda: make_controller(controller, **settings), watch, guard.setup_timeout
+            )
+        if over is None:
+            return made
+        error, reason = over, CONTROLLER_TIMEOUT  # it returned, over its limit
     except (KeyboardInterrupt, ShipgymError):
         raise
+    except CallTimeout as exc:
+        error, reason = str(exc), CONTROLLER_TIMEOUT
     except BaseException as exc:  # the controller's own code: a failure of its episodes
-        name = label.controller if label is not None else record.name
-        seed = settings.get("training_seed")
-        return _Unmade(name, record.kind, record.action_mode, seed, error_line(exc)), (
-            record.action_mode
-        )
+        error = error_line(exc)
+    name = label.controller if label is not None else record.name
+    seed = settings.get("training_seed")
+    unmade = _Unmade(name, record.kind, record.action_mode, seed, error, reason)
+    return unmade, record.action_mode
+
+
+def failed_episode(
+    controller: ControllerSpec,
+    scenario: Any,
+    seed: int,
+    reason: str,
+    error: str,
+    guard: ActGuard,
+    label: EpisodeLabel,
+) -> EpisodeResult:
+    """The episode of ``controller`` (its kind and action mode; nothing of it is made)
+    that ended at its reset with ``reason`` and ``error`` (one line), as a controller's that
+    could not be made: a job whose process ended or was killed before it gave its results
+    (:mod:`shipgym_baselines.isolation`)."""
+    record = resolve_controller(controller)
+    policy = _Unmade(
+        label.controller, record.kind, record.action_mode, label.training_seed, error, reason, ""
+    )
+    return run_episode(policy, scenario, seed, record.action_mode, guard=guard, label=label)
 
 
 class _Episode:
@@ -525,7 +597,7 @@ def run_episode(
         else:
             reset = functools.partial(policy.reset, context, seed=seed)
         with _watched(guard):
-            _, _, failure = _call(guard, reset, timed=False)
+            _, _, failure = _call(guard, reset, setup=True)
             took: float | None = None  # no act call yet
             while failure is None and not episode.done:
                 action, took, failure = _act(
@@ -933,11 +1005,11 @@ def _lockstep(
     batch = not isinstance(policy, list)
     contexts = episodes.contexts()
     if batch:
-        _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), timed=False)
+        _, _, failure = _call(guard, lambda: policy.reset_batch(contexts), setup=True)
         failures = [failure] * n
     else:
         failures = [
-            _call(guard, functools.partial(p.reset, context, seed=seed), timed=False)[2]
+            _call(guard, functools.partial(p.reset, context, seed=seed), setup=True)[2]
             for p, context, seed in zip(policy, contexts, episodes.seeds, strict=True)
         ]
     for i, failure in enumerate(failures):

@@ -63,7 +63,7 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult
 from shipgym_baselines.records.jsonfiles import from_plain, plain
-from shipgym_baselines.records.outfiles import write_bytes
+from shipgym_baselines.records.outfiles import open_regular, refuse_special, write_bytes
 
 #: the references with a table, in the order they are computed
 REFERENCES = (ORACLE, ORACLE_FROZEN)
@@ -231,9 +231,12 @@ def fill_tables(
     no table at all (:func:`foreign`), is refused (:class:`RunError` naming the file and what
     differs) unless ``replace``: then its bytes are kept as :func:`backup_path` (refused when
     that file exists with other bytes: it is never overwritten) and the file starts afresh.
-    Every refusal comes before any file is written."""
+    A link or anything but a regular file in a file's place is refused too (a table is
+    written through no link).  Every refusal comes before any file is written."""
     tables: dict[str, ReferenceTable] = {}
     replaced = []
+    for path in files.values():  # written through no link: refused before any work
+        refuse_special(path, "--table")
     for ref, path in files.items():
         why = foreign(path, ref)
         if why is None:
@@ -302,7 +305,7 @@ def user_cache_path(reference: str = ORACLE) -> Path:
 def _locked(file: Path) -> Iterator[None]:
     """Hold the exclusive lock of ``file`` (on ``<file>.lock``; waits for another holder)."""
     file.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(file.with_name(file.name + ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
+    fd = open_regular(file.with_name(file.name + ".lock"), os.O_RDWR | os.O_CREAT)  # no link
     try:
         fcntl.lockf(fd, fcntl.LOCK_EX)
         yield

@@ -63,9 +63,10 @@ def add_act_timeout_option(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=ACT_TIMEOUT_S,
         metavar="SECONDS",
-        help=f"wall time one act call of a controller may take (default {ACT_TIMEOUT_S:g} s); "
-        "a slower call ends its episode as controller_timeout, as a call that raises or "
-        "gives a malformed or non-finite action ends it as controller_error; the run goes on",
+        help=f"CPU time one act call of a controller may take (default {ACT_TIMEOUT_S:g} s; "
+        "ten times it in wall time; construction and reset 30 times it, at least 60 s); a "
+        "slower call ends its episode as controller_timeout, as a call that raises or gives "
+        "a malformed or non-finite action ends it as controller_error; the run goes on",
     )
 
 

@@ -24,6 +24,12 @@ Where the episodes go:
 - ``--table FILE``: that file (one reference, the ``oracle`` unless ``--reference`` names
   another).
 
+A ``--packaged`` or ``--table`` file is locked while it is filled
+(:func:`~shipgym_baselines.records.locking.file_lock`, ``<file>.lock`` beside it): a second
+fill of the same file is refused in one line naming the first.  It is written through no
+link (:func:`~shipgym_baselines.records.outfiles.write_bytes`): a link in its place is
+refused in one line.
+
 A ``--packaged`` or ``--table`` file of another env revision, reference, oracle revision or
 oracle settings is refused in one line unless ``--replace``, which keeps the old file as
 ``FILE.bak`` (never overwriting another one) and starts it afresh
@@ -91,19 +97,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import contextlib
     import functools
-    import os
 
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-    from shipgym_baselines.leaderboard import Job, iter_results, suite_scenario, trials
+    from shipgym_baselines.leaderboard import Job, suite_scenario, trials
     from shipgym_baselines.leaderboard.jobs import suite_scenarios
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.leaderboard.twins import plan_twins
+    from shipgym_baselines.records.locking import file_lock
+    from shipgym_baselines.records.runrecord import now
     from shipgym_baselines.references import (
         ReferenceCache,
-        ReferenceTable,
-        announce,
         fill_tables,
         lookup,
         table_path,
@@ -152,42 +158,28 @@ def run(args: argparse.Namespace) -> int:
             candidates.append((ORACLE, job, v.name, v.seed, v.scenario))
     if args.validation and ORACLE not in chosen:
         sys.stderr.write("references: --validation fills the oracle's table only: ignored\n")
-    tables: dict[str, ReferenceTable | ReferenceCache]
-    if args.table is not None or args.packaged:
-        files = {ref: args.table if args.table is not None else table_path(ref) for ref in chosen}
-        tables = dict(fill_tables(files, args.replace))
-        holds = {ref: tables[ref].lookup for ref in chosen}
-    else:
-        tables = {ref: ReferenceCache(reference=ref) for ref in chosen}
-        holds = {ref: functools.partial(lookup, cache=tables[ref], reference=ref) for ref in chosen}
-        if args.replace:
-            sys.stderr.write(
-                "references: --replace: a per-user cache of another revision is replaced "
-                "anyway (it holds only computed references): ignored\n"
-            )
-    jobs, trial_of, held = [], {}, 0
-    todo: dict[str, list] = {ref: [] for ref in chosen}
-    for ref, job, name, seed, trial in candidates:
-        if holds[ref](trial, seed) is not None:
-            held += 1
-        elif (ref, name, seed) not in trial_of:
-            trial_of[(ref, name, seed)] = trial
-            todo[ref].append(trial)
-            jobs.append(job)
-    for ref in chosen:
-        announce(todo[ref], f"written to {tables[ref].path} after each", ref)
-    start = time.perf_counter()
-    done = 0
-    with closing(iter_results(jobs, "local", args.workers or os.cpu_count() or 1)) as results:
-        for batch in results:
-            for result in batch:
-                ref = result.controller
-                tables[ref].store(trial_of[(ref, result.scenario, result.seed)], result)
-                done += 1
+    with contextlib.ExitStack() as locks:
+        if args.table is not None or args.packaged:
+            files = {r: args.table if args.table is not None else table_path(r) for r in chosen}
+            option = "--table" if args.table is not None else "--packaged"
+            for file in files.values():  # one fill per file: a second is refused in one line
+                locks.enter_context(file_lock(file, now(), option))
+            filled = fill_tables(files, args.replace)
+            tables: dict[str, Any] = dict(filled)
+            holds = {ref: filled[ref].lookup for ref in chosen}
+        else:
+            caches = {ref: ReferenceCache(reference=ref) for ref in chosen}
+            tables = dict(caches)
+            holds = {
+                ref: functools.partial(lookup, cache=caches[ref], reference=ref) for ref in chosen
+            }
+            if args.replace:
                 sys.stderr.write(
-                    f"references: {done}/{len(jobs)} {ref} {result.scenario} seed "
-                    f"{result.seed}: cost {result.metrics.get('cost')}\n"
+                    "references: --replace: a per-user cache of another revision is replaced "
+                    "anyway (it holds only computed references): ignored\n"
                 )
+        start = time.perf_counter()
+        done, held = _fill(candidates, chosen, tables, holds, args.workers)
     wall = time.perf_counter() - start
     paths = {ref: str(tables[ref].path) for ref in chosen}
     summary = {
@@ -200,3 +192,42 @@ def run(args: argparse.Namespace) -> int:
     where = ", ".join(paths.values())
     emit(args, summary, f"references: {done} computed, {held} held, {wall:.0f} s: {where}")
     return 0
+
+
+def _fill(
+    candidates: list[tuple[str, Any, str, int, Any]],
+    chosen: list[str],
+    tables: dict[str, Any],
+    holds: dict[str, Any],
+    workers: int | None,
+) -> tuple[int, int]:
+    """Run each reference on the candidate trials its table does not hold, storing each
+    episode as it ends; (episodes computed, trials held already)."""
+    import os
+
+    from shipgym_baselines.leaderboard import iter_results
+    from shipgym_baselines.references import announce
+
+    jobs, trial_of, held = [], {}, 0
+    todo: dict[str, list] = {ref: [] for ref in chosen}
+    for ref, job, name, seed, trial in candidates:
+        if holds[ref](trial, seed) is not None:
+            held += 1
+        elif (ref, name, seed) not in trial_of:
+            trial_of[(ref, name, seed)] = trial
+            todo[ref].append(trial)
+            jobs.append(job)
+    for ref in chosen:
+        announce(todo[ref], f"written to {tables[ref].path} after each", ref)
+    done = 0
+    with closing(iter_results(jobs, "local", workers or os.cpu_count() or 1)) as results:
+        for batch in results:
+            for result in batch:
+                ref = result.controller
+                tables[ref].store(trial_of[(ref, result.scenario, result.seed)], result)
+                done += 1
+                sys.stderr.write(
+                    f"references: {done}/{len(jobs)} {ref} {result.scenario} seed "
+                    f"{result.seed}: cost {result.metrics.get('cost')}\n"
+                )
+    return done, held

@@ -16,6 +16,7 @@ the output (``training_seed``, ``training_seeds``; None and [] for an untrained 
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 from collections.abc import Callable
@@ -109,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     from shipgym.scenarios import load_scenario
     from shipgym.scenarios.trials import trial_scenario
     from shipgym_baselines.evaluation import ActGuard, evaluate
+    from shipgym_baselines.isolation import call, isolated, run_isolated
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard import check_controllers, plot_results
     from shipgym_baselines.leaderboard.suite import load_suite
@@ -139,7 +141,14 @@ def run(args: argparse.Namespace) -> int:
     # as the leaderboard names them: a scenario file under its name:
     table_name = scenario.name if is_path(args.scenario) else args.scenario
     named = EpisodeLabel(table_name, label, training_seed)
-    (result,) = evaluate(args.controller, trial, [args.seed], guard=guard, label=named, **settings)
+    play = functools.partial(
+        evaluate, args.controller, trial, [args.seed], guard=guard, label=named, **settings
+    )
+    if isolated(args.controller):  # in a process of its own, as in a leaderboard run
+        failed = functools.partial(_failed, args.controller, trial, args.seed, guard, named)
+        (result,) = run_isolated(call, play, failed, guard.setup_timeout)
+    else:
+        (result,) = play()
     row = result.row()
     # after "seed": which of the agent's policies ran (as the leaderboard's episodes name it)
     at = list(row).index("seed") + 1
@@ -164,6 +173,16 @@ def run(args: argparse.Namespace) -> int:
         f"suite {suite.name!r}{policy})\n"
     )
     return 0
+
+
+def _failed(
+    controller: Any, trial: Any, seed: int, guard: Any, label: Any, reason: str, error: str
+) -> list[Any]:
+    """The episode of a controller whose process ended or was killed before it gave it
+    (:mod:`shipgym_baselines.isolation`)."""
+    from shipgym_baselines.evaluation import failed_episode
+
+    return [failed_episode(controller, trial, seed, reason, error, guard, label)]
 
 
 def _write(out: Path, force: bool, metrics: str, draw: Callable[[], list[Path]]) -> list[str]:

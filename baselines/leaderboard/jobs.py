@@ -22,6 +22,7 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
 from shipgym_baselines.executor import BACKENDS as BACKENDS  # re-exported by the package
 from shipgym_baselines.executor import map_jobs
+from shipgym_baselines.isolation import isolated, run_isolated
 from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.leaderboard.twins import plan_twins, twin_record
 from shipgym_baselines.plugins import ControllerSpec
@@ -226,12 +227,43 @@ def announce_references(jobs: Iterable[Job]) -> None:
 
 def work(job: Job) -> list[EpisodeResult]:
     """A job's episodes: a privileged reference's from its table (:func:`reference_work`), a
-    single seed through :func:`run_job`, several through :func:`run_batch`."""
+    single seed through :func:`run_job`, several through :func:`run_batch`; a controller
+    whose code is not the benchmark's own plays them in a process of its own
+    (:mod:`shipgym_baselines.isolation`: a call that never ends, or a process that ends,
+    fails the job's episodes, not the run)."""
     if job.references == "table" and grants_truth(job.controller):
         return reference_work(job)
+    if isolated(job.controller):
+        failed = functools.partial(failed_episodes, job)
+        return run_isolated(play, job, failed, _guard(job).setup_timeout)
+    return play(job)
+
+
+def play(job: Job) -> list[EpisodeResult]:
+    """:func:`work`'s episodes of a controller: a single seed through :func:`run_job`,
+    several through :func:`run_batch` (top-level: a child process runs it)."""
     if len(job.seeds) == 1 and job.dealt is None:
         return [run_job((job.controller, job.scenario, job.seeds[0], *job[3:]))]
     return run_batch(job)
+
+
+def failed_episodes(job: Job, reason: str, error: str) -> list[EpisodeResult]:
+    """Every episode of ``job`` failed with ``reason`` and ``error`` at its reset (its
+    process ended without its results: :func:`~shipgym_baselines.evaluation.failed_episode`),
+    in the order :func:`play` gives them."""
+    guard, name = _guard(job), job.label.controller
+    return [
+        evaluation.failed_episode(
+            job.controller,
+            trial,
+            seed,
+            reason,
+            error,
+            guard,
+            EpisodeLabel(job.scenario, name, training_seed),
+        )
+        for (seed, training_seed), trial in zip(job.runs(), trials(job), strict=True)
+    ]
 
 
 def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[EpisodeResult]]:

@@ -43,7 +43,7 @@ from shipgym_baselines.leaderboard.jobs import (
 from shipgym_baselines.leaderboard.outputs import load_results, write_results
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerSpec
-from shipgym_baselines.records.episodes import EpisodeResult, controller_failed
+from shipgym_baselines.records.episodes import STATS_ERROR, EpisodeResult, controller_failed
 from shipgym_baselines.records.folders import check_out_dir, check_out_usable
 from shipgym_baselines.records.runlog import RunLog
 from shipgym_baselines.records.runrecord import read_run
@@ -183,7 +183,13 @@ def check_failure_options(act_timeout: float, retry_failed: bool, resume: bool) 
 
 def announce_failure(result: EpisodeResult, announced: set[str]) -> None:
     """One line on stderr at the first episode of a controller ended by its failure (its
-    error; the run goes on); ``announced``: the controllers already named, updated."""
+    error; the run goes on), and one at the first whose figures were left out (their
+    ``stats_error``); ``announced``: the controllers (and ``<name> figures``) already
+    named, updated.  Said here, in the run's own process, whichever process played it."""
+    why = result.metrics.get(STATS_ERROR)
+    if why and f"{result.controller} figures" not in announced:
+        announced.add(f"{result.controller} figures")
+        notice(f"shipgym: {result.controller}'s {why}: its figures are left out, the episode kept")
     if not controller_failed(result.metrics) or result.controller in announced:
         return
     announced.add(result.controller)

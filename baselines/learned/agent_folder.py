@@ -20,6 +20,7 @@ from typing import Any
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records.folders import check_out_dir, check_out_usable
+from shipgym_baselines.records.jsonfiles import read_json
 from shipgym_baselines.records.locking import out_lock
 from shipgym_baselines.records.manifest import Manifest, clear_listed
 from shipgym_baselines.records.outfiles import check_no_links, make_dir, write_text
@@ -82,6 +83,20 @@ def agent_run(out: str | Path, name: str, resume: bool, force: bool) -> Iterator
         manifest.compact()
 
 
+def read_record(file: Path, key: str | None = None) -> Any:
+    """A JSON record of a training run (its ``key`` only, if given); a :class:`RunError`
+    in one line naming the file when it cannot be read, or lacks ``key`` (a damaged record:
+    the run is trained afresh with ``--force``)."""
+    try:
+        record = read_json(file)
+        return record if key is None else record[key]
+    except RunError as exc:
+        why = str(exc)
+    except (KeyError, TypeError, IndexError):
+        why = f"{file}: no {key!r} in it"
+    raise RunError(f"{why}: a damaged record of the run (--force trains it afresh)")
+
+
 def write_json_file(file: Path, value: Any, indent: int | None = 2) -> None:
     """``value`` as JSON in ``file``, atomically and through no link (its folder made if
     missing)."""
@@ -97,7 +112,7 @@ def check_tuned_from(out: Path, tuned_from: dict[str, Any] | None, resuming: boo
     file = out / TUNED_FROM_FILE
     record = json.loads(json.dumps(tuned_from))  # as JSON reads it back
     if resuming and file.is_file():
-        started = json.loads(file.read_text())
+        started = read_record(file)
         if _substance(started) != _substance(record):
             raise RunError(
                 f"--resume: {out} was started with other settings ({file}); train it "

@@ -56,7 +56,9 @@ import dataclasses
 import hashlib
 import io
 import json
+import pickle
 import time
+import zipfile
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Literal, Protocol
@@ -301,8 +303,6 @@ def load_student(
 ) -> Any:
     """The student saved at ``path``, rebuilt from ``settings`` for the spaces, its weights
     read as data (``torch.load(weights_only=True)``: nothing unpickled)."""
-    import zipfile
-
     import torch
 
     from shipgym_baselines.learned.loading import WEIGHTS_ENTRY
@@ -313,7 +313,14 @@ def load_student(
             weights = archive.read(WEIGHTS_ENTRY)
         state = torch.load(io.BytesIO(weights), map_location="cpu", weights_only=True)
         model.policy.load_state_dict(state, strict=True)
-    except (OSError, KeyError, RuntimeError, zipfile.BadZipFile) as exc:
+    except (
+        OSError,
+        KeyError,
+        RuntimeError,
+        EOFError,
+        pickle.UnpicklingError,
+        zipfile.BadZipFile,
+    ) as exc:
         raise RunError(f"{path}: not a student of these settings ({exc})") from None
     model.policy.set_training_mode(False)
     return model
@@ -806,8 +813,14 @@ def load_dataset(out: str | Path, rounds: int | None = None) -> dict[str, np.nda
         file = _round_file(folder, round_)
         if not file.is_file():
             raise RunError(f"{folder}: round {round_}'s labelled states ({file}) are missing")
-        with np.load(file, allow_pickle=False) as data:
-            parts.append({key: data[key] for key in DATA_KEYS})
+        try:
+            with np.load(file, allow_pickle=False) as data:
+                parts.append({key: data[key] for key in DATA_KEYS})
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise RunError(
+                f"{file}: round {round_}'s labelled states are unreadable ({exc}): train the "
+                "run afresh (--force)"
+            ) from None
     return {key: np.concatenate([p[key] for p in parts]) for key in DATA_KEYS}
 
 

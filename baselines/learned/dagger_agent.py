@@ -60,6 +60,7 @@ import numpy as np
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
+from shipgym_baselines.learned.agent_folder import read_record
 from shipgym_baselines.learned.dagger_config import ENV_SEED_STRIDE as ENV_SEED_STRIDE
 from shipgym_baselines.learned.dagger_config import STUDENT_KWARGS as STUDENT_KWARGS
 from shipgym_baselines.learned.dagger_config import DaggerHyperparams as DaggerHyperparams
@@ -147,7 +148,7 @@ def finished(out: Path, config: Any) -> dict[str, Any] | None:
     meta_file = out / "meta.json"
     if not (meta_file.is_file() and (out / "model.zip").is_file()):
         return None
-    meta = json.loads(meta_file.read_text())
+    meta = read_record(meta_file)
     done = meta.get("dagger", {}).get("rounds", 0) >= hyperparams(config).rounds
     done = done or int(meta.get("env_steps", 0)) >= config.n_timesteps
     return meta if done or meta.get("stopped_on_plateau_at") is not None else None
@@ -185,7 +186,7 @@ class _Selection:
         """The scores of the first ``finished_rounds`` rounds kept from an earlier session."""
         if not self.file.is_file():
             return
-        data = json.loads(self.file.read_text())
+        data = read_record(self.file)
         if data.get("trials") != [list(t) for t in self.trials]:
             return  # scored on other trials: rescored
         keep = [i for i, r in enumerate(data["rounds"]) if r < finished_rounds]
@@ -311,7 +312,7 @@ def _train_dagger(
     done_rounds: list[dict[str, Any]] = []
     if resume:
         rounds_file = run_dir / dagger.ROUNDS_FILE
-        done_rounds = json.loads(rounds_file.read_text()) if rounds_file.is_file() else []
+        done_rounds = read_record(rounds_file) if rounds_file.is_file() else []
         scores.read(len(done_rounds))
     start = time.perf_counter()
     wall_offset = scores.wall[-1] if scores.wall else 0.0

@@ -99,9 +99,12 @@ def reference_costs(
     header = oracle_header()
     revision = {"env_revision": header["env_revision"], "oracle": header["oracle"]}
     if cache is not None and cache.is_file():
-        data = json.loads(cache.read_text())
-        if data.get("trials") == wanted and all(data.get(k) == v for k, v in revision.items()):
-            return data["references"]
+        try:  # a cache: an unreadable one is computed again
+            data = json.loads(cache.read_text())
+            if data.get("trials") == wanted and all(data.get(k) == v for k, v in revision.items()):
+                return list(data["references"])
+        except (OSError, ValueError, AttributeError, KeyError, TypeError):
+            pass
     refs = [reference_cost(name, seed) for name, seed in trials]
     if cache is not None:
         from shipgym_baselines.learned.agent_folder import write_json_file

@@ -38,11 +38,12 @@ rounds of DAgger instead of checkpoints.
 from __future__ import annotations
 
 import io
-import json
+import os
+import pickle
 import re
-import shutil
 import sys
 import time
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -52,7 +53,12 @@ from shipgym.limits import worker_count
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.executor import map_jobs
-from shipgym_baselines.learned.agent_folder import BEST_FILE, agent_run, write_json_file
+from shipgym_baselines.learned.agent_folder import (
+    BEST_FILE,
+    agent_run,
+    read_record,
+    write_json_file,
+)
 from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS as TRAINING_OUTPUTS
 from shipgym_baselines.learned.agent_folder import TUNED_FROM_FILE as TUNED_FROM_FILE
 from shipgym_baselines.learned.agent_folder import check_agent_folder as check_agent_folder
@@ -74,7 +80,7 @@ from shipgym_baselines.learned.trust import (
     written_here,
 )
 from shipgym_baselines.records.manifest import Manifest
-from shipgym_baselines.records.outfiles import write_bytes
+from shipgym_baselines.records.outfiles import make_dir, refuse_special, write_bytes
 
 _CKPT = re.compile(r"ckpt_(\d+)_steps\.zip$")
 
@@ -104,11 +110,6 @@ def _callbacks(
         def _on_training_start(self) -> None:
             from tqdm import tqdm
 
-            logs = self.model.logger.get_dir()
-            if logs:  # the TensorBoard folder SB3 just made for this run, and its files
-                folder = Path(logs).absolute()
-                manifest.record([folder, *sorted(folder.iterdir())])
-
             self.bar = tqdm(
                 total=config.n_timesteps,
                 initial=self.model.num_timesteps,
@@ -131,17 +132,31 @@ def _callbacks(
     progress_cb = _Progress()
 
     class _Checkpoint(CheckpointCallback):
+        """SB3's checkpoint files (:func:`checkpoint_names`), each written atomically
+        through no link (:func:`~shipgym_baselines.records.outfiles.write_bytes`), listed
+        before it is written, its SHA-256 recorded after (:func:`remember_written`)."""
+
+        def _init_callback(self) -> None:
+            make_dir(out / "checkpoints")  # a link in its place is refused
+
         def _on_step(self) -> bool:
             if self.n_calls % self.save_freq:
-                return super()._on_step()
+                return True
             steps = self.num_timesteps
             manifest.claim(*[f"checkpoints/{name}" for name in checkpoint_names(steps)])
             state = {"num_timesteps": self.model.num_timesteps, "wall_time_s": progress_cb.wall()}
             write_json_file(out / "checkpoints" / "state.json", state, None)
-            go_on = super()._on_step()
+            model, statistics, buffer = (out / "checkpoints" / n for n in checkpoint_names(steps))
+            save_model(self.model, model)
+            replay = getattr(self.model, "replay_buffer", None)
+            if self.save_replay_buffer and replay is not None:  # SB3's pickles, as it saves them
+                write_bytes(buffer, pickle.dumps(replay, protocol=pickle.HIGHEST_PROTOCOL))
+            normalizer = self.model.get_vec_normalize_env()
+            if self.save_vecnormalize and normalizer is not None:
+                write_bytes(statistics, pickle.dumps(normalizer))
             for file in checkpoint_files(out, steps):  # the bytes this run wrote
                 remember_written(file)
-            return go_on
+            return True
 
     off_policy = config.algo in ("sac", "td3")
     checkpoint = _Checkpoint(
@@ -204,7 +219,7 @@ def _read_best(out: Path, history_best: float) -> float:
     """The value of the saved best model: from :data:`BEST_FILE`, else (a run from before
     the file) the best of the history on disk."""
     file = out / "eval" / BEST_FILE
-    return float(json.loads(file.read_text())["value"]) if file.is_file() else history_best
+    return float(read_record(file, "value")) if file.is_file() else history_best
 
 
 def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: int | None):
@@ -215,15 +230,28 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
 
     curves = _Curves(config, out)
 
+    class _Evaluation(EvalCallback):
+        """SB3's EvalCallback, its files written through no link: its history
+        (``np.savez``) into memory, written by :class:`_AfterEval`; the best model by
+        :class:`_NewBest`."""
+
+        def _init_callback(self) -> None:
+            super()._init_callback()  # no folder made: no path given
+            make_dir(out / "eval")  # a link in its place is refused
+            self.log_path = io.BytesIO()
+
     class _AfterEval(BaseCallback):
         def _on_step(self) -> bool:
             parent = self.parent
+            write_bytes(out / "eval" / "evaluations.npz", parent.log_path.getvalue())
+            parent.log_path = io.BytesIO()  # the next evaluation's history
             return curves.after_evaluation(
                 parent.evaluations_timesteps, parent.evaluations_results, None
             )
 
-    class _NewBest(BaseCallback):  # best_model.zip was just saved: record its value
+    class _NewBest(BaseCallback):  # a new best: save it, and record its value
         def _on_step(self) -> bool:
+            save_model(self.model, out / "best_model.zip")
             write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
             return True
 
@@ -235,12 +263,10 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
         history_steps=config.env.history_steps,
     )
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
-    evaluation = EvalCallback(
+    evaluation = _Evaluation(
         eval_env,
         callback_after_eval=_AfterEval(),
         callback_on_new_best=_NewBest(),
-        best_model_save_path=str(out),
-        log_path=str(out / "eval"),
         eval_freq=max(config.eval.freq // n_envs, 1),
         n_eval_episodes=config.eval.n_episodes,
         deterministic=True,
@@ -251,12 +277,20 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
     if resumed_at is not None and previous.is_file():  # keep the history and the best
         import numpy as np
 
-        data = np.load(previous)
-        keep = _kept_history(data["timesteps"].tolist(), resumed_at)
-        evaluation.evaluations_timesteps = data["timesteps"].tolist()[:keep]
-        evaluation.evaluations_results = data["results"].tolist()[:keep]
-        evaluation.evaluations_length = data["ep_lengths"].tolist()[:keep]
-        history_best = float(np.max(np.mean(data["results"], axis=1)))
+        try:
+            with np.load(previous, allow_pickle=False) as data:
+                steps, results = data["timesteps"].tolist(), data["results"].tolist()
+                lengths = data["ep_lengths"].tolist()
+                history_best = float(np.max(np.mean(data["results"], axis=1)))
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise RunError(
+                f"{previous}: unreadable ({exc}): a damaged record of the run (--force trains "
+                "it afresh)"
+            ) from None
+        keep = _kept_history(steps, resumed_at)
+        evaluation.evaluations_timesteps = steps[:keep]
+        evaluation.evaluations_results = results[:keep]
+        evaluation.evaluations_length = lengths[:keep]
         evaluation.best_mean_reward = _read_best(out, history_best)
     return evaluation
 
@@ -288,8 +322,8 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             self.selection: list[float] = []
             self.best = float("inf")
             if resumed_at is not None and history.is_file():
-                data = json.loads(history.read_text())
-                keep = _kept_history(data["env_steps"], resumed_at)
+                data = read_record(history)
+                keep = _kept_history(read_record(history, "env_steps"), resumed_at)
                 self.steps, self.returns = data["env_steps"][:keep], data["returns"][:keep]
                 self.selection = data["selection"][:keep]
                 self.best = _read_best(out, min(data["selection"], default=float("inf")))
@@ -332,6 +366,44 @@ def _relative_cost_callback(config: AgentConfig, out: Path, n_envs: int, resumed
             return curves.after_evaluation(self.steps, self.returns, self.selection)
 
     return _RelativeCostEval()
+
+
+#: the folder of a run's TensorBoard logs, one ``<name>_<k>`` folder per fresh start
+TB_FOLDER = "tb"
+
+
+def training_logger(out: Path, name: str, tensorboard: bool, manifest: Manifest, resumed: bool):
+    """SB3's logger of a training run: TensorBoard's events in ``tb/<name>_<k>/`` (``k``:
+    the next number on a fresh run, the newest on a resumed one, as SB3 numbers them), or
+    no output at all (``tensorboard`` False, or TensorBoard not installed).  The folders
+    are made through no link (:func:`~shipgym_baselines.records.outfiles.make_dir`) and the
+    events file gets a random suffix, so no link can be waiting in its place; it is listed
+    in the manifest as soon as it exists."""
+    from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
+    from stable_baselines3.common.utils import get_latest_run_id
+
+    if tensorboard:
+        try:
+            from torch.utils.tensorboard import SummaryWriter
+        except ImportError:
+            sys.stderr.write("tensorboard not installed: no TensorBoard logs\n")
+            tensorboard = False
+    if not tensorboard:
+        return Logger(folder=None, output_formats=[])
+    latest = get_latest_run_id(str(out / TB_FOLDER), name)
+    folder = out / TB_FOLDER / f"{name}_{max(latest, 1) if resumed else latest + 1}"
+    make_dir(folder.parent)
+    make_dir(folder)
+    suffix = f".{os.urandom(8).hex()}"
+
+    class _TensorBoard(TensorBoardOutputFormat):
+        def __init__(self) -> None:
+            self.writer = SummaryWriter(log_dir=str(folder), filename_suffix=suffix)
+            self._is_closed = False
+
+    output = _TensorBoard()
+    manifest.record([p.absolute() for p in folder.iterdir() if p.name.endswith(suffix)])
+    return Logger(folder=str(folder), output_formats=[output])
 
 
 def checkpoints(out: Path) -> list[tuple[Path, int]]:
@@ -516,7 +588,7 @@ def _train(
             previous = (previous[0], steps)
         state_file = out / "checkpoints" / "state.json"
         if state_file.is_file():
-            wall_offset = float(json.loads(state_file.read_text())["wall_time_s"])
+            wall_offset = float(read_record(state_file, "wall_time_s"))
     else:
         if config.env.normalize_per_ship:
             from shipgym_baselines.learned.per_ship import VecNormalizePerShip
@@ -525,27 +597,18 @@ def _train(
         elif config.env.normalize_reward:
             # an array γ (gamma_seconds) broadcasts over the envs in VecNormalize's returns
             venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
-        tb = None
-        if tensorboard:
-            try:
-                import tensorboard
-
-                tb = str(out / "tb")
-            except ImportError:
-                sys.stderr.write("tensorboard not installed: no TensorBoard logs\n")
         model = cls(
             config.policy,
             venv,
             seed=config.seed,
             device="cpu",
-            tensorboard_log=tb,
             verbose=0,
             **build_hyperparams(config, venv.action_space.shape[0]),
         )
-    if model.tensorboard_log is None:  # else SB3 makes an empty SB3-<time> folder in /tmp
-        from stable_baselines3.common.logger import Logger
-
-        model.set_logger(Logger(folder=None, output_formats=[]))
+    # the run's own logger (SB3 would make an empty SB3-<time> folder in /tmp without
+    # TensorBoard, and write where a resumed zip says with it)
+    logger = training_logger(out, config.name, tensorboard, manifest, resumed=previous is not None)
+    model.set_logger(logger)
     if config.env.gamma_seconds is not None:
         # the rollout buffer's GAE broadcasts an (n_envs,) γ: each env its ship's
         # exp(−Ts/τ); SB3's time-limit bootstrap keeps the scalar hyperparams γ
@@ -567,6 +630,7 @@ def _train(
             reset_num_timesteps=previous is None,
             tb_log_name=config.name,
         )
+    logger.close()  # the TensorBoard events flushed
     save_model(model, out / "model.zip")
     meta = training_meta(
         config,
@@ -603,7 +667,7 @@ def finished_run(out: str | Path, n_timesteps: int) -> dict[str, Any] | None:
     meta_file = Path(out) / "meta.json"
     if not (meta_file.is_file() and (Path(out) / "model.zip").is_file()):
         return None
-    meta = json.loads(meta_file.read_text())
+    meta = read_record(meta_file)
     done = int(meta.get("env_steps", 0)) >= n_timesteps
     return meta if done or meta.get("stopped_on_plateau_at") is not None else None
 
@@ -623,7 +687,8 @@ POLICY_FILES = (
 def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
     """Copy the best model (else the final one) as ``model.zip``, ``meta.json`` and the
     run's ``vecnormalize.json`` (if any) into ``dest`` (a policy dir); nothing else (no
-    pickle: a stale ``vecnormalize.pkl`` there is removed)."""
+    pickle: a stale ``vecnormalize.pkl`` there is removed).  Each file is written through
+    no link: a link in place of one is refused in one line, before any is written."""
     src = Path(out_dir)
     model = src / "best_model.zip"
     if not model.is_file():
@@ -632,13 +697,15 @@ def export_policy(out_dir: str | Path, dest: str | Path) -> Path:
         raise RunError(f"{src}: no trained model (model.zip / meta.json) to export")
     target = Path(dest)
     target.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(model, target / "model.zip")
-    shutil.copyfile(src / "meta.json", target / "meta.json")
+    for name in POLICY_FILES:  # written through no link: refused before any is written
+        refuse_special(target / name)
+    write_bytes(target / "model.zip", model.read_bytes())
+    write_bytes(target / "meta.json", (src / "meta.json").read_bytes())
     for name in POLICY_FILES[2:]:
         (target / name).unlink(missing_ok=True)  # not a stale one
     for name in POLICY_FILES[2:4]:  # the observation statistics and the learning curve
         if (src / name).is_file():
-            shutil.copyfile(src / name, target / name)
+            write_bytes(target / name, (src / name).read_bytes())
     return target
 
 
@@ -652,7 +719,7 @@ def ship_policy(out_dir: str | Path, root: str | Path | None = None) -> Path:
     meta_file = Path(out_dir) / "meta.json"
     if not meta_file.is_file():
         raise RunError(f"{out_dir}: no trained model (model.zip / meta.json) to export")
-    meta = json.loads(meta_file.read_text())
+    meta = read_record(meta_file)
     if not isinstance(meta.get("name"), str) or not isinstance(meta.get("seed"), int):
         raise RunError(f"{meta_file}: a shipped policy needs its 'name' and its 'seed'")
     agent = Path(root if root is not None else POLICY_DIR) / meta["name"]

@@ -16,6 +16,7 @@ from typing import Any
 import yaml
 
 from shipgym.config import catalogue
+from shipgym_baselines.errors import RunError
 
 #: the section of settings that hold for every ship
 ALL_SHIPS = "all"
@@ -31,13 +32,20 @@ def chosen_file(controller: str, folder: str | os.PathLike | None = None) -> Pat
 
 
 def read_chosen(controller: str, folder: str | os.PathLike | None = None) -> dict[str, Any]:
-    """The chosen-settings document of ``controller`` (empty when there is none)."""
+    """The chosen-settings document of ``controller`` (empty when there is none); a
+    :class:`RunError` in one line naming the file when it is no such document."""
     file = chosen_file(controller, folder)
     if not file.is_file():
         return {}
-    data = yaml.safe_load(file.read_text(encoding="utf-8")) or {}
-    if not isinstance(data, dict):
-        raise ValueError(f"{file}: a mapping of 'controller', 'ships', 'studies' expected")
+    try:
+        data = yaml.safe_load(file.read_text(encoding="utf-8")) or {}
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        why = " ".join(str(exc).split())
+        raise RunError(f"{file}: unreadable chosen settings ({why})") from None
+    if not isinstance(data, dict) or not all(
+        isinstance(data.get(key) or {}, dict) for key in ("ships", "studies")
+    ):
+        raise RunError(f"{file}: a mapping of 'controller', 'ships', 'studies' expected")
     return data
 
 

@@ -13,6 +13,10 @@ writes its own holder into it.  The file is not a run's output: the "not empty" 
 link (:func:`shipgym_baselines.records.outfiles.open_regular`): a link, a folder or a hard link in
 its place is refused in one line, and whatever it points to is left as it was (the "not
 empty" check and ``--force`` see it, too).
+
+A single file that a command fills over a long time (``shipgym references --table`` /
+``--packaged``) or reads, changes and writes back (a study's chosen settings) is locked the
+same way by :func:`file_lock`, on ``<file>.lock`` beside it.
 """
 
 from __future__ import annotations
@@ -20,10 +24,11 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import functools
 import json
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from shipgym_baselines.errors import RunError
@@ -62,15 +67,27 @@ def _acquire(folder: Path, start_time: str) -> int:
     """The descriptor of the locked lock file of ``folder``; a :class:`RunError` naming
     the holder when another process holds it, or naming the lock file when it is a link
     or no regular file of its own (:func:`~shipgym_baselines.records.outfiles.open_regular`)."""
-    file = folder / LOCK_FILE
+    return _acquire_file(folder / LOCK_FILE, start_time, lambda who: in_use(folder, who))
+
+
+def _acquire_file(
+    file: Path,
+    start_time: str,
+    busy: Callable[[str], RunError],
+    wait: bool = False,
+    elsewhere: str = "--out",
+) -> int:
+    """The descriptor of the lock file ``file``, locked, the holder written into it;
+    ``busy(holder)``: the refusal raised when another process holds it (``wait``: wait
+    for it to end instead); ``elsewhere``: the option a link's refusal names."""
     while True:
-        fd = open_regular(file, os.O_RDWR | os.O_CREAT)
+        fd = open_regular(file, os.O_RDWR | os.O_CREAT, elsewhere=elsewhere)
         try:
-            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.lockf(fd, fcntl.LOCK_EX if wait else fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
             os.close(fd)
             if exc.errno in (errno.EACCES, errno.EAGAIN):
-                raise in_use(folder, _holder(file)) from None
+                raise busy(_holder(file)) from None
             raise
         try:  # the file may have been removed by its last holder meanwhile: lock the new one
             same = os.path.samestat(os.fstat(fd), os.stat(file))
@@ -141,4 +158,48 @@ def out_lock(out: str | os.PathLike, start_time: str) -> Iterator[Path]:
                 folder.rmdir()  # only if empty: a run refused before writing leaves nothing
 
 
-__all__ = ["LOCK_FILE", "in_use", "lock_holder", "out_lock"]
+def lock_file_of(file: str | os.PathLike) -> Path:
+    """The lock file of ``file`` (:func:`file_lock`): ``<file>.lock`` beside it."""
+    path = Path(file)
+    return path.with_name(f"{path.name}.lock")
+
+
+@contextlib.contextmanager
+def file_lock(
+    file: str | os.PathLike, start_time: str, option: str, wait: bool = False
+) -> Iterator[Path]:
+    """Hold the exclusive lock of the single file ``file`` (:func:`lock_file_of`; its
+    folder made if missing) for the ``with`` body: another process filling it is refused at
+    once, in one line naming ``option`` (the command's option that named the file) and the
+    holder; ``wait``: wait for the other process instead (a short read-modify-write).  A
+    link or anything but a regular file in the lock file's place is refused in one line;
+    the lock file is removed at the end, as :func:`out_lock` removes its own."""
+    path = Path(file)
+    key = Path(os.path.abspath(lock_file_of(path)))
+    if key in _HELD:
+        raise _file_in_use(path, option, f"process {os.getpid()}, this one")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RunError(f"{option} {path}: cannot create its folder ({exc.strerror})") from None
+    busy = functools.partial(_file_in_use, path, option)
+    fd = _acquire_file(key, start_time, busy, wait, elsewhere=option)
+    _HELD.add(key)
+    try:
+        yield path
+    finally:
+        _HELD.discard(key)
+        with contextlib.suppress(OSError):
+            key.unlink()  # while locked: the next holder finds a fresh file
+        os.close(fd)
+
+
+def _file_in_use(file: Path, option: str, holder: str) -> RunError:
+    """The refusal of a file another process fills (``holder``: who)."""
+    return RunError(
+        f"{option} {file} is being written by another process ({holder}): wait for it to "
+        "end, or choose another file"
+    )
+
+
+__all__ = ["LOCK_FILE", "file_lock", "in_use", "lock_file_of", "lock_holder", "out_lock"]

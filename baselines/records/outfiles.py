@@ -59,19 +59,20 @@ def _kind(mode: int) -> str:
     return "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "not a regular file"
 
 
-def refusal(path: str | os.PathLike, what: str) -> RunError:
-    """The one-line refusal to write ``path``, which is ``what`` (a link names its target)."""
+def refusal(path: str | os.PathLike, what: str, elsewhere: str = "--out") -> RunError:
+    """The one-line refusal to write ``path``, which is ``what`` (a link names its target);
+    ``elsewhere``: the option that names another place."""
     target = ""
     if what == "a symbolic link":
         with contextlib.suppress(OSError):
             target = f" to {os.readlink(path)}"
     return RunError(
         f"{os.fspath(path)} is {what}{target}: a run writes no file through it; remove it "
-        "or choose another --out"
+        f"or choose another {elsewhere}"
     )
 
 
-def refuse_special(path: str | os.PathLike) -> None:
+def refuse_special(path: str | os.PathLike, elsewhere: str = "--out") -> None:
     """A :class:`RunError` if ``path`` exists and is not a regular file (a link, a folder,
     a FIFO, …); nothing if it is one or does not exist."""
     try:
@@ -79,7 +80,7 @@ def refuse_special(path: str | os.PathLike) -> None:
     except FileNotFoundError:
         return
     if not stat.S_ISREG(mode):
-        raise refusal(path, _kind(mode))
+        raise refusal(path, _kind(mode), elsewhere)
 
 
 def check_no_links(folder: str | os.PathLike) -> None:
@@ -96,23 +97,26 @@ def check_no_links(folder: str | os.PathLike) -> None:
                 raise refusal(path, _kind(mode))
 
 
-def open_regular(path: str | os.PathLike, flags: int, mode: int = 0o644) -> int:
+def open_regular(
+    path: str | os.PathLike, flags: int, mode: int = 0o644, elsewhere: str = "--out"
+) -> int:
     """A descriptor of ``path`` opened with ``flags`` (``O_CREAT`` to make it) and never
     through a link; a :class:`RunError` naming it when it is a link, not a regular file,
-    or a file with other names (a hard link: writing would change that file too)."""
+    or a file with other names (a hard link: writing would change that file too);
+    ``elsewhere``: the option that names another place, as the refusal says it."""
     try:
         fd = os.open(path, flags | os.O_NOFOLLOW | os.O_NONBLOCK, mode)
     except OSError as exc:
         if exc.errno == errno.ELOOP:
-            raise refusal(path, "a symbolic link") from None
+            raise refusal(path, "a symbolic link", elsewhere) from None
         if exc.errno in (errno.EISDIR, errno.ENXIO):
-            refuse_special(path)
+            refuse_special(path, elsewhere)
         raise
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode) or info.st_nlink > 1:
         os.close(fd)
         what = _kind(info.st_mode) if not stat.S_ISREG(info.st_mode) else "a hard link"
-        raise refusal(path, what)
+        raise refusal(path, what, elsewhere)
     os.set_blocking(fd, True)
     return fd
 

@@ -38,6 +38,9 @@ from shipgym_baselines.records.chosen import packaged_chosen as packaged_chosen
 from shipgym_baselines.records.chosen import read_chosen as read_chosen
 from shipgym_baselines.records.chosen import section_record as section_record
 from shipgym_baselines.records.chosen import tuned_settings as tuned_settings
+from shipgym_baselines.records.locking import file_lock
+from shipgym_baselines.records.outfiles import refuse_special, write_text
+from shipgym_baselines.records.runrecord import now
 
 
 def write_chosen(
@@ -49,8 +52,25 @@ def write_chosen(
 ) -> tuple[Path, dict[str, Any] | None]:
     """Set the ``section`` (a ship or ``all``) of ``controller``'s chosen settings to
     ``settings`` (with the study's summary ``study``), keeping the other sections; returns
-    the file and the settings it replaced (None: a new section)."""
+    the file and the settings it replaced (None: a new section).  The file is read,
+    changed and written under its lock (two studies of two ships that end together keep
+    both sections) and written through no link (a link in its place is refused in one
+    line): :mod:`shipgym_baselines.records.locking`, :mod:`~shipgym_baselines.records.outfiles`."""
     file = chosen_file(controller, folder)
+    with file_lock(file, now(), "--chosen-dir", wait=True):
+        return _write_chosen(controller, section, settings, study, folder, file)
+
+
+def _write_chosen(
+    controller: str,
+    section: str,
+    settings: dict[str, Any],
+    study: dict[str, Any],
+    folder: str | os.PathLike | None,
+    file: Path,
+) -> tuple[Path, dict[str, Any] | None]:
+    """:func:`write_chosen` once the file is locked."""
+    refuse_special(file, "--chosen-dir")  # before the result is merged into what it points to
     data = read_chosen(controller, folder)
     ships = dict(data.get("ships") or {})
     studies = dict(data.get("studies") or {})
@@ -66,10 +86,7 @@ def write_chosen(
         f"# Chosen settings of {controller}, written by `shipgym tune` (docs/tuning.md): one\n"
         "# section per ship (or 'all'); each study's report is named under 'studies'.\n"
     )
-    file.parent.mkdir(parents=True, exist_ok=True)
-    staged = file.with_name(f"{file.name}.{os.getpid()}.tmp")
-    staged.write_text(header + yaml.safe_dump(document, sort_keys=False), encoding="utf-8")
-    os.replace(staged, file)
+    write_text(file, header + yaml.safe_dump(document, sort_keys=False))  # atomic, no link
     packaged_chosen.cache_clear()
     return file, replaced
 

@@ -29,30 +29,32 @@ the same validation trials, or with ``force`` (:mod:`~shipgym_baselines.tuning.p
 study from the shared storage.
 
 A study's folder is locked while the study runs, as a run folder is
-(:func:`~shipgym_baselines.records.locking.out_lock`): a second process on the same study
-is refused in one line naming the holder, so two processes never draw the same trials.
+(:func:`~shipgym_baselines.records.locking.out_lock`), and so is a SQLite ``--storage``
+outside it (:func:`storage_lock`): a second process on the same study is refused in one
+line naming the holder, so two processes never draw the same trials.
 The folder holds no link (refused in one line), and the report is written through none,
 listed in the folder's manifest (:mod:`~shipgym_baselines.records.manifest`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import hashlib
 import json
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.executor import BACKENDS as BACKENDS  # public here too
 from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
-from shipgym_baselines.records.locking import out_lock
+from shipgym_baselines.records.locking import file_lock, out_lock
 from shipgym_baselines.records.manifest import Manifest
-from shipgym_baselines.records.outfiles import check_no_links, write_text
+from shipgym_baselines.records.outfiles import check_no_links, refuse_special, write_text
 from shipgym_baselines.records.runrecord import now
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
@@ -158,10 +160,9 @@ def _plan(
 def study_exists(plan: StudyPlan) -> bool:
     import optuna
 
-    if plan.storage.startswith("sqlite:///"):
-        db = Path(plan.storage[len("sqlite:///") :])
-        if not db.is_file():
-            return False
+    db = sqlite_file(plan.storage)
+    if db is not None and not db.is_file():
+        return False
     return plan.study_name in optuna.study.get_all_study_names(plan.storage)
 
 
@@ -356,7 +357,8 @@ def run_study(
     total = int(n_trials if n_trials is not None else plan.config.budget)
     if total < 1:
         raise RunError(f"--trials {total}: at least 1")
-    with out_lock(plan.folder, now()):
+    check_chosen(plan)  # before any trial, not after the last
+    with out_lock(plan.folder, now()), storage_lock(plan):
         check_no_links(plan.folder)
         manifest = Manifest(plan.folder)
         if plan.storage == default_storage(plan.folder):
@@ -365,6 +367,38 @@ def run_study(
             report = _run_locked(plan, total, resume, backend, workers, progress, force)
         manifest.compact(keep=(REPORT_FILE,))
         return report
+
+
+def check_chosen(plan: StudyPlan) -> None:
+    """A :class:`RunError` in one line, before the study's first trial, when the chosen
+    settings it will write cannot be: a link or no regular file in the file's place, or a
+    file that is no chosen-settings document."""
+    if plan.chosen_dir is None:
+        return
+    file = chosen_settings.chosen_file(plan.config.controller, plan.chosen_dir)
+    refuse_special(file, "--chosen-dir")
+    chosen_settings.read_chosen(plan.config.controller, plan.chosen_dir)
+
+
+@contextlib.contextmanager
+def storage_lock(plan: StudyPlan) -> Iterator[None]:
+    """Hold the lock of a SQLite ``--storage`` outside the study's folder (``<db>.lock``):
+    two processes on one study through one storage, each with its own ``--out``, would
+    draw the same trials; the second is refused in one line naming the first.  The
+    default storage lies in the folder, which :func:`run_study` locks already; a server
+    storage (``postgresql://…``) is not locked here: run one ``tune`` per study on it."""
+    db = sqlite_file(plan.storage)
+    if db is None or plan.storage == default_storage(plan.folder):
+        yield
+        return
+    with file_lock(db, now(), "--storage"):
+        yield
+
+
+def sqlite_file(storage: str) -> Path | None:
+    """The database file of a SQLite storage URL (None: another storage)."""
+    prefix = "sqlite:///"
+    return Path(storage[len(prefix) :]) if storage.startswith(prefix) else None
 
 
 def default_storage(folder: Path) -> str:

@@ -387,7 +387,8 @@ def test_in_lockstep_a_hanging_call_ends_only_its_episode(scratch_registry: None
 
 
 def test_a_slow_reset_is_no_timeout() -> None:
-    """``reset`` may build (and compile) a solver: only ``act`` calls have the limit."""
+    """``reset`` may build (and compile) a solver: it has a longer limit than ``act``
+    (:attr:`ActGuard.setup_timeout`, 60 s here)."""
 
     class SlowReset(GoesWrong):
         def reset(self, context: Any, seed: int | None = None) -> None:
@@ -468,6 +469,86 @@ def test_a_failed_controllers_figures_that_fail_are_left_out() -> None:
     result = run_episode(NoStats(_raise), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard())
     assert result.metrics["termination_reason"] == "controller_error"
     assert result.metrics["stats_error"].startswith("episode_stats() raised RuntimeError")
+
+
+def test_the_setup_limit_is_thirty_acts_and_at_least_a_minute() -> None:
+    assert ActGuard(10.0).setup_timeout == 300.0
+    assert ActGuard(0.05).setup_timeout == 60.0
+    assert ActGuard(math.inf).setup_timeout == math.inf
+
+
+@pytest.fixture
+def quick_setup(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No one-minute floor under the setup limit: 30 × the act limit."""
+    monkeypatch.setattr(evaluation, "SETUP_MIN_S", 0.0)
+
+
+class SpinningReset(PIDLOS):
+    name = "spinning_reset"
+
+    def reset(self, context: Any, seed: int | None = None) -> None:
+        _spin()
+
+
+class BlockingReset(PIDLOS):
+    name = "blocking_reset"
+
+    def reset(self, context: Any, seed: int | None = None) -> None:
+        _block()
+
+
+@pytest.mark.parametrize(
+    ("policy", "message"),
+    [
+        (SpinningReset, r"the call ran 0\.3\d* s of CPU time, over the limit of 0\.3 s"),
+        (
+            BlockingReset,
+            r"the call had not returned after 3(\.\d+)? s, 10 times the limit of 0\.3 s",
+        ),
+    ],
+)
+def test_a_reset_that_never_returns_ends_its_episode_as_controller_timeout(
+    quick_setup: None, policy: type, message: str
+) -> None:
+    """``reset`` is held to the setup limit (30 × 0.01 s here): past it in CPU time, or
+    past ten times it in wall time, the episode ends before any act, and the loop goes on."""
+    start = time.perf_counter()
+    result = run_episode(policy(), "rudder_aging", EVAL_SEED_OFFSET, guard=ActGuard(0.01))
+    assert time.perf_counter() - start < 10.0
+    m = result.metrics
+    assert m["termination_reason"] == "controller_timeout" and m["steps"] == 1
+    assert re.fullmatch(message, m["error"]), m["error"]
+
+
+class SpinningConstructor(PIDLOS):
+    def __init__(self) -> None:
+        _spin()
+
+
+def test_a_constructor_that_never_returns_fails_every_episode(
+    scratch_registry: None, quick_setup: None
+) -> None:
+    """Construction is held to the setup limit too: a constructor that computes forever
+    fails each of its episodes at its reset as controller_timeout, in every path of the
+    loop."""
+    register_controller("test_spins_when_made", lambda: SpinningConstructor())
+    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
+    results = [
+        *evaluate_batch("test_spins_when_made", "rudder_aging", seeds, guard=ActGuard(0.01)),
+        *evaluate("test_spins_when_made", "rudder_aging", seeds[:1], guard=ActGuard(0.01)),
+    ]
+    for result in results:
+        m = result.metrics
+        assert (result.controller, m["termination_reason"]) == (
+            "test_spins_when_made",
+            "controller_timeout",
+        )
+        assert re.fullmatch(
+            r"the controller could not be made: the call ran 0\.3\d* s of CPU time, over the "
+            r"limit of 0\.3 s",
+            m["error"],
+        ), m["error"]
+        assert m["steps"] == 1
 
 
 class Unbuildable(PIDLOS):

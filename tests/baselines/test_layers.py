@@ -52,8 +52,9 @@ LAYERS: dict[str, int] = {
     f"{B}.references": 2,
     f"{B}.classical": 2,
     f"{B}.learned": 2,
-    # 3 — the evaluation loop
+    # 3 — the evaluation loop, and a controller's own process for it
     f"{B}.evaluation": 3,
+    f"{B}.isolation": 3,
     # 4 — tuning, training the learned agents (their configs, the trainers, model
     #     selection), the papers' reproductions (with the scenario variants they use)
     f"{B}.tuning": 4,

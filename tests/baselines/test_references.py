@@ -392,3 +392,66 @@ def test_the_default_counts_what_the_shipped_table_holds(
     summary = json.loads(capsys.readouterr().out)
     assert (summary["computed"], summary["held"]) == (0, 32)
     assert summary["table"] == str(user_cache_path()) and not user_cache_path().exists()
+
+
+HOLD_TABLE = """
+import sys, time
+from shipgym_baselines.records.locking import file_lock
+with file_lock(sys.argv[1], "2026-01-02T03:04:05+00:00", "--table"):
+    print("locked", flush=True)
+    time.sleep(600)
+"""
+
+
+def test_a_second_fill_of_one_table_is_refused_naming_the_first(
+    oracle: CountingOracle, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two ``shipgym references --table FILE`` at once would each replace the file with
+    its own entries: the second is refused in one line naming the first, before any work,
+    and the file is filled once the first has ended."""
+    import subprocess
+    import sys
+
+    from shipgym_baselines.cli import main
+
+    table = tmp_path / "t.json.gz"
+    root = Path(__file__).resolve().parents[2]
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD_TABLE, str(table)], cwd=root, stdout=subprocess.PIPE, text=True
+    )
+    argv = ["references", "--suite", str(_tiny_suite(tmp_path)), "--table", str(table)]
+    argv += ["--workers", "1"]
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+        assert main(argv) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert f"--table {table} is being written by another process (process {holder.pid}" in line
+        assert oracle.runs == [] and not table.exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    # a lock file left by a killed process is free: the kernel released it with the process
+    assert (tmp_path / "t.json.gz.lock").is_file()
+    assert main(argv) == 0 and len(ReferenceTable.load(table).entries) == 1
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("t.")) == [
+        "t.json.gz"  # no lock file left
+    ]
+
+
+@pytest.mark.parametrize("planted", ["t.json.gz", "t.json.gz.lock"])
+def test_a_table_fill_writes_through_no_link(
+    planted: str, oracle: CountingOracle, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link in place of the table or of its lock file: refused in one line naming it,
+    what it points to untouched."""
+    from shipgym_baselines.cli import main
+
+    victim = tmp_path / "victim.txt"
+    victim.write_text("untouched")
+    (tmp_path / planted).symlink_to(victim)
+    argv = ["references", "--suite", str(_tiny_suite(tmp_path))]
+    argv += ["--table", str(tmp_path / "t.json.gz"), "--workers", "1"]
+    assert main(argv) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert f"{tmp_path / planted} is " in line
+    assert victim.read_text() == "untouched" and (tmp_path / planted).is_symlink()

@@ -9,6 +9,7 @@ thread (:func:`one_thread`): on two cores more threads are slower.
 
 from __future__ import annotations
 
+import io
 import json
 from pathlib import Path
 from typing import Any
@@ -75,18 +76,26 @@ class Estimator:
         return mean.astype(float), np.exp(np.clip(log_var, LOG_VAR_MIN, LOG_VAR_MAX))
 
     def save(self, folder: Path) -> None:
-        """The weights and standardisation (``estimator.pt``) and ``meta.json``."""
+        """The weights and standardisation (``estimator.pt``) and ``meta.json``, each
+        written whole through no link (:mod:`shipgym_baselines.records.outfiles`; a run
+        folder's manifest lists them)."""
+        from shipgym_baselines.records.outfiles import make_dir, write_bytes, write_text
+
         torch = one_thread()
-        folder.mkdir(parents=True, exist_ok=True)
+        if not folder.is_dir():
+            folder.parent.mkdir(parents=True, exist_ok=True)
+            make_dir(folder)
+        weights = io.BytesIO()
         torch.save(
             {
                 "state_dict": self.net.state_dict(),
                 "mean": torch.from_numpy(self.mean),
                 "std": torch.from_numpy(self.std),
             },
-            folder / WEIGHTS_FILE,
+            weights,
         )
-        (folder / META_FILE).write_text(json.dumps(self.meta, indent=1) + "\n")
+        write_bytes(folder / WEIGHTS_FILE, weights.getvalue())
+        write_text(folder / META_FILE, json.dumps(self.meta, indent=1) + "\n")
 
     @classmethod
     def load(cls, folder: Path) -> Estimator:

@@ -18,13 +18,17 @@
 
 Each round's data (``data/round_<r>.npz``) and φ (``round_<r>/``) are kept when finished:
 ``--resume`` starts after the last finished step.  ``DIR/estimator`` is the last round's φ.
+
+``DIR`` is written as every run folder is (:mod:`shipgym_baselines.records`): locked while
+the training runs, each file listed in ``manifest.txt`` before it is written, written
+whole and through no link; a folder holding a link is refused.
 """
 
 from __future__ import annotations
 
 import argparse
+import io
 import json
-import shutil
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -41,6 +45,11 @@ from shipgym_baselines.learned.plant_id.features import STEP_FEATURES, WINDOW, s
 from shipgym_baselines.learned.plant_id.labels import SLOTS, Labeller, slot_mask
 from shipgym_baselines.learned.plant_id.network import Estimator, build, nll, one_thread
 from shipgym_baselines.privileged import teacher_truth
+from shipgym_baselines.records.folders import check_out_dir, check_out_usable
+from shipgym_baselines.records.locking import out_lock
+from shipgym_baselines.records.manifest import Manifest
+from shipgym_baselines.records.outfiles import check_no_links, make_dir, write_bytes, write_text
+from shipgym_baselines.records.runrecord import now
 from shipgym_baselines.registry import make_controller
 
 #: the behaviour controller of round 0
@@ -184,10 +193,10 @@ def rmse(estimator: Estimator, data: dict[str, np.ndarray]) -> dict[str, float]:
 
 
 def save_data(path: Path, data: dict[str, np.ndarray]) -> None:
-    """``data`` as ``path`` (written whole, then renamed: never half a file)."""
-    tmp = path.with_suffix(".tmp.npz")
-    np.savez_compressed(tmp, **data)
-    tmp.replace(path)
+    """``data`` as ``path`` (written whole, through no link: never half a file)."""
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **data)
+    write_bytes(path, buffer.getvalue())
 
 
 def load_data(path: Path) -> dict[str, np.ndarray]:
@@ -207,10 +216,36 @@ def train(
     workers: int = 2,
     validation_trials: int = 32,
 ) -> dict[str, Any]:
-    """The rounds of module doc; returns the meta written to ``out/meta.json``."""
-    if out.exists() and any(out.iterdir()) and not resume:
-        raise FileExistsError(f"{out} is not empty: --resume it or choose a new folder")
-    (out / "data").mkdir(parents=True, exist_ok=True)
+    """The rounds of module doc, in the run folder ``out`` (module doc); returns the meta
+    written to ``out/estimator/meta.json``.  A folder that is not empty is refused unless
+    ``resume`` (:class:`RunError`, one line)."""
+    check_out_usable(out, resume=resume)
+    with out_lock(out, now()):
+        check_no_links(out)
+        if not resume:
+            check_out_dir(out, note=" (a φ training's folder)")
+        manifest = Manifest(out)
+        with manifest.recording():
+            meta = _train(
+                seed, out, first, later, rounds, updates, later_updates, workers, validation_trials
+            )
+        manifest.compact()
+        return meta
+
+
+def _train(
+    seed: int,
+    out: Path,
+    first: int,
+    later: int,
+    rounds: int,
+    updates: int,
+    later_updates: int,
+    workers: int,
+    validation_trials: int,
+) -> dict[str, Any]:
+    """:func:`train` in its folder, locked and recording."""
+    make_dir(out / "data")
     cost_file = out / "cost.json"
     cost = json.loads(cost_file.read_text()) if cost_file.exists() else {"rounds": []}
     val_file = out / "data" / "validation.npz"
@@ -237,7 +272,7 @@ def train(
                     "behaviour": BEHAVIOUR if r == 0 else "nmpc_learned_id",
                 }
             ]
-            cost_file.write_text(json.dumps(cost, indent=1))
+            write_text(cost_file, json.dumps(cost, indent=1))
         parts.append(load_data(shard))
         if (folder / "meta.json").exists():
             estimator = Estimator.load(folder)
@@ -269,10 +304,8 @@ def train(
         "data_cost": cost["rounds"],
     }
     final = out / "estimator"
-    if final.exists():
-        shutil.rmtree(final)
-    estimator.save(final)
-    (final / "meta.json").write_text(json.dumps(meta, indent=1) + "\n")
+    estimator.save(final)  # its two files replaced whole
+    write_text(final / "meta.json", json.dumps(meta, indent=1) + "\n")
     return meta
 
 

@@ -1,6 +1,7 @@
 """What an entrant can do to a leaderboard run: report figures, fail to be made, fail in
-``episode_stats``, hang.  None of it changes another controller's score, the references are
-never judged as entrants, and the run always ends with its record complete."""
+``episode_stats``, hang, end its process, ignore the timeout.  None of it changes another
+controller's score, the references are never judged as entrants, and the run always ends
+with its record complete."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from shipgym_baselines import isolation
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runrecord import read_run
 
@@ -64,8 +66,55 @@ class Hangs(PIDLOS):
         while self.calls == 3 and not os.environ.get("FIXED"):
             pass  # computes forever
         return super().act(obs, info)
+
+
+class EndsItsProcess(Hangs):
+    name = "ends_its_process"
+
+    def act(self, obs, info):
+        self.calls += 1
+        if self.calls == 3 and not os.environ.get("FIXED"):
+            os._exit(0)
+        return PIDLOS.act(self, obs, info)
+
+
+class IgnoresTheSignal(Hangs):
+    name = "ignores_the_signal"
+
+    def act(self, obs, info):
+        import signal
+
+        self.calls += 1
+        if self.calls == 3 and not os.environ.get("FIXED"):
+            signal.signal(signal.SIGUSR2, signal.SIG_IGN)
+            while True:
+                pass
+        return PIDLOS.act(self, obs, info)
+
+
+class SwallowsEverything(Hangs):
+    name = "swallows_everything"
+
+    def act(self, obs, info):
+        self.calls += 1
+        while self.calls == 3 and not os.environ.get("FIXED"):
+            try:
+                while True:
+                    pass
+            except BaseException:
+                pass
+        return PIDLOS.act(self, obs, info)
 """
-CLASSES = ("Twin", "Claims", "Listing", "Unbuildable", "Hangs")
+CLASSES = (
+    "Twin",
+    "Claims",
+    "Listing",
+    "Unbuildable",
+    "Hangs",
+    "EndsItsProcess",
+    "IgnoresTheSignal",
+    "SwallowsEverything",
+)
 #: a tiny limit: the computed oracle's calls take far longer, the PIDs' far less
 ACT_TIMEOUT = "0.002"
 
@@ -114,11 +163,13 @@ def _main(argv: list[str], monkeypatch: pytest.MonkeyPatch) -> tuple[int, str]:
 
 @pytest.fixture(scope="module")
 def entrants_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, str]:
-    """The suite run once: (the suite file, the run folder, what stderr said)."""
+    """The suite run once: (the suite file, the run folder, what stderr said).  A call
+    that does not end when asked is killed 0.5 s after ten times the limit (not 5 s)."""
     root = tmp_path_factory.mktemp("entrants")
     suite = _suite(root)
     with pytest.MonkeyPatch.context() as mp:
         mp.delenv("FIXED", raising=False)
+        mp.setattr(isolation, "GRACE_S", 0.5)
         code, stderr = _main(_argv(suite, root / "out"), mp)
     assert code == 0, stderr
     return suite, root / "out", stderr
@@ -183,6 +234,35 @@ def test_a_hanging_act_ends_its_episode_and_the_run_finishes(entrants_run: tuple
     assert record["status"] == "complete" and record["act_timeout"] == float(ACT_TIMEOUT)
 
 
+def test_a_plugin_that_ends_its_process_fails_its_episodes_and_the_run_finishes(
+    entrants_run: tuple,
+) -> None:
+    """``os._exit(0)`` inside ``act``: the plug-in plays in a process of its own, so only
+    its episodes fail, named; the run and the other controllers go on."""
+    _, out, stderr = entrants_run
+    ended = _episodes(out)["ends_its_process"]
+    assert ended["termination_reason"] == "controller_error" and ended["steps"] == 1
+    assert ended["error"] == "the controller's process ended with exit code 0"
+    assert "shipgym: ends_its_process failed on mine seed 10000" in stderr
+    assert read_run(out)["status"] == "complete"
+    assert _episodes(out)["twin"]["termination_reason"] == "goal"
+
+
+@pytest.mark.parametrize("name", ["ignores_the_signal", "swallows_everything"])
+def test_a_call_that_will_not_end_has_its_process_killed(entrants_run: tuple, name: str) -> None:
+    """A call that ignores the watchdog's signal, or catches the timeout and goes on: its
+    process is killed once it outlives ten times the limit (and a grace), its episodes
+    fail as controller_timeout, and the run finishes."""
+    _, out, _ = entrants_run
+    episode = _episodes(out)[name]
+    assert episode["termination_reason"] == "controller_timeout"
+    assert episode["error"] == (
+        "the call had not returned after 0.52 s, 10 times the limit of 0.002 s and 0.5 s "
+        "more, nor ended when asked: its process was killed"
+    )
+    assert read_run(out)["status"] == "complete"
+
+
 def test_resume_after_the_fix_runs_the_failed_entrants_again(
     entrants_run: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -193,8 +273,8 @@ def test_resume_after_the_fix_runs_the_failed_entrants_again(
     code, _ = _main(_argv(suite, out, "--resume", "--retry-failed"), monkeypatch)
     assert code == 0 and read_run(out)["status"] == "complete"
     episodes = _episodes(out)
-    assert episodes["unbuildable"]["termination_reason"] == "goal"
-    assert episodes["hangs"]["termination_reason"] == "goal"
+    for name in ("unbuildable", "hangs", "ends_its_process", "ignores_the_signal"):
+        assert episodes[name]["termination_reason"] == "goal", name
 
 
 def test_resume_under_another_limit_is_refused_in_one_line(

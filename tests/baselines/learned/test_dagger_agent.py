@@ -170,6 +170,37 @@ def test_a_run_killed_while_scoring_resumes_without_relabelling(
         train_dagger(config, tmp_path / "empty", resume=True, progress=False)
 
 
+@pytest.mark.parametrize("damaged", ["rounds.json", "data/round_001.npz"])
+def test_a_damaged_record_of_a_dagger_run_is_one_line(
+    damaged: str, trained: dict[str, Any], tmp_path: Path
+) -> None:
+    """``resume`` on a run whose round record or labelled states are damaged: one line
+    naming the file, not a traceback."""
+    from shipgym_baselines.errors import RunError
+
+    out = tmp_path / "agent"
+    shutil.copytree(trained["out"], out)
+    (out / "meta.json").unlink()  # not finished: the run's files are read
+    selection = out / "eval" / "selection.json"
+    data = json.loads(selection.read_text())
+    selection.write_text(
+        json.dumps(
+            {
+                k: v[:1] if isinstance(v, list) and k not in ("trials", "references") else v
+                for k, v in data.items()
+            }
+        )
+    )
+    (out / RUN_DIR / damaged).write_text("{not json")
+    config = AgentConfig.model_validate(
+        {**TINY, "seed": 1, "hyperparams": {**TINY["hyperparams"], "rounds": ROUNDS + 1}}
+    )
+    with pytest.raises(RunError) as refused:
+        train_dagger(config, out, resume=True, progress=False)
+    assert str(out / RUN_DIR / damaged) in str(refused.value)
+    assert "\n" not in str(refused.value)
+
+
 def test_the_packaged_configs() -> None:
     """bc: the student dagger's study chose (``--settings tuned``) but the history;
     ppo_history: PPO with a window."""

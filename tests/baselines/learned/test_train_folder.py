@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import re
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ import pytest
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.learned.agents import load_agent_config
-from shipgym_baselines.learned.train import checkpoint_names, train
+from shipgym_baselines.learned.train import checkpoint_names, export_policy, train
 from shipgym_baselines.learned.trust import trusting_pickle
 from shipgym_baselines.records.manifest import check_listed, read_manifest
 from tests.baselines.learned.test_train_curves import _tiny
@@ -51,11 +52,72 @@ def _copy(source: Path, target: Path) -> Path:
 
 def test_every_file_a_run_writes_is_listed(trained: Path) -> None:
     """Checkpoints, evaluations and TensorBoard logs: all in the manifest, nothing else
-    in the folder."""
+    in the folder.  TensorBoard's events file ends in a random suffix (no link can wait
+    for its name)."""
     listed = read_manifest(trained)
     assert {f"checkpoints/{name}" for name in checkpoint_names(128)[:1]} <= listed
-    assert any(p.startswith("tb/ppo_tiny_") and "events" in p for p in listed)
+    (events,) = [p for p in listed if p.startswith("tb/ppo_tiny_1/events.out.tfevents.")]
+    assert re.fullmatch(r".*\.[0-9a-f]{16}", events), events
     assert check_listed(trained) <= listed
+
+
+#: files SB3 writes during a run (checkpoints, the evaluations' history, the best model)
+DURING_THE_RUN = (
+    "checkpoints/ckpt_128_steps.zip",
+    "checkpoints/ckpt_vecnormalize_128_steps.pkl",
+    "eval/evaluations.npz",
+    "best_model.zip",
+)
+
+
+@pytest.mark.parametrize("planted", DURING_THE_RUN)
+def test_a_link_planted_during_a_run_is_not_written_through(
+    planted: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A link that appears in the agent folder after the run checked it (planted as the
+    run makes ``checkpoints/`` and ``eval/``), in place of a file SB3 writes: the run ends
+    in one line naming it, and the file it points to is untouched."""
+    from shipgym_baselines.learned import train as train_module
+
+    out, victim = tmp_path / "run", tmp_path / "victim.txt"
+    victim.write_text("untouched")
+    made = train_module.make_dir
+
+    def planting(folder: Path) -> Path:
+        path = made(folder)
+        link = out / planted
+        if Path(folder) in (link.parent, out / "eval") and not link.is_symlink():
+            link.symlink_to(victim)
+        return path
+
+    monkeypatch.setattr(train_module, "make_dir", planting)
+    with pytest.raises(RunError, match=f"{re.escape(planted)} is a symbolic link"):
+        train(_tiny(n_timesteps=128), out_dir=out, progress=False, tensorboard=False)
+    assert victim.read_text() == "untouched"
+
+
+def test_a_resumed_run_logs_into_its_tensorboard_folder(trained: Path, tmp_path: Path) -> None:
+    """A resumed run adds a second events file to ``tb/ppo_tiny_1`` (where SB3 would
+    continue too), listed; the folder's other files are its own."""
+    with trusting_pickle(True):
+        out = _copy(trained, tmp_path / "run")
+        train(_tiny(), out_dir=out, n_timesteps=384, resume=True, progress=False)
+    events = sorted(p.name for p in (out / "tb" / "ppo_tiny_1").iterdir())
+    assert len(events) == 2 and sorted(p.name for p in (out / "tb").iterdir()) == ["ppo_tiny_1"]
+    assert {f"tb/ppo_tiny_1/{e}" for e in events} <= read_manifest(out)
+
+
+def test_export_writes_through_no_link(trained: Path, tmp_path: Path) -> None:
+    """A link in place of a policy folder's file: refused in one line before any file is
+    written, what it points to untouched."""
+    victim = tmp_path / "victim.txt"
+    victim.write_text("untouched")
+    dest = tmp_path / "policy"
+    dest.mkdir()
+    (dest / "meta.json").symlink_to(victim)
+    with pytest.raises(RunError, match=r"meta\.json is a symbolic link"):
+        export_policy(trained, dest)
+    assert victim.read_text() == "untouched" and sorted(os.listdir(dest)) == ["meta.json"]
 
 
 def test_force_keeps_the_users_files_and_refuses_in_one_line(trained: Path, tmp_path: Path) -> None:
@@ -177,3 +239,28 @@ def test_another_users_checkpoints_need_trust_pickle(
     with trusting_pickle(True):
         meta = train(_tiny(), out_dir=out, n_timesteps=384, resume=True, progress=False)
     assert meta["env_steps"] == 384
+
+
+@pytest.mark.parametrize(
+    "damaged",
+    [
+        "meta.json",
+        "checkpoints/state.json",
+        "eval/best.json",
+        "tuned_from.json",
+        "eval/evaluations.npz",
+    ],
+)
+def test_a_damaged_record_of_the_run_is_one_line(
+    damaged: str, trained: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--resume`` on a folder whose record of the run (not a checkpoint) is damaged: one
+    line naming the file and that ``--force`` trains it afresh, not a traceback."""
+    same_user(trained, monkeypatch)
+    out = _copy(trained, tmp_path / "run")
+    (out / damaged).write_text("{not json")
+    with pytest.raises(RunError) as refused:
+        train(_tiny(), out_dir=out, n_timesteps=384, resume=True, progress=False)
+    line = str(refused.value)
+    assert line.startswith(str(out / damaged)) and "\n" not in line
+    assert line.endswith("a damaged record of the run (--force trains it afresh)")

@@ -33,3 +33,14 @@ def test_the_ship_section_else_the_all_section(
 def test_the_reader_stays_importable_from_tuning() -> None:
     for name in ("ALL_SHIPS", "chosen_dir", "read_chosen", "section_record", "tuned_settings"):
         assert getattr(tuning_chosen, name) is getattr(chosen, name)
+
+
+@pytest.mark.parametrize("text", ["untouched\n", "ships: [1, 2]\n", "ships: {a: 1\n"])
+def test_a_file_that_is_no_chosen_settings_is_one_line(tmp_path: Path, text: str) -> None:
+    from shipgym_baselines.errors import RunError
+
+    (tmp_path / "pid_los.yaml").write_text(text)
+    with pytest.raises(RunError) as refused:
+        chosen.read_chosen("pid_los", tmp_path)
+    assert str(refused.value).startswith(f"{tmp_path / 'pid_los.yaml'}: ")
+    assert "\n" not in str(refused.value)

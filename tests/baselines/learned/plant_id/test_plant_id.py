@@ -15,12 +15,14 @@ from shipgym.envs.context import ControllerContext
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.envs.truth import PlantTruth
 from shipgym.scenarios import load_scenario
+from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.learned.plant_id.controller import NmpcLearnedId
 from shipgym_baselines.learned.plant_id.features import Window, episode_windows, step_row
 from shipgym_baselines.learned.plant_id.labels import SLOTS, Labeller, plant_of, slot_mask
 from shipgym_baselines.learned.plant_id.network import Estimator, build
 from shipgym_baselines.learned.plant_id.train import rollout, windows
+from shipgym_baselines.records.manifest import check_listed, read_manifest
 from shipgym_baselines.registry import make_controller, resolve_controller
 
 torch = pytest.importorskip("torch")
@@ -166,8 +168,13 @@ def test_training_writes_its_rounds_and_resumes_without_collecting_again(tmp_pat
     assert [c["episodes"] for c in meta["data_cost"]] == [2, 1]
     assert meta["data_cost"][1]["behaviour"] == "nmpc_learned_id"
     shards = {p.name: p.stat().st_mtime_ns for p in (out / "data").iterdir()}
-    with pytest.raises(FileExistsError):
+    with pytest.raises(RunError, match="is not empty"):
         trainer.train(0, out, False, **kwargs)
+    assert check_listed(out) <= read_manifest(out)  # every file the run wrote, listed
+    (out / "notes.txt").symlink_to(tmp_path / "mine.txt")  # a run writes through no link
+    with pytest.raises(RunError, match=r"notes\.txt is a symbolic link"):
+        trainer.train(0, out, True, **kwargs)
+    (out / "notes.txt").unlink()
     import shutil
 
     shutil.rmtree(out / "round_001")
