@@ -68,12 +68,8 @@ def run(args: argparse.Namespace) -> int:
     plans = plan_studies(
         args.name, args.ship, args.out, args.storage, args.chosen_dir, promote=args.promote
     )
-    from shipgym_baselines.tuning.estimate import start_line
-
     reports: list[dict[str, Any]] = []
     for plan in plans:
-        trials = args.trials if args.trials is not None else plan.config.budget
-        sys.stderr.write(start_line(plan, trials) + "\n")
         report = run_study(
             plan,
             n_trials=args.trials,

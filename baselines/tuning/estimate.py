@@ -1,6 +1,7 @@
-"""What ``shipgym tune`` says before a study: one line with the study, its trials, the
-validation trials each scores, and an estimate from the shipped study's own CPU time
-(``configs/tuning/reports/<name>/<ship or all>/tuning_report.json``: its ``cpu_s``)."""
+"""What ``shipgym tune`` says as a study starts, after its checks: one line with the
+study, its trials, the validation trials each scores, and an estimate from the shipped
+study's own CPU time (``configs/tuning/reports/<name>/<ship or all>/tuning_report.json``:
+its ``cpu_s``)."""
 
 from __future__ import annotations
 
@@ -51,6 +52,6 @@ def start_line(plan: StudyPlan, trials: int) -> str:
             f"{per_trial:.1f} CPU s a trial)"
         )
     return (
-        f"tune: {plan.study_name}: {trials} trials of {config.controller} ({where}), each "
+        f"{plan.study_name}: {trials} trials of {config.controller} ({where}), each "
         f"{each} {validation} validation trials, after the default settings; {estimate}"
     )

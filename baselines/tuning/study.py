@@ -415,8 +415,12 @@ def _run_locked(
     progress: Progress | None,
     force: bool,
 ) -> dict[str, Any]:
-    """:func:`run_study` once the study's folder is locked."""
+    """:func:`run_study` once the study's folder is locked; its start-up line
+    (:func:`~shipgym_baselines.tuning.estimate.start_line`) once the study opened."""
+    from shipgym_baselines.tuning.estimate import start_line
+
     study = open_study(plan, resume)
+    say(progress, start_line(plan, total))
     scorer = Scorer(plan, progress)
     if "default_ratios" not in study.user_attrs:
         say(progress, f"{plan.study_name}: scoring the default settings")

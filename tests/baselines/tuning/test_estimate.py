@@ -23,6 +23,6 @@ def test_the_estimate_is_the_shipped_studys_cpu_per_trial() -> None:
 def test_the_start_line_names_the_study_and_its_trials() -> None:
     (plan,) = [p for p in plan_studies("lqr", None, None, None, None) if p.ship == "blanke"]
     line = start_line(plan, 7)
-    assert line.startswith(f"tune: {plan.study_name}: 7 trials of lqr (blanke), each scored on ")
+    assert line.startswith(f"{plan.study_name}: 7 trials of lqr (blanke), each scored on ")
     assert f" on {len(plan_trials(plan))} validation trials" in line
     assert "the shipped study:" in line
