@@ -113,8 +113,12 @@ def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -
     for png in out.glob("*.png"):
         assert f"<code>{png.name}</code>" in html, png.name
     embedded = re.findall("data:image/(?:png|webp);base64,", html)  # lossless, the PNG's pixels
-    # the ranking, scenario and held-out figures, and the shipped ppo's learning curves
-    assert len(embedded) == len(list(out.glob("*.png"))) == 8
+    linked = re.findall(r'src="(scenario_[^"]+\.png)"', html)  # the files beside the page
+    # the ranking figures and the shipped ppo's learning curves embedded; the scenario
+    # figures (rudder_aging, mariner_track, heldout:0) linked
+    assert len(embedded) == 5
+    assert sorted(linked) == sorted(p.name for p in out.glob("scenario_*.png"))
+    assert len(embedded) + len(linked) == len(list(out.glob("*.png"))) == 8
     assert (out / "learning_curves.png").is_file()
     assert "data:image/svg" not in html
     assert all(row["controller"] in html for row in rows)
