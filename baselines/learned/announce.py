@@ -63,7 +63,7 @@ def too_short_line(config: AgentConfig, meta: dict[str, Any]) -> str | None:
     steps, every = int(meta.get("env_steps", 0)), config.eval.freq
     folder = meta.get("out_dir")
     validated = folder is not None and (Path(folder) / CURVE_FILE).is_file()
-    if config.algo == "dagger" or validated:
+    if config.algo == "dagger" or validated or steps >= every:
         return None
     return (
         f"note: {config.name} seed {meta.get('seed')}: {steps:,} env steps, fewer than the "
