@@ -16,6 +16,9 @@ import numpy as np
 
 from shipgym_baselines.tuning.objective import geometric_mean
 
+#: a study's report, in its folder (and the shipped studies' under configs/tuning/reports)
+REPORT_FILE = "tuning_report.json"
+
 #: bootstrap resamples and confidence of the report's intervals
 RESAMPLES = 2000
 CONFIDENCE = 0.95

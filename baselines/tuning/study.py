@@ -58,12 +58,12 @@ from shipgym_baselines.records.outfiles import check_no_links, refuse_special, w
 from shipgym_baselines.records.runrecord import now
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
+from shipgym_baselines.tuning.estimate import cpu_duration, recorded_cpu_s
 from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
-from shipgym_baselines.tuning.report import best_vs_default, trial_rows
+from shipgym_baselines.tuning.report import REPORT_FILE, best_vs_default, trial_rows
 from shipgym_baselines.tuning.space import TuningConfig, load_tuning
 from shipgym_baselines.tuning.validation import ValidationTrial, oracle_costs, validation_trials
 
-REPORT_FILE = "tuning_report.json"
 STORAGE_FILE = "study.db"
 #: the folder under ``--out`` that a study's chosen settings go to unless promoted
 CHOSEN_FOLDER = "chosen"
@@ -417,8 +417,6 @@ def _run_locked(
 ) -> dict[str, Any]:
     """:func:`run_study` once the study's folder is locked; its start-up line
     (:func:`~shipgym_baselines.tuning.estimate.start_line`) once the study opened."""
-    from shipgym_baselines.tuning.estimate import start_line
-
     study = open_study(plan, resume)
     say(progress, start_line(plan, total))
     scorer = Scorer(plan, progress)
@@ -440,6 +438,30 @@ def _run_locked(
             )
     study = open_study(plan, resume=True, create=False)
     return write_report(plan, study, scorer, force, progress)
+
+
+def start_line(plan: StudyPlan, trials: int) -> str:
+    """The line a study starts with, after its checks: the study, its ``trials``, the
+    validation trials each scores, and an estimate from the shipped study's CPU per trial
+    (:func:`~shipgym_baselines.tuning.estimate.recorded_cpu_s`; a resumed study runs only
+    the trials it lacks: the estimate is then an upper bound)."""
+    config = plan.config
+    validation = len(plan_trials(plan))
+    where = plan.ship or "every ship"
+    each = "a training run scored on" if config.kind == "learned" else "scored on"
+    recorded = recorded_cpu_s(config.name, plan.ship)
+    if recorded is None:
+        estimate = "no shipped study of this name and ship to estimate from"
+    else:
+        per_trial, default = recorded
+        estimate = (
+            f"at most about {cpu_duration(per_trial * trials + default)} (the shipped study: "
+            f"{per_trial:.1f} CPU s a trial)"
+        )
+    return (
+        f"{plan.study_name}: {trials} trials of {config.controller} ({where}), each "
+        f"{each} {validation} validation trials, after the default settings; {estimate}"
+    )
 
 
 def _progress_callback(plan: StudyPlan, progress: Progress | None) -> Callable[..., None]:

@@ -7,8 +7,8 @@ import json
 from pathlib import Path
 
 from shipgym.config import catalogue
-from shipgym_baselines.tuning.estimate import recorded_cpu_s, start_line
-from shipgym_baselines.tuning.study import plan_studies, plan_trials
+from shipgym_baselines.tuning.estimate import recorded_cpu_s
+from shipgym_baselines.tuning.study import plan_studies, plan_trials, start_line
 
 
 def test_the_estimate_is_the_shipped_studys_cpu_per_trial() -> None:
