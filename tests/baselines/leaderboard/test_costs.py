@@ -24,34 +24,16 @@ from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, TWIN_PLAYERS, TWIN_SCENARIOS
 from shipgym_baselines.registry import training_seeds
 
-#: the default suite's whole run, CPU seconds (README: 1,097 CPU s on a 2-core machine)
-DEFAULT_RUN_CPU_S = 1097.0
-#: how far the estimate may be from it, either way: the recorded costs, measured on a 2-core
-#: VM, estimate 921 CPU s with the tables' (0.84×), and a measurement moves by ±13 % from
-#: run to run (docs/leaderboard-cost.md)
+#: the default suite's whole run, CPU seconds (docs/run_summary.json: 896 CPU s on two quiet
+#: cores, the suite as shipped with its twins)
+DEFAULT_RUN_CPU_S = 896.0
+#: how far the estimate may be from it, either way: the recorded costs estimate 994 CPU s
+#: with the tables' (1.11×), and a measurement moves by ±13 % from run to run
+#: (docs/leaderboard-cost.md)
 FACTOR = 1.25
-#: the default suite's episodes in that recorded run (before the no-change twins): 384
-#: trials (36 scenarios × 8 seeds, 16 held-out × 4, 16 in-range × 2) for each of its 25
-#: rows, a learned agent's training seeds sharing them
-DEFAULT_EPISODES = 9_600
-#: the suite of that recorded run: the default suite's scenarios and controllers on 8 seeds,
-#: held-out on 4, 16 in-range scenarios, without twins
-#: the controllers of that recorded run: Liu et al.'s whole NMPC family, no NMPC on an
-#: estimated plant (nmpc_ekf, nmpc_learned_id came later and cost the oracle's each)
-RECORDED_NMPC = (
-    "nmpc_lambda_lssvm",
-    "nmpc_wlssvm",
-    "nmpc",
-    "nmpc_lambda_lssvm_svf",
-    "nmpc_wlssvm_svf",
-)
-RECORDED_SUITE = {
-    "seeds": 8,
-    "heldout_seeds": 4,
-    "inrange_scenarios": 16,
-    "inrange_seeds": 2,
-    "twins": False,
-}
+#: the default suite's episodes in that run: its trials and their twins' for each row, a
+#: learned agent's training seeds sharing them
+DEFAULT_EPISODES = 3_162
 
 
 def default_plan(
@@ -59,7 +41,7 @@ def default_plan(
 ) -> tuple[list[Job], dict, dict]:
     """The default suite's jobs, scenarios (its twins' too) and resolved suite, planned as
     the leaderboard plans them; ``twins=False``: as the suite without its no-change twins;
-    ``changes``: other suite keys changed (e.g. :data:`RECORDED_SUITE`)."""
+    ``changes``: other suite keys changed (e.g. ``seeds``)."""
     spec = load_suite("default").model_copy(update={"twins": twins, **changes})
     names = controllers or list(spec.controllers)
     labels = check_controllers(names)
@@ -72,14 +54,8 @@ def default_plan(
 
 
 def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
-    # the recorded run predates the no-change twins and the fewer seeds that fit them:
-    # estimate the plan it ran
-    now = load_suite("default").controllers
-    rest = [
-        c for c in now if c not in {"nmpc", "nmpc_lambda_lssvm_svf", "nmpc_ekf", "nmpc_learned_id"}
-    ]
-    jobs, scenarios, record = default_plan(list(RECORDED_NMPC) + rest, **RECORDED_SUITE)
-    assert TWIN_SCENARIOS not in record
+    jobs, scenarios, record = default_plan()
+    assert TWIN_SCENARIOS in record
     cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
     assert DEFAULT_RUN_CPU_S / FACTOR < cpu < DEFAULT_RUN_CPU_S * FACTOR, cpu
     total = sum(len(job.seeds) for job in jobs)
@@ -144,9 +120,9 @@ def test_a_controller_without_recorded_costs_takes_its_kinds(tmp_path: Path) -> 
 
 
 def test_the_default_suite_with_its_twins_has_the_episodes_the_docs_state() -> None:
-    """5,760 episodes, 2,016 of them on the 40 twins that are no scenario of the suite
+    """3,162 episodes, 1,050 of them on the 25 twins that are no scenario of the suite
     (README, docs/getting-started.md, docs/leaderboard.md)."""
     jobs, _, record = default_plan()
-    assert sum(len(job.seeds) for job in jobs) == 5_760
-    assert len(record[TWIN_SCENARIOS]) == 40
-    assert sum(len(job.seeds) for job in jobs if job.scenario in record[TWIN_SCENARIOS]) == 2_016
+    assert sum(len(job.seeds) for job in jobs) == DEFAULT_EPISODES
+    assert len(record[TWIN_SCENARIOS]) == 25
+    assert sum(len(job.seeds) for job in jobs if job.scenario in record[TWIN_SCENARIOS]) == 1_050
