@@ -44,6 +44,7 @@ from shipgym_baselines.learned.plant_id.features import Window
 from shipgym_baselines.learned.plant_id.labels import SLOTS, UNLEARNED, plant_of, slot_mask
 from shipgym_baselines.learned.plant_id.network import WEIGHTS_FILE, Estimator
 from shipgym_baselines.policy import Style
+from shipgym_baselines.records.chosen import tuned_settings
 from shipgym_baselines.registry import register_controller
 
 #: the shipped estimators: ``seed_<k>`` folders
@@ -64,12 +65,26 @@ def shipped_seeds(folder: Path = SHIPPED) -> tuple[int, ...]:
     )
 
 
+#: s of the fallback before tuning: to the nominal ship (``prior_std``, ln factors and slot
+#: units) and to the servo's windowed fit (``fit_std``)
+FALLBACK_DEFAULTS = {"prior_std": 0.5, "fit_std": 0.1}
+
+
+def _positive(key: str, value: Any) -> float:
+    """``value`` as a float > 0, else a ValueError that names ``key``."""
+    number = float(value)
+    if not number > 0:
+        raise ValueError(f"{key} must be > 0, got {value!r}")
+    return number
+
+
 @register_controller("nmpc_learned_id", family="learned", look=Style("#9467bd", "-", "P"))
 class NmpcLearnedId(PlantNMPC):
     """``nmpc_learned_id`` (module doc).  ``training_seed``: which shipped estimator (None:
     the first); ``folder``: an estimator's folder instead of a shipped one; ``prior_std``
     and ``fit_std``: s of the fallback to the nominal ship and to the servo's fit (ln-factor
-    and slot units)."""
+    and slot units; None: the ship's chosen value with ``preset="tuned"``, the default, from
+    ``configs/tuning/chosen/nmpc_learned_id.yaml``, else :data:`FALLBACK_DEFAULTS`)."""
 
     kind: ClassVar[str] = "learned"
     training_seeds: ClassVar[tuple[int | None, ...]] = shipped_seeds() or (None,)
@@ -79,14 +94,17 @@ class NmpcLearnedId(PlantNMPC):
         self,
         training_seed: int | None = None,
         folder: str | Path | None = None,
-        prior_std: float = 0.5,
-        fit_std: float = 0.1,
+        prior_std: float | None = None,
+        fit_std: float | None = None,
         settings: OracleSettings | None = None,
+        preset: str = "tuned",
     ) -> None:
         super().__init__(settings)
-        for key, value in (("prior_std", prior_std), ("fit_std", fit_std)):
-            if not value > 0:
-                raise ValueError(f"{key} must be > 0, got {value!r}")
+        if preset not in ("tuned", "default"):
+            raise ValueError(f"preset must be 'tuned' or 'default', got {preset!r}")
+        self.preset = preset
+        given = {"prior_std": prior_std, "fit_std": fit_std}
+        self.explicit = {k: _positive(k, v) for k, v in given.items() if v is not None}
         if folder is None:
             seeds = shipped_seeds()
             if not seeds:
@@ -102,12 +120,20 @@ class NmpcLearnedId(PlantNMPC):
         else:
             self.training_seed = training_seed
         self.estimator = Estimator.load(Path(folder))
-        self.prior_var = prior_std**2
-        self.fit_var = fit_std**2
         self.estimate_log: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def fallback_settings(self, ship: str) -> dict[str, float]:
+        """``prior_std`` and ``fit_std`` on ``ship``: those given to the constructor over the
+        chosen ones (``preset="tuned"``) over :data:`FALLBACK_DEFAULTS`."""
+        chosen = tuned_settings(self.name, ship) if self.preset == "tuned" else {}
+        values = {**FALLBACK_DEFAULTS, **{k: chosen[k] for k in FALLBACK_DEFAULTS if k in chosen}}
+        return {k: _positive(k, v) for k, v in {**values, **self.explicit}.items()}
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self.start(context)
+        fallback = self.fallback_settings(context.ship)
+        self.prior_var = fallback["prior_std"] ** 2
+        self.fit_var = fallback["fit_std"] ** 2
         model = context.nominal_model
         self.window = Window(context)
         self.mask = slot_mask(context.ship)

@@ -202,3 +202,23 @@ def test_dealt_trials_are_each_seeds_own_episode() -> None:
     ]
     assert [r.training_seed for r in dealt] == [first, second]
     assert [r.metrics["cost"] for r in dealt] == [r.metrics["cost"] for r in alone]
+
+
+def test_the_fallback_reads_the_ships_chosen_spreads_under_the_given_ones(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from shipgym_baselines.learned.plant_id import controller as module
+
+    chosen = {"mariner": {"prior_std": 2.0, "fit_std": 0.3}}
+    monkeypatch.setattr(module, "tuned_settings", lambda name, ship: dict(chosen.get(ship, {})))
+    tuned = NmpcLearnedId()
+    assert tuned.fallback_settings("mariner") == {"prior_std": 2.0, "fit_std": 0.3}
+    assert tuned.fallback_settings("blanke") == module.FALLBACK_DEFAULTS  # none chosen
+    given = NmpcLearnedId(fit_std=0.05)
+    assert given.fallback_settings("mariner") == {"prior_std": 2.0, "fit_std": 0.05}
+    default = NmpcLearnedId(preset="default")
+    assert default.fallback_settings("mariner") == module.FALLBACK_DEFAULTS
+    with pytest.raises(ValueError, match="prior_std must be > 0"):
+        NmpcLearnedId(prior_std=0.0)
+    with pytest.raises(ValueError, match="preset must be"):
+        NmpcLearnedId(preset="paper")
