@@ -72,6 +72,15 @@ def test_the_estimate_of_the_default_suite_is_near_its_recorded_run() -> None:
     )
 
 
+def test_the_default_suite_is_estimated_within_its_ten_minutes_on_two_cores() -> None:
+    """The budget (docs/leaderboard.md, "The default run's size"): by the recorded costs the
+    default suite, its twins and its tables take at most 10 minutes of wall on 2 workers, so
+    that a row or a scenario added to it cannot quietly put the run over its target."""
+    jobs, scenarios, _ = default_plan()
+    cpu = estimate_cpu_s(jobs, scenarios) + TABLES_CPU_S_PER_SCENARIO * len(scenarios)
+    assert cpu / 2 <= 600.0, f"{cpu / 2:.0f} s on 2 workers"
+
+
 def test_the_twins_add_one_episode_per_player_and_trial_of_each_new_twin() -> None:
     bare, bare_scenarios, _ = default_plan(twins=False)
     jobs, scenarios, record = default_plan()
