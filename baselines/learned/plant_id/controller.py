@@ -72,7 +72,10 @@ FALLBACK_DEFAULTS = {"prior_std": 0.5, "fit_std": 0.1}
 
 def _positive(key: str, value: Any) -> float:
     """``value`` as a float > 0, else a ValueError that names ``key``."""
-    number = float(value)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{key} must be a number > 0, got {value!r}") from None
     if not number > 0:
         raise ValueError(f"{key} must be > 0, got {value!r}")
     return number
@@ -126,8 +129,14 @@ class NmpcLearnedId(PlantNMPC):
         """``prior_std`` and ``fit_std`` on ``ship``: those given to the constructor over the
         chosen ones (``preset="tuned"``) over :data:`FALLBACK_DEFAULTS`."""
         chosen = tuned_settings(self.name, ship) if self.preset == "tuned" else {}
-        values = {**FALLBACK_DEFAULTS, **{k: chosen[k] for k in FALLBACK_DEFAULTS if k in chosen}}
-        return {k: _positive(k, v) for k, v in {**values, **self.explicit}.items()}
+        unknown = sorted(set(chosen) - set(FALLBACK_DEFAULTS))
+        if unknown:
+            raise ValueError(
+                f"nmpc_learned_id's chosen settings on {ship} name {unknown}; "
+                f"valid: {sorted(FALLBACK_DEFAULTS)}"
+            )
+        values = {**FALLBACK_DEFAULTS, **chosen, **self.explicit}
+        return {k: _positive(k, v) for k, v in values.items()}
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
         self.start(context)

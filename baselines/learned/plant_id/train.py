@@ -100,7 +100,8 @@ def _episode(job: tuple[str, dict, int, str | None]) -> dict[str, np.ndarray]:
     if folder is None:
         policy, _ = make_controller(BEHAVIOUR)
     else:
-        policy, _ = make_controller("nmpc_learned_id", folder=folder)
+        # the spreads of the fallback before tuning: the chosen ones were tuned on a trained φ
+        policy, _ = make_controller("nmpc_learned_id", folder=folder, preset="default")
     return rollout(scenario, policy, seed)
 
 

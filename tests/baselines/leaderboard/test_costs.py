@@ -24,11 +24,11 @@ from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, TWIN_PLAYERS, TWIN_SCENARIOS
 from shipgym_baselines.registry import training_seeds
 
-#: the default suite's whole run, CPU seconds (docs/run_summary.json: 896 CPU s on two quiet
+#: the default suite's whole run, CPU seconds (docs/run_summary.json: 914 CPU s on two quiet
 #: cores, the suite as shipped with its twins)
-DEFAULT_RUN_CPU_S = 896.0
+DEFAULT_RUN_CPU_S = 914.0
 #: how far the estimate may be from it, either way: the recorded costs estimate 994 CPU s
-#: with the tables' (1.11×), and a measurement moves by ±13 % from run to run
+#: with the tables' (1.09×), and a measurement moves by ±13 % from run to run
 #: (docs/leaderboard-cost.md)
 FACTOR = 1.25
 #: the default suite's episodes in that run: its trials and their twins' for each row, a

@@ -44,7 +44,7 @@ def test_packaged_suites_load() -> None:
 
 
 def test_default_suite_holds_the_matrix_and_two_held_out_scenarios_a_ship() -> None:
-    """The scenario matrix but blanke_current_shift (its 80 L route was a tenth of the run;
+    """The scenario matrix but blanke_current_shift (its 85 L route was a tenth of the run;
     blanke_current_shift_curved keeps the family), Liu et al.'s four nomoto2 scenarios and
     their smooth variants, the five KVLCC2 scenarios of the unseen-hull split, and the
     held-out scenarios heldout:0-7 (two on each ship)."""

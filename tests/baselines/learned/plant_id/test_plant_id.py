@@ -222,3 +222,37 @@ def test_the_fallback_reads_the_ships_chosen_spreads_under_the_given_ones(
         NmpcLearnedId(prior_std=0.0)
     with pytest.raises(ValueError, match="preset must be"):
         NmpcLearnedId(preset="paper")
+
+
+def test_the_shipped_chosen_spreads_reach_the_fallback_at_reset() -> None:
+    """The packaged chosen file: nomoto2 and the Esso Osaka have tuned sections, the Mariner
+    and the Blanke vessel kept the settings before tuning; reset reads the ship's own."""
+    from shipgym_baselines.learned.plant_id import controller as module
+    from shipgym_baselines.records.chosen import tuned_settings
+
+    policy = NmpcLearnedId()
+    for ship in ("mariner", "blanke"):
+        assert tuned_settings("nmpc_learned_id", ship) == {}
+        assert policy.fallback_settings(ship) == module.FALLBACK_DEFAULTS
+    for ship in ("nomoto2", "esso_osaka"):
+        chosen = tuned_settings("nmpc_learned_id", ship)
+        assert set(chosen) == set(module.FALLBACK_DEFAULTS)
+        assert chosen != module.FALLBACK_DEFAULTS
+    env = ShipPathFollowEnv(load_scenario("rudder_aging"))  # nomoto2
+    env.reset(seed=0)
+    policy.reset(env.controller_context)
+    chosen = tuned_settings("nmpc_learned_id", "nomoto2")
+    assert policy.prior_var == pytest.approx(chosen["prior_std"] ** 2)
+    assert policy.fit_var == pytest.approx(chosen["fit_std"] ** 2)
+    env.close()
+
+
+def test_a_chosen_file_with_an_unknown_or_empty_spread_is_named(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from shipgym_baselines.learned.plant_id import controller as module
+
+    for bad, match in (({"prior_sd": 1.0}, "prior_sd"), ({"fit_std": None}, "fit_std")):
+        monkeypatch.setattr(module, "tuned_settings", lambda name, ship, bad=bad: dict(bad))
+        with pytest.raises(ValueError, match=match):
+            NmpcLearnedId().fallback_settings("mariner")
