@@ -25,6 +25,7 @@ import casadi as ca
 import numpy as np
 
 from shipgym.errors import ShipgymError
+from shipgym.models.hull import Hull
 
 
 class ParameterError(ShipgymError, ValueError):
@@ -238,6 +239,24 @@ class ShipModel(ABC):
     #: structural variants of the equations (first = default), e.g. a source code's
     #: literal form and its corrected form; ``()`` when the model has one form
     variants: ClassVar[tuple[str, ...]] = ()
+    #: main particulars at the reference draught, for a loading change
+    #: (:mod:`shipgym.models.loading`); None: the model has no loading-condition model
+    hull: ClassVar[Hull | None] = None
+    #: parameter -> the draught factor it is multiplied by, where a loading change is a
+    #: product (:meth:`loading_change`'s default)
+    scaled_by: ClassVar[dict[str, str]] = {}
+
+    @classmethod
+    def loading_change(
+        cls, params: ParameterRecord, factors: dict[str, float], draught_ratio: float
+    ) -> dict[str, float]:
+        """The parameters of ``params`` (config units) that change when the draught becomes
+        ``draught_ratio``·T, given the hull's draught factors
+        (:func:`shipgym.models.hull.draught_factors`): by default each of :attr:`scaled_by`
+        × its factor."""
+        if cls.hull is None:
+            raise ValueError(f"no loading-condition model for {cls.name!r}")
+        return {name: getattr(params, name) * factors[key] for name, key in cls.scaled_by.items()}
 
     def __init__(self, params: ParameterRecord | None = None, variant: str | None = None) -> None:
         self.params = params if params is not None else self.params_type()

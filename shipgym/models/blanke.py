@@ -96,6 +96,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
+from shipgym.models.hull import Hull
 
 DEG = math.pi / 180.0
 
@@ -292,6 +293,20 @@ class Blanke(_Blanke3DOF):
     rudder_rate_limit = 5.0 * DEG  # per instance: params.delta_dot_max
     #: rudder-force model, see the module docstring
     variants = ("effective_angle", "linear")
+    #: Blanke & Christensen (1993) naval vessel, C_B = ∇/(LBT) = 357/(51.5·8.6·2.3), for a
+    #: loading change (SI): m, I_z × f_m; Y_v̇, N_ṙ, Y_|u|v, Y_ur, N_|u|v, N_|u|r × the factors
+    #: of Y'_v̇, N'_ṙ, Y'_v, Y'_r, N'_v, N'_r
+    hull = Hull(L=51.5, B=8.6, T=2.3, C_B=357.0 / (51.5 * 8.6 * 2.3))
+    scaled_by: ClassVar[dict[str, str]] = {
+        "m": "mass",
+        "Iz": "mass",
+        "Y_vdot": "Yvdot",
+        "N_rdot": "Nrdot",
+        "Y_auv": "Yv",
+        "Y_ur": "Yr",
+        "N_auv": "Nv",
+        "N_aur": "Nr",
+    }
 
     def rudder_forces(
         self, u: Any, v: Any, r: Any, delta: Any, p: Any, ops: SimpleNamespace

@@ -134,6 +134,7 @@ import numpy as np
 from scipy.optimize import root
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
+from shipgym.models.hull import Hull, inertia_after
 
 DEG = math.pi / 180.0
 #: regularisation of the speeds divided by (U, c) at rest [m/s]; far below any used speed
@@ -310,6 +311,32 @@ class EssoOsaka(ShipModel):
     control_period = 0.5  # Ts [s] at λ = 100 (our choice; the papers give none)
     fine_step = 0.05  # h [s] at λ = 100 (our choice)
     variants = ("literal", "intended_fix")
+    #: main particulars of the full-scale ship (data file §1.2), for a loading change
+    hull = Hull(L=325.0, B=53.0, T=21.73, C_B=0.831)
+
+    @classmethod
+    def loading_change(
+        cls, params: ParameterRecord, factors: dict[str, float], draught_ratio: float
+    ) -> dict[str, float]:
+        """The loading change (prime): m' and (m − X_u̇)' × the mass factor; (m − Y_v̇)' =
+        m'·f_m − Y'_v̇·f_Y'v̇ with Y'_v̇ = m' − (m − Y_v̇)'; (I_z − N_ṙ)' = I'_z·f_m − N'_ṙ·f_N'ṙ
+        with I'_z = 0.0625 m' (radius of gyration 0.25 L, data file §1.2); Y'_v, Y'_r, N'_v,
+        N'_r × their factors; the draught T itself (wetted surface)."""
+        if not isinstance(params, EssoOsakaParams):
+            raise TypeError(f"esso_osaka needs EssoOsakaParams, got {type(params).__name__}")
+        f, m = factors, params.m
+        iz = 0.0625 * m
+        return {
+            "m": m * f["mass"],
+            "m_Xudot": params.m_Xudot * f["mass"],
+            "m_Yvdot": inertia_after(m, m - params.m_Yvdot, f, "Yvdot"),
+            "Iz_Nrdot": inertia_after(iz, iz - params.Iz_Nrdot, f, "Nrdot"),
+            "Yv": params.Yv * f["Yv"],
+            "Yr": params.Yr * f["Yr"],
+            "Nv": params.Nv * f["Nv"],
+            "Nr": params.Nr * f["Nr"],
+            "T": params.T * draught_ratio,
+        }
 
     def __init__(self, params: ParameterRecord | None = None, variant: str | None = None) -> None:
         super().__init__(params, variant)

@@ -92,6 +92,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
+from shipgym.models.hull import Hull
 
 DEG = math.pi / 180.0
 #: regularisation of the speed U divided by at rest [m/s]; far below any used speed
@@ -332,6 +333,22 @@ class KVLCC2(ShipModel):
     rudder_limit = 35.0 * DEG  # δmax [rad]; per instance: params.delta_max
     rudder_rate_limit = 15.68 * DEG  # SIMMAN model-scale rate [rad/s]; per instance
     control_period = 0.5  # Ts [s] at λ = 1 (our choice); per instance ×√λ
+    #: full scale (Yasukawa & Yoshimura 2015, Table 1), for a loading change (MMG standard
+    #: method, prime on ½ρL²d at the reference draught d, which stays: the factors then scale
+    #: the dimensional forces): the displacement volume ∇ and m'_x × the mass factor (I_zG
+    #: follows ∇ at the same k_zz), m'_y and J'_z × the factors of Y'_v̇ and N'_ṙ (they are
+    #: −Y'_v̇, −N'_ṙ), Y'_v, Y'_R, N'_v, N'_R × theirs; the resistance R'_0 is kept
+    hull = Hull(L=320.0, B=58.0, T=20.8, C_B=0.810)
+    scaled_by: ClassVar[dict[str, str]] = {
+        "volume": "mass",
+        "m_x": "mass",
+        "m_y": "Yvdot",
+        "J_z": "Nrdot",
+        "Y_v": "Yv",
+        "Y_R": "Yr",
+        "N_v": "Nv",
+        "N_R": "Nr",
+    }
     fine_step = 0.05  # h [s] at λ = 1 (our choice); per instance ×√λ
 
     def __init__(self, params: ParameterRecord | None = None, variant: str | None = None) -> None:

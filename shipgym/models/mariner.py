@@ -75,6 +75,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
+from shipgym.models.hull import Hull, inertia_after
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,6 +116,10 @@ class MarinerParams(ParameterRecord):
         return out
 
 
+#: Mariner yaw inertia split (Fossen's mariner.m, prime ×1e-5 removed): I'_z, N'_ṙ
+MARINER_IZ, MARINER_NRDOT = 39.2e-5, -43.8e-5
+
+
 class Mariner(ShipModel):
     """mariner: de Wit–Oppe model of the m.s. Compass Island (Borkowski 2018 eq. (35))."""
 
@@ -124,6 +129,25 @@ class Mariner(ShipModel):
     params_type = MarinerParams
     rudder_limit = 0.6  # δmax [rad] (Borkowski 2018 §5); per instance: params.delta_max
     rudder_rate_limit = 0.066  # δ̇max [rad/s] (Borkowski 2018 §5); per instance: params
+    #: Mariner class after Chislett & Strøm-Tejsen (1965) (B, C_B as commonly quoted, T from
+    #: Fossen's m' = 798e-5 = C_B·B·T/(½L²): an assumption), for a loading change
+    hull = Hull(L=160.93, B=23.17, T=7.47, C_B=0.6)
+
+    @classmethod
+    def loading_change(
+        cls, params: ParameterRecord, factors: dict[str, float], draught_ratio: float
+    ) -> dict[str, float]:
+        """The loading change of ṙ = −a1·r − a2·r³ + a3·δ, read as the yaw row of the linear
+        model without sway coupling, a1 = −N_r/(I_z − N_ṙ), a3 = N_δ/(I_z − N_ṙ): a1 × f_Nr/f_I
+        and a3 × 1/f_I, f_I the factor of (I_z − N_ṙ) split as :data:`MARINER_IZ`,
+        :data:`MARINER_NRDOT`."""
+        if not isinstance(params, MarinerParams):
+            raise TypeError(f"mariner needs MarinerParams, got {type(params).__name__}")
+        f_inertia = inertia_after(MARINER_IZ, MARINER_NRDOT, factors, "Nrdot") / (
+            MARINER_IZ - MARINER_NRDOT
+        )
+        return {"a1": params.a1 * factors["Nr"] / f_inertia, "a3": params.a3 / f_inertia}
+
     control_period = 1.0  # Ts [s] (our choice; the paper gives none)
     fine_step = 0.1  # h [s] (our choice)
     #: "algebraic": v = r1·r + r3·r³ (units of r1, r3; data file §2.1);
