@@ -124,6 +124,15 @@ def lock_holder(folder: str | os.PathLike) -> str | None:
     return None
 
 
+def _release(key: Path, lock_file: Path, fd: int) -> None:
+    """End a hold of this process: ``key`` off the held set, ``lock_file`` removed while
+    still locked (the next holder finds a fresh file), then the lock released."""
+    _HELD.discard(key)
+    with contextlib.suppress(OSError):
+        lock_file.unlink()
+    os.close(fd)
+
+
 @contextlib.contextmanager
 def out_lock(out: str | os.PathLike, start_time: str) -> Iterator[Path]:
     """Hold the exclusive lock of the folder ``out`` (made if missing; removed again if
@@ -149,10 +158,7 @@ def out_lock(out: str | os.PathLike, start_time: str) -> Iterator[Path]:
     try:
         yield folder
     finally:
-        _HELD.discard(key)
-        with contextlib.suppress(OSError):
-            (folder / LOCK_FILE).unlink()  # while locked: the next holder finds a fresh file
-        os.close(fd)
+        _release(key, folder / LOCK_FILE, fd)
         if made:
             with contextlib.suppress(OSError):
                 folder.rmdir()  # only if empty: a run refused before writing leaves nothing
@@ -188,10 +194,7 @@ def file_lock(
     try:
         yield path
     finally:
-        _HELD.discard(key)
-        with contextlib.suppress(OSError):
-            key.unlink()  # while locked: the next holder finds a fresh file
-        os.close(fd)
+        _release(key, key, fd)
 
 
 def _file_in_use(file: Path, option: str, holder: str) -> RunError:

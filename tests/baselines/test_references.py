@@ -28,6 +28,7 @@ from shipgym_baselines.references import (
     user_cache_path,
 )
 from shipgym_baselines.tuning.validation import oracle_costs, validation_trials
+from tests.baselines.records.conftest import file_held_elsewhere
 
 #: these tests read the notice lines, which the suite silences
 pytestmark = pytest.mark.usefixtures("loud")
@@ -394,42 +395,22 @@ def test_the_default_counts_what_the_shipped_table_holds(
     assert summary["table"] == str(user_cache_path()) and not user_cache_path().exists()
 
 
-HOLD_TABLE = """
-import sys, time
-from shipgym_baselines.records.locking import file_lock
-with file_lock(sys.argv[1], "2026-01-02T03:04:05+00:00", "--table"):
-    print("locked", flush=True)
-    time.sleep(600)
-"""
-
-
 def test_a_second_fill_of_one_table_is_refused_naming_the_first(
     oracle: CountingOracle, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Two ``shipgym references --table FILE`` at once would each replace the file with
     its own entries: the second is refused in one line naming the first, before any work,
     and the file is filled once the first has ended."""
-    import subprocess
-    import sys
-
     from shipgym_baselines.cli import main
 
     table = tmp_path / "t.json.gz"
-    root = Path(__file__).resolve().parents[2]
-    holder = subprocess.Popen(
-        [sys.executable, "-c", HOLD_TABLE, str(table)], cwd=root, stdout=subprocess.PIPE, text=True
-    )
     argv = ["references", "--suite", str(_tiny_suite(tmp_path)), "--table", str(table)]
     argv += ["--workers", "1"]
-    try:
-        assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+    with file_held_elsewhere(table, "--table") as holder:
         assert main(argv) == 2
         (line,) = capsys.readouterr().err.strip().splitlines()
         assert f"--table {table} is being written by another process (process {holder.pid}" in line
         assert oracle.runs == [] and not table.exists()
-    finally:
-        holder.kill()
-        holder.wait()
     # a lock file left by a killed process is free: the kernel released it with the process
     assert (tmp_path / "t.json.gz.lock").is_file()
     assert main(argv) == 0 and len(ReferenceTable.load(table).entries) == 1

@@ -3,7 +3,11 @@ and one clean run of it."""
 
 from __future__ import annotations
 
+import contextlib
 import json
+import subprocess
+import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -63,3 +67,33 @@ def copy_run(source: Path, target: Path) -> Path:
     for name in ("run.json", "episodes.jsonl"):
         (target / name).write_bytes((source / name).read_bytes())
     return target
+
+
+#: a process that holds a file's lock (:func:`~shipgym_baselines.records.locking.file_lock`)
+#: until it is killed: argv[1] the file, argv[2] the option that names it
+HOLD_FILE_LOCK = """
+import sys, time
+from shipgym_baselines.records.locking import file_lock
+with file_lock(sys.argv[1], "2026-01-02T03:04:05+00:00", sys.argv[2]):
+    print("locked", flush=True)
+    time.sleep(600)
+"""
+
+
+@contextlib.contextmanager
+def file_held_elsewhere(file: Path, option: str) -> Iterator[subprocess.Popen[str]]:
+    """Another process holding ``file``'s lock (named by ``option``) for the ``with`` body;
+    killed at its end (the kernel then releases the lock, the lock file stays)."""
+    root = Path(__file__).resolve().parents[3]
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD_FILE_LOCK, str(file), option],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+        yield holder
+    finally:
+        holder.kill()
+        holder.wait()

@@ -29,6 +29,7 @@ from shipgym_baselines.tuning.validation import (
     oracle_costs,
     validation_trials,
 )
+from tests.baselines.records.conftest import file_held_elsewhere
 from tests.baselines.records.test_locking import hold
 
 #: the packaged distributions' folder
@@ -686,43 +687,23 @@ def test_a_link_in_a_study_folder_is_refused(tiny: Path, tmp_path: Path) -> None
     assert not (tmp_path / "elsewhere.json").exists()
 
 
-HOLD_STORAGE = """
-import sys, time
-from shipgym_baselines.records.locking import file_lock
-with file_lock(sys.argv[1], "2026-01-02T03:04:05+00:00", "--storage"):
-    print("locked", flush=True)
-    time.sleep(600)
-"""
-
-
 def test_a_second_process_on_a_shared_storage_is_refused_in_one_line(
     tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Two ``tune --resume`` on one study through one SQLite ``--storage``, each with its
     own ``--out``: both would draw the same trials.  While one holds the storage, the other
     is refused in one line naming it, and adds nothing to the study."""
-    import subprocess
-    import sys
-
     db = tmp_path / "shared.db"
     storage = f"sqlite:///{db}"
     argv = ["tune", str(tiny), "--ship", "nomoto2", "--storage", storage]
     argv += ["--chosen-dir", str(tmp_path / "chosen"), "--trials", "1"]
     assert main([*argv, "--out", str(tmp_path / "a")]) == 0
-    root = Path(__file__).resolve().parents[3]
-    holder = subprocess.Popen(
-        [sys.executable, "-c", HOLD_STORAGE, str(db)], cwd=root, stdout=subprocess.PIPE, text=True
-    )
-    try:
-        assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+    with file_held_elsewhere(db, "--storage") as holder:
         capsys.readouterr()
         assert main([*argv, "--out", str(tmp_path / "b"), "--resume", "--trials", "2"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         (line,) = [x for x in err if x.startswith("shipgym tune: error: ")]  # one line
         assert f"--storage {db} is being written by another process (process {holder.pid}" in line
-    finally:
-        holder.kill()
-        holder.wait()
     study = optuna.load_study(study_name="pid_los_tiny:nomoto2", storage=storage)
     assert len(study.trials) == 1
     assert main([*argv, "--out", str(tmp_path / "b"), "--resume", "--trials", "2"]) == 0
