@@ -1,8 +1,7 @@
 """Controllers, the evaluation loop, the leaderboard and the ``shipgym`` CLI on top of shipgym.
 
 ``from shipgym_baselines import register_controller`` enters a controller (see
-:mod:`shipgym_baselines.registry`); it is imported on first use, so
-``import shipgym_baselines.x`` stays light.
+:mod:`shipgym_baselines.registry`).
 """
 
 from __future__ import annotations
@@ -12,9 +11,9 @@ from typing import Any
 __all__ = ["register_controller"]
 
 
-def __getattr__(name: str) -> Any:
-    if name == "register_controller":
-        from shipgym_baselines.registry import register_controller
+def register_controller(*args: Any, **kwargs: Any) -> Any:
+    """:func:`shipgym_baselines.registry.register_controller`, with the same arguments (the
+    registry is imported on the first call, so ``import shipgym_baselines.x`` stays light)."""
+    from shipgym_baselines.registry import register_controller as register
 
-        return register_controller
-    raise AttributeError(f"module 'shipgym_baselines' has no attribute {name!r}")
+    return register(*args, **kwargs)

@@ -8,7 +8,6 @@ here), as a bad scenario file does.
 
 from __future__ import annotations
 
-from shipgym.config import ConfigError
 from shipgym.errors import ShipgymError
 from shipgym.limits import MAX_SEEDS
 
@@ -62,7 +61,6 @@ def check_seeds(seeds: int, option: str = "seeds") -> None:
 
 __all__ = [
     "BackendError",
-    "ConfigError",
     "ControllerError",
     "RunError",
     "RunFailed",

@@ -30,7 +30,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.core import TRAJECTORY_KEYS, check_action
 from shipgym.envs.eval_trials import EvaluationTrialsVectorEnv, lockstep_problem
 from shipgym.errors import ShipgymError
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec

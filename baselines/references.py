@@ -58,7 +58,7 @@ import numpy as np
 from shipgym.codegen import user_cache_dir
 from shipgym.envs.core import ENV_REVISION
 from shipgym.notices import duration, notice
-from shipgym.scenarios import Scenario
+from shipgym.scenarios.loader import Scenario
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import EpisodeResult

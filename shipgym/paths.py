@@ -48,7 +48,6 @@ __all__ = [
     "along_track_reached",
     "cross_track",
     "segment_frame",
-    "wrap_angle",
 ]
 
 

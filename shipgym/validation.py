@@ -14,7 +14,8 @@ import dataclasses
 import math
 
 from shipgym.manoeuvres import turning_circle, zigzag
-from shipgym.models import MODELS, ShipModel
+from shipgym.models import MODELS
+from shipgym.models.base import ShipModel
 
 #: figure key -> (what, unit); turning figures of the starboard turn (δ > 0), ``_port`` the
 #: port turn, ``_mean`` their mean; zig-zags start to starboard

@@ -76,24 +76,16 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.angles import wrap_angle
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
 from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.metrics import high_frequency_power
-from shipgym.paths import wrap_angle
 from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
-from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
-from shipgym_baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
+from shipgym_baselines.classical.adaptive.design_model import nominal_design_model
 from shipgym_baselines.classical.adaptive.lowpass import SecondOrderLowPass
 from shipgym_baselines.classical.adaptive.predictor import StatePredictor
-from shipgym_baselines.classical.adaptive.projection import projection
-from shipgym_baselines.classical.adaptive.settings import (
-    FILTER_PLACEMENTS,
-    PAPER_SHIP_LENGTH,
-    PAPER_SHIP_SPEED,
-    Gains,
-    L1BacksteppingSettings,
-)
+from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import Style, check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
@@ -103,23 +95,9 @@ from shipgym_baselines.registry import register_controller
 cubic_damping_from_zigzag = ship_cubic_damping
 
 __all__ = [
-    "FILTER_PLACEMENTS",
-    "PAPER_SHIP_LENGTH",
-    "PAPER_SHIP_SPEED",
     "AdaptiveBackstepping",
-    "Gains",
     "L1Backstepping",
-    "L1BacksteppingSettings",
-    "NonlinearNomoto",
-    "SecondOrderLowPass",
-    "StatePredictor",
-    "backstepping_rudder",
     "cubic_damping_from_zigzag",
-    "high_frequency_power",
-    "linearised_closed_loop_poles",
-    "nominal_design_model",
-    "projection",
-    "tvvf_heading_derivatives",
 ]
 
 

@@ -65,9 +65,10 @@ from typing import Any
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
+from shipgym.angles import wrap_angle
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import ContinuousLeastSquares, first_order_nomoto
-from shipgym.paths import wrap_angle
+from shipgym.identification.continuous_ls import ContinuousLeastSquares
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import Style, check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings

@@ -52,7 +52,7 @@ import numpy as np
 
 from shipgym.codegen import compiled_all
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
+from shipgym.identification.online import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2
 from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp

@@ -32,9 +32,9 @@ import numpy as np
 
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.adaptation import Adaptation
 from shipgym.identification.ekf import FilterSettings, ShipEKF
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.identification.servo import ServoFit, servo_constants
 from shipgym_baselines.classical.oracle import REAL_TIME_SETTINGS, OracleSettings, PlantNMPC
 from shipgym_baselines.policy import Style

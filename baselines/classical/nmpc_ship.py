@@ -71,8 +71,8 @@ import math
 from typing import Any
 
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.front_end import SVF_BANDWIDTH
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.identification.online import PAPER_LAMBDA_C, PAPER_UPDATE_EVERY, PAPER_WINDOW
 from shipgym.identification.zigzag import ship_nomoto
 from shipgym.models.base import ParameterError

@@ -158,7 +158,7 @@ import numpy as np
 from shipgym.codegen import compiled_all
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
-from shipgym.identification import first_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models.base import ShipModel
 from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
 from shipgym_baselines.errors import ControllerError

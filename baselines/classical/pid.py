@@ -72,7 +72,7 @@ from shipgym.autopilot import (
 )
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import desired_heading
-from shipgym.identification import first_order_nomoto, second_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto, second_order_nomoto
 from shipgym.models.base import ShipModel
 from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical.drift import course_and_drift

@@ -1,7 +1,7 @@
 """``shipgym leaderboard`` (the suite's controllers) and ``shipgym evaluate`` (one policy).
 
 Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
-:mod:`shipgym_baselines.records.runs`); a folder that is not empty is refused before any work unless
+:mod:`shipgym_baselines.records`); a folder that is not empty is refused before any work unless
 ``--resume`` or ``--force``.  The default ``--out``: ``results/<suite>`` for a suite's own
 controllers, ``results/evaluate/<suite>/<controllers>`` for the controllers given
 (``evaluate``'s policy, ``--controllers``: one folder per suite and set of controllers, outside
@@ -191,7 +191,7 @@ def run(args: argparse.Namespace) -> int:
     elif out is None:
         out = suite_folder(args.suite)
         note = f" (the leaderboard's folder for --suite {args.suite}; give --out for another)"
-    from shipgym_baselines.leaderboard import check_failure_options
+    from shipgym_baselines.leaderboard.run import check_failure_options
 
     # before any work: bad options, an unusable --out, a bad suite, --out in use or not empty
     check_failure_options(args.act_timeout, args.retry_failed, args.resume)
@@ -201,7 +201,8 @@ def run(args: argparse.Namespace) -> int:
     if policy is None and args.name:
         controllers = named_controllers(controllers or list(spec.controllers), args.name)
     check_out_dir(out, resume=args.resume, force=args.force, note=note)
-    from shipgym_baselines.leaderboard import run_leaderboard, terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
+    from shipgym_baselines.leaderboard.run import run_leaderboard
 
     rows = run_leaderboard(
         suite=args.suite,

@@ -25,7 +25,8 @@ from shipgym.manoeuvres import (
     zigzag,
 )
 from shipgym.manoeuvring_standards import TURNING_RUDDER_DEG, imo_criteria
-from shipgym.models import MODELS, ShipModel
+from shipgym.models import MODELS
+from shipgym.models.base import ShipModel
 from shipgym_baselines.cli.options import add_json_option, emit
 from shipgym_baselines.errors import RunError
 

@@ -102,8 +102,7 @@ def run(args: argparse.Namespace) -> int:
 
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-    from shipgym_baselines.leaderboard import Job, suite_scenario, trials
-    from shipgym_baselines.leaderboard.jobs import suite_scenarios
+    from shipgym_baselines.leaderboard.jobs import Job, suite_scenario, suite_scenarios, trials
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.leaderboard.twins import plan_twins
     from shipgym_baselines.records.locking import file_lock
@@ -205,7 +204,7 @@ def _fill(
     episode as it ends; (episodes computed, trials held already)."""
     import os
 
-    from shipgym_baselines.leaderboard import iter_results
+    from shipgym_baselines.leaderboard.jobs import iter_results
     from shipgym_baselines.references import announce
 
     jobs, trial_of, held = [], {}, 0

@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
         command=command_line(args),
         vector_figures=args.vector_figures,
     )
-    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
 
     for source in sources:
         if source["status"] != "complete":

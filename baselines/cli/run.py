@@ -107,12 +107,13 @@ def run(args: argparse.Namespace) -> int:
     run the episode, write its files, print its metrics."""
     from shipgym.animation import check_video_file
     from shipgym.config import is_path
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
     from shipgym.scenarios.trials import trial_scenario
     from shipgym_baselines.evaluation import ActGuard, evaluate
     from shipgym_baselines.isolation import call, isolated, run_isolated
     from shipgym_baselines.jsonout import dumps
-    from shipgym_baselines.leaderboard import check_controllers, plot_results
+    from shipgym_baselines.leaderboard.jobs import check_controllers
+    from shipgym_baselines.leaderboard.outputs import plot_results
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.episodes import EpisodeLabel
     from shipgym_baselines.records.folders import check_out_dir
@@ -228,7 +229,7 @@ def _suite_file(scenario: str, suite: Any) -> str:
     """``scenario``, or the YAML file of the suite's own scenario of that name (a name that
     is neither a catalogue scenario, a held-out one nor a path)."""
     from shipgym.config import is_path
-    from shipgym.scenarios import list_scenarios, load_scenario
+    from shipgym.scenarios.loader import list_scenarios, load_scenario
     from shipgym_baselines.leaderboard.suite import name_scenarios
 
     if is_path(scenario) or ":" in scenario or scenario in list_scenarios():

@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     """One line per catalogue scenario: name, ship, description (``--json``: the names)."""
     if args.validate is not None:
         return validate(args)
-    from shipgym.scenarios import list_scenarios, load_scenario
+    from shipgym.scenarios.loader import list_scenarios, load_scenario
 
     names = list_scenarios()
     lines = []

@@ -83,8 +83,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
     """One job per (agent, seed) with its output directory (``train_sweep``'s input)."""
+    from shipgym_baselines.learned.agent_folder import check_agent_folder
     from shipgym_baselines.learned.agents import list_agent_configs, load_agent_config
-    from shipgym_baselines.learned.train import check_agent_folder
 
     if args.timesteps is not None:
         check_count(args.timesteps, "--timesteps")

@@ -14,7 +14,9 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
-from shipgym_baselines.leaderboard.ranking import BASELINE, GAIN, PROB
+from shipgym_baselines.leaderboard.headroom import GAIN
+from shipgym_baselines.leaderboard.ranking import PROB
+from shipgym_baselines.registry import BASELINE
 
 #: how a cell reads: the row's rank in its table, the controller's name (the page: with its
 #: swatch), a text, a count (a list: its length), a value with its 95 % interval

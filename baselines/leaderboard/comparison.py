@@ -27,7 +27,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.leaderboard.ranking import REFERENCE_KIND
+from shipgym_baselines.leaderboard.scores import REFERENCE_KIND
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from shipgym.config import is_path
 from shipgym.notices import duration
-from shipgym.scenarios import Scenario
+from shipgym.scenarios.loader import Scenario
 
 if TYPE_CHECKING:
     from shipgym_baselines.leaderboard.jobs import Job

@@ -49,33 +49,6 @@ Functions (each returns the written files, the PNG then any vector copy):
 
 from __future__ import annotations
 
-from shipgym_baselines.leaderboard.curve_figures import LEARNING_CURVES_STEM as LEARNING_CURVES_STEM
-from shipgym_baselines.leaderboard.curve_figures import plot_learning_curves as plot_learning_curves
 
 # each kind of figure has its module (scenario_figures, ranking_figures, curve_figures; what
 # they share: panels, figure_files); their names stay importable from here
-from shipgym_baselines.leaderboard.figure_files import LEGEND_KEY as LEGEND_KEY
-from shipgym_baselines.leaderboard.figure_files import LEGEND_TOP_KEY as LEGEND_TOP_KEY
-from shipgym_baselines.leaderboard.figure_files import LIGHT_FIGURES as LIGHT_FIGURES
-from shipgym_baselines.leaderboard.figure_files import PAGE_COLOURS as PAGE_COLOURS
-from shipgym_baselines.leaderboard.figure_files import PAGE_GREYS as PAGE_GREYS
-from shipgym_baselines.leaderboard.figure_files import PAGE_WIDTH as PAGE_WIDTH
-from shipgym_baselines.leaderboard.figure_files import figure_colours as figure_colours
-from shipgym_baselines.leaderboard.figure_files import figure_stem as figure_stem
-from shipgym_baselines.leaderboard.figure_files import page_palette as page_palette
-from shipgym_baselines.leaderboard.figure_files import pyplot as pyplot
-from shipgym_baselines.leaderboard.figure_files import save_figure as save_figure
-from shipgym_baselines.leaderboard.figure_files import write_page_png as write_page_png
-from shipgym_baselines.leaderboard.panels import PANEL_CONTROLLERS as PANEL_CONTROLLERS
-from shipgym_baselines.leaderboard.panels import controller_family as controller_family
-from shipgym_baselines.leaderboard.panels import family_panels as family_panels
-from shipgym_baselines.leaderboard.ranking_figures import FROZEN_LABEL as FROZEN_LABEL
-from shipgym_baselines.leaderboard.ranking_figures import PROFILE_REPS as PROFILE_REPS
-from shipgym_baselines.leaderboard.ranking_figures import frozen_marks as frozen_marks
-from shipgym_baselines.leaderboard.ranking_figures import plot_ranking as plot_ranking
-from shipgym_baselines.leaderboard.scenario_figures import DrawnEpisode as DrawnEpisode
-from shipgym_baselines.leaderboard.scenario_figures import episodes_to_draw as episodes_to_draw
-from shipgym_baselines.leaderboard.scenario_figures import median_ace_episode as median_ace_episode
-from shipgym_baselines.leaderboard.scenario_figures import plot_scenario as plot_scenario
-from shipgym_baselines.leaderboard.scenario_figures import plot_scenarios as plot_scenarios
-from shipgym_baselines.leaderboard.scenario_figures import scenario_geometry as scenario_geometry

@@ -12,15 +12,11 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from shipgym.config import is_path
-from shipgym.scenarios import Scenario, load_scenario
-from shipgym.scenarios.trials import TrialRandomization as TrialRandomization  # re-exported
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
-from shipgym.scenarios.trials import trial_scenario as trial_scenario  # re-exported
 from shipgym_baselines import evaluation
-from shipgym_baselines.errors import BackendError as BackendError  # re-exported by the package
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
-from shipgym_baselines.executor import BACKENDS as BACKENDS  # re-exported by the package
 from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.isolation import isolated, run_isolated
 from shipgym_baselines.leaderboard.suite import scenario_names

@@ -20,12 +20,10 @@ from shipgym_baselines.leaderboard.columns import (
     shown,
 )
 from shipgym_baselines.leaderboard.escaping import md_cell
+from shipgym_baselines.leaderboard.headroom import HEADROOM_EXPLAINED, headroom_grid
 from shipgym_baselines.leaderboard.ranking import (
-    HEADROOM_EXPLAINED,
-    ORACLE,
     PARTIAL,
     SCORE_EXPLAINED,
-    headroom_grid,
     is_partial,
     no_ranking,
     resolution_lines,
@@ -33,6 +31,7 @@ from shipgym_baselines.leaderboard.ranking import (
 from shipgym_baselines.leaderboard.splits import TEST_SPLITS, split_label, table_title
 from shipgym_baselines.leaderboard.tables import generalisation, generalisation_splits
 from shipgym_baselines.leaderboard.verdict import verdict
+from shipgym_baselines.privileged import ORACLE
 
 
 def _interval(value: Any, ci: Any, digits: int = 2) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 
 from shipgym.config import is_path
 from shipgym.notices import notice
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.jsonout import dumps, dumps_rows

@@ -43,26 +43,18 @@ from typing import Any
 
 # the page's tables, cells and figures have their own modules (html_cells, page_sections,
 # page_figures); their names stay importable from here
-from shipgym_baselines.leaderboard.html_cells import SORT_DIGITS as SORT_DIGITS
 from shipgym_baselines.leaderboard.html_cells import esc
 from shipgym_baselines.leaderboard.html_cells import packed_body as packed_body
-from shipgym_baselines.leaderboard.html_cells import sort_keys as sort_keys
 from shipgym_baselines.leaderboard.html_cells import swatch_css as swatch_css
-from shipgym_baselines.leaderboard.html_cells import unpacked_body as unpacked_body
-from shipgym_baselines.leaderboard.page_figures import PageImage as PageImage
-from shipgym_baselines.leaderboard.page_figures import embedded_figures as embedded_figures
 from shipgym_baselines.leaderboard.page_figures import figure_sections as figure_sections
-from shipgym_baselines.leaderboard.page_figures import page_image as page_image
 from shipgym_baselines.leaderboard.page_figures import reference_css
-from shipgym_baselines.leaderboard.page_sections import ROW_METRICS as ROW_METRICS
 from shipgym_baselines.leaderboard.page_sections import headroom_html as headroom_html
 from shipgym_baselines.leaderboard.page_sections import ranking_tables as ranking_tables
 from shipgym_baselines.leaderboard.page_sections import row_table as row_table
 from shipgym_baselines.leaderboard.page_sections import score_table as score_table
 from shipgym_baselines.leaderboard.page_sections import share_html
-from shipgym_baselines.leaderboard.ranking import ORACLE_FROZEN, SCORE_EXPLAINED, no_ranking
-from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
-from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES  # re-exported
+from shipgym_baselines.leaderboard.ranking import SCORE_EXPLAINED, no_ranking
+from shipgym_baselines.privileged import ORACLE_FROZEN
 from shipgym_baselines.records.outfiles import write_bytes
 
 PAGE_FILE = "leaderboard.html"

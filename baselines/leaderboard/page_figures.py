@@ -17,8 +17,8 @@ from urllib.parse import quote
 from shipgym_baselines.leaderboard.curve_figures import LEARNING_CURVES_STEM
 from shipgym_baselines.leaderboard.figure_files import LEGEND_KEY, LEGEND_TOP_KEY, figure_stem
 from shipgym_baselines.leaderboard.html_cells import esc, swatch_class
-from shipgym_baselines.leaderboard.ranking import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.leaderboard.style import controller_style
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 
 def anchor(name: str) -> str:

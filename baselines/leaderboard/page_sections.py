@@ -8,6 +8,7 @@ from typing import Any
 
 from shipgym_baselines.leaderboard.change_share import SHARE_GRID_EXPLAINED
 from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
+from shipgym_baselines.leaderboard.headroom import HEADROOM_EXPLAINED, headroom_grid
 from shipgym_baselines.leaderboard.html_cells import (
     Td,
     esc,
@@ -20,17 +21,10 @@ from shipgym_baselines.leaderboard.html_cells import (
     value_cell,
 )
 from shipgym_baselines.leaderboard.page_figures import anchor
-from shipgym_baselines.leaderboard.ranking import (
-    HEADROOM_EXPLAINED,
-    ORACLE,
-    ORACLE_FROZEN,
-    PARTIAL,
-    headroom_grid,
-    is_partial,
-    resolution_lines,
-)
+from shipgym_baselines.leaderboard.ranking import PARTIAL, is_partial, resolution_lines
 from shipgym_baselines.leaderboard.splits import split_label, table_title
 from shipgym_baselines.learned.curves import SEED_FLAG_RULE, flag_text
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 #: the long table's metric columns: key → header (with units)
 ROW_METRICS = {

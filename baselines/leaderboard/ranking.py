@@ -69,45 +69,21 @@ from shipgym_baselines.leaderboard.change_share import TWIN_FIELDS, episode_cost
 
 # the statistics, the episodes' scores and what adaptation is worth have their own
 # modules (intervals, scores, headroom); their names stay importable from here
-from shipgym_baselines.leaderboard.headroom import CHANGE_FAMILIES as CHANGE_FAMILIES
-from shipgym_baselines.leaderboard.headroom import GAIN as GAIN
 from shipgym_baselines.leaderboard.headroom import GAP_FIELDS as GAP_FIELDS
-from shipgym_baselines.leaderboard.headroom import GAP_HEADROOM as GAP_HEADROOM
-from shipgym_baselines.leaderboard.headroom import HEADROOM_EXPLAINED as HEADROOM_EXPLAINED
-from shipgym_baselines.leaderboard.headroom import NO_GAP as NO_GAP
-from shipgym_baselines.leaderboard.headroom import OTHER_FAMILY as OTHER_FAMILY
-from shipgym_baselines.leaderboard.headroom import change_family as change_family
 from shipgym_baselines.leaderboard.headroom import gap_fields as gap_fields
-from shipgym_baselines.leaderboard.headroom import gap_matrices as gap_matrices
-from shipgym_baselines.leaderboard.headroom import gmean_headroom as gmean_headroom
-from shipgym_baselines.leaderboard.headroom import headroom_grid as headroom_grid
-from shipgym_baselines.leaderboard.headroom import headroom_table as headroom_table
-from shipgym_baselines.leaderboard.headroom import scenario_ships as scenario_ships
-from shipgym_baselines.leaderboard.headroom import trial_headroom as trial_headroom
 from shipgym_baselines.leaderboard.intervals import AGGREGATE_REPS as AGGREGATE_REPS
-from shipgym_baselines.leaderboard.intervals import CONFIDENCE as CONFIDENCE
-from shipgym_baselines.leaderboard.intervals import ROW_REPS as ROW_REPS
-from shipgym_baselines.leaderboard.intervals import bootstrap_indices as bootstrap_indices
 from shipgym_baselines.leaderboard.intervals import bounds
 from shipgym_baselines.leaderboard.intervals import geometric_mean as geometric_mean
 from shipgym_baselines.leaderboard.intervals import interquartile_mean as interquartile_mean
 from shipgym_baselines.leaderboard.intervals import interval_estimate as interval_estimate
 from shipgym_baselines.leaderboard.intervals import (
-    probability_of_improvement as probability_of_improvement,
-)
-from shipgym_baselines.leaderboard.intervals import (
     probability_of_lower_ratio as probability_of_lower_ratio,
 )
 from shipgym_baselines.leaderboard.intervals import row_intervals as row_intervals
 from shipgym_baselines.leaderboard.intervals import seeded_global_rng as seeded_global_rng
-from shipgym_baselines.leaderboard.intervals import (
-    stratified_bootstrap_ci as stratified_bootstrap_ci,
-)
 from shipgym_baselines.leaderboard.scores import FAILED_EPISODES as FAILED_EPISODES
-from shipgym_baselines.leaderboard.scores import FAILURE_REASONS as FAILURE_REASONS
 from shipgym_baselines.leaderboard.scores import REFERENCE_KIND as REFERENCE_KIND
 from shipgym_baselines.leaderboard.scores import controller_kinds as controller_kinds
-from shipgym_baselines.leaderboard.scores import is_failure as is_failure
 from shipgym_baselines.leaderboard.scores import ranked_scenarios as ranked_scenarios
 from shipgym_baselines.leaderboard.scores import rated_scenarios
 from shipgym_baselines.leaderboard.scores import run_matrix as run_matrix
@@ -119,10 +95,6 @@ from shipgym_baselines.privileged import ORACLE_FROZEN as ORACLE_FROZEN
 
 # an episode its controller ended is told by its record, in records.episodes; these names
 # stay importable from here
-from shipgym_baselines.records.episodes import CONTROLLER_ERROR as CONTROLLER_ERROR
-from shipgym_baselines.records.episodes import CONTROLLER_TIMEOUT as CONTROLLER_TIMEOUT
-from shipgym_baselines.records.episodes import controller_failed as controller_failed
-
 # the controller of the probability of improvement
 from shipgym_baselines.registry import BASELINE
 

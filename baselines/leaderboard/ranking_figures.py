@@ -22,16 +22,12 @@ from shipgym_baselines.leaderboard.panels import (
     legend_below,
     log_ratio_axis,
 )
-from shipgym_baselines.leaderboard.ranking import (
-    BASELINE,
-    ORACLE_FROZEN,
-    PARTIAL,
-    PROB,
-    performance_profiles,
-)
+from shipgym_baselines.leaderboard.ranking import PARTIAL, PROB, performance_profiles
 from shipgym_baselines.leaderboard.scores import scored_episodes
 from shipgym_baselines.leaderboard.splits import figure_title
 from shipgym_baselines.leaderboard.style import controller_style
+from shipgym_baselines.privileged import ORACLE_FROZEN
+from shipgym_baselines.registry import BASELINE
 
 #: bootstrap replications of the performance profiles' shaded intervals (rliable's bootstrap
 #: costs ≈ 10 ms a replication for 20 controllers; the bands need no more)

@@ -1,7 +1,7 @@
 """``shipgym report``: the tables and plots rebuilt from one or more run folders.
 
 Each folder is a ``leaderboard`` or ``evaluate`` run (``run.json`` + ``episodes.jsonl``,
-:mod:`shipgym_baselines.records.runs`); several merge into one table (separate ``evaluate`` runs of
+:mod:`shipgym_baselines.records`); several merge into one table (separate ``evaluate`` runs of
 different
 policies on the same suite give the leaderboard of those policies).  Runs that give the same
 scenario name different settings, draw their trials differently (``randomize``), or hold the

@@ -26,7 +26,6 @@ from shipgym_baselines.leaderboard.comparison import (
     with_references,
 )
 from shipgym_baselines.leaderboard.costs import eta_line
-from shipgym_baselines.leaderboard.figures import median_ace_episode
 from shipgym_baselines.leaderboard.jobs import (
     Job,
     announce_references,
@@ -41,6 +40,7 @@ from shipgym_baselines.leaderboard.jobs import (
     suite_scenarios,
 )
 from shipgym_baselines.leaderboard.outputs import load_results, write_results
+from shipgym_baselines.leaderboard.scenario_figures import median_ace_episode
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.records.episodes import STATS_ERROR, EpisodeResult, controller_failed

@@ -371,7 +371,7 @@ def plot_scenarios(
     episode), in sorted order; ``scenarios``: name → what
     :func:`shipgym.scenarios.load_scenario` takes (``run.json``'s settings; default: the
     name).  Returns every written file."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     by_scenario: dict[str, dict[str, DrawnEpisode | tuple]] = defaultdict(dict)
     for (scenario, controller), episode in drawn.items():

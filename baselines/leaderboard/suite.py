@@ -13,6 +13,7 @@ import yaml
 from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
 from shipgym.config import (
+    ConfigError,
     ConfigFile,
     Name,
     StrictModel,
@@ -33,10 +34,15 @@ from shipgym.limits import (
     MAX_SEEDS,
     MAX_SUITE_SCENARIOS,
 )
-from shipgym.scenarios import Scenario, list_scenarios, load_scenario
-from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
+from shipgym.scenarios.loader import (
+    Problem,
+    Scenario,
+    check_scenario_file,
+    list_scenarios,
+    load_scenario,
+    yaml_line,
+)
 from shipgym.scenarios.trials import TrialRandomization
-from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec, anchored
 from shipgym_baselines.records.trials import ALL, LearnedTrials
 

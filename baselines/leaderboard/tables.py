@@ -11,16 +11,11 @@ from typing import Any
 import numpy as np
 
 from shipgym.metrics import aggregate
-from shipgym_baselines.leaderboard.ranking import BASELINE as BASELINE  # re-exported
-from shipgym_baselines.leaderboard.ranking import PROB as PROB  # re-exported
-from shipgym_baselines.leaderboard.ranking import row_intervals
+from shipgym_baselines.leaderboard.intervals import row_intervals
 
 # the splits are defined in .splits; these names stay importable from here
 from shipgym_baselines.leaderboard.splits import ALWAYS_GENERALISED
 from shipgym_baselines.leaderboard.splits import GENERALISATION_SPLITS as GENERALISATION_SPLITS
-from shipgym_baselines.leaderboard.splits import SPLIT_TITLES as SPLIT_TITLES
-from shipgym_baselines.leaderboard.splits import TEST_SPLITS as TEST_SPLITS
-from shipgym_baselines.leaderboard.splits import YOURS as YOURS
 from shipgym_baselines.leaderboard.splits import scenario_split as scenario_split
 from shipgym_baselines.records.episodes import CONTROLLER_STATS, EpisodeResult
 from shipgym_baselines.registry import controller_kind

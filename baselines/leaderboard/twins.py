@@ -25,7 +25,7 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from shipgym.scenarios import Scenario
+from shipgym.scenarios.loader import Scenario
 from shipgym.scenarios.twins import nominal_twin, settings_without_labels
 from shipgym_baselines.records.trials import TWIN_SCENARIOS, TWINS
 

@@ -42,7 +42,8 @@ from shipgym_baselines.leaderboard.headroom import (
     scenario_ships,
     trial_headroom,
 )
-from shipgym_baselines.leaderboard.ranking import is_failure, is_partial
+from shipgym_baselines.leaderboard.ranking import is_partial
+from shipgym_baselines.leaderboard.scores import is_failure
 from shipgym_baselines.leaderboard.splits import split_label, suite_splits
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 

@@ -16,9 +16,8 @@ from typing import Any, Literal
 from pydantic import Field, StrictInt, ValidationInfo, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from shipgym.config import StrictModel, list_names, load_yaml_model, resolve
+from shipgym.config import ConfigError, StrictModel, list_names, load_yaml_model, resolve
 from shipgym.limits import MAX_HISTORY_STEPS
-from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.learned.curves import PlateauRule
 
 ALGOS = ("ppo", "sac", "td3", "recurrent_ppo", "dagger")

@@ -61,11 +61,7 @@ import numpy as np
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.learned.agent_folder import read_record
-from shipgym_baselines.learned.dagger_config import ENV_SEED_STRIDE as ENV_SEED_STRIDE
-from shipgym_baselines.learned.dagger_config import STUDENT_KWARGS as STUDENT_KWARGS
-from shipgym_baselines.learned.dagger_config import DaggerHyperparams as DaggerHyperparams
 from shipgym_baselines.learned.dagger_config import check_config as check_config
-from shipgym_baselines.learned.dagger_config import hyperparameter_names as hyperparameter_names
 from shipgym_baselines.learned.dagger_config import hyperparams as hyperparams
 from shipgym_baselines.learned.dagger_config import settings as settings
 from shipgym_baselines.learned.meta import training_meta

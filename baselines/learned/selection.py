@@ -75,7 +75,7 @@ def geometric_mean_ratio(costs: Sequence[float], references: Sequence[float]) ->
 
 def reference_cost(scenario_name: str, seed: int, action_mode: str = "rudder") -> dict[str, Any]:
     """{"cost": C_ref, "reference": "oracle" | "pid_los"} of one trial (module doc)."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
     from shipgym_baselines.evaluation import evaluate
     from shipgym_baselines.references import shipped_table
 

@@ -59,9 +59,6 @@ from shipgym_baselines.learned.agent_folder import (
     read_record,
     write_json_file,
 )
-from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS as TRAINING_OUTPUTS
-from shipgym_baselines.learned.agent_folder import TUNED_FROM_FILE as TUNED_FROM_FILE
-from shipgym_baselines.learned.agent_folder import check_agent_folder as check_agent_folder
 from shipgym_baselines.learned.agent_folder import check_tuned_from as check_tuned_from
 from shipgym_baselines.learned.agent_folder import write_best as write_best
 from shipgym_baselines.learned.agents import (

@@ -7,7 +7,6 @@ the rows are :func:`shipgym_baselines.reproduce.rows.reproduction_row`'s, the ta
 """
 
 from shipgym_baselines.reproduce import borkowski2018, liu2019, morenosalinas2013, xu2020, xu2021
-from shipgym_baselines.reproduce.protocol import Outcome, Reproduction
 
 #: paper id -> its package: ``REPRODUCTION`` (a :class:`Reproduction`) and, what
 #: :mod:`shipgym_baselines.cli` calls, ``run(out_dir, seeds, progress) -> rows`` (writes the report)
@@ -20,4 +19,6 @@ PAPERS = {
     "xu2021": xu2021,
 }
 
-__all__ = ["PAPERS", "Outcome", "Reproduction"]
+__all__ = [
+    "PAPERS",
+]

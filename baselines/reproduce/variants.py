@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 
 
 def scenario_variant(

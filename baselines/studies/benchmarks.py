@@ -92,7 +92,7 @@ def bench_pchip_projection(
 ) -> dict[str, float]:
     """Closest-point tracking on a PCHIP path (the tracker's per-step projection): µs per
     call for one ship along a ship-like track, and µs per ship for ``batch`` ships at once."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
     from shipgym.tracking import PathTracker
 
     sc = load_scenario(scenario)
@@ -153,7 +153,7 @@ def identification_log(
     import gymnasium as gym
 
     import shipgym  # noqa: F401
-    from shipgym.identification import PersistentExcitation
+    from shipgym.identification.online import PersistentExcitation
     from shipgym_baselines.classical.pid import PIDLOS
 
     env = gym.make(
@@ -191,12 +191,9 @@ def bench_identification(seed: int = 0, excitation_deg: float = 1.0) -> dict[str
     """
     import math
 
-    from shipgym.identification import (
-        IdentificationError,
-        LambdaLSSVM,
-        WeightedLSSVMOnline,
-        fit_nomoto2,
-    )
+    from shipgym.identification.errors import IdentificationError
+    from shipgym.identification.nomoto import fit_nomoto2
+    from shipgym.identification.online import LambdaLSSVM, WeightedLSSVMOnline
 
     identifiers = (("lambda_lssvm", LambdaLSSVM), ("weighted_lssvm", WeightedLSSVMOnline))
     out: dict[str, Any] = {}
@@ -327,7 +324,7 @@ def solve_times_per_ship(
     ``{controller}_solves``.  ``clock="step"``: the whole step's times instead (``step_times``
     and ``step_cpu_times``: estimate and solve, of a controller that estimates the plant),
     the keys ``{controller}_step_…``."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
     from shipgym_baselines.evaluation import run_episode
     from shipgym_baselines.privileged import grants_truth
     from shipgym_baselines.registry import make_controller

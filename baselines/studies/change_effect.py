@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym.scenarios.twins import nominal_twin
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode

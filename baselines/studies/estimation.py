@@ -39,10 +39,10 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.adaptation import QUANTITIES
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models import MODELS
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
 from shipgym_baselines.studies.change_effect import change_time

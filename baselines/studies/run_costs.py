@@ -22,19 +22,7 @@ from typing import Any
 
 from shipgym_baselines import evaluation
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-from shipgym_baselines.leaderboard.costs import (  # noqa: F401  (the estimate, re-exported)
-    COMPILATIONS,
-    COSTS_FILE,
-    FALLBACK_KINDS,
-    TABLES_CPU_S_PER_SCENARIO,
-    estimate_cpu_s,
-    eta_line,
-    limit_steps,
-    median,
-    recorded_costs,
-    step_cost,
-    tables_line,
-)
+from shipgym_baselines.leaderboard.costs import COSTS_FILE, FALLBACK_KINDS, limit_steps, median
 from shipgym_baselines.plugins import ControllerSpec
 
 
@@ -87,7 +75,7 @@ def profile_suite(
     from tqdm import tqdm
 
     from shipgym_baselines.errors import check_seeds
-    from shipgym_baselines.leaderboard import (
+    from shipgym_baselines.leaderboard.jobs import (
         check_controllers,
         plan_jobs,
         suite_record,
@@ -203,7 +191,7 @@ def record_costs(
     ``cache``: a folder keeping each profile once measured (a second call reads it)."""
     import platform
 
-    from shipgym_baselines.leaderboard import Job, suite_scenario, work
+    from shipgym_baselines.leaderboard.jobs import Job, suite_scenario, work
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.runrecord import git_commit
     from shipgym_baselines.registry import controller_kind, controller_label

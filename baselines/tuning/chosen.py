@@ -31,13 +31,9 @@ import yaml
 
 # the reader sits below the controllers (records/chosen.py: a controller's 'tuned' preset
 # reads it); its names stay importable from here
-from shipgym_baselines.records.chosen import ALL_SHIPS as ALL_SHIPS
-from shipgym_baselines.records.chosen import chosen_dir as chosen_dir
 from shipgym_baselines.records.chosen import chosen_file as chosen_file
 from shipgym_baselines.records.chosen import packaged_chosen as packaged_chosen
 from shipgym_baselines.records.chosen import read_chosen as read_chosen
-from shipgym_baselines.records.chosen import section_record as section_record
-from shipgym_baselines.records.chosen import tuned_settings as tuned_settings
 from shipgym_baselines.records.locking import file_lock
 from shipgym_baselines.records.outfiles import refuse_special, write_text
 from shipgym_baselines.records.runrecord import now

@@ -50,7 +50,6 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.executor import BACKENDS as BACKENDS  # public here too
 from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
 from shipgym_baselines.records.locking import file_lock, out_lock
 from shipgym_baselines.records.manifest import Manifest

@@ -15,8 +15,8 @@ import os
 from typing import Any
 
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.records.chosen import ALL_SHIPS, chosen_file, read_chosen
 from shipgym_baselines.tuning import chosen as chosen_settings
-from shipgym_baselines.tuning.chosen import ALL_SHIPS, chosen_file, read_chosen
 from shipgym_baselines.tuning.learned import apply_overrides
 from shipgym_baselines.tuning.space import TuningConfig, TuningError, load_tuning
 

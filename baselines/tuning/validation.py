@@ -25,7 +25,7 @@ import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.sampling import load_distribution
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET

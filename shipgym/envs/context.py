@@ -10,8 +10,7 @@ import numpy as np
 from shipgym.envs.core import scenario_context_row
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
-from shipgym.scenarios import Scenario
-from shipgym.scenarios.loader import nominal_nomoto
+from shipgym.scenarios.loader import Scenario, nominal_nomoto
 from shipgym.tracking import PathTracker
 
 

@@ -40,9 +40,8 @@ from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym.metrics import EpisodeLog, MetricSettings
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY
-from shipgym.scenarios import Scenario
 from shipgym.scenarios.events import ParameterSchedule
-from shipgym.scenarios.loader import nominal_nomoto
+from shipgym.scenarios.loader import Scenario, nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
 
 ACTION_MODES = ("rudder", "guidance")

@@ -34,7 +34,7 @@ from shipgym.envs.row_tracking import RouteGroups
 from shipgym.envs.trial_rows import Trial, TrialRowsVectorEnv, shared_constants_problem
 from shipgym.errors import ShipgymError
 from shipgym.metrics import compute_metrics
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 
 
 class LockstepError(ShipgymError):

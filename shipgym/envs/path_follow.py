@@ -51,15 +51,17 @@ from shipgym.angles import wrap_angle
 from shipgym.disturbances import SensorModel
 from shipgym.envs import core
 from shipgym.envs.context import ControllerContext
-from shipgym.envs.core import GUIDANCE_OFFSET_MAX, LOG_FIELDS, OBS_HIGH, OBS_LOW, OBS_NAMES
+from shipgym.envs.core import LOG_FIELDS, OBS_HIGH, OBS_LOW
 from shipgym.envs.truth import PlantTruth
 from shipgym.metrics import EpisodeLog, compute_metrics
 from shipgym.numerics import SCALAR
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import apply_trial, draw_trial, env_randomization
 from shipgym.tracking import TrackFrame
 
-__all__ = ["GUIDANCE_OFFSET_MAX", "OBS_NAMES", "ShipPathFollowEnv"]
+__all__ = [
+    "ShipPathFollowEnv",
+]
 
 
 class ShipPathFollowEnv(gym.Env):

@@ -35,7 +35,6 @@ from gymnasium.vector import AutoresetMode
 
 from shipgym.envs import core
 from shipgym.envs.trial_rows import Trial, TrialRowsVectorEnv, shared_constants_problem
-from shipgym.scenarios import ScenarioConfig
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import (
     DistributionError,
@@ -44,8 +43,12 @@ from shipgym.scenarios.sampling import (
     train_rng,
     train_scenario_seed,
 )
+from shipgym.scenarios.schema import ScenarioConfig
 
-__all__ = ["ShipTrialsVectorEnv", "Trial", "ship_index_of"]
+__all__ = [
+    "ShipTrialsVectorEnv",
+    "ship_index_of",
+]
 
 
 def ship_index_of(distribution: ScenarioDistribution, ship: int | str) -> int:

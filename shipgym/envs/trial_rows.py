@@ -34,8 +34,7 @@ from shipgym.envs import core
 from shipgym.envs.row_tracking import RouteGroups, RowTrackers
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.numerics import ARRAY, SCALAR
-from shipgym.scenarios import Scenario
-from shipgym.scenarios.loader import nominal_nomoto
+from shipgym.scenarios.loader import Scenario, nominal_nomoto
 from shipgym.tracking import PathTracker, TrackFrame
 
 

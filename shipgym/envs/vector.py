@@ -40,8 +40,8 @@ from shipgym.envs import core
 from shipgym.envs.core import LOG_FIELDS
 from shipgym.metrics import compute_metrics
 from shipgym.numerics import ARRAY
-from shipgym.scenarios import Scenario, load_scenario
 from shipgym.scenarios.events import EVENT_TIME_EPS as _EVENT_EPS
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import apply_trial, draw_trial, env_randomization
 
 

@@ -55,9 +55,8 @@ import dataclasses
 
 import numpy as np
 
-from shipgym.identification.errors import check_sampling_step
+from shipgym.identification.errors import IdentificationError, check_sampling_step
 from shipgym.identification.lssvm import lssvm_dual, lssvm_primal
-from shipgym.identification.nomoto import IdentificationError
 from shipgym.models.base import NUMPY, ShipModel
 from shipgym.models.blanke import (
     COEFFICIENT_NAMES,

@@ -40,17 +40,14 @@ from shipgym.identification.front_end import (
     FrontEndSettings,
     RegressionSignals,
     difference_signals,
-    forward_difference,
 )
 from shipgym.identification.lssvm import LSSVMSolution, lssvm_primal, weighted_lssvm
 from shipgym.models.nomoto2 import Nomoto2Params
 
 __all__ = [
     "GAMMA",
-    "IdentificationError",
     "NomotoRegression",
     "fit_nomoto2",
-    "forward_difference",
     "front_end_settings",
     "nomoto_regressors",
     "params_from_theta1",

@@ -34,11 +34,14 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.identification.errors import check_sample_keys, check_sampling_step
+from shipgym.identification.errors import (
+    IdentificationError,
+    check_sample_keys,
+    check_sampling_step,
+)
 from shipgym.identification.front_end import FrontEndSettings
 from shipgym.identification.lssvm import LSSVMSolution
 from shipgym.identification.nomoto import (
-    IdentificationError,
     excitation_problem,
     front_end_settings,
     params_from_theta1,

@@ -20,9 +20,9 @@ import functools
 
 import numpy as np
 
-from shipgym.identification.errors import check_sampling_step
+from shipgym.identification.errors import IdentificationError, check_sampling_step
 from shipgym.identification.lssvm import lssvm_primal
-from shipgym.identification.nomoto import IdentificationError, time_constants
+from shipgym.identification.nomoto import time_constants
 from shipgym.manoeuvres import ManoeuvreLog, zigzag
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2Params, nomoto2_first_order

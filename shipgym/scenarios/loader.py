@@ -25,9 +25,10 @@ from shipgym.config import (
     resolve,
     validate_model,
 )
-from shipgym.identification import first_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.limits import MAX_EPISODE_STEPS, MAX_SUBSTEPS
-from shipgym.models import MODELS, ParameterError, ParameterRecord, ShipModel
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
 from shipgym.paths import PchipPath, WaypointPath
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
 from shipgym.scenarios.nominal import nominal_problem

@@ -16,9 +16,10 @@ import math
 from typing import Any
 
 from shipgym.autopilot import PIDGains
-from shipgym.identification import IdentificationError, first_order_nomoto
+from shipgym.identification.errors import IdentificationError
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.manoeuvres import ManoeuvreError
-from shipgym.models import ParameterError
+from shipgym.models.base import ParameterError
 
 #: the rudder angle [deg] of the zig-zag that identifies a ship without a closed form
 ZIGZAG_RUDDER_DEG = 20.0

@@ -304,7 +304,8 @@ class DistributionConfig(StrictModel):
 def _check_ship(ship: ShipSampling, key: str, split: str, path: PathSampling) -> None:
     """A known model with valid nominal parameters, currents below its speed, and jumps a
     real plant can take within the shortest route's time limit (module doc)."""
-    from shipgym.models import MODELS, ParameterError
+    from shipgym.models import MODELS
+    from shipgym.models.base import ParameterError
 
     if ship.model not in MODELS:
         raise ValueError(f"{key}.model: unknown model {ship.model!r}; valid: {sorted(MODELS)}")
@@ -333,7 +334,8 @@ def _check_ship(ship: ShipSampling, key: str, split: str, path: PathSampling) ->
 def _check_jumps(ship: ShipSampling, key: str, split: str, shortest: float) -> None:
     """Jump times before ``shortest`` [s]; each parameter change at both ends of its range
     builds the model."""
-    from shipgym.models import MODELS, ParameterError
+    from shipgym.models import MODELS
+    from shipgym.models.base import ParameterError
 
     jumps = ship.jumps
     if jumps.kinds and jumps.time[1] >= shortest:

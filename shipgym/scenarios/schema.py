@@ -18,36 +18,22 @@ from pydantic import AfterValidator, Field, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
 from shipgym.config import Name, StrictModel
-from shipgym.disturbance_config import (
-    ConstantCurrent,
-    CurrentConfig,
-    DisturbanceConfig,
-    GaussMarkovCurrent,
-    SensorConfig,
-    TwoPhaseCurrent,
-    WaveConfig,
-)
+from shipgym.disturbance_config import DisturbanceConfig, SensorConfig
 from shipgym.limits import MAX_POSITION_M, MAX_WAYPOINTS
-from shipgym.models import MODELS, ParameterError
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
 
 #: one problem found by a check across keys: (location, message, the input at fault)
 KeyProblem = tuple[tuple[str | int, ...], str, Any]
 
 __all__ = [
-    "ConstantCurrent",
-    "CurrentConfig",
-    "DisturbanceConfig",
     "EventConfig",
-    "GaussMarkovCurrent",
     "GuidanceConfig",
     "InitialState",
     "PathConfig",
     "RewardConfig",
     "ScenarioConfig",
-    "SensorConfig",
     "ShipConfig",
-    "TwoPhaseCurrent",
-    "WaveConfig",
 ]
 
 

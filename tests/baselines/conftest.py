@@ -31,7 +31,7 @@ SMOKE_CONTROLLERS = ["pid_los", "zero_rudder"]
 def smoke_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The smoke suite run once (one seed, :data:`SMOKE_CONTROLLERS`), complete: copy it
     (:func:`copy_folder`) before changing it."""
-    from shipgym_baselines.leaderboard import run_leaderboard
+    from shipgym_baselines.leaderboard.run import run_leaderboard
 
     out = tmp_path_factory.mktemp("smoke") / "out"
     run_leaderboard(

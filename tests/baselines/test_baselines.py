@@ -13,7 +13,7 @@ import pytest
 from shipgym.autopilot import HeadingPID, PIDGains
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.evaluation import evaluate, run_episode
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 
 
 def test_pid_gains_place_closed_loop_poles() -> None:
@@ -127,7 +127,7 @@ def test_the_page_and_the_run_folder_are_light(smoke: tuple[Path, list[dict]]) -
 def test_the_smoke_leaderboard_opens_with_its_verdict(smoke: tuple[Path, list[dict]]) -> None:
     """leaderboard.md, the terminal summary and the page open with the run's two sentences:
     the catalogue leader of aggregate.json with its IQM, the learned agent's rank."""
-    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
     from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name
 
     out, _ = smoke
@@ -221,8 +221,8 @@ def test_default_suite_has_every_controller_and_learned_agent() -> None:
     """Every controller on main and every shipped policy is on the default board, but three
     of Liu et al.'s identifier rows, which play in the quick suite (the default run's
     time: docs/leaderboard.md, "The default run's size")."""
-    from shipgym.scenarios import list_scenarios
-    from shipgym_baselines.leaderboard import load_suite
+    from shipgym.scenarios.loader import list_scenarios
+    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.learned.policy import shipped_policies
     from shipgym_baselines.registry import CONTROLLERS
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shipgym.scenarios import ScenarioError
+from shipgym.scenarios.loader import ScenarioError
 from shipgym_baselines.cli import build_parser, main
 from shipgym_baselines.errors import ControllerError
 

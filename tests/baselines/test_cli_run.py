@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import trial_scenario
 from shipgym_baselines.cli import main
 from shipgym_baselines.cli.run import default_out
@@ -134,7 +134,7 @@ def test_a_learned_agent_replays_the_leaderboards_episode_of_a_training_seed(
 ) -> None:
     """``--training-seed K`` runs the policy the leaderboard runs as training seed K (its
     ``Job``), named in the output; without it the first training seed runs."""
-    from shipgym_baselines.leaderboard import Job, run_batch
+    from shipgym_baselines.leaderboard.jobs import Job, run_batch
 
     argv = ("heldout:0", "ppo", "--seed", "10001", "--suite", "smoke")
     first = run_json(capsys, *argv, "--out", str(tmp_path / "a"))

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.classical.reference import ZeroRudder

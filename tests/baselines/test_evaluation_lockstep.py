@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from shipgym.envs.eval_trials import lockstep_problem
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate_batch, run_episode
-from shipgym_baselines.leaderboard import Job, trials
+from shipgym_baselines.leaderboard.jobs import Job, trials
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import make_controller
 

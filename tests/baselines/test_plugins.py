@@ -19,11 +19,13 @@ import numpy as np
 import pytest
 import yaml
 
+from shipgym.config import ConfigError
 from shipgym.envs.context import ControllerContext
 from shipgym_baselines.cli import main
-from shipgym_baselines.errors import ConfigError, ControllerError, RunError
+from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, run_episode
-from shipgym_baselines.leaderboard import check_controllers, run_job, run_leaderboard
+from shipgym_baselines.leaderboard.jobs import check_controllers, run_job
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerEntry, anchored, entry_point_names, parse_spec
 from shipgym_baselines.registry import (

@@ -13,10 +13,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines import evaluation, leaderboard, references
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard import Job, announce_references, reference_work, trials
+from shipgym_baselines.leaderboard.jobs import Job, announce_references, reference_work, trials
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult
 from shipgym_baselines.references import (
     ORACLE_CPU_S_PER_STEP,

@@ -128,8 +128,13 @@ def test_the_registry_is_read_only() -> None:
         CONTROLLERS["pid_los"] = CONTROLLERS["lqr"]  # type: ignore[index]
 
 
-def test_register_controller_is_exported_from_baselines() -> None:
-    assert shipgym_baselines.register_controller is register_controller
+def test_register_controller_of_the_package_registers(scratch_registry: None) -> None:
+    @shipgym_baselines.register_controller("test_from_the_package")
+    class HoldZero(ZeroRudder):
+        """Zero rudder under another name."""
+
+    assert HoldZero.name == "test_from_the_package"
+    assert make_controller("test_from_the_package")[0].name == "test_from_the_package"
 
 
 def test_decorator_registers_a_class_and_gives_it_the_name(scratch_registry: None) -> None:

@@ -14,8 +14,8 @@ sys.path.insert(0, str(REPO / "docs" / "_ext"))
 from shipgym_docs import controllers  # noqa: E402
 
 from shipgym.models import MODELS  # noqa: E402
+from shipgym_baselines.records.chosen import read_chosen  # noqa: E402
 from shipgym_baselines.registry import CONTROLLERS  # noqa: E402
-from shipgym_baselines.tuning.chosen import read_chosen  # noqa: E402
 
 #: the ship no tuning study covers (docs/ships.md, KVLCC2)
 UNTUNED = "kvlcc2"

@@ -45,7 +45,7 @@ def test_the_evaluate_example_gives_the_leaderboards_episodes(
     records for those seeds: the leaderboard, run on a suite of that one scenario and
     controller with the default suite's trial ranges, gives the same episodes."""
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-    from shipgym_baselines.leaderboard import run_leaderboard
+    from shipgym_baselines.leaderboard.run import run_leaderboard
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.episodes import read_episodes
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.core import HISTORY_MEASUREMENTS, OBS_NAMES
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 
 GOLDEN = Path(__file__).resolve().parent / "shipped_policy_actions.npz"
 #: one scenario per catalogue ship, whose context rows the wide observations carry

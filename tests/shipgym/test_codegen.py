@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from shipgym import codegen
-from shipgym.models import Nomoto2
+from shipgym.models.nomoto2 import Nomoto2
 
 #: these tests read the notice lines, which the suite silences
 pytestmark = pytest.mark.usefixtures("loud")

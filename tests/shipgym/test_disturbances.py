@@ -15,6 +15,7 @@ import pytest
 from scipy.linalg import solve_continuous_lyapunov, solve_discrete_lyapunov
 from scipy.signal import lfilter, welch
 
+from shipgym.disturbance_config import ConstantCurrent, DisturbanceConfig, WaveConfig
 from shipgym.disturbances import (
     Disturbances,
     WaveFilter,
@@ -24,8 +25,12 @@ from shipgym.disturbances import (
     wave_spectrum,
 )
 from shipgym.envs.path_follow import ShipPathFollowEnv
-from shipgym.scenarios import ScenarioError, list_scenarios, load_scenario, scenario_from_dict
-from shipgym.scenarios.schema import ConstantCurrent, DisturbanceConfig, WaveConfig
+from shipgym.scenarios.loader import (
+    ScenarioError,
+    list_scenarios,
+    load_scenario,
+    scenario_from_dict,
+)
 
 DEG = math.pi / 180.0
 NAMES = ("current_x", "current_y", "yaw_disturbance")

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from shipgym.angles import wrap_angle
 from shipgym.guidance import (
     lookahead_los_heading,
     los_heading,
@@ -15,7 +16,7 @@ from shipgym.guidance import (
     los_radius,
     los_relative_heading,
 )
-from shipgym.paths import segment_frame, wrap_angle
+from shipgym.paths import segment_frame
 
 # --------------------------------------------------------------------------------------------
 # Hand-computed LOS case: leg (0,0)→(10,0), ship at (2, 1), L = 1

@@ -13,18 +13,17 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 
 import shipgym  # noqa: F401
+from shipgym.angles import wrap_angle
 from shipgym.autopilot import HeadingPID, PIDGains
-from shipgym.envs.path_follow import GUIDANCE_OFFSET_MAX
+from shipgym.envs.core import GUIDANCE_OFFSET_MAX
 from shipgym.guidance import (
     lookahead_los_heading,
     tvvf_heading,
     tvvf_theta,
     vector_field_heading,
 )
-from shipgym.identification import first_order_nomoto
-from shipgym.paths import wrap_angle
-from shipgym.scenarios import ScenarioError, load_scenario
-from shipgym.scenarios.loader import scenario_from_dict
+from shipgym.identification.nominal import first_order_nomoto
+from shipgym.scenarios.loader import ScenarioError, load_scenario, scenario_from_dict
 
 HALF_PI = math.pi / 2
 

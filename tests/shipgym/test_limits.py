@@ -25,8 +25,12 @@ from shipgym.limits import (
     LimitError,
     worker_count,
 )
-from shipgym.scenarios import ScenarioError, load_scenario
-from shipgym.scenarios.loader import catalogue_dir, check_scenario_file
+from shipgym.scenarios.loader import (
+    ScenarioError,
+    catalogue_dir,
+    check_scenario_file,
+    load_scenario,
+)
 from shipgym.scenarios.trials import TrialRandomization
 
 

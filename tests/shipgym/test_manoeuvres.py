@@ -10,7 +10,7 @@ import pytest
 from scipy.optimize import brentq
 
 from shipgym.manoeuvres import ManoeuvreError, turning_circle, zigzag
-from shipgym.models import Nomoto2, Nomoto2Params
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
 from shipgym_baselines.cli import main
 
 

@@ -8,6 +8,7 @@ from dataclasses import astuple
 import numpy as np
 import pytest
 
+from shipgym.angles import wrap_angle
 from shipgym.paths import (
     LegFrame,
     PchipPath,
@@ -16,7 +17,6 @@ from shipgym.paths import (
     advance_leg,
     along_track_reached,
     segment_frame,
-    wrap_angle,
 )
 
 # --------------------------------------------------------------------------------------------

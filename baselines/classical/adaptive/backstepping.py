@@ -8,7 +8,7 @@ are exact (c = 1 s⁻¹ in the paper; :mod:`.settings`, "Gain transfer").
 
 from __future__ import annotations
 
-from shipgym.paths import wrap_angle
+from shipgym.angles import wrap_angle
 from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto
 from shipgym_baselines.classical.adaptive.settings import Gains
 

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.cubic_damping import ship_cubic_damping
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models.base import ShipModel
 from shipgym.models.nomoto2 import Nomoto2
 

@@ -37,8 +37,7 @@ from typing import Any
 import numpy as np
 
 from shipgym.envs.path_follow import ShipPathFollowEnv
-from shipgym.scenarios import load_scenario
-from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.loader import build_scenario, load_scenario
 from shipgym.scenarios.sampling import load_distribution, train_rng
 from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.learned.plant_id.features import STEP_FEATURES, WINDOW, step_row

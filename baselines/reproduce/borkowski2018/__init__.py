@@ -26,19 +26,8 @@ Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the run
 :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from shipgym_baselines.reproduce.borkowski2018.claims import PAPER_MAX_REDUCTION
-from shipgym_baselines.reproduce.borkowski2018.experiment import (
-    CONTROLLERS,
-    GUESSES,
-    PAPER_GUESS,
-    SCENARIO,
-    TRUTH,
-    build_scenario,
-    case_name,
-    run_experiment,
-)
-from shipgym_baselines.reproduce.borkowski2018.figures import plot_runs, plots
-from shipgym_baselines.reproduce.borkowski2018.quality_index import cumulative_J
+from shipgym_baselines.reproduce.borkowski2018.experiment import run_experiment
+from shipgym_baselines.reproduce.borkowski2018.figures import plots
 from shipgym_baselines.reproduce.borkowski2018.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
@@ -46,20 +35,7 @@ REPRODUCTION = Reproduction("borkowski2018", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
 
 __all__ = [
-    "CONTROLLERS",
-    "GUESSES",
-    "PAPER_GUESS",
-    "PAPER_MAX_REDUCTION",
     "REPRODUCTION",
-    "SCENARIO",
-    "TRUTH",
-    "build_scenario",
-    "case_name",
-    "cumulative_J",
     "markdown",
-    "plot_runs",
-    "plots",
-    "report",
     "run",
-    "run_experiment",
 ]

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.classical.lqr import LQR, AdaptiveLQR
 from shipgym_baselines.errors import check_seeds
 from shipgym_baselines.reproduce.borkowski2018.claims import case_claims, summary_claims

@@ -10,14 +10,8 @@ Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the run
 :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from shipgym_baselines.reproduce.liu2019.experiment import (
-    CASES,
-    CONTROLLERS,
-    PUBLISHED,
-    READINGS,
-    run_experiment,
-)
-from shipgym_baselines.reproduce.liu2019.figures import plot_case, plots
+from shipgym_baselines.reproduce.liu2019.experiment import run_experiment
+from shipgym_baselines.reproduce.liu2019.figures import plots
 from shipgym_baselines.reproduce.liu2019.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
@@ -25,15 +19,7 @@ REPRODUCTION = Reproduction("liu2019", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
 
 __all__ = [
-    "CASES",
-    "CONTROLLERS",
-    "PUBLISHED",
-    "READINGS",
     "REPRODUCTION",
     "markdown",
-    "plot_case",
-    "plots",
-    "report",
     "run",
-    "run_experiment",
 ]

@@ -29,20 +29,8 @@ Parts (:mod:`shipgym_baselines.reproduce.protocol`): :mod:`.experiment` (the fit
 rows), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
-from shipgym_baselines.reproduce.morenosalinas2013.experiment import (
-    CASES,
-    CONTROLLERS,
-    HEADING_NOISE,
-    LOWPASS_HZ,
-    PUBLISHED,
-    SAMPLING_TIME,
-    SIGNALS,
-    TURNING_DURATION,
-    VELOCITY_NOISE,
-    ZIGZAG_DURATION,
-    run_experiment,
-)
-from shipgym_baselines.reproduce.morenosalinas2013.figures import plot_series, plots
+from shipgym_baselines.reproduce.morenosalinas2013.experiment import run_experiment
+from shipgym_baselines.reproduce.morenosalinas2013.figures import plots
 from shipgym_baselines.reproduce.morenosalinas2013.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
@@ -50,21 +38,7 @@ REPRODUCTION = Reproduction("morenosalinas2013", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
 
 __all__ = [
-    "CASES",
-    "CONTROLLERS",
-    "HEADING_NOISE",
-    "LOWPASS_HZ",
-    "PUBLISHED",
     "REPRODUCTION",
-    "SAMPLING_TIME",
-    "SIGNALS",
-    "TURNING_DURATION",
-    "VELOCITY_NOISE",
-    "ZIGZAG_DURATION",
     "markdown",
-    "plot_series",
-    "plots",
-    "report",
     "run",
-    "run_experiment",
 ]

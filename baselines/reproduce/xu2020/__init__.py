@@ -59,49 +59,15 @@ order them), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
 from shipgym_baselines.reproduce.protocol import Reproduction
-from shipgym_baselines.reproduce.xu2020.controllers import CONTROLLERS, GAINS
 from shipgym_baselines.reproduce.xu2020.experiment import run_experiment
-from shipgym_baselines.reproduce.xu2020.figures import plot_case, plots
-from shipgym_baselines.reproduce.xu2020.identification import identification_rows
-from shipgym_baselines.reproduce.xu2020.metrics import EPISODE_METRICS, episode_figures
-from shipgym_baselines.reproduce.xu2020.published import (
-    PUBLISHED,
-    PUBLISHED_GAINS,
-    PUBLISHED_NOMOTO,
-)
-from shipgym_baselines.reproduce.xu2020.scenarios import (
-    BASE_SCENARIO,
-    CASES,
-    CURVED_INITIAL_SPEED,
-    NO_RATE_LIMIT,
-    SETTINGS,
-    build_scenario,
-)
+from shipgym_baselines.reproduce.xu2020.figures import plots
 from shipgym_baselines.reproduce.xu2020.tables import report
 
 REPRODUCTION = Reproduction("xu2020", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
 
 __all__ = [
-    "BASE_SCENARIO",
-    "CASES",
-    "CONTROLLERS",
-    "CURVED_INITIAL_SPEED",
-    "EPISODE_METRICS",
-    "GAINS",
-    "NO_RATE_LIMIT",
-    "PUBLISHED",
-    "PUBLISHED_GAINS",
-    "PUBLISHED_NOMOTO",
     "REPRODUCTION",
-    "SETTINGS",
-    "build_scenario",
-    "episode_figures",
-    "identification_rows",
     "markdown",
-    "plot_case",
-    "plots",
-    "report",
     "run",
-    "run_experiment",
 ]

@@ -85,62 +85,17 @@ log), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
 from shipgym_baselines.reproduce.protocol import Reproduction
-from shipgym_baselines.reproduce.xu2021.claims import CLAIM_MARGIN, CLAIMS, FILTER_CLAIMS, claims
-from shipgym_baselines.reproduce.xu2021.controllers import (
-    AB,
-    CONTROLLERS,
-    L1,
-    L1_ADAPTIVE,
-    L1_VARIANTS,
-    PID,
-    Recorded,
-)
-from shipgym_baselines.reproduce.xu2021.current import DisturbanceLog, current_speed
+from shipgym_baselines.reproduce.xu2021.claims import claims
 from shipgym_baselines.reproduce.xu2021.experiment import run_experiment
-from shipgym_baselines.reproduce.xu2021.figures import plot_runs, plots
-from shipgym_baselines.reproduce.xu2021.linearised import linear_analysis, loop_margins
-from shipgym_baselines.reproduce.xu2021.metrics import (
-    CUTOFF,
-    CUTOFF_HIGH,
-    METRICS,
-    PHASES,
-    episode_figures,
-)
-from shipgym_baselines.reproduce.xu2021.scenario import SCENARIO, build_scenario, switch_time
+from shipgym_baselines.reproduce.xu2021.figures import plots
 from shipgym_baselines.reproduce.xu2021.tables import report
 
 REPRODUCTION = Reproduction("xu2021", run_experiment, report, plots)
 run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
 
 __all__ = [
-    "AB",
-    "CLAIMS",
-    "CLAIM_MARGIN",
-    "CONTROLLERS",
-    "CUTOFF",
-    "CUTOFF_HIGH",
-    "FILTER_CLAIMS",
-    "L1",
-    "L1_ADAPTIVE",
-    "L1_VARIANTS",
-    "METRICS",
-    "PHASES",
-    "PID",
     "REPRODUCTION",
-    "SCENARIO",
-    "DisturbanceLog",
-    "Recorded",
-    "build_scenario",
     "claims",
-    "current_speed",
-    "episode_figures",
-    "linear_analysis",
-    "loop_margins",
     "markdown",
-    "plot_runs",
-    "plots",
-    "report",
     "run",
-    "run_experiment",
-    "switch_time",
 ]

@@ -9,13 +9,10 @@ import gymnasium as gym
 import numpy as np
 import scipy.optimize
 
-from shipgym.identification import first_order_nomoto
-from shipgym_baselines.classical.l1_backstepping import (
-    Gains,
-    L1BacksteppingSettings,
-    linearised_closed_loop_poles,
-    nominal_design_model,
-)
+from shipgym.identification.nominal import first_order_nomoto
+from shipgym_baselines.classical.adaptive.design_model import nominal_design_model
+from shipgym_baselines.classical.adaptive.loop_analysis import linearised_closed_loop_poles
+from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 from shipgym_baselines.classical.pid import PIDTVVF
 from shipgym_baselines.reproduce.xu2021.controllers import AB, L1, L1_ADAPTIVE, PID
 

@@ -8,8 +8,8 @@ from typing import Any
 import numpy as np
 
 from shipgym.angles import wrap_angle
+from shipgym.metrics import high_frequency_power
 from shipgym.tracking import PathTracker
-from shipgym_baselines.classical.l1_backstepping import high_frequency_power
 from shipgym_baselines.records.episodes import CONTROLLER_STATS, EpisodeResult
 from shipgym_baselines.reproduce.xu2021.controllers import Recorded
 from shipgym_baselines.reproduce.xu2021.scenario import switch_time

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 
 SCENARIO = "osaka_stochastic_current"
 

@@ -16,7 +16,7 @@ import gymnasium as gym
 
 import shipgym
 from shipgym.envs import core
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_docs.pages import rst_block, table, write_text
 
 PREFIX = "ShipPathFollow"

@@ -20,8 +20,7 @@ import numpy as np
 import yaml
 
 from shipgym.config import catalogue, list_names
-from shipgym.scenarios import load_scenario
-from shipgym.scenarios.loader import Scenario, list_scenarios
+from shipgym.scenarios.loader import Scenario, list_scenarios, load_scenario
 from shipgym_docs.pages import cell, table, write_bytes, write_text
 
 

@@ -12,7 +12,7 @@ import yaml
 import shipgym_baselines.classical.l1_backstepping as l1
 from shipgym.envs.context import ControllerContext
 from shipgym.metrics import high_frequency_power
-from shipgym.scenarios import catalogue_dir, scenario_from_dict
+from shipgym.scenarios.loader import catalogue_dir, scenario_from_dict
 from shipgym_baselines.classical.l1_backstepping import AdaptiveBackstepping, L1Backstepping
 from shipgym_baselines.evaluation import run_episode
 

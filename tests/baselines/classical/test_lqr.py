@@ -11,9 +11,9 @@ import pytest
 from scipy.linalg import solve_continuous_are
 
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import first_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models.mariner import MarinerParams
-from shipgym.scenarios import load_scenario, scenario_from_dict
+from shipgym.scenarios.loader import load_scenario, scenario_from_dict
 from shipgym_baselines.classical.lqr import (
     LQR,
     AdaptiveLQR,

@@ -8,8 +8,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from shipgym.models import Nomoto2, Nomoto2Params
-from shipgym.scenarios import scenario_from_dict
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
+from shipgym.scenarios.loader import scenario_from_dict
 from shipgym_baselines.classical.nmpc import NMPC, NMPCLambdaLSSVM, NMPCSettings, NMPCSolver
 from shipgym_baselines.evaluation import evaluate, run_episode
 

@@ -9,7 +9,7 @@ import math
 import pytest
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.classical.nmpc_ekf import NmpcEkf
 from shipgym_baselines.classical.oracle import OracleSettings
 from shipgym_baselines.evaluation import evaluate, run_episode

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from shipgym.envs.context import ControllerContext
-from shipgym.identification import first_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models.nomoto2 import nomoto2_first_order
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.classical.nmpc import NMPC, NMPCSettings
 from shipgym_baselines.classical.nmpc_ship import (
     PAPER_Q,

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from shipgym.envs.context import ControllerContext
-from shipgym.models import Nomoto2, Nomoto2Params
-from shipgym.scenarios import load_scenario
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.classical import nmpc as nmpc_module
 from shipgym_baselines.classical.nmpc import (
     NMPC,

@@ -16,7 +16,7 @@ import pytest
 
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.truth import PlantTruth
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.classical.oracle import (
     LAST_LEG,
     TAIL_TERMS,
@@ -38,7 +38,7 @@ from shipgym_baselines.classical.oracle import (
 )
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import evaluate, run_episode
-from shipgym_baselines.leaderboard import Job, trials, work
+from shipgym_baselines.leaderboard.jobs import Job, trials, work
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerEntry
 from shipgym_baselines.privileged import grants_truth

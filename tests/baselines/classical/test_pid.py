@@ -19,9 +19,10 @@ from shipgym.autopilot import (
     vyshnegradsky_solutions,
 )
 from shipgym.guidance import tvvf_heading, vector_field_heading
-from shipgym.identification import first_order_nomoto, second_order_nomoto
-from shipgym.models import Mariner, Nomoto2
-from shipgym.scenarios import scenario_from_dict
+from shipgym.identification.nominal import first_order_nomoto, second_order_nomoto
+from shipgym.models.mariner import Mariner
+from shipgym.models.nomoto2 import Nomoto2
+from shipgym.scenarios.loader import scenario_from_dict
 from shipgym_baselines.classical.pid import (
     PIDLOS,
     PIDTVVF,
@@ -233,7 +234,7 @@ def test_paper_preset_is_the_literal_design_and_guidance_settings_reach_the_law(
     import math
 
     from shipgym.envs.context import ControllerContext
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     ctx = ControllerContext.of(load_scenario("nominal"), "rudder")
     pid = PIDLOS(preset="paper", los_radius_L=5.0)

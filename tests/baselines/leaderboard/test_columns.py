@@ -11,7 +11,8 @@ from shipgym_baselines.leaderboard.columns import (
     page_columns,
     shown,
 )
-from shipgym_baselines.leaderboard.ranking import AGGREGATE_FIELDS, GAIN, PROB
+from shipgym_baselines.leaderboard.headroom import GAIN
+from shipgym_baselines.leaderboard.ranking import AGGREGATE_FIELDS, PROB
 
 
 def test_markdown_shows_every_column_with_a_markdown_header() -> None:

@@ -244,7 +244,7 @@ def test_a_run_started_without_the_references_resumes_without_them(
     one_scenario: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A run of an earlier version (or ``--no-references``) is finished as it was started."""
-    from shipgym_baselines.leaderboard import run_leaderboard
+    from shipgym_baselines.leaderboard.run import run_leaderboard
 
     out, given = tmp_path / "before", ["pid_los", "zero_rudder", "oracle"]
     run_leaderboard(one_scenario, 1, out, workers=1, show_progress=False, controllers=given)

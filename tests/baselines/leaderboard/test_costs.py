@@ -5,13 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
-from shipgym_baselines.leaderboard import (
-    Job,
-    check_controllers,
-    plan_run,
-    suite_record,
-    suite_scenario,
-)
 from shipgym_baselines.leaderboard.costs import (
     TABLES_CPU_S_PER_SCENARIO,
     estimate_cpu_s,
@@ -19,7 +12,14 @@ from shipgym_baselines.leaderboard.costs import (
     recorded_costs,
     step_cost,
 )
-from shipgym_baselines.leaderboard.jobs import run_scenarios
+from shipgym_baselines.leaderboard.jobs import (
+    Job,
+    check_controllers,
+    plan_run,
+    run_scenarios,
+    suite_record,
+    suite_scenario,
+)
 from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, TWIN_PLAYERS, TWIN_SCENARIOS
 from shipgym_baselines.registry import training_seeds

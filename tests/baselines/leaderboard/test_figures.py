@@ -13,18 +13,20 @@ import pytest
 from PIL import Image
 
 from shipgym_baselines.leaderboard import figures
-from shipgym_baselines.leaderboard.figures import (
+from shipgym_baselines.leaderboard.figure_files import (
     LEGEND_KEY,
     LEGEND_TOP_KEY,
     PAGE_COLOURS,
     PAGE_WIDTH,
+)
+from shipgym_baselines.leaderboard.ranking import aggregate_ranking
+from shipgym_baselines.leaderboard.ranking_figures import plot_ranking
+from shipgym_baselines.leaderboard.scenario_figures import (
     DrawnEpisode,
     episodes_to_draw,
     median_ace_episode,
-    plot_ranking,
     plot_scenario,
 )
-from shipgym_baselines.leaderboard.ranking import aggregate_ranking
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 
 SVG = "{http://www.w3.org/2000/svg}"

@@ -10,16 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from shipgym_baselines.errors import ConfigError, RunError
-from shipgym_baselines.leaderboard import (
-    COLUMNS,
-    Job,
-    plan_jobs,
-    plan_run,
-    run_batch,
-    run_job,
-    run_leaderboard,
-)
+from shipgym.config import ConfigError
+from shipgym_baselines.errors import RunError
+from shipgym_baselines.leaderboard.jobs import Job, plan_jobs, plan_run, run_batch, run_job
+from shipgym_baselines.leaderboard.run import run_leaderboard
+from shipgym_baselines.leaderboard.tables import COLUMNS
 from shipgym_baselines.learned.policy import model_zip
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runrecord import read_run
@@ -157,7 +152,7 @@ def test_rows_carry_an_interval_for_every_metric(randomised: Path) -> None:
 
 
 def test_without_the_oracle_the_ranking_says_what_it_needs(randomised: Path) -> None:
-    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
 
     assert json.loads((randomised / "aggregate.json").read_text()) == []
     assert json.loads((randomised / "scenario_scores.json").read_text()) == []
@@ -233,7 +228,7 @@ def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     """The run's sentences (shipgym_baselines.leaderboard.verdict; two without the frozen
     optimum) first; a report folder (no episodes of its own) prints those its leaderboard.md
     opens with; no ranking: none."""
-    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
 
     verdict = (
         "`pid_los` is the only ranked controller on the 2 catalogue scenarios, at IQM 1.250 "
@@ -675,7 +670,7 @@ def test_a_scenario_file_named_as_a_catalogue_scenario_is_refused(tmp_path: Path
 
 
 def test_a_copy_of_a_catalogue_scenario_is_that_scenario(tmp_path: Path) -> None:
-    from shipgym_baselines.leaderboard import suite_record, suite_scenarios
+    from shipgym_baselines.leaderboard.jobs import suite_record, suite_scenarios
     from shipgym_baselines.leaderboard.suite import load_suite
 
     copy = tmp_path / "copy.yaml"
@@ -723,7 +718,7 @@ def test_the_gap_to_the_frozen_optimum_in_every_output(randomised: Path, tmp_pat
     the page's long ranking and the verdict's two more sentences."""
     import math
 
-    from shipgym_baselines.leaderboard import terminal_summary
+    from shipgym_baselines.leaderboard.outputs import terminal_summary
 
     gap = with_stand_in_references(randomised, tmp_path)
     (pid,) = json.loads((gap / "aggregate.json").read_text())  # oracle_frozen is not ranked
@@ -776,7 +771,7 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     scenario is its own split in every output, beside the other two, run on its own seeds
     (``run.json``'s ``scenario_seeds``); its oracle reference is read from the shipped
     table, which holds the default suite's in-range trials."""
-    from shipgym_baselines.leaderboard import trials
+    from shipgym_baselines.leaderboard.jobs import trials
     from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.references import shipped_table
 

@@ -14,9 +14,10 @@ import pytest
 from PIL import Image
 
 from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
-from shipgym_baselines.leaderboard.figures import DrawnEpisode, plot_scenario
 from shipgym_baselines.leaderboard.headroom import GAIN
-from shipgym_baselines.leaderboard.page import PAGE_FILE, page, unpacked_body, write_html
+from shipgym_baselines.leaderboard.html_cells import unpacked_body
+from shipgym_baselines.leaderboard.page import PAGE_FILE, page, write_html
+from shipgym_baselines.leaderboard.scenario_figures import DrawnEpisode, plot_scenario
 
 CONTROLLERS = [
     "pid_los",

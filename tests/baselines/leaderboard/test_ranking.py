@@ -16,8 +16,8 @@ from shipgym_baselines.leaderboard.ranking import (
     performance_profiles,
     resolution,
     scenario_scores,
-    scored_episodes,
 )
+from shipgym_baselines.leaderboard.scores import scored_episodes
 
 ORACLE_COST = 100.0
 KINDS = {"oracle": "reference", "zero_rudder": "reference", "agent": "learned"}
@@ -223,8 +223,8 @@ def test_an_episode_without_a_finite_cost_moves_its_scenario_to_the_partial_tabl
 def test_without_pid_los_no_row_claims_a_comparison_with_it() -> None:
     """pid_los not ranked: every row's probability of improvement over it is None, and
     leaderboard.md's and the page's tables drop the column."""
-    from shipgym_baselines.leaderboard import ranking_tables
-    from shipgym_baselines.leaderboard.page import ranking_tables as page_tables
+    from shipgym_baselines.leaderboard.markdown import ranking_tables
+    from shipgym_baselines.leaderboard.page_sections import ranking_tables as page_tables
 
     eps = _episodes({"nmpc": [1.1] * 3, "lqr": [1.3] * 3})
     rows = aggregate_ranking(eps, {"a": "catalogue", "b": "catalogue"}, reps=100)

@@ -38,7 +38,7 @@ def test_a_scenario_falls_in_its_split(scenario: str, own: tuple[str, ...], spli
 def test_the_unseen_hull_scenarios_are_those_on_an_unseen_hull() -> None:
     """A run's scenarios on the KVLCC2 (shipgym.models.UNSEEN_HULLS), read from their
     recorded settings, whatever their name."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     settings = {
         name: load_scenario(name).config.model_dump(mode="json")

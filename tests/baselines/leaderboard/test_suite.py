@@ -8,9 +8,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shipgym.config import list_names
+from shipgym.config import ConfigError, list_names
 from shipgym.limits import MAX_SUITE_SCENARIOS
-from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.leaderboard.suite import SuiteConfig, list_suites, load_suite
 
 
@@ -48,7 +47,7 @@ def test_default_suite_holds_the_matrix_and_two_held_out_scenarios_a_ship() -> N
     blanke_current_shift_curved keeps the family), Liu et al.'s four nomoto2 scenarios and
     their smooth variants, the five KVLCC2 scenarios of the unseen-hull split, and the
     held-out scenarios heldout:0-7 (two on each ship)."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
     from shipgym_baselines.studies.change_effect import matrix_scenarios
 
     default = load_suite("default")
@@ -99,7 +98,7 @@ def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
     """quick: 3 seeds, the default suite's controllers (and Liu et al.'s three identifier
     rows the default leaves out) and trials, 12 scenarios = 4 ships × (rudder aging,
     current shift, manoeuvrability change)."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     quick, default = load_suite("quick"), load_suite("default")
     assert quick.seeds == 3 and quick.heldout_scenarios == 0

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.cli import main
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.leaderboard.summary import readme_table, run_summary
 from shipgym_baselines.leaderboard.verdict import folder_verdict
 from shipgym_baselines.records.episodes import read_episodes

@@ -86,8 +86,11 @@ def test_validation_trials_are_fixed_and_never_heldout() -> None:
 
 
 def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
-    from shipgym_baselines.leaderboard.figures import LEARNING_CURVES_STEM, plot_learning_curves
-    from shipgym_baselines.leaderboard.page import figure_sections
+    from shipgym_baselines.leaderboard.curve_figures import (
+        LEARNING_CURVES_STEM,
+        plot_learning_curves,
+    )
+    from shipgym_baselines.leaderboard.page_figures import figure_sections
     from shipgym_baselines.learned.curves import agent_curves
 
     root = tmp_path / "policies"

@@ -18,13 +18,14 @@ import pytest
 import yaml
 
 import shipgym  # noqa: F401  (registers the envs)
+from shipgym.config import ConfigError
 from shipgym.envs import core
-from shipgym_baselines.errors import ConfigError
 from shipgym_baselines.evaluation import evaluate, evaluate_batch
 from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
 from shipgym_baselines.learned.curves import CURVE_KEYS, load_curve
 from shipgym_baselines.learned.dagger import ROUND_KEYS, load_student, student_state
-from shipgym_baselines.learned.dagger_agent import RUN_DIR, finished, settings, train_dagger
+from shipgym_baselines.learned.dagger_agent import RUN_DIR, finished, train_dagger
+from shipgym_baselines.learned.dagger_config import settings
 from shipgym_baselines.learned.loading import load_data_only
 from shipgym_baselines.learned.policy import LearnedPolicy, read_policy
 from shipgym_baselines.learned.train import POLICY_FILES, ship_policy

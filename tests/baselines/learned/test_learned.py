@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 import shipgym
-from shipgym.scenarios import ScenarioError, load_scenario
+from shipgym.scenarios.loader import ScenarioError, load_scenario
 from shipgym.scenarios.sampling import (
     DistributionError,
     load_distribution,
@@ -21,7 +21,8 @@ from shipgym.scenarios.sampling import (
     train_scenario_seed,
 )
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from shipgym_baselines.leaderboard import run_job, run_leaderboard
+from shipgym_baselines.leaderboard.jobs import run_job
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
 from shipgym_baselines.learned.policy import LearnedPolicy
 from shipgym_baselines.learned.train import export_policy, latest_checkpoint, train

@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from shipgym_baselines.jsonout import dumps
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 
 TINY = {
     "name": "tiny",

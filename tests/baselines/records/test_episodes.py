@@ -12,7 +12,7 @@ import pytest
 
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.records.episodes import episode_key, read_episodes
 from shipgym_baselines.records.runrecord import read_run
 from tests.baselines.conftest import SMOKE_CONTROLLERS, copy_folder

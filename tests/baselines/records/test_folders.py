@@ -13,7 +13,7 @@ import pytest
 
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.folders import check_out_dir, clear_outputs
 from shipgym_baselines.records.manifest import snapshot
@@ -101,7 +101,8 @@ def test_finding4_report_force_deletes_only_its_listed_outputs(
 
 
 def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
-    from shipgym_baselines.learned.train import TRAINING_OUTPUTS, train
+    from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS
+    from shipgym_baselines.learned.train import train
 
     out = tmp_path / "agent"
     out.mkdir()

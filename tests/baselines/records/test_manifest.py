@@ -109,7 +109,8 @@ def test_a_file_added_during_the_figures_stage_is_not_the_runs(
 ) -> None:
     """A user's file that appears while the tables and figures are drawn is not listed in
     the manifest, and the next ``--force`` refuses to delete it (naming it)."""
-    from shipgym_baselines.leaderboard import figures, run_leaderboard
+    from shipgym_baselines.leaderboard import figures
+    from shipgym_baselines.leaderboard.run import run_leaderboard
 
     out = copy_folder(smoke_run, tmp_path / "out")
     draw = figures.plot_scenarios

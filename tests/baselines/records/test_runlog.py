@@ -19,7 +19,7 @@ import pytest
 import shipgym_baselines.leaderboard.jobs
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError, RunFailed
-from shipgym_baselines.leaderboard import run_leaderboard
+from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runlog import RunInterrupted
 from shipgym_baselines.records.runrecord import read_run

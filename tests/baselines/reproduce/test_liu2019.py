@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from shipgym_baselines.reproduce.liu2019 import markdown, run_experiment
-from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED
+from shipgym_baselines.reproduce.liu2019 import markdown
+from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED, run_experiment
 
 #: the paper-literal ACE [m] (si reading, 1 seed) as recorded before the SVF front end:
 #: the extension must not move them.  Bit for bit on the recording machine; to

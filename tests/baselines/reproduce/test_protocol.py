@@ -9,8 +9,9 @@ import math
 import pytest
 
 from shipgym_baselines.cli import build_parser
-from shipgym_baselines.reproduce import PAPERS, Outcome, Reproduction, borkowski2018
+from shipgym_baselines.reproduce import PAPERS, borkowski2018
 from shipgym_baselines.reproduce.borkowski2018.claims import case_claims
+from shipgym_baselines.reproduce.protocol import Outcome, Reproduction
 from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
 from shipgym_baselines.reproduce.rows import reproduction_row
 
@@ -102,7 +103,7 @@ def test_a_paper_report_of_known_rows() -> None:
 def test_borkowski_keeps_the_papers_1000_s_runs() -> None:
     """mariner_track's time limit lets a controller finish the route; the reproduction still
     cuts the episode at the paper's 1000 s (its J is over those)."""
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     assert borkowski2018.build_scenario().config.time_limit == 1000.0
     assert load_scenario("mariner_track").config.time_limit > 1000.0

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
 from shipgym_baselines.studies.change_effect import (

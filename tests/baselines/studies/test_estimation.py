@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.studies.estimation import SETTLED_L, play, summary
 
 

@@ -171,7 +171,7 @@ def test_chosen_settings_reach_the_default_construction(
     settings win); preset='paper' ignores it; a ship without a section keeps the paper's
     design."""
     from shipgym.envs.context import ControllerContext
-    from shipgym.scenarios import load_scenario
+    from shipgym.scenarios.loader import load_scenario
 
     chosen.write_chosen("pid_los", "nomoto2", {"natural_frequency_T": 2.9}, {}, tmp_path)
     monkeypatch.setattr(chosen_reader, "chosen_dir", lambda: tmp_path)  # the reader's folder
@@ -181,7 +181,7 @@ def test_chosen_settings_reach_the_default_construction(
         tuned, paper = PIDLOS(), PIDLOS(preset="paper")
         tuned.reset(ctx)
         paper.reset(ctx)
-        from shipgym.identification import first_order_nomoto
+        from shipgym.identification.nominal import first_order_nomoto
 
         _, T = first_order_nomoto(ctx.nominal_model)
         assert tuned.gains.kp == pytest.approx(paper.gains.kp * (2.9 / T) ** 2)

@@ -18,7 +18,7 @@ from gymnasium.utils.env_match import check_environments_match
 
 import shipgym
 from shipgym.envs.vector import ShipPathFollowVectorEnv
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from tests.shipgym.envs.spawn_worker import make_and_step
 
 SHIP_IDS = sorted(shipgym.ENV_IDS)

@@ -13,8 +13,7 @@ import shipgym
 from shipgym.envs import core
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.envs.vector import ShipPathFollowVectorEnv
-from shipgym.scenarios import load_scenario
-from shipgym.scenarios.loader import nominal_nomoto
+from shipgym.scenarios.loader import load_scenario, nominal_nomoto
 from shipgym.scenarios.sampling import load_distribution, train_rng
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from shipgym.envs import core
 from shipgym.numerics import ARRAY, SCALAR
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.tracking import TrackFrame
 
 K = core.StepConstants.of(load_scenario("nominal"))

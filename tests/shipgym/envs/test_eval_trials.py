@@ -16,7 +16,7 @@ from shipgym.envs.eval_trials import (
     lockstep_problem,
 )
 from shipgym.envs.path_follow import ShipPathFollowEnv
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 
 SEEDS = [10_000, 10_001, 10_002]
 

@@ -17,7 +17,7 @@ from shipgym.envs.randomized import ShipPathFollowRandomizedEnv
 from shipgym.envs.ship_batch import ShipTrialsVectorEnv
 from shipgym.envs.vector import ShipPathFollowVectorEnv
 from shipgym.limits import MAX_HISTORY_STEPS
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.sampling import train_scenario_seed
 
 N = 3

@@ -15,7 +15,7 @@ from gymnasium.utils.env_checker import check_env as gym_check_env
 
 import shipgym  # registers the environments
 from shipgym.envs import core
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("ShipPathFollow"))
 MODES = ("rudder", "guidance")

@@ -11,7 +11,7 @@ import pytest
 
 from shipgym.envs import row_tracking
 from shipgym.envs.row_tracking import RouteGroups, route_key
-from shipgym.scenarios import Scenario, load_scenario
+from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.tracking import PathTracker, TrackFrame
 
 FIELDS = [f.name for f in dataclasses.fields(TrackFrame)]

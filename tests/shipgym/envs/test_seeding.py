@@ -15,8 +15,7 @@ from gymnasium.utils.env_checker import check_env
 import shipgym
 from shipgym.envs import core
 from shipgym.envs.path_follow import ShipPathFollowEnv
-from shipgym.scenarios import load_scenario
-from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.loader import build_scenario, load_scenario
 from shipgym.scenarios.sampling import load_distribution
 from shipgym.scenarios.trials import env_randomization
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 
 
 def _run_to(env: gym.Env, t: float) -> None:

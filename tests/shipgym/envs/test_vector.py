@@ -8,8 +8,7 @@ import pytest
 
 import shipgym  # noqa: F401
 from shipgym.envs.vector import ShipPathFollowVectorEnv
-from shipgym.scenarios import Scenario, load_scenario
-from shipgym.scenarios.loader import scenario_from_dict
+from shipgym.scenarios.loader import Scenario, load_scenario, scenario_from_dict
 
 N = 4
 

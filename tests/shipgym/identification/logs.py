@@ -8,8 +8,8 @@ import numpy as np
 
 from shipgym.disturbance_config import SensorConfig
 from shipgym.disturbances import SensorModel
-from shipgym.models import Nomoto2, Nomoto2Params
 from shipgym.models.integrator import PeriodIntegrator
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
 
 #: the fine sampling step of the nomoto2 scenarios [s]
 H = 0.01

@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from shipgym.identification.cubic_damping import fit_cubic_damping, ship_cubic_damping
-from shipgym.models import Nomoto2, Nomoto2Params
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
 
 K, T, H = 0.3, 4.0, 0.01  # [1/s], [s], [s]
 

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.adaptation import QUANTITIES, Adaptation
 from shipgym.identification.ekf import FilterSettings, ShipEKF, full_rudder_bias
+from shipgym.identification.nominal import first_order_nomoto
 from shipgym.identification.servo import ServoFit, servo_constants, servo_step
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change

@@ -9,17 +9,15 @@ import numpy as np
 import pytest
 from scipy.signal import cont2discrete
 
-from shipgym.identification import (
+from shipgym.identification.errors import IdentificationError
+from shipgym.identification.front_end import (
     FrontEndSettings,
     HampelFilter,
-    IdentificationError,
     StateVariableFilter,
-    fit_nomoto2,
-    nomoto_regressors,
-    regression_rows,
+    difference_signals,
 )
-from shipgym.identification.front_end import difference_signals
-from shipgym.models import Nomoto2Params
+from shipgym.identification.nomoto import fit_nomoto2, nomoto_regressors, regression_rows
+from shipgym.models.nomoto2 import Nomoto2Params
 from tests.shipgym.identification.logs import H, measured_heading, simulate
 
 

@@ -7,25 +7,20 @@ import math
 import numpy as np
 import pytest
 
-from shipgym.identification import (
-    ContinuousLeastSquares,
-    IdentificationError,
-    LambdaLSSVM,
-    PersistentExcitation,
-    WeightedLSSVMOnline,
-    fit_nomoto2,
-    fit_nomoto_zigzag,
-    forward_difference,
+from shipgym.identification.continuous_ls import ContinuousLeastSquares
+from shipgym.identification.errors import IdentificationError
+from shipgym.identification.front_end import forward_difference
+from shipgym.identification.lssvm import (
+    _quantiles,
     lssvm_dual,
     lssvm_primal,
-    params_from_theta1,
     robust_weights,
-    theta1_from_params,
     weighted_lssvm,
-    zigzag_nomoto,
 )
-from shipgym.identification.lssvm import _quantiles
-from shipgym.models import Nomoto2, Nomoto2Params
+from shipgym.identification.nomoto import fit_nomoto2, params_from_theta1, theta1_from_params
+from shipgym.identification.online import LambdaLSSVM, PersistentExcitation, WeightedLSSVMOnline
+from shipgym.identification.zigzag import fit_nomoto_zigzag, zigzag_nomoto
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
 from tests.shipgym.identification.logs import H, simulate
 
 

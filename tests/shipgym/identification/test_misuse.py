@@ -7,9 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shipgym.identification import IdentificationError, LambdaLSSVM, fit_nomoto2
-from shipgym.identification.errors import minimum_samples
-from shipgym.models import Nomoto2Params
+from shipgym.identification.errors import IdentificationError, minimum_samples
+from shipgym.identification.nomoto import fit_nomoto2
+from shipgym.identification.online import LambdaLSSVM
+from shipgym.models.nomoto2 import Nomoto2Params
 from tests.shipgym.identification.logs import H, simulate
 
 

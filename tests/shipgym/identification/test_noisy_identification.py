@@ -7,13 +7,10 @@ import math
 
 import pytest
 
-from shipgym.identification import (
-    IdentificationError,
-    LambdaLSSVM,
-    WeightedLSSVMOnline,
-    fit_nomoto2,
-)
-from shipgym.models import Nomoto2Params
+from shipgym.identification.errors import IdentificationError
+from shipgym.identification.nomoto import fit_nomoto2
+from shipgym.identification.online import LambdaLSSVM, WeightedLSSVMOnline
+from shipgym.models.nomoto2 import Nomoto2Params
 from tests.shipgym.identification.logs import H, measured_heading, simulate
 
 #: a ship unlike the paper's (slower, larger gain, other servo and bias)

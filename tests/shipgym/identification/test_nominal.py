@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from shipgym.identification import first_order_nomoto, second_order_nomoto
+from shipgym.identification.nominal import first_order_nomoto, second_order_nomoto
 from shipgym.identification.zigzag import ship_nomoto
-from shipgym.models import MODELS, Nomoto2, ParameterError
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
+from shipgym.models.nomoto2 import Nomoto2
 
 
 def test_nomoto2_nominal_model_is_its_own_closed_form() -> None:

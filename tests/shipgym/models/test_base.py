@@ -14,16 +14,17 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from shipgym.models import (
-    MODELS,
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
+from shipgym.models.integrator import PeriodIntegrator
+from shipgym.models.nomoto2 import (
     Nomoto2,
     Nomoto2Params,
-    ParameterError,
     UnitReading,
+    paper_to_si,
     params_from_paper,
+    si_to_paper,
 )
-from shipgym.models.integrator import PeriodIntegrator
-from shipgym.models.nomoto2 import paper_to_si, si_to_paper
 
 DEG = math.pi / 180.0
 H = 0.01  # fine step [s] (Liu et al. 2019 §4)

@@ -16,11 +16,14 @@ import math
 import numpy as np
 import pytest
 
-from shipgym.identification import IdentificationError, fit_blanke
-from shipgym.identification.blanke import simulate_commands
+from shipgym.identification.blanke import fit_blanke, simulate_commands
+from shipgym.identification.errors import IdentificationError
 from shipgym.manoeuvres import turning_circle, zigzag
-from shipgym.models import MODELS, Blanke, BlankeParams, ParameterError
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
 from shipgym.models.blanke import (
+    Blanke,
+    BlankeParams,
     BlankeRegression,
     regression_coefficients,
 )
@@ -259,7 +262,7 @@ def test_fit_rejects_bad_data():
 def test_reproduce_returns_the_documented_rows(tmp_path):
     from shipgym_baselines.cli import build_parser
     from shipgym_baselines.reproduce import PAPERS
-    from shipgym_baselines.reproduce.morenosalinas2013 import PUBLISHED, SIGNALS
+    from shipgym_baselines.reproduce.morenosalinas2013.experiment import PUBLISHED, SIGNALS
 
     module = PAPERS["morenosalinas2013"]
     assert build_parser().parse_args(["reproduce", "morenosalinas2013"]).paper == (

@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from shipgym.manoeuvres import turning_circle
-from shipgym.models import MODELS, EssoOsaka, EssoOsakaParams, ParameterError
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
+from shipgym.models.esso_osaka import EssoOsaka, EssoOsakaParams
 from shipgym.models.integrator import PeriodIntegrator
 
 DEG = math.pi / 180.0

@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 from shipgym.manoeuvres import turning_circle, zigzag
-from shipgym.models import KVLCC2, MODELS, KVLCC2Params, ParameterError
-from shipgym.models.kvlcc2 import FULL_SCALE, full_scale
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
+from shipgym.models.kvlcc2 import FULL_SCALE, KVLCC2, KVLCC2Params, full_scale
 
 DEG = math.pi / 180.0
 

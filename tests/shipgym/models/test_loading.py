@@ -7,7 +7,8 @@ import math
 
 import pytest
 
-from shipgym.models import MODELS, ShipModel
+from shipgym.models import MODELS
+from shipgym.models.base import ShipModel
 from shipgym.models.hull import Hull, clarke_derivatives, draught_factors
 from shipgym.models.loading import HULLS, loading_change
 

@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 from shipgym.manoeuvres import ManoeuvreError, turning_circle, zigzag
-from shipgym.models import MODELS, Mariner, MarinerParams, ParameterError
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
 from shipgym.models.integrator import PeriodIntegrator
+from shipgym.models.mariner import Mariner, MarinerParams
 
 DEG = math.pi / 180.0
 R_MAX = 0.0191  # rad/s, Borkowski (2018) §5

@@ -11,7 +11,7 @@ import pytest
 import shipgym  # noqa: F401
 from shipgym.identification.zigzag import ship_nomoto
 from shipgym.models import MODELS
-from shipgym.scenarios import load_scenario, scenario_from_dict
+from shipgym.scenarios.loader import load_scenario, scenario_from_dict
 
 SHIP_IDS = {
     "nomoto2": "ShipPathFollow-v0",

@@ -15,8 +15,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from shipgym.scenarios import list_scenarios
-from shipgym.scenarios.loader import catalogue_dir
+from shipgym.scenarios.loader import catalogue_dir, list_scenarios
 
 
 def _leaves(data: Any, path: tuple = ()) -> Iterator[tuple[tuple, float]]:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shipgym.models import Nomoto2Params, ParameterError
+from shipgym.models.base import ParameterError
+from shipgym.models.nomoto2 import Nomoto2Params
 from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
 
 NOMINAL = Nomoto2Params()  # Tc = 0.1 s, K = 0.506 1/s

@@ -16,9 +16,9 @@ from gymnasium.utils.env_checker import check_env
 
 import shipgym
 from shipgym.identification.zigzag import ship_nomoto
-from shipgym.models import KVLCC2Params
+from shipgym.models.kvlcc2 import KVLCC2Params
 from shipgym.models.loading import loading_change
-from shipgym.scenarios import list_scenarios, load_scenario
+from shipgym.scenarios.loader import list_scenarios, load_scenario
 
 SCENARIOS = (
     "kvlcc2_nominal",

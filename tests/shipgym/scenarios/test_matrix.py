@@ -16,7 +16,7 @@ import pytest
 import shipgym
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
-from shipgym.scenarios import list_scenarios, load_scenario
+from shipgym.scenarios.loader import list_scenarios, load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
 

@@ -8,14 +8,14 @@ from typing import Any
 import pytest
 import yaml
 
-from shipgym.scenarios import (
+from shipgym.disturbance_config import SensorConfig
+from shipgym.scenarios.loader import (
     ScenarioError,
     catalogue_dir,
     list_scenarios,
     load_scenario,
     scenario_from_dict,
 )
-from shipgym.scenarios.schema import SensorConfig
 
 NOMOTO = [n for n in list_scenarios() if load_scenario(n).model.name == "nomoto2"]
 

@@ -15,8 +15,7 @@ import yaml
 
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
-from shipgym.scenarios import ScenarioError, list_scenarios, load_scenario
-from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.loader import ScenarioError, build_scenario, list_scenarios, load_scenario
 from shipgym.scenarios.sampling import (
     DistributionConfig,
     DistributionError,

@@ -12,10 +12,9 @@ import pytest
 import yaml
 
 import shipgym  # noqa: F401  (registers the environments)
-from shipgym.models import Nomoto2Params
-from shipgym.scenarios import (
-    ParameterEvent,
-    ParameterSchedule,
+from shipgym.models.nomoto2 import Nomoto2Params
+from shipgym.scenarios.events import ParameterEvent, ParameterSchedule
+from shipgym.scenarios.loader import (
     Scenario,
     ScenarioError,
     catalogue_dir,
@@ -306,7 +305,7 @@ def test_off_grid_event_acts_at_its_substep() -> None:
 
 def test_ramp_event_through_the_env_matches_an_independent_simulation() -> None:
     """The env applies the schedule per substep (during the ramp and after it)."""
-    from shipgym.models import Nomoto2
+    from shipgym.models.nomoto2 import Nomoto2
 
     events = [{"time": 3.0, "kind": "ramp", "duration": 2.2, "params": {"Tc": 0.8, "K": 1.5}}]
     sc = scenario_from_dict(minimal_config(time_limit=10.0, events=events))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from shipgym.paths import segment_frame
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import (
     TRIAL_STREAM,
     TrialRandomization,

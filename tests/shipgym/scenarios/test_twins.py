@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym.scenarios.twins import has_change, nominal_twin, same_trial
 

@@ -12,8 +12,7 @@ import pytest
 import yaml
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.scenarios import ScenarioError
-from shipgym.scenarios.loader import catalogue_dir, check_scenario_file
+from shipgym.scenarios.loader import ScenarioError, catalogue_dir, check_scenario_file
 from shipgym_baselines.cli import main
 from tests.shipgym.scenarios.fuzz import write_fuzzed
 

@@ -11,9 +11,18 @@ from typing import Any
 import pytest
 import yaml
 
-from shipgym.models import MODELS, Nomoto2Params, ParameterError
-from shipgym.scenarios import ScenarioError, list_scenarios, load_scenario, scenario_from_dict
-from shipgym.scenarios.loader import Problem, check_scenario_file, yaml_line
+from shipgym.models import MODELS
+from shipgym.models.base import ParameterError
+from shipgym.models.nomoto2 import Nomoto2Params
+from shipgym.scenarios.loader import (
+    Problem,
+    ScenarioError,
+    check_scenario_file,
+    list_scenarios,
+    load_scenario,
+    scenario_from_dict,
+    yaml_line,
+)
 
 
 def config(**overrides: Any) -> dict[str, Any]:

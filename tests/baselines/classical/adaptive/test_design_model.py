@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from shipgym.identification import first_order_nomoto
 from shipgym.identification.cubic_damping import ship_cubic_damping
-from shipgym.models import MODELS, Nomoto2, Nomoto2Params
+from shipgym.identification.nominal import first_order_nomoto
+from shipgym.models import MODELS
+from shipgym.models.nomoto2 import Nomoto2, Nomoto2Params
 from shipgym_baselines.classical.adaptive.design_model import NonlinearNomoto, nominal_design_model
 
 

@@ -14,7 +14,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs.context import ControllerContext
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.envs.truth import PlantTruth
-from shipgym.scenarios import load_scenario
+from shipgym.scenarios.loader import load_scenario
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.learned.plant_id.controller import NmpcLearnedId
