@@ -21,6 +21,7 @@ from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.jsonout import dumps, dumps_rows
+from shipgym_baselines.leaderboard import curve_figures, ranking_figures, scenario_figures
 from shipgym_baselines.leaderboard.change_share import (
     NO_SCENARIO_CELLS,
     episode_costs,
@@ -101,7 +102,7 @@ def write_results(
     :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
     vector copy too (the page shows the PNGs).
     """
-    from shipgym_baselines.leaderboard import figures, page
+    from shipgym_baselines.leaderboard import page
 
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
     results = sorted(results, key=_order)
@@ -117,7 +118,7 @@ def write_results(
         notice(tables_line(len(splits), workers or os.cpu_count() or 1))
     for line in refused_trials(episodes):  # a reference's failure: never a denominator
         notice(line)
-    drawn = figures.episodes_to_draw([r for r in results if r.scenario in splits])
+    drawn = scenario_figures.episodes_to_draw([r for r in results if r.scenario in splits])
     shown = sorted({scenario for scenario, _ in drawn})
     with _pool(workers or os.cpu_count() or 1, len(shown)) as pool:
         boards = [
@@ -132,7 +133,7 @@ def write_results(
         ]
         plots = {
             scenario: pool.submit(
-                carried(figures.plot_scenarios),
+                carried(scenario_figures.plot_scenarios),
                 out,
                 {key: ep for key, ep in drawn.items() if key[0] == scenario},
                 suite["scenarios"],
@@ -147,7 +148,7 @@ def write_results(
         )
         ranking_plots = [
             pool.submit(
-                carried(figures.plot_ranking),
+                carried(ranking_figures.plot_ranking),
                 out,
                 [r for r in board if r["split"].removesuffix(PARTIAL) == split],
                 shown_episodes,
@@ -190,7 +191,7 @@ def write_results(
         write_tables(rows, out, head=head)
         files = [f for future in ranking_plots for f in future.result()]
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
-        files += figures.plot_learning_curves(out, curves, vector_figures)
+        files += curve_figures.plot_learning_curves(out, curves, vector_figures)
     lead = verdict(board, shown_episodes, plain_name, headroom)
     page.write_html(
         out,

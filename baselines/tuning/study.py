@@ -51,6 +51,7 @@ from typing import Any
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.executor import RaySetup, check_backend, map_jobs
+from shipgym_baselines.records import chosen as chosen_records
 from shipgym_baselines.records.locking import file_lock, out_lock
 from shipgym_baselines.records.manifest import Manifest
 from shipgym_baselines.records.outfiles import check_no_links, refuse_special, write_text
@@ -92,7 +93,7 @@ class StudyPlan:
 
     @property
     def section(self) -> str:
-        return self.ship or chosen_settings.ALL_SHIPS
+        return self.ship or chosen_records.ALL_SHIPS
 
 
 def plan_studies(
@@ -114,7 +115,7 @@ def plan_studies(
             "give one of them"
         )
     if promote:
-        chosen = chosen_settings.chosen_dir()
+        chosen = chosen_records.chosen_dir()
     else:
         chosen = Path(chosen_dir) if chosen_dir is not None else base / CHOSEN_FOLDER
     if not config.per_ship:
@@ -596,7 +597,7 @@ def write_chosen(
     file = chosen_settings.chosen_file(controller, plan.chosen_dir)
     where = f"{file} [{plan.section}]"
     block["file"] = str(file)
-    held = chosen_settings.section_record(controller, plan.section, plan.chosen_dir)
+    held = chosen_records.section_record(controller, plan.section, plan.chosen_dir)
     if held is not None:
         incumbent = block["incumbent"] = _incumbent(plan, scorer, held, progress)
         c = incumbent["comparison"] = promotion.compare(ratios, incumbent.pop("ratios"))

@@ -15,8 +15,8 @@ import os
 from typing import Any
 
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.records import chosen
 from shipgym_baselines.records.chosen import ALL_SHIPS, chosen_file, read_chosen
-from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning.learned import apply_overrides
 from shipgym_baselines.tuning.space import TuningConfig, TuningError, load_tuning
 
@@ -73,7 +73,7 @@ def tuned_agent(
     study = (document.get("studies") or {}).get(ALL_SHIPS) or {}
     # the packaged file by its path in the repository (a record that does not name the
     # machine it was trained on), another folder's as given
-    packaged = file.parent == chosen_settings.chosen_dir()
+    packaged = file.parent == chosen.chosen_dir()
     shown = f"configs/tuning/chosen/{file.name}" if packaged else str(file)
     tuned_from = {
         "chosen": shown,

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 import yaml
 
-import shipgym_baselines.classical.l1_backstepping as l1
 from shipgym.envs.context import ControllerContext
 from shipgym.metrics import high_frequency_power
 from shipgym.scenarios.loader import catalogue_dir, scenario_from_dict
@@ -26,31 +25,6 @@ def _context(scenario: str, **make_kwargs: object) -> ControllerContext:
         return env.unwrapped.controller_context
     finally:
         env.close()
-
-
-def test_the_parts_stay_importable_from_the_controller_module() -> None:
-    """The names the reproduction code imports from l1_backstepping are the parts' own."""
-    from shipgym import guidance, metrics
-    from shipgym.identification import cubic_damping
-    from shipgym_baselines.classical.adaptive import (
-        design_model,
-        loop_analysis,
-        lowpass,
-        predictor,
-        projection,
-        settings,
-    )
-
-    assert l1.Gains is settings.Gains
-    assert l1.L1BacksteppingSettings is settings.L1BacksteppingSettings
-    assert l1.nominal_design_model is design_model.nominal_design_model
-    assert l1.linearised_closed_loop_poles is loop_analysis.linearised_closed_loop_poles
-    assert l1.high_frequency_power is metrics.high_frequency_power
-    assert l1.SecondOrderLowPass is lowpass.SecondOrderLowPass
-    assert l1.StatePredictor is predictor.StatePredictor
-    assert l1.projection is projection.projection
-    assert l1.tvvf_heading_derivatives is guidance.tvvf_heading_derivatives
-    assert l1.cubic_damping_from_zigzag is cubic_damping.ship_cubic_damping
 
 
 def test_closed_loop_bias_estimate_stays_bounded_when_the_bias_exceeds_the_rudder() -> None:

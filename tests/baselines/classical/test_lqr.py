@@ -26,6 +26,7 @@ from shipgym_baselines.classical.lqr import (
 from shipgym_baselines.cli import build_parser
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.reproduce import PAPERS, borkowski2018
+from shipgym_baselines.reproduce.borkowski2018 import experiment, quality_index
 
 PAPER = LQRWeights()  # λy = 1/2000, λψ = 1, λδ = 5 (Borkowski 2018 §5)
 MARINER = MarinerParams()
@@ -223,7 +224,7 @@ def test_reproduction_rows_and_J_replay(tmp_path) -> None:  # type: ignore[no-un
     for row in rows:
         assert {"case", "controller", "metric", "ours", "paper"} <= row.keys()
     index = {(r["case"], r["controller"], r["metric"]): r["ours"] for r in rows}
-    case = borkowski2018.case_name(0.02, 0.002)
+    case = experiment.case_name(0.02, 0.002)
     ratio = index[(case, "adaptive_lqr", "J_ratio")]
     assert ratio == pytest.approx(
         index[(case, "adaptive_lqr", "J")] / index[(case, "lqr", "J")], rel=1e-12
@@ -235,7 +236,7 @@ def test_reproduction_rows_and_J_replay(tmp_path) -> None:  # type: ignore[no-un
     data["time_limit"] = 150.0
     scenario = scenario_from_dict(data)
     result = run_episode(LQR(preset="paper"), scenario, 10_000)
-    J_t = borkowski2018.cumulative_J(scenario, result.trajectory, scenario.control_period)
+    J_t = quality_index.cumulative_J(scenario, result.trajectory, scenario.control_period)
     assert J_t[-1] == pytest.approx(result.metrics["J"], rel=1e-9)
     assert J_t[-1] == pytest.approx(index[(case, "lqr", "J")], rel=1e-9)
 

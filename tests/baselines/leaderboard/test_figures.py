@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from shipgym_baselines.leaderboard import figures
+from shipgym_baselines.leaderboard import ranking_figures
 from shipgym_baselines.leaderboard.figure_files import (
     LEGEND_KEY,
     LEGEND_TOP_KEY,
@@ -252,7 +252,7 @@ def test_the_ranking_figure_marks_the_frozen_optimum(tmp_path: Path) -> None:
     assert {r["controller"] for r in aggregate} == {"pid_los", "lqr"}
     files = plot_ranking(tmp_path, aggregate, episodes, splits, vector=True)
     ratios = np.array([(24.0 + k) / (8.0 + k) for k in (1, 2, 0)] * 2)  # seeds 10000-10002
-    marks = figures.frozen_marks(ratios)
+    marks = ranking_figures.frozen_marks(ratios)
     assert marks["cost_ratio_gmean"] == pytest.approx(np.exp(np.mean(np.log(ratios))))
     text = svg_text(files[1])
     for key in ("cost_ratio_iqm", "cost_ratio_gmean"):

@@ -175,7 +175,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
 ) -> None:
     """A run that selects on the validation cost ratio is drawn on it (log axis, the oracle
     at 1, each seed's best point ringed); one without it on its return."""
-    from shipgym_baselines.leaderboard import curve_figures, figures
+    from shipgym_baselines.leaderboard import curve_figures
 
     drawn = {}
 
@@ -189,7 +189,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
         "dagger": [{**ratio, "selection": [5.0, 2.0, 2.5], "seed": 0}],
         "ppo": [{**ratio, "seed": 0}],
     }
-    figures.plot_learning_curves(tmp_path, curves, stem="mine")
+    curve_figures.plot_learning_curves(tmp_path, curves, stem="mine")
     by_cost, by_return = drawn["mine"].axes[:2]
     assert by_cost.get_yscale() == "log" and by_return.get_yscale() == "linear"
     assert by_cost.get_ylabel() == "validation cost / oracle's"

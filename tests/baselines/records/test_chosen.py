@@ -30,11 +30,6 @@ def test_the_ship_section_else_the_all_section(
         chosen.packaged_chosen.cache_clear()
 
 
-def test_the_reader_stays_importable_from_tuning() -> None:
-    for name in ("ALL_SHIPS", "chosen_dir", "read_chosen", "section_record", "tuned_settings"):
-        assert getattr(tuning_chosen, name) is getattr(chosen, name)
-
-
 @pytest.mark.parametrize("text", ["untouched\n", "ships: [1, 2]\n", "ships: {a: 1\n"])
 def test_a_file_that_is_no_chosen_settings_is_one_line(tmp_path: Path, text: str) -> None:
     from shipgym_baselines.errors import RunError

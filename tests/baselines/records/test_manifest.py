@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.errors import RunError
+from shipgym_baselines.leaderboard import scenario_figures
 from shipgym_baselines.records.locking import LOCK_FILE
 from shipgym_baselines.records.manifest import (
     MANIFEST_FILE,
@@ -109,17 +110,16 @@ def test_a_file_added_during_the_figures_stage_is_not_the_runs(
 ) -> None:
     """A user's file that appears while the tables and figures are drawn is not listed in
     the manifest, and the next ``--force`` refuses to delete it (naming it)."""
-    from shipgym_baselines.leaderboard import figures
     from shipgym_baselines.leaderboard.run import run_leaderboard
 
     out = copy_folder(smoke_run, tmp_path / "out")
-    draw = figures.plot_scenarios
+    draw = scenario_figures.plot_scenarios
 
     def draw_while_the_user_saves(folder: Path, *args: object, **kwargs: object) -> list[Path]:
         (folder / "holiday.png").write_text("a user's")  # saved meanwhile, e.g. by a viewer
         return draw(folder, *args, **kwargs)
 
-    monkeypatch.setattr(figures, "plot_scenarios", draw_while_the_user_saves)
+    monkeypatch.setattr(scenario_figures, "plot_scenarios", draw_while_the_user_saves)
     settings = {"seeds": 1, "controllers": SMOKE_CONTROLLERS, "show_progress": False}
     run_leaderboard("smoke", out_dir=out, resume=True, **settings)  # the tables again
     listed = read_manifest(out)

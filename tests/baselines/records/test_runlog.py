@@ -19,6 +19,7 @@ import pytest
 import shipgym_baselines.leaderboard.jobs
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError, RunFailed
+from shipgym_baselines.leaderboard import scenario_figures
 from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runlog import RunInterrupted
@@ -256,19 +257,18 @@ def test_a_link_planted_while_the_tables_are_written_is_refused(
 ) -> None:
     """A link that appears during the run, as a table the run is about to write: that
     write is refused (the run fails in one line) and the link's target is unchanged."""
-    from shipgym_baselines.leaderboard import figures
 
     notes = tmp_path / "notes.txt"
     notes.write_text("my notes\n")
     out = copy_folder(smoke_run, tmp_path / "out")
-    draw = figures.plot_scenarios
+    draw = scenario_figures.plot_scenarios
 
     def plant_then_draw(folder: Path, *args: object, **kwargs: object) -> list[Path]:
         (folder / "aggregate.json").unlink(missing_ok=True)
         (folder / "aggregate.json").symlink_to(notes)
         return draw(folder, *args, **kwargs)
 
-    monkeypatch.setattr(figures, "plot_scenarios", plant_then_draw)
+    monkeypatch.setattr(scenario_figures, "plot_scenarios", plant_then_draw)
     with pytest.raises(RunError, match=r"aggregate\.json is a symbolic link"):
         run_leaderboard(
             "smoke",

@@ -10,6 +10,7 @@ import pytest
 
 from shipgym_baselines.cli import build_parser
 from shipgym_baselines.reproduce import PAPERS, borkowski2018
+from shipgym_baselines.reproduce.borkowski2018 import experiment
 from shipgym_baselines.reproduce.borkowski2018.claims import case_claims
 from shipgym_baselines.reproduce.protocol import Outcome, Reproduction
 from shipgym_baselines.reproduce.report import cell, index, seeds_of, table
@@ -86,7 +87,7 @@ def test_table_of_known_rows() -> None:
 def test_a_paper_report_of_known_rows() -> None:
     """Borkowski's table line of the paper's initial guess from its rows (the numbers of
     the 1-seed run)."""
-    case = borkowski2018.case_name(*borkowski2018.PAPER_GUESS)
+    case = experiment.case_name(*experiment.PAPER_GUESS)
     figures = {
         ("lqr", "J"): 26512.07,
         ("adaptive_lqr", "J"): 21934.31,
@@ -105,6 +106,6 @@ def test_borkowski_keeps_the_papers_1000_s_runs() -> None:
     cuts the episode at the paper's 1000 s (its J is over those)."""
     from shipgym.scenarios.loader import load_scenario
 
-    assert borkowski2018.build_scenario().config.time_limit == 1000.0
+    assert experiment.build_scenario().config.time_limit == 1000.0
     assert load_scenario("mariner_track").config.time_limit > 1000.0
-    assert borkowski2018.build_scenario(150.0).config.time_limit == 150.0
+    assert experiment.build_scenario(150.0).config.time_limit == 150.0

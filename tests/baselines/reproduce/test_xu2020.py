@@ -13,6 +13,7 @@ from shipgym.models import MODELS
 from shipgym_baselines.cli import build_parser
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.reproduce import PAPERS, xu2020
+from shipgym_baselines.reproduce.xu2020 import controllers, metrics, published, scenarios
 
 pytestmark = pytest.mark.skipif("esso_osaka" not in MODELS, reason="esso_osaka not registered")
 
@@ -36,7 +37,7 @@ def test_short_run_rows_markdown_and_files(tmp_path) -> None:  # type: ignore[no
         assert ROW_KEYS <= row.keys()
         assert row["paper"] is None or isinstance(row["paper"], float)
     assert json.loads((tmp_path / "xu2020.json").read_text()) == rows
-    for case in xu2020.CASES:
+    for case in scenarios.CASES:
         assert (tmp_path / f"xu2020_{case}.png").stat().st_size > 0
     index = {(r["case"], r["controller"], r["metric"], r["setting"], r["gains"]): r for r in rows}
     # Tables 2–3 attached to both readings; Table 2 LOS mean 0.64 m, Table 3 VF std 0.47 m
@@ -64,16 +65,16 @@ def test_short_run_rows_markdown_and_files(tmp_path) -> None:  # type: ignore[no
 
 def test_bad_names() -> None:
     with pytest.raises(ValueError, match="unknown case"):
-        xu2020.build_scenario("zigzag")
+        scenarios.build_scenario("zigzag")
     with pytest.raises(ValueError, match="settings"):
         xu2020.run("/nonexistent", settings=("full_scale",))
 
 
 def test_literal_zigzag_fit_near_the_published_model() -> None:
     """§5.2: K = 0.185 1/s, T1 = 7.8569 s (model scale); ours within 5 % and 10 %."""
-    fit, _ = ship_nomoto(xu2020.build_scenario("straight", "literal").model)
-    assert fit.K == pytest.approx(xu2020.PUBLISHED_NOMOTO["K"], rel=0.05)
-    assert fit.T1 == pytest.approx(xu2020.PUBLISHED_NOMOTO["T1"], rel=0.10)
+    fit, _ = ship_nomoto(scenarios.build_scenario("straight", "literal").model)
+    assert fit.K == pytest.approx(published.PUBLISHED_NOMOTO["K"], rel=0.05)
+    assert fit.T1 == pytest.approx(published.PUBLISHED_NOMOTO["T1"], rel=0.10)
 
 
 def test_steady_leg_offset_and_trim_rudder() -> None:
@@ -86,7 +87,7 @@ def test_steady_leg_offset_and_trim_rudder() -> None:
     * the rudder is the cruise trim (the δ balancing the propeller asymmetry Y0, N0; a
       uniform current exerts no moment), the ≈ 0.8° mean rudder of the tables' signed reading.
     """
-    scenario = xu2020.build_scenario("straight", "literal_no_rate_limit", time_limit=250.0)
+    scenario = scenarios.build_scenario("straight", "literal_no_rate_limit", time_limit=250.0)
     model, g = scenario.model, scenario.config.guidance
     cruise = model.cruise_state()
     u, v = cruise[model.state_index("u")], cruise[model.state_index("v")]
@@ -100,7 +101,7 @@ def test_steady_leg_offset_and_trim_rudder() -> None:
         "pid_lookahead_los": g.lookahead_L * model.length * math.tan(angle),
         "pid_vf": g.vf_tau_L * model.length * angle / math.radians(g.vf_chi_e_deg),
     }
-    for cls in xu2020.CONTROLLERS:
+    for cls in controllers.CONTROLLERS:
         policy = cls()
         result = run_episode(policy, scenario, 10_000)
         tr = result.trajectory
@@ -109,7 +110,7 @@ def test_steady_leg_offset_and_trim_rudder() -> None:
         np.testing.assert_allclose(tr["rudder_angle"][late], trim, atol=math.radians(0.01))
         # the signed figures use the leaderboard metrics' samples (end of each step) and
         # ψd of every step
-        figures = xu2020.episode_figures(result, policy.desired_log)
+        figures = metrics.episode_figures(result, policy.desired_log)
         assert len(policy.desired_log) == result.metrics["steps"]
         assert np.mean(np.abs(tr["cross_track_error"][1:])) == pytest.approx(
             figures["mean_abs_cross_track"], rel=1e-12

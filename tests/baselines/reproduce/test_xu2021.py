@@ -14,6 +14,8 @@ from shipgym_baselines.cli import build_parser
 from shipgym_baselines.evaluation import run_episode
 from shipgym_baselines.jsonout import finite_or_none
 from shipgym_baselines.reproduce import PAPERS, xu2021
+from shipgym_baselines.reproduce.xu2021 import controllers, current, linearised, metrics
+from shipgym_baselines.reproduce.xu2021 import scenario as xu2021_scenario
 
 pytestmark = pytest.mark.skipif("esso_osaka" not in MODELS, reason="esso_osaka not registered")
 
@@ -25,7 +27,7 @@ def short_run(tmp_path_factory):  # type: ignore[no-untyped-def]
     """L1 (filter on the command) and adaptive backstepping over 300 s (switch at 150 s)."""
     out = tmp_path_factory.mktemp("xu2021")
     rows = xu2021.run(
-        out, seeds=1, controllers=(xu2021.L1, xu2021.AB), time_limit=300.0, plot=False
+        out, seeds=1, controllers=(controllers.L1, controllers.AB), time_limit=300.0, plot=False
     )
     return out, rows, {(r["case"], r["controller"], r["metric"]): r for r in rows}
 
@@ -41,17 +43,23 @@ def test_short_run_rows_markdown_and_files(short_run) -> None:  # type: ignore[n
         assert ROW_KEYS <= row.keys()
         assert row["paper"] is None or isinstance(row["paper"], bool | float)
     assert json.loads((out / "xu2021.json").read_text()) == finite_or_none(rows)
-    for phase in xu2021.PHASES:
-        for label in (xu2021.L1, xu2021.AB):
+    for phase in metrics.PHASES:
+        for label in (controllers.L1, controllers.AB):
             assert 0 < index[(phase, label, "ace")]["ours"] < 10.0  # m, inside the corridor
     # the paper has no numbers for §5.2: only its claims and the UGAS statement carry one
-    assert all(r["paper"] is None for r in rows if r["case"] in xu2021.PHASES)
-    assert index[("claims", xu2021.L1, "reaches_goal")]["paper"] is True
-    assert index[("claims", xu2021.L1, "ace_ratio_to_adaptive_backstepping")]["paper"] == 1.0
-    assert index[("linearised", xu2021.L1, "stable")]["paper"] is True
+    assert all(r["paper"] is None for r in rows if r["case"] in metrics.PHASES)
+    assert index[("claims", controllers.L1, "reaches_goal")]["paper"] is True
+    assert index[("claims", controllers.L1, "ace_ratio_to_adaptive_backstepping")]["paper"] == 1.0
+    assert index[("linearised", controllers.L1, "stable")]["paper"] is True
     md = xu2021.markdown(rows)
     assert md == (out / "xu2021.md").read_text()
-    for text in ("**weak_current**", "**strong_current**", "**claims**", xu2021.L1, xu2021.AB):
+    for text in (
+        "**weak_current**",
+        "**strong_current**",
+        "**claims**",
+        controllers.L1,
+        controllers.AB,
+    ):
         assert text in md
     assert "| ACE = mean \\|e\\| [m] |" in md  # pipes escaped inside table cells
 
@@ -59,10 +67,10 @@ def test_short_run_rows_markdown_and_files(short_run) -> None:  # type: ignore[n
 def test_episode_figures_match_the_leaderboard_metrics() -> None:
     """The per-phase figures count the same steps as shipgym.metrics: over the whole
     episode, ACE, mean |ψ̃| and mean |δ| equal the leaderboard's metrics."""
-    scenario = xu2021.build_scenario(120.0)
-    recorder = xu2021.Recorded(AdaptiveBackstepping(preset="paper"), xu2021.AB)
+    scenario = xu2021_scenario.build_scenario(120.0)
+    recorder = controllers.Recorded(AdaptiveBackstepping(preset="paper"), controllers.AB)
     result = run_episode(recorder, scenario, 10_000)
-    fig = xu2021.episode_figures(scenario, result, recorder)["episode"]
+    fig = metrics.episode_figures(scenario, result, recorder)["episode"]
     m = result.metrics
     assert fig["ace"] == pytest.approx(m["ace"], rel=1e-12)
     assert fig["std_abs_e"] == pytest.approx(m["std_abs_cross_track"], rel=1e-12)
@@ -86,7 +94,7 @@ def test_filter_on_the_command_removes_its_high_frequency_content(short_run) -> 
     def ours(label: str, metric: str) -> float:
         return index[("episode", label, metric)]["ours"]
 
-    l1, ab = xu2021.L1, xu2021.AB
+    l1, ab = controllers.L1, controllers.AB
     assert ours(l1, "command_hf1_rms_deg") < 0.2 * ours(ab, "command_hf1_rms_deg")
     assert ours(l1, "command_hf_rms_deg") < 0.8 * ours(ab, "command_hf_rms_deg")
     assert ours(l1, "mean_abs_rudder_rate_deg_s") > 2.0 * ours(ab, "mean_abs_rudder_rate_deg_s")
@@ -97,24 +105,24 @@ def test_linearised_loop_of_the_paper_design(short_run) -> None:
     """With C(s) on the command the loop crosses over near 0.45 rad/s with a negative phase
     margin (−26°) and a right-half-plane pole (+0.070 1/s); without it, it is stable."""
     _, _, index = short_run
-    lin = {m: index[("linearised", xu2021.L1, m)]["ours"] for m in ("crossover", "stable")}
+    lin = {m: index[("linearised", controllers.L1, m)]["ours"] for m in ("crossover", "stable")}
     assert lin["crossover"] == pytest.approx(0.448, abs=0.01)
-    assert index[("linearised", xu2021.L1, "phase_margin_deg")]["ours"] == pytest.approx(
+    assert index[("linearised", controllers.L1, "phase_margin_deg")]["ours"] == pytest.approx(
         -26.3, abs=1.0
     )
-    assert index[("linearised", xu2021.L1, "max_pole_real")]["ours"] == pytest.approx(
+    assert index[("linearised", controllers.L1, "max_pole_real")]["ours"] == pytest.approx(
         0.0703, abs=0.002
     )
     assert lin["stable"] is False
-    assert index[("linearised", xu2021.AB, "stable")]["ours"] is True
+    assert index[("linearised", controllers.AB, "stable")]["ours"] is True
 
 
 def test_loop_margins_of_an_integrator_and_a_first_order_lag() -> None:
     """L = k/s: crossover k, phase margin 90°.  L = k/(s(s + 1)), k = 2: |L(jω)| = 1 at
     ω² = (−1 + √(1 + 4k²))/2 and PM = atan(1/ω)."""
-    wc, pm = xu2021.loop_margins(np.array([3.0]), np.array([1.0, 0.0]))
+    wc, pm = linearised.loop_margins(np.array([3.0]), np.array([1.0, 0.0]))
     assert (wc, pm) == (pytest.approx(3.0, rel=1e-9), pytest.approx(90.0, abs=1e-7))
-    wc, pm = xu2021.loop_margins(np.array([2.0]), np.array([1.0, 1.0, 0.0]))
+    wc, pm = linearised.loop_margins(np.array([2.0]), np.array([1.0, 1.0, 0.0]))
     w = math.sqrt((-1.0 + math.sqrt(17.0)) / 2.0)
     assert wc == pytest.approx(w, rel=1e-9)
     assert pm == pytest.approx(math.degrees(math.atan(1.0 / w)), abs=1e-7)
@@ -123,7 +131,7 @@ def test_loop_margins_of_an_integrator_and_a_first_order_lag() -> None:
 def test_adaptive_filter_placement_with_frozen_estimates_is_adaptive_backstepping() -> None:
     """filter_placement="adaptive" filters only δ − δ_nom: with the adaptation frozen at
     the nominal estimates that share is 0 and the commands equal the unfiltered law's."""
-    scenario = xu2021.build_scenario(60.0)
+    scenario = xu2021_scenario.build_scenario(60.0)
     frozen = {"preset": "paper", "gamma_rho": 0.0, "gamma_sigma": 0.0, "gamma_b": 0.0}
     a = run_episode(L1Backstepping(filter_placement="adaptive", **frozen), scenario, 3)
     b = run_episode(AdaptiveBackstepping(**frozen), scenario, 3)
@@ -139,10 +147,13 @@ def test_current_is_read_from_the_env_log_after_the_episode() -> None:
     (h apart from t = 0, n_sub samples per step), the same under two controllers with one
     seed (its draws do not depend on the actions), from about 0.1 to about 0.2 m/s at the
     switch."""
-    scenario = xu2021.build_scenario(200.0)
+    scenario = xu2021_scenario.build_scenario(200.0)
     logs, results = [], []
-    for policy in (AdaptiveBackstepping(preset="paper"), xu2021.CONTROLLERS[xu2021.PID]()):
-        log = xu2021.DisturbanceLog()
+    for policy in (
+        AdaptiveBackstepping(preset="paper"),
+        controllers.CONTROLLERS[controllers.PID](),
+    ):
+        log = current.DisturbanceLog()
         results.append(run_episode(policy, scenario, 7, after_episode=log.read))
         logs.append(log.episodes[0])
     steps = min(r.metrics["steps"] for r in results)
@@ -153,8 +164,8 @@ def test_current_is_read_from_the_env_log_after_the_episode() -> None:
         assert log["t"].size == result.metrics["steps"] * n_sub
         np.testing.assert_allclose(log["t"], h * np.arange(log["t"].size), atol=1e-9)
     n = steps * n_sub
-    t, speed = xu2021.current_speed(logs[0])
-    np.testing.assert_array_equal(speed[:n], xu2021.current_speed(logs[1])[1][:n])
-    switch = xu2021.switch_time(scenario)
+    t, speed = current.current_speed(logs[0])
+    np.testing.assert_array_equal(speed[:n], current.current_speed(logs[1])[1][:n])
+    switch = xu2021_scenario.switch_time(scenario)
     before, after = speed[t < switch].mean(), speed[t >= switch].mean()
     assert 0.05 < before < 0.15 and 0.15 < after < 0.25

@@ -422,10 +422,10 @@ def test_a_short_study_leaves_the_packaged_settings_byte_identical(
     tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Without --promote a study writes its chosen settings into OUT/chosen only."""
-    packaged = _digests(chosen.chosen_dir())
+    packaged = _digests(chosen_reader.chosen_dir())
     out = tmp_path / "out"
     assert main(["tune", str(tiny), "--out", str(out), "--trials", "1"]) == 0
-    assert _digests(chosen.chosen_dir()) == packaged
+    assert _digests(chosen_reader.chosen_dir()) == packaged
     written = chosen.read_chosen("pid_los", out / "chosen")
     assert written["studies"]["nomoto2"]["study"] == "pid_los_tiny:nomoto2"
     record = written["studies"]["nomoto2"]["validation"]
@@ -442,7 +442,7 @@ def test_promote_targets_the_packaged_folder_and_excludes_chosen_dir(
     tiny: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (plan,) = plan_studies(str(tiny), out=tmp_path / "out", promote=True)
-    assert plan.chosen_dir == chosen.chosen_dir()
+    assert plan.chosen_dir == chosen_reader.chosen_dir()
     (plan,) = plan_studies(str(tiny), out=tmp_path / "out")
     assert plan.chosen_dir == tmp_path / "out" / "chosen"
     with pytest.raises(RunError, match="--promote"):
@@ -525,7 +525,7 @@ def test_the_packaged_records_reproduce_their_ratios() -> None:
     promotion (the incumbent is scored again)."""
     from shipgym_baselines.tuning.promotion import incumbent_settings, recorded_ratios, revisions
 
-    settings, summary = chosen.section_record("pid_los", "nomoto2")
+    settings, summary = chosen_reader.section_record("pid_los", "nomoto2")
     config = load_tuning("pid_los")
     v = config.validation
     trials = validation_trials(v.distribution, "nomoto2", v.per_ship, config.ships)
@@ -625,7 +625,7 @@ def test_the_chosen_settings_score_what_their_record_says(tmp_path: Path) -> Non
     (plan,) = plan_studies(str(file), out=tmp_path / "out", chosen_dir=tmp_path / "chosen")
     report = run_study(plan, n_trials=2)
     assert report["chosen"]["kept_default"] is False and report["chosen"]["written"]
-    settings, summary = chosen.section_record("pid_los", "nomoto2", tmp_path / "chosen")
+    settings, summary = chosen_reader.section_record("pid_los", "nomoto2", tmp_path / "chosen")
     assert settings == {"tuning": "pole_placement", **report["best_params"]}
     trials = validation_trials("validation", "nomoto2", 1)
     oracle = report["validation"]["oracle_costs"]
