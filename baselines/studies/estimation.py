@@ -41,7 +41,7 @@ import numpy as np
 
 from shipgym.identification.adaptation import QUANTITIES
 from shipgym.identification.nominal import first_order_nomoto
-from shipgym.models import MODELS
+from shipgym.models import MODELS, UNSEEN_HULLS
 from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
@@ -268,7 +268,7 @@ def draw(rows: Sequence[dict], summaries: dict, out: Path) -> None:
 
 def validation_trials(per_ship: int) -> list[str]:
     """The first ``per_ship`` validation trials of every trained ship (interleaved)."""
-    ships = len([m for m in MODELS if m != "kvlcc2"])
+    ships = len([m for m in MODELS if m not in UNSEEN_HULLS])
     return [f"validation:{i}" for i in range(per_ship * ships)]
 
 

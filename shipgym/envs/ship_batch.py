@@ -35,7 +35,7 @@ from gymnasium.vector import AutoresetMode
 
 from shipgym.envs import core
 from shipgym.envs.trial_rows import Trial, TrialRowsVectorEnv, shared_constants_problem
-from shipgym.scenarios.loader import build_scenario
+from shipgym.scenarios.loader import Scenario, build_scenario
 from shipgym.scenarios.sampling import (
     DistributionError,
     ScenarioDistribution,
@@ -43,7 +43,6 @@ from shipgym.scenarios.sampling import (
     train_rng,
     train_scenario_seed,
 )
-from shipgym.scenarios.schema import ScenarioConfig
 
 __all__ = [
     "ShipTrialsVectorEnv",
@@ -99,21 +98,23 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         self.distribution = dist
         self.ship_index = ship_index_of(dist, ship)
         self.ship = dist.config.ships[self.ship_index].model
-        self._first = build_scenario(self._draw(train_rng(0), "first"))
+        self._first = self._draw(train_rng(0), "first")
         super().__init__(
             num_envs, self._first, action_mode, compile, context_features, history_steps
         )
         self.episode_metrics = False  # a training env: no per-episode metrics
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
-        #: the config of each env's current trial (names ``<distribution>:train-<seed>``)
-        self.trial_configs: list[ScenarioConfig | None] = [None] * num_envs
+        #: each env's current trial (names ``<distribution>:train-<seed>``)
+        self.trial_scenarios: list[Scenario | None] = [None] * num_envs
         self._autoreset = np.zeros(num_envs, dtype=bool)
         self._started = False
 
-    def _draw(self, rng: np.random.Generator, label: str) -> ScenarioConfig:
-        return self.distribution.sample(
+    def _draw(self, rng: np.random.Generator, label: str) -> Scenario:
+        """The trial ``label`` drawn from the ship's distribution with ``rng``."""
+        config = self.distribution.sample(
             rng, name=f"{self.distribution.name}:train-{label}", ship_index=self.ship_index
         )
+        return build_scenario(config, config.name)
 
     # ------------------------------------------------------------------ gym vector API
     def reset(
@@ -161,16 +162,15 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         """Draw env i's next trial from its generator (the randomised env's order)."""
         rng = self._rngs[i]
         scenario_seed = train_scenario_seed(rng)
-        config = self._draw(train_rng(scenario_seed), str(scenario_seed))
+        sc = self._draw(train_rng(scenario_seed), str(scenario_seed))
         episode_seed = int(rng.integers(0, 2**31 - 1))
-        sc = build_scenario(config, config.name)
         problem = shared_constants_problem(self._first, sc)
         if problem is not None:
             raise DistributionError(
                 f"{self.distribution.name}: ship {self.ship!r} draws trials whose {problem}; "
                 "the trial env needs them shared"
             )
-        self.trial_configs[i] = config
+        self.trial_scenarios[i] = sc
         return Trial.of(sc, episode_seed, self.action_mode, self.context_features)
 
     def _reset_envs(self, mask: np.ndarray) -> None:

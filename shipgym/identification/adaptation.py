@@ -4,7 +4,8 @@ A change family moves many model parameters at once (a loading change moves the 
 eight hull derivatives), but through a handful of physical quantities.  An estimator that
 adapts the ship's own model estimates those quantities, each as the natural logarithm η of
 a factor on the nominal model (η = 0: the nominal ship), and maps them onto the model's
-parameter vector with :meth:`Adaptation.params`:
+parameter vector with :meth:`Adaptation.params`.  Each ship's record declares its quantities
+(``Ship.adapted``, :mod:`shipgym.models.ship`):
 
 ===============  ======================  =========================================
 quantity         family it follows       parameters it moves (ship)
@@ -38,74 +39,17 @@ loading changes are ×0.4 and ×1.35).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 
 from shipgym.models.base import ParameterRecord
 from shipgym.models.loading import loading_change
+from shipgym.models.ship import Quantity, ShipTable
 
-
-@dataclasses.dataclass(frozen=True)
-class Quantity:
-    """One adapted quantity: η = ln(factor) on ``params`` (or the draught, ``draught``),
-    bounded to ``[ln low, ln high]``."""
-
-    name: str
-    params: tuple[str, ...]  # the model parameters × e^η (empty for the draught)
-    low: float  # factor [-]
-    high: float  # factor [-]
-    draught: bool = False  # η is ln of the draught ratio (loading_change)
-
-    @property
-    def bounds(self) -> tuple[float, float]:
-        """(ln low, ln high)."""
-        return math.log(self.low), math.log(self.high)
-
-
-def _servo(name: str) -> Quantity:
-    return Quantity("servo", (name,), 0.5, 400.0)
-
-
-def _rate(name: str) -> Quantity:
-    return Quantity("rate", (name,), 0.1, 2.0)
-
-
-_DRAUGHT = Quantity("draught", (), 0.3, 1.6, draught=True)
-
-#: the adapted quantities of each ship (module doc's table)
-QUANTITIES: dict[str, tuple[Quantity, ...]] = {
-    "nomoto2": (
-        _servo("Tc"),
-        Quantity("gain", ("K",), 1.0 / 3.0, 20.0),
-        Quantity("time", ("T1",), 0.5, 3.0),
-    ),
-    "esso_osaka": (
-        _servo("T_servo"),
-        _rate("rudder_rate"),
-        Quantity("rudder", ("Yd", "Nd"), 1.0 / 3.0, 3.0),
-        _DRAUGHT,
-    ),
-    "mariner": (
-        _servo("T_delta"),
-        _rate("delta_dot_max"),
-        Quantity("rudder", ("a3",), 1.0 / 3.0, 3.0),
-        _DRAUGHT,
-    ),
-    "blanke": (
-        _servo("T_delta"),
-        _rate("delta_dot_max"),
-        Quantity("rudder", ("dCL",), 1.0 / 3.0, 3.0),
-        _DRAUGHT,
-    ),
-    "kvlcc2": (
-        _servo("T_servo"),
-        _rate("rudder_rate"),
-        Quantity("rudder", ("f_alpha",), 1.0 / 3.0, 3.0),
-        _DRAUGHT,
-    ),
-}
+#: model id -> the adapted quantities of the ship (each ship record's ``adapted``; the module
+#: doc's table)
+QUANTITIES: ShipTable[tuple[Quantity, ...]] = ShipTable(lambda ship: ((ship.name, ship.adapted),))
 
 
 class Adaptation:

@@ -1,24 +1,21 @@
-"""Ship models: one right-hand side each, evaluated by numpy and CasADi."""
+"""Ship models: one right-hand side each, evaluated by numpy and CasADi; each module ends with
+its ship's record (:mod:`shipgym.models.ship`), registered here."""
 
+from shipgym.models import blanke, esso_osaka, kvlcc2, mariner, nomoto2
 from shipgym.models.base import ShipModel
-from shipgym.models.blanke import Blanke
-from shipgym.models.esso_osaka import EssoOsaka
-from shipgym.models.kvlcc2 import KVLCC2
-from shipgym.models.mariner import Mariner
-from shipgym.models.nomoto2 import Nomoto2
+from shipgym.models.ship import ShipSet, ShipTable, register
 
-#: model id -> class; the scenario loader and the env look models up here.
-MODELS: dict[str, type[ShipModel]] = {
-    "nomoto2": Nomoto2,
-    "mariner": Mariner,
-    "blanke": Blanke,
-    "esso_osaka": EssoOsaka,
-    "kvlcc2": KVLCC2,
-}
+for _ship in (nomoto2.SHIP, mariner.SHIP, blanke.SHIP, esso_osaka.SHIP, kvlcc2.SHIP):
+    register(_ship)
 
-#: hulls no controller is tuned or trained on: the leaderboard's unseen-hull split.  Only a
-#: ``test_only`` distribution may list one (:mod:`shipgym.scenarios.sampling`).
-UNSEEN_HULLS: frozenset[str] = frozenset({"kvlcc2"})
+#: model id -> class (every registered ship's record); the scenario loader and the env look
+#: models up here.
+MODELS: ShipTable[type[ShipModel]] = ShipTable(lambda ship: ((ship.name, ship.model),))
+
+#: hulls no controller is tuned or trained on (records with ``unseen``): the leaderboard's
+#: unseen-hull split.  Only a ``test_only`` distribution may list one
+#: (:mod:`shipgym.scenarios.sampling`).
+UNSEEN_HULLS: ShipSet = ShipSet(lambda ship: ship.unseen)
 
 __all__ = [
     "MODELS",

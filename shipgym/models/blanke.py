@@ -97,6 +97,14 @@ import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.models.hull import Hull
+from shipgym.models.ship import (
+    DRAUGHT,
+    EnvId,
+    Ship,
+    rate_quantity,
+    rudder_quantity,
+    servo_quantity,
+)
 
 DEG = math.pi / 180.0
 
@@ -492,3 +500,19 @@ def regression_coefficients(
         delta_max=p.delta_max,
         delta_dot_max=p.delta_dot_max,
     )
+
+
+#: the blanke ship
+SHIP = Ship(
+    model=Blanke,
+    adapted=(
+        servo_quantity("T_delta"),
+        rate_quantity("delta_dot_max"),
+        rudder_quantity("dCL"),
+        DRAUGHT,
+    ),
+    env_ids=(
+        EnvId("ShipPathFollow-Blanke-v0", "blanke_current_shift", 3500),
+        EnvId("ShipPathFollow-Blanke-v1", "blanke_rudder_aging", 1290),
+    ),
+)

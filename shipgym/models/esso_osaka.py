@@ -135,6 +135,15 @@ from scipy.optimize import root
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
 from shipgym.models.hull import Hull, inertia_after
+from shipgym.models.ship import (
+    DRAUGHT,
+    EnvId,
+    Published,
+    Ship,
+    rate_quantity,
+    rudder_quantity,
+    servo_quantity,
+)
 
 DEG = math.pi / 180.0
 #: regularisation of the speeds divided by (U, c) at rest [m/s]; far below any used speed
@@ -552,3 +561,38 @@ def _self_propulsion_ratio(p: Any, ops: SimpleNamespace) -> Any:
     s_over_l2 = (1.7 * p.T + p.B * p.C_B) / p.L
     const = p.eta1 - p.C_R * s_over_l2
     return (-p.eta2 + ops.sqrt(p.eta2 * p.eta2 - 4.0 * p.eta3 * const)) / (2.0 * p.eta3)
+
+
+#: the 3 m Esso Osaka model of Osaka University (FRT-DS-ESSO, CC BY-NC: numbers only),
+#: means of its port and starboard 35° turns and its 20/20 zig-zag, as quoted
+FRT = "NAOE-5thLab FRT-DS-ESSO, free-running tests of a 3 m Esso Osaka model (quoted)"
+FRT_WHY = "15 %: the 3 m model is another scale and loading than the seeds' 1:100 model"
+
+#: the esso_osaka ship
+SHIP = Ship(
+    model=EssoOsaka,
+    adapted=(
+        servo_quantity("T_servo"),
+        rate_quantity("rudder_rate"),
+        rudder_quantity("Yd", "Nd"),
+        DRAUGHT,
+    ),
+    env_ids=(
+        EnvId("ShipPathFollow-EssoOsaka-v0", "osaka_stochastic_current", 4000),
+        EnvId("ShipPathFollow-EssoOsaka-v1", "esso_osaka_rudder_aging", 632),
+    ),
+    published=(
+        Published("advance_mean", 2.57, FRT, 0.15, FRT_WHY),
+        Published("tactical_diameter_mean", 2.55, FRT, 0.15, FRT_WHY),
+        Published(
+            "r_prime_mean",
+            0.38,
+            FRT,
+            None,
+            "outside: the tests lose 61 % of their speed at constant rps; the model holds it",
+        ),
+        Published("speed_loss_mean", 0.61, FRT, None, "outside: as r′"),
+        Published("overshoot_20_1", 3.1, FRT, None, "outside: the model answers faster"),
+        Published("switch_20", 3.14, FRT, None, "outside: as the overshoot"),
+    ),
+)

@@ -13,8 +13,8 @@ linear derivatives only), and so are the cross added masses Y'_ṙ, N'_v̇ (thei
 change sign within the draughts used: a ratio means nothing there).
 
 :func:`loading_change` maps the factors onto each model's parameters by the model's own
-``loading_change`` and ``hull`` (:data:`HULLS`: the particulars the regression is evaluated
-with, read off the models):
+``loading_change`` and ``hull``, read off its record (:data:`HULLS`: the particulars the
+regression is evaluated with):
 
 * ``esso_osaka`` (prime): m' and (m − X_u̇)' × the mass factor; (m − Y_v̇)' =
   m'·f_m − Y'_v̇·f_Y'v̇ with Y'_v̇ = m' − (m − Y_v̇)'; (I_z − N_ṙ)' = I'_z·f_m − N'_ṙ·f_N'ṙ with
@@ -35,19 +35,23 @@ with, read off the models):
 
 from __future__ import annotations
 
-from shipgym.models import MODELS
 from shipgym.models.hull import Hull, draught_factors
+from shipgym.models.ship import SHIPS, ShipTable
 
-#: the particulars each ship's regression is evaluated with: each model's own ``hull``
-HULLS: dict[str, Hull] = {name: m.hull for name, m in MODELS.items() if m.hull is not None}
+#: the particulars each ship's regression is evaluated with: each record's ``hull`` (ships
+#: without one have no loading change)
+HULLS: ShipTable[Hull] = ShipTable(
+    lambda ship: ((ship.name, ship.hull),) if ship.hull is not None else ()
+)
 
 
 def loading_change(model: str, params: object, draught_ratio: float) -> dict[str, float]:
     """The parameters of ``model`` (``params``: its record before the change, config units)
     that change when the draught becomes ``draught_ratio``·T (module doc)."""
-    if model not in HULLS:
+    hull = HULLS.get(model)
+    if hull is None:
         raise ValueError(f"no loading-condition model for {model!r}; valid: {sorted(HULLS)}")
-    ship = MODELS[model]
-    if not isinstance(params, ship.params_type):
-        raise TypeError(f"{model} needs {ship.params_type.__name__}, got {type(params).__name__}")
-    return ship.loading_change(params, draught_factors(HULLS[model], draught_ratio), draught_ratio)
+    ship = SHIPS[model]
+    if not isinstance(params, ship.params):
+        raise TypeError(f"{model} needs {ship.params.__name__}, got {type(params).__name__}")
+    return ship.loading_change(params, draught_factors(hull, draught_ratio), draught_ratio)

@@ -76,6 +76,15 @@ import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
 from shipgym.models.hull import Hull, inertia_after
+from shipgym.models.ship import (
+    DRAUGHT,
+    EnvId,
+    Published,
+    Ship,
+    rate_quantity,
+    rudder_quantity,
+    servo_quantity,
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -225,3 +234,28 @@ class Mariner(ShipModel):
     def nominal_speed(self) -> float:
         """Straight-line equilibrium speed S/f [m/s] (7.857 m/s; the paper starts at 7.7)."""
         return self.params.S / self.params.f
+
+
+#: the mariner ship
+SHIP = Ship(
+    model=Mariner,
+    adapted=(
+        servo_quantity("T_delta"),
+        rate_quantity("delta_dot_max"),
+        rudder_quantity("a3"),
+        DRAUGHT,
+    ),
+    env_ids=(
+        EnvId("ShipPathFollow-Mariner-v0", "mariner_track", 2400),
+        EnvId("ShipPathFollow-Mariner-v1", "mariner_rudder_aging", 894),
+    ),
+    published=(
+        Published(
+            "steady_turn_rate",
+            0.0191,
+            "Borkowski (2018) §5: r_max at full rudder (0.6 rad; our turn at the rudder limit)",
+            0.01,
+            "1 %: a closed form of the same model",
+        ),
+    ),
+)

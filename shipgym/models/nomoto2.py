@@ -27,6 +27,7 @@ from types import SimpleNamespace
 from typing import Any, ClassVar
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
+from shipgym.models.ship import EnvId, Quantity, Ship, servo_quantity
 
 DEG = math.pi / 180.0
 
@@ -167,3 +168,15 @@ class Nomoto2(ShipModel):
     @property
     def nominal_speed(self) -> float:
         return self.params.u0
+
+
+#: the nomoto2 ship: the manoeuvrability change moves its K (×12 in the catalogue) and T1
+SHIP = Ship(
+    model=Nomoto2,
+    adapted=(
+        servo_quantity("Tc"),
+        Quantity("gain", ("K",), 1.0 / 3.0, 20.0),
+        Quantity("time", ("T1",), 0.5, 3.0),
+    ),
+    env_ids=(EnvId("ShipPathFollow-v0", "rudder_aging", 180),),
+)

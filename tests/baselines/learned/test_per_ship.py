@@ -57,7 +57,7 @@ def test_batched_training_env_spans_the_ships_with_their_gammas() -> None:
     # env g of the whole is seeded 3 + g: ship k's first env is env 2k
     assert envs[1].ship_index == 1
     inner = venv.venv
-    assert [e.trial_configs[0].ship.model for e in inner.envs] == [e.ship for e in envs]
+    assert [e.trial_scenarios[0].config.ship.model for e in inner.envs] == [e.ship for e in envs]
     for _ in range(5):
         obs, rewards, _dones, infos = venv.step(np.zeros((8, 1), dtype=np.float32))
     assert obs.shape == (8, 16) and rewards.shape == (8,) and len(infos) == 8

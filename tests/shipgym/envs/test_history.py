@@ -175,7 +175,7 @@ def test_training_env_windows_equal_the_single_env_on_its_drawn_trials() -> None
     for i in range(N):
         gen, _ = seeding.np_random(5 + i)  # env i's generator: scenario seed, episode seed
         train_scenario_seed(gen)
-        single = ShipPathFollowEnv(env.trial_configs[i], history_steps=k)
+        single = ShipPathFollowEnv(env.trial_scenarios[i], history_steps=k)
         o, _ = single.reset(seed=int(gen.integers(0, 2**31 - 1)))
         np.testing.assert_array_equal(obs[i], o)
         singles.append(single)

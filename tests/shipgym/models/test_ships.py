@@ -11,15 +11,11 @@ import pytest
 import shipgym  # noqa: F401
 from shipgym.identification.zigzag import ship_nomoto
 from shipgym.models import MODELS
+from shipgym.models.ship import SHIPS
 from shipgym.scenarios.loader import load_scenario, scenario_from_dict
 
-SHIP_IDS = {
-    "nomoto2": "ShipPathFollow-v0",
-    "esso_osaka": "ShipPathFollow-EssoOsaka-v0",
-    "mariner": "ShipPathFollow-Mariner-v0",
-    "blanke": "ShipPathFollow-Blanke-v0",
-    "kvlcc2": "ShipPathFollow-KVLCC2-v1",
-}
+#: each ship's oldest gymnasium id (its record's first)
+SHIP_IDS = {name: ship.env_ids[0].id for name, ship in SHIPS.items()}
 
 DISTURBANCES = {
     "calm": {},
