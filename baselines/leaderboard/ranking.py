@@ -69,14 +69,11 @@ from shipgym_baselines.leaderboard.change_share import TWIN_FIELDS, episode_cost
 
 # the statistics, the episodes' scores and what adaptation is worth have their own
 # modules (intervals, scores, headroom); their names stay importable from here
-from shipgym_baselines.leaderboard.headroom import CHANGE_FAMILIES as CHANGE_FAMILIES
 from shipgym_baselines.leaderboard.headroom import GAIN as GAIN
 from shipgym_baselines.leaderboard.headroom import GAP_FIELDS as GAP_FIELDS
 from shipgym_baselines.leaderboard.headroom import GAP_HEADROOM as GAP_HEADROOM
 from shipgym_baselines.leaderboard.headroom import HEADROOM_EXPLAINED as HEADROOM_EXPLAINED
 from shipgym_baselines.leaderboard.headroom import NO_GAP as NO_GAP
-from shipgym_baselines.leaderboard.headroom import OTHER_FAMILY as OTHER_FAMILY
-from shipgym_baselines.leaderboard.headroom import change_family as change_family
 from shipgym_baselines.leaderboard.headroom import gap_fields as gap_fields
 from shipgym_baselines.leaderboard.headroom import gap_matrices as gap_matrices
 from shipgym_baselines.leaderboard.headroom import gmean_headroom as gmean_headroom
