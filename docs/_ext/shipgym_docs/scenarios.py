@@ -21,6 +21,7 @@ import yaml
 
 from shipgym.config import catalogue, list_names
 from shipgym.scenarios import load_scenario
+from shipgym.scenarios.families import FAMILIES
 from shipgym.scenarios.loader import Scenario, list_scenarios
 from shipgym_docs.pages import cell, table, write_bytes, write_text
 
@@ -114,6 +115,7 @@ def page(name: str, used: list[str]) -> str:
     route, limit, steps = size(sc)
     rows = [
         ("ship", f"{{ref}}`{sc.model.name} <ship-{sc.model.name}>`"),
+        ("change family", f"`{sc.family}`: {FAMILIES[sc.family].changes}"),
         ("what changes, when", changes(sc)),
         ("path", f"{sc.config.path.type}, {len(sc.config.path.waypoints)} waypoints"),
         ("route length", route),
