@@ -216,10 +216,10 @@ def test_the_headroom_table_per_ship_and_change_family() -> None:
     assert table[("mariner", "other")] == (pytest.approx(1.2), 1)
     assert rows[3]["scenarios"] == ["rudder_aging", "rudder_aging_long"]
     without = {k: v for k, v in ships.items() if k != "mariner_track"}
-    with pytest.raises(ValueError, match="no ship .*mariner_track"):
+    with pytest.raises(ValueError, match=r"no ship .*mariner_track"):
         headroom_table(eps, without, families, splits)
     without = {k: v for k, v in families.items() if k != "mariner_track"}
-    with pytest.raises(ValueError, match="no change family .*mariner_track"):
+    with pytest.raises(ValueError, match=r"no change family .*mariner_track"):
         headroom_table(eps, ships, without, splits)
     with pytest.raises(ValueError, match=r"'x'.*ship\.model"):
         scenario_ships({"x": {"name": "x"}})

@@ -61,11 +61,9 @@ def test_a_runs_families_are_its_files_family_keys(tmp_path: Path) -> None:
     mine.write_text(f"name: my_rudder_aging\nfamily: current_shift\n{base}")
     bare = tmp_path / "bare.yaml"
     bare.write_text(f"name: rudder_aging_mine\n{base}")
+    names = "mariner_rudder_aging osaka_curved heldout:3 my_rudder_aging gone rudder_aging_mine"
     suite = {
-        "scenarios": dict.fromkeys(
-            ["mariner_rudder_aging", "osaka_curved", "heldout:3", "my_rudder_aging"]
-            + ["rudder_aging_mine", "gone"]
-        ),
+        "scenarios": dict.fromkeys(names.split()),
         "scenario_files": {
             "my_rudder_aging": str(mine),
             "rudder_aging_mine": str(bare),
@@ -77,8 +75,8 @@ def test_a_runs_families_are_its_files_family_keys(tmp_path: Path) -> None:
         "osaka_curved": "other",
         "heldout:3": "other",
         "my_rudder_aging": "current_shift",
-        "rudder_aging_mine": "other",
         "gone": "other",
+        "rudder_aging_mine": "other",
     }
 
 
