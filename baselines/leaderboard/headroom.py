@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.scenarios.families import FAMILIES
 from shipgym_baselines.leaderboard.intervals import (
     AGGREGATE_REPS,
     bounds,
@@ -165,24 +166,6 @@ def _cells(tasks: list[str], seeds: np.ndarray, mask: np.ndarray) -> Iterator[tu
             yield task, seeds[r, c], bool(mask[r, c])
 
 
-#: the change families of the catalogue's scenario names, in the headroom table's order
-#: (``{ship}_{family}[_{variant}]``; nomoto2's without the ship: ``{family}[_{variant}]``)
-CHANGE_FAMILIES = ("nominal", "rudder_aging", "current_shift", "maneuverability_change")
-#: the family of a scenario whose name has none of them (e.g. ``osaka_curved``)
-OTHER_FAMILY = "other"
-
-
-def change_family(scenario: str) -> str:
-    """The change family a scenario's name states (:data:`CHANGE_FAMILIES`, by the
-    catalogue's naming rule: the family as a whole ``_``-separated part of the name), else
-    :data:`OTHER_FAMILY`."""
-    parts = f"_{scenario}_"
-    for family in CHANGE_FAMILIES:
-        if f"_{family}_" in parts:
-            return family
-    return OTHER_FAMILY
-
-
 def scenario_ships(settings: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
     """scenario → its ship (the model's name) from scenario settings as ``run.json`` keeps
     them (``scenarios``: name → the scenario's settings, ``ship.model``)."""
@@ -198,28 +181,31 @@ def scenario_ships(settings: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
 def headroom_table(
     episodes: Sequence[Mapping[str, Any]],
     ships: Mapping[str, str],
+    families: Mapping[str, str],
     splits: Mapping[str, str],
     split: str = "catalogue",
 ) -> list[dict[str, Any]]:
     """The headroom per ship × change family over the trials of ``split``'s scenarios:
-    rows ``ship``, ``family`` (:func:`change_family`), ``scenarios`` (their names),
-    ``trials`` and ``headroom_gmean`` (the geometric mean of C_frozen / C_oracle over the
-    trials, :func:`trial_headroom`); ships in the order of ``ships``, families in
-    :data:`CHANGE_FAMILIES` order then :data:`OTHER_FAMILY`.  ``ships``: scenario → ship
-    (:func:`scenario_ships`); a scenario of the split missing from it raises ValueError.
-    Empty without both references' episodes."""
+    rows ``ship``, ``family``, ``scenarios`` (their names), ``trials`` and
+    ``headroom_gmean`` (the geometric mean of C_frozen / C_oracle over the trials,
+    :func:`trial_headroom`); ships in the order of ``ships``, families in the order of
+    :data:`shipgym.scenarios.families.FAMILIES`.  ``ships`` / ``families``: scenario → its
+    ship (:func:`scenario_ships`) / change family
+    (:func:`~shipgym_baselines.leaderboard.splits.suite_families`); a scenario of the split
+    missing from either raises ValueError.  Empty without both references' episodes."""
     headroom = trial_headroom(episodes)
     mine = sorted({s for s, _ in headroom if splits.get(s, "catalogue") == split})
-    missing = [s for s in mine if s not in ships]
-    if missing:
-        raise ValueError(f"headroom_table: no ship for scenario(s) {', '.join(missing)}")
+    for what, known in (("ship", ships), ("change family", families)):
+        missing = [s for s in mine if s not in known]
+        if missing:
+            raise ValueError(f"headroom_table: no {what} for scenario(s) {', '.join(missing)}")
     order = list(dict.fromkeys(ships.values()))
-    families = (*CHANGE_FAMILIES, OTHER_FAMILY)
+    family_order = list(FAMILIES)
     cells: dict[tuple[str, str], list[str]] = defaultdict(list)
     for s in mine:
-        cells[(ships[s], change_family(s))].append(s)
+        cells[(ships[s], families[s])].append(s)
     rows = []
-    for ship, family in sorted(cells, key=lambda k: (order.index(k[0]), families.index(k[1]))):
+    for ship, family in sorted(cells, key=lambda k: (order.index(k[0]), family_order.index(k[1]))):
         names = cells[(ship, family)]
         gmean, trials = gmean_headroom(headroom, names) or (math.nan, 0)
         rows.append(
@@ -238,9 +224,9 @@ def headroom_grid(
     headroom: Sequence[Mapping[str, Any]],
 ) -> tuple[list[str], list[str], dict[tuple[str, str], Mapping[str, Any]]]:
     """The layout of :func:`headroom_table`'s rows as a table: the ships in row order, the
-    families present in :data:`CHANGE_FAMILIES` order (then :data:`OTHER_FAMILY`) and the
+    families present in the order of :data:`shipgym.scenarios.families.FAMILIES` and the
     row of each (ship, family)."""
     present = {r["family"] for r in headroom}
-    families = [f for f in (*CHANGE_FAMILIES, OTHER_FAMILY) if f in present]
+    families = [f for f in FAMILIES if f in present]
     ships = list(dict.fromkeys(r["ship"] for r in headroom))
     return ships, families, {(r["ship"], r["family"]): r for r in headroom}

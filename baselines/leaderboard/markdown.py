@@ -7,6 +7,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from shipgym.scenarios.families import family_label
 from shipgym_baselines.leaderboard.change_share import (
     CHANGE_SHARE_EXPLAINED,
     NOMINAL,
@@ -153,7 +154,7 @@ def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
         "",
         HEADROOM_EXPLAINED,
         "",
-        "| ship | " + " | ".join(f.replace("_", " ") for f in families) + " |",
+        "| ship | " + " | ".join(family_label(f) for f in families) + " |",
         "|---|" + "---|" * len(families),
     ]
     for ship in ships:
@@ -181,7 +182,7 @@ def share_markdown(shares: Mapping[str, Any]) -> list[str]:
         "|---|---|---|" + "---|" * len(controllers),
     ]
     for row in shares["rows"]:
-        cells = [md_cell(row["ship"]), row["family"].replace("_", " "), str(row["trials"])]
+        cells = [md_cell(row["ship"]), family_label(row["family"]), str(row["trials"])]
         cells += [_interval(row["shares"][c], None) for c in controllers]
         lines.append("| " + " | ".join(cells) + " |")
     return [*lines, ""]

@@ -34,7 +34,7 @@ from shipgym_baselines.leaderboard.comparison import (
 )
 from shipgym_baselines.leaderboard.costs import tables_line
 from shipgym_baselines.leaderboard.escaping import csv_cell, plain_text
-from shipgym_baselines.leaderboard.headroom import change_family, headroom_table, scenario_ships
+from shipgym_baselines.leaderboard.headroom import headroom_table, scenario_ships
 from shipgym_baselines.leaderboard.markdown import (
     generalisation_table,
     markdown_table,
@@ -49,7 +49,7 @@ from shipgym_baselines.leaderboard.ranking import (
 )
 from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
 from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, refused_trials, scored_episodes
-from shipgym_baselines.leaderboard.splits import suite_splits
+from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
 from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
 from shipgym_baselines.leaderboard.tables import (
     AGGREGATE_FILE,
@@ -176,8 +176,9 @@ def write_results(
         left_out = sorted({e["scenario"] for e in episodes} - {e["scenario"] for e in ranked})
         note = comparison_note(suite, out)
         ships = scenario_ships(suite["scenarios"])
-        headroom = headroom_table(ranked, ships, splits)
-        shares = share_table(board, scored, ships, splits, twins)
+        families = suite_families(suite)
+        headroom = headroom_table(ranked, ships, families, splits)
+        shares = share_table(board, scored, ships, families, splits, twins)
         head = ranking_markdown(
             board,
             scores,
@@ -228,20 +229,21 @@ def share_table(
     board: list[dict[str, Any]],
     scored: list[dict[str, Any]],
     ships: Mapping[str, str],
+    families: Mapping[str, str],
     splits: Mapping[str, str],
     twins: Mapping[str, str],
 ) -> dict[str, Any]:
     """The change share per ship × change family of the verdict's table's top competitors
     and best learned agent (:func:`~shipgym_baselines.leaderboard.change_share.share_grid`):
     ``split``, ``controllers`` and ``rows``; empty without twins or a ranking.  ``scored``:
-    as :func:`add_twin_cells` reads them."""
+    as :func:`add_twin_cells` reads them; ``ships`` / ``families``: scenario → its ship /
+    change family."""
     table = main_table(board)
     if not twins or not table:
         return {}
     split = table[0]["split"]
     controllers = share_controllers(table)
     scenarios = [s for s in splits if splits[s] == split and s in table[0]["scenarios"]]
-    families = {s: change_family(s) for s in scenarios}
     grid = share_grid(scored, controllers, ships, families, scenarios, twins)
     return {"split": split, "controllers": controllers, "rows": grid}
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from shipgym.scenarios.families import family_label
 from shipgym_baselines.leaderboard.change_share import SHARE_GRID_EXPLAINED
 from shipgym_baselines.leaderboard.columns import RankingColumn, count, page_columns, shown
 from shipgym_baselines.leaderboard.headroom import HEADROOM_EXPLAINED, headroom_grid
@@ -202,7 +203,7 @@ def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
         return ""
     ships, families, cells = headroom_grid(headroom)
     columns = [("ship", "ship", "text")]
-    columns += [(f, esc(f.replace("_", " ")), "number") for f in families]
+    columns += [(f, esc(family_label(f)), "number") for f in families]
     body = []
     for ship in ships:
         tds = [text_cell(ship)]
@@ -236,7 +237,7 @@ def share_html(shares: Mapping[str, Any]) -> str:
     columns += [(f"share:{c}", esc(c), "number") for c in controllers]
     body = []
     for row in shares["rows"]:
-        tds = [text_cell(row["ship"]), text_cell(row["family"].replace("_", " "))]
+        tds = [text_cell(row["ship"]), text_cell(family_label(row["family"]))]
         tds += [value_cell(row["trials"])]
         tds += [value_cell(row["shares"][c]) for c in controllers]
         body.append(tds)

@@ -1,5 +1,6 @@
 """The leaderboard's scenario splits: their names, which split a scenario falls in, and how
-the tables, the figures and the sentences title each.
+the tables, the figures and the sentences title each; and the change family of a run's
+scenarios (:func:`suite_families`).
 
 Every split is one entry of :data:`SPLITS` (the ranking is computed per split, each in its
 own table and figures); a new split needs its entry there, with ``test=True`` when its
@@ -14,6 +15,8 @@ from typing import Any
 
 from shipgym.config import is_path
 from shipgym.models import UNSEEN_HULLS
+from shipgym.scenarios.families import OTHER
+from shipgym.scenarios.loader import ScenarioError, list_scenarios, load_scenario_file
 
 
 @dataclass(frozen=True)
@@ -108,3 +111,24 @@ def suite_splits(suite: Mapping[str, Any]) -> dict[str, str]:
     own = suite.get("scenario_files", {})
     unseen = unseen_hull_scenarios(suite["scenarios"])
     return {s: scenario_split(s, own, unseen) for s in suite["scenarios"]}
+
+
+def suite_families(suite: Mapping[str, Any]) -> dict[str, str]:
+    """Scenario → change family of a resolved suite (``run.json``'s; never its no-change
+    twins): the ``family:`` of the file the scenario was read from, the suite's own
+    (``scenario_files``) or the catalogue's of that name; ``other`` for a named test
+    scenario (``heldout:3``) and for a file no longer readable.  ``run.json`` records no
+    family (the settings it keeps are the plant's), so a run of any age reads the same."""
+    own = suite.get("scenario_files", {})
+    catalogue = set(list_scenarios())
+    files = {s: own.get(s, s if s in catalogue else None) for s in suite["scenarios"]}
+    return {s: OTHER if file is None else _file_family(file) for s, file in files.items()}
+
+
+def _file_family(file: str) -> str:
+    """The change family a scenario file (a path or a catalogue name) names; ``other``
+    when it cannot be read."""
+    try:
+        return load_scenario_file(file).family
+    except ScenarioError:
+        return OTHER

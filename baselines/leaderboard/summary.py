@@ -33,7 +33,7 @@ from shipgym_baselines.leaderboard.headroom import (
     trial_headroom,
 )
 from shipgym_baselines.leaderboard.ranking import is_partial
-from shipgym_baselines.leaderboard.splits import suite_splits
+from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
 from shipgym_baselines.leaderboard.verdict import folder_verdict
 
 #: the summary's layout; bump when a field changes meaning
@@ -86,7 +86,8 @@ def _headroom(
     if found is None:
         return None
     worth, trials = found
-    cells = headroom_table(episodes, scenario_ships(suite["scenarios"]), suite_splits(suite), split)
+    ships = scenario_ships(suite["scenarios"])
+    cells = headroom_table(episodes, ships, suite_families(suite), suite_splits(suite), split)
     return {
         "gmean": worth,
         "trials": trials,

@@ -33,9 +33,9 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from shipgym.scenarios.families import NOMINAL
 from shipgym_baselines.leaderboard.change_share import SHARE
 from shipgym_baselines.leaderboard.headroom import (
-    CHANGE_FAMILIES,
     GAP_HEADROOM,
     gmean_headroom,
     headroom_table,
@@ -44,13 +44,11 @@ from shipgym_baselines.leaderboard.headroom import (
 )
 from shipgym_baselines.leaderboard.ranking import is_partial
 from shipgym_baselines.leaderboard.scores import is_failure
-from shipgym_baselines.leaderboard.splits import split_label, suite_splits
+from shipgym_baselines.leaderboard.splits import split_label, suite_families, suite_splits
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 #: the kind whose best row the second sentence names
 LEARNED = "learned"
-#: the change family of the scenarios without a change (left out of the headroom's range)
-NO_CHANGE = CHANGE_FAMILIES[0]
 #: the verdict's most sentences, and a sentence's most words
 MAX_SENTENCES, MAX_WORDS = 4, 30
 #: a scenario's failures are "where most controllers fail" when more than this fraction of
@@ -216,7 +214,7 @@ def headroom_sentence(
         f"{'s' if trials != 1 else ''} ({code(ORACLE_FROZEN)} over {code(ORACLE)}, geometric "
         "mean)"
     )
-    cells = [r["headroom_gmean"] for r in headroom if r["family"] != NO_CHANGE]
+    cells = [r["headroom_gmean"] for r in headroom if r["family"] != NOMINAL]
     if len(cells) > 1:
         text += f", from {min(cells):.2f}× to {max(cells):.2f}× across ship × change family"
     return f"{text}."
@@ -301,7 +299,8 @@ def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_co
     if (folder / RUN_FILE).is_file():
         suite = read_run(folder)["suite"]
         ships = scenario_ships(suite["scenarios"])
-        headroom = headroom_table(episodes, ships, suite_splits(suite), table[0]["split"])
+        families = suite_families(suite)
+        headroom = headroom_table(episodes, ships, families, suite_splits(suite), table[0]["split"])
     return verdict(board, episodes, code, headroom)
 
 

@@ -30,7 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.scenarios.loader import Scenario, load_scenario
+from shipgym.scenarios.families import CHANGES
+from shipgym.scenarios.loader import Scenario, list_scenarios, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym.scenarios.twins import nominal_twin
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
@@ -45,14 +46,25 @@ MATTERS = 1.3
 #: Osaka manoeuvrability changes they no longer degrade by 1.3x: the measurement of whether
 #: a change matters keeps the design that was never tuned for it.
 REFERENCE_SETTINGS: dict[str, Any] = {"preset": "paper"}
+#: the ships of the scenario matrix (docs/scenario-matrix.md), in its order
 SHIPS = ("esso_osaka", "mariner", "blanke")
-FAMILIES = ("rudder_aging", "current_shift", "maneuverability_change")
 
 
 def matrix_scenarios(curved: bool = True) -> list[str]:
-    """The matrix's scenarios with a change: ``{ship}_{family}`` (and ``_curved``)."""
-    variants = ("", "_curved") if curved else ("",)
-    return [f"{s}_{f}{v}" for s in SHIPS for f in FAMILIES for v in variants]
+    """The matrix's scenarios with a change: the catalogue's of each of :data:`SHIPS` in a
+    family with a change (:data:`shipgym.scenarios.families.CHANGES`), by ship, family and
+    name; ``curved``: with those on a PCHIP curve."""
+    found = []
+    for name in list_scenarios():
+        scenario = load_scenario(name)
+        config = scenario.config
+        if (
+            config.ship.model in SHIPS
+            and scenario.family in CHANGES
+            and (curved or config.path.type != "pchip")
+        ):
+            found.append((SHIPS.index(config.ship.model), CHANGES.index(scenario.family), name))
+    return [name for *_, name in sorted(found)]
 
 
 def change_time(scenario: Scenario) -> float | None:

@@ -25,9 +25,8 @@ from shipgym_baselines.leaderboard.change_share import (
     trial_cells,
     twin_fields,
 )
-from shipgym_baselines.leaderboard.headroom import change_family
 from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, scored_episodes
-from shipgym_baselines.leaderboard.splits import suite_splits
+from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
 from shipgym_baselines.leaderboard.tables import episode_rows, rankable
 from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 from shipgym_baselines.records.episodes import read_episodes
@@ -52,12 +51,13 @@ def family_shares(
     suite, scored = run_episodes(folder)
     twins = twins_of(suite)
     splits = suite_splits(suite)
+    families = suite_families(suite)
     kinds = {c["name"]: c["kind"] for c in suite["controllers"]}
     costs = episode_costs(scored)
     by_family: dict[str, list[str]] = {}
     for s, sp in splits.items():
         if sp == split and s in twins:
-            by_family.setdefault(change_family(s), []).append(s)
+            by_family.setdefault(families[s], []).append(s)
     out = {}
     for family, scenarios in by_family.items():
         rows = []

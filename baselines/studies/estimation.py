@@ -42,6 +42,7 @@ import numpy as np
 from shipgym.identification.adaptation import QUANTITIES
 from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models import MODELS, UNSEEN_HULLS
+from shipgym.scenarios.families import CHANGES, family_label
 from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
@@ -55,7 +56,6 @@ PROBE_RUDDER = math.radians(10.0)
 PROBE_T = 2.0
 #: steps scored per episode (evenly spaced)
 SCORED_STEPS = 60
-FAMILIES = ("rudder_aging", "current_shift", "maneuverability_change")
 
 
 def probe_positions(
@@ -72,8 +72,9 @@ def probe_positions(
     return np.stack([x[model.state_index("x")], x[model.state_index("y")]], axis=1)
 
 
-def change_family(scenario: Scenario, end: float, w_start: np.ndarray, w_end: np.ndarray) -> str:
-    """The family of the trial's change, read off the truth (module doc); "none"."""
+def truth_family(scenario: Scenario, end: float, w_start: np.ndarray, w_end: np.ndarray) -> str:
+    """The family of the trial's change (:data:`shipgym.scenarios.families.CHANGES`), read
+    off the truth (module doc; a sampled trial's file names none); "none"."""
     ship = scenario.model.name
     servo = {p for q in QUANTITIES[ship] if q.name == "servo" for p in q.params}
     before = scenario.schedule.record_at(0.0).as_dict()
@@ -145,7 +146,7 @@ def score_episode(policy: Any, scenario: Scenario, disturbances: dict[str, np.nd
         "current_true_m_s": [r[6] for r in rows],
     }
     change = change_time(scenario)
-    family = change_family(scenario, float(times[-1]) if times.size else 0.0, w_true[0], w_true[-1])
+    family = truth_family(scenario, float(times[-1]) if times.size else 0.0, w_true[0], w_true[-1])
     after = times >= (change if change is not None else math.inf)
     out: dict[str, Any] = {
         "scenario": scenario.name,
@@ -224,11 +225,9 @@ def draw(rows: Sequence[dict], summaries: dict, out: Path) -> None:
     fig, ax = plt.subplots(figsize=(6.4, 3.2))
     width = 0.8 / max(1, len(controllers))
     for i, c in enumerate(controllers):
-        values = [summaries[c].get(f, {}).get("error_share", np.nan) for f in FAMILIES]
-        ax.bar(np.arange(len(FAMILIES)) + i * width, values, width, label=c)
-    ax.set_xticks(
-        np.arange(len(FAMILIES)) + 0.4 - width / 2, [f.replace("_", " ") for f in FAMILIES]
-    )
+        values = [summaries[c].get(f, {}).get("error_share", np.nan) for f in CHANGES]
+        ax.bar(np.arange(len(CHANGES)) + i * width, values, width, label=c)
+    ax.set_xticks(np.arange(len(CHANGES)) + 0.4 - width / 2, [family_label(f) for f in CHANGES])
     ax.axhline(1.0, color="0.4", lw=0.8, ls="--")
     ax.set_ylabel("error left of the nominal's (median)")
     ax.legend(frameon=False)

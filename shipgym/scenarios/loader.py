@@ -99,6 +99,11 @@ class Scenario:
         return self.config.name
 
     @property
+    def family(self) -> str:
+        """The change family the file names (:mod:`shipgym.scenarios.families`)."""
+        return self.config.family
+
+    @property
     def nominal_params(self):
         return self.schedule.nominal
 

@@ -8,7 +8,8 @@ change:
 * every parameter event is removed, so the ship keeps its nominal parameters;
 * a two-phase current becomes its first phase for the whole episode: a Gauss–Markov
   current about the first phase's mean with the same fluctuation, or no current at all
-  when that phase is calm and steady (speed 0, no fluctuation).
+  when that phase is calm and steady (speed 0, no fluctuation);
+* its change family is :data:`~shipgym.scenarios.families.NOMINAL`.
 
 The twin of a trial is the twin of the scenario, drawn with the same seed: the trial
 randomisation (:mod:`shipgym.scenarios.trials`) draws every range on every trial from the
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from shipgym.scenarios.families import NOMINAL
 from shipgym.scenarios.loader import Scenario
 
 #: the settings that label a scenario without changing what happens in it
@@ -41,7 +43,7 @@ def nominal_twin(scenario: Scenario, name: str | None = None) -> Scenario | None
     config = scenario.config
     current = config.disturbances.current
     drop = ["events"]
-    overrides: dict[str, Any] = {}
+    overrides: dict[str, Any] = {"family": NOMINAL}
     if getattr(current, "kind", None) == "two_phase":
         drop.append("disturbances.current")
         if current.speed > 0.0 or current.sigma > 0.0 or current.direction_sigma_deg > 0.0:

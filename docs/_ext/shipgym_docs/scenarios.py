@@ -20,6 +20,7 @@ import numpy as np
 import yaml
 
 from shipgym.config import catalogue, list_names
+from shipgym.scenarios.families import FAMILIES
 from shipgym.scenarios.loader import Scenario, list_scenarios, load_scenario
 from shipgym_docs.pages import cell, table, write_bytes, write_text
 
@@ -113,6 +114,7 @@ def page(name: str, used: list[str]) -> str:
     route, limit, steps = size(sc)
     rows = [
         ("ship", f"{{ref}}`{sc.model.name} <ship-{sc.model.name}>`"),
+        ("change family", f"`{sc.family}`: {FAMILIES[sc.family].changes}"),
         ("what changes, when", changes(sc)),
         ("path", f"{sc.config.path.type}, {len(sc.config.path.waypoints)} waypoints"),
         ("route length", route),

@@ -11,7 +11,6 @@ from shipgym_baselines.leaderboard.change_share import TWIN_FIELDS
 from shipgym_baselines.leaderboard.headroom import (
     GAIN,
     GAP_FIELDS,
-    change_family,
     gap_matrices,
     headroom_table,
     scenario_ships,
@@ -23,6 +22,7 @@ from shipgym_baselines.leaderboard.ranking import (
     scenario_scores,
 )
 from shipgym_baselines.leaderboard.scores import controller_kinds, scored_episodes
+from shipgym_baselines.leaderboard.splits import suite_families
 
 #: one scenario, five trials: (C_oracle, C_frozen, C of "x"), by hand
 #:   trial 0: headroom 400/100 = 4,   gain 400/200 = 2,       gap log 2 / log 4 = 0.5, beats
@@ -175,16 +175,6 @@ def test_the_frozen_optimum_is_a_reference_whatever_its_kind_says() -> None:
     assert "oracle_frozen" not in {r["controller"] for r in aggregate_ranking(eps, {"a": "c"})}
 
 
-def test_change_family_follows_the_catalogues_names() -> None:
-    assert change_family("esso_osaka_current_shift_curved") == "current_shift"
-    assert change_family("rudder_aging_long") == "rudder_aging"
-    assert change_family("maneuverability_change") == "maneuverability_change"
-    assert change_family("blanke_nominal") == "nominal"
-    assert change_family("nominal") == "nominal"
-    assert change_family("osaka_curved") == "other"
-    assert change_family("my_rudder_agingx") == "other"  # a whole part of the name only
-
-
 def test_the_headroom_table_per_ship_and_change_family() -> None:
     def trial(scenario: str, seed: int, oracle: float, frozen: float) -> list[dict]:
         return [
@@ -209,8 +199,9 @@ def test_the_headroom_table_per_ship_and_change_family() -> None:
         )
     }
     ships = scenario_ships(settings)
+    families = suite_families({"scenarios": settings})  # the catalogue files' family: keys
     splits = {s: "heldout" if s.startswith("heldout") else "catalogue" for s in ships}
-    rows = headroom_table(eps, ships, splits)
+    rows = headroom_table(eps, ships, families, splits)
     table = {(r["ship"], r["family"]): (r["headroom_gmean"], r["trials"]) for r in rows}
     assert [(r["ship"], r["family"]) for r in rows] == [  # ships as run.json lists them
         ("mariner", "nominal"),
@@ -224,8 +215,25 @@ def test_the_headroom_table_per_ship_and_change_family() -> None:
     assert table[("mariner", "nominal")] == (pytest.approx(1.0), 1)
     assert table[("mariner", "other")] == (pytest.approx(1.2), 1)
     assert rows[3]["scenarios"] == ["rudder_aging", "rudder_aging_long"]
-    with pytest.raises(ValueError, match="mariner_track"):
-        headroom_table(eps, {k: v for k, v in ships.items() if k != "mariner_track"}, splits)
+    without = {k: v for k, v in ships.items() if k != "mariner_track"}
+    with pytest.raises(ValueError, match=r"no ship .*mariner_track"):
+        headroom_table(eps, without, families, splits)
+    without = {k: v for k, v in families.items() if k != "mariner_track"}
+    with pytest.raises(ValueError, match=r"no change family .*mariner_track"):
+        headroom_table(eps, ships, without, splits)
     with pytest.raises(ValueError, match=r"'x'.*ship\.model"):
         scenario_ships({"x": {"name": "x"}})
-    assert headroom_table([e for e in eps if e["controller"] == "oracle"], ships, splits) == []
+    oracle_only = [e for e in eps if e["controller"] == "oracle"]
+    assert headroom_table(oracle_only, ships, families, splits) == []
+
+
+def test_the_headroom_table_reads_the_family_never_the_name() -> None:
+    """A scenario named as one family and filed under another is in the other's cell."""
+    eps = [
+        {"scenario": "rudder_aging", "controller": c, "seed": 1, "cost": cost}
+        for c, cost in (("oracle", 1.0), ("oracle_frozen", 2.0))
+    ]
+    ships = {"rudder_aging": "nomoto2"}
+    splits = {"rudder_aging": "catalogue"}
+    rows = headroom_table(eps, ships, {"rudder_aging": "current_shift"}, splits)
+    assert [(r["family"], r["scenarios"]) for r in rows] == [("current_shift", ["rudder_aging"])]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from shipgym_baselines.leaderboard.splits import (
@@ -14,6 +16,7 @@ from shipgym_baselines.leaderboard.splits import (
     figure_title,
     scenario_split,
     split_label,
+    suite_families,
     table_title,
     unseen_hull_scenarios,
 )
@@ -46,6 +49,35 @@ def test_the_unseen_hull_scenarios_are_those_on_an_unseen_hull() -> None:
     }
     settings["renamed"] = settings["kvlcc2_nominal"]
     assert unseen_hull_scenarios(settings) == {"kvlcc2_nominal", "renamed"}
+
+
+def test_a_runs_families_are_its_files_family_keys(tmp_path: Path) -> None:
+    """Each scenario's family is the ``family:`` of the file it was read from (the catalogue's
+    of its name, or the suite's own file), never its name: a file named like a family but
+    filed under another keeps its key, one without the key and a test scenario are
+    ``other``, and so is a suite's file that is gone."""
+    mine = tmp_path / "mine.yaml"
+    base = "path: {waypoints: [[0, 0], [10, 0]]}\ntime_limit: 10.0\n"
+    mine.write_text(f"name: my_rudder_aging\nfamily: current_shift\n{base}")
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(f"name: rudder_aging_mine\n{base}")
+    names = "mariner_rudder_aging osaka_curved heldout:3 my_rudder_aging gone rudder_aging_mine"
+    suite = {
+        "scenarios": dict.fromkeys(names.split()),
+        "scenario_files": {
+            "my_rudder_aging": str(mine),
+            "rudder_aging_mine": str(bare),
+            "gone": str(tmp_path / "gone.yaml"),
+        },
+    }
+    assert suite_families(suite) == {
+        "mariner_rudder_aging": "rudder_aging",
+        "osaka_curved": "other",
+        "heldout:3": "other",
+        "my_rudder_aging": "current_shift",
+        "gone": "other",
+        "rudder_aging_mine": "other",
+    }
 
 
 def test_the_test_splits_are_the_named_test_scenarios_in_order() -> None:

@@ -16,12 +16,14 @@ import pytest
 import shipgym
 from shipgym.models import MODELS
 from shipgym.models.loading import loading_change
+from shipgym.scenarios import families
 from shipgym.scenarios.loader import list_scenarios, load_scenario
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
 from shipgym_baselines.registry import make_controller
 
 SHIPS = ("esso_osaka", "mariner", "blanke")
-FAMILIES = ("rudder_aging", "current_shift", "maneuverability_change")
+#: the families with a change (shipgym.scenarios.families)
+FAMILIES = families.CHANGES
 CHANGES = [f"{s}_{f}{v}" for s in SHIPS for f in FAMILIES for v in ("", "_curved")]
 MATRIX = [f"{s}_nominal" for s in SHIPS] + CHANGES
 #: kept as it was (ShipPathFollow-Blanke-v0's default): its own 85 L route, 700 s
@@ -52,6 +54,15 @@ def test_the_matrix_is_in_the_catalogue_with_the_old_names() -> None:
     kept |= {f"{f}_{v}" for f in FAMILIES for v in ("long", "smooth")}
     kept |= {"osaka_curved", "osaka_stochastic_current", "mariner_track", KEPT}
     assert kept <= names
+
+
+def test_each_matrix_scenario_is_filed_under_its_family() -> None:
+    """``{ship}_{family}[_curved]`` has ``family: {family}``; ``{ship}_nominal`` nominal."""
+    for ship in SHIPS:
+        assert load_scenario(f"{ship}_nominal").family == families.NOMINAL
+        for family in FAMILIES:
+            for variant in ("", "_curved"):
+                assert load_scenario(f"{ship}_{family}{variant}").family == family
 
 
 @pytest.mark.parametrize("name", MATRIX)
