@@ -1122,7 +1122,7 @@ def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) 
     # the suite file's reader sits beside this loop (the leaderboard's suite module imports
     # nothing above it); the drawing is the leaderboard job's: the scenario loaded by name,
     # else rebuilt from its settings, each seed's trial from the suite's ranges
-    from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.suite import load_suite
 
     spec = load_suite(suite)
     if isinstance(scenario, str | os.PathLike):

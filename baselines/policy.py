@@ -3,8 +3,8 @@ the figures draw a controller: its family (the column, :data:`FAMILIES`) and its
 (:class:`Style`), traits of its registration
 (:func:`shipgym_baselines.registry.register_controller`; the learned agents':
 :data:`shipgym_baselines.learned.policy.AGENT_LOOKS`), read by
-:func:`shipgym_baselines.leaderboard.figures.controller_family` and
-:func:`shipgym_baselines.leaderboard.style.controller_style`."""
+:func:`shipgym_baselines.plots.figures.controller_family` and
+:func:`shipgym_baselines.plots.style.controller_style`."""
 
 from __future__ import annotations
 

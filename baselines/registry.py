@@ -179,7 +179,7 @@ def register_controller(
     (None: every ship).  ``family``: the figures' column, one of
     :data:`~shipgym_baselines.policy.FAMILIES` (every built-in declares one); ``look``: its
     :class:`~shipgym_baselines.policy.Style` in every figure (None: the figures derive
-    both from the kind and name, :mod:`shipgym_baselines.leaderboard.style`).  A name
+    both from the kind and name, :mod:`shipgym_baselines.plots.style`).  A name
     registered to another factory is an error.
     """
     if factory is None:

@@ -14,12 +14,13 @@ import importlib
 
 from tests.import_graph import edges, files, find_cycle, import_graph, imported_names, layer, within
 
-#: The layer of every shipgym module, lowest first; an entry for a package covers its
-#: submodules unless they have their own.  A module imports only modules of its own or a
-#: lower layer.
+#: The layer of every folder of shipgym and of every module at its top, lowest first; an
+#: entry for a folder covers every module in it (no folder spans two layers).  A module
+#: imports only modules of its own or a lower layer.
 LAYERS: dict[str, int] = {
     # 0 — foundations: the error base, config files, scalar/array operation sets, angle
-    #     arithmetic, path geometry, the terminal's notice lines
+    #     arithmetic, path geometry, the terminal's notice lines, CasADi functions compiled
+    #     to C
     "shipgym.errors": 0,
     "shipgym.limits": 0,
     "shipgym.notices": 0,
@@ -27,35 +28,34 @@ LAYERS: dict[str, int] = {
     "shipgym.numerics": 0,
     "shipgym.angles": 0,
     "shipgym.paths": 0,
-    # 1 — ship models: one right-hand side per ship, parameter records, RK4
+    "shipgym.codegen": 0,
+    # 1 — ship models: each ship's record and right-hand side, parameter records, RK4, the
+    #     unrolled CasADi control period
     "shipgym.models": 1,
-    # 2 — integration: the unrolled CasADi control period, compiled to C
-    "shipgym.models.integrator": 2,
-    "shipgym.codegen": 2,
-    # 3 — standard manoeuvres (zig-zag, turning circle) simulated on a model
-    "shipgym.manoeuvres": 3,
+    # 2 — standard manoeuvres (zig-zag, turning circle) simulated on a model
+    "shipgym.manoeuvres": 2,
     # the IMO manoeuvring criteria (MSC.137(76)) a manoeuvre is measured against
-    "shipgym.manoeuvring_standards": 3,
+    "shipgym.manoeuvring_standards": 2,
     # every ship's standard manoeuvres beside the published values of its hull
-    "shipgym.validation": 3,
-    # 4 — identification: LS-SVM fits, online identifiers, nominal models from zig-zags
-    "shipgym.identification": 4,
-    # 5 — guidance laws, heading autopilots, path tracking, disturbances and sensors (and
+    "shipgym.validation": 2,
+    # 3 — identification: LS-SVM fits, online identifiers, nominal models from zig-zags
+    "shipgym.identification": 3,
+    # 4 — guidance laws, heading autopilots, path tracking, disturbances and sensors (and
     #     their validated settings)
-    "shipgym.guidance": 5,
-    "shipgym.autopilot": 5,
-    "shipgym.tracking": 5,
-    "shipgym.disturbances": 5,
-    "shipgym.disturbance_config": 5,
-    # 6 — scenarios: config schema, loader, events, distributions
-    "shipgym.scenarios": 6,
-    # 7 — an episode's metrics and rendering
-    "shipgym.metrics": 7,
-    "shipgym.rendering": 7,
-    "shipgym.animation": 7,
-    # 8 — the environments, and the package itself (it registers them)
-    "shipgym.envs": 8,
-    "shipgym": 8,
+    "shipgym.guidance": 4,
+    "shipgym.autopilot": 4,
+    "shipgym.tracking": 4,
+    "shipgym.disturbances": 4,
+    "shipgym.disturbance_config": 4,
+    # 5 — scenarios: change families, config schema, loader, events, distributions
+    "shipgym.scenarios": 5,
+    # 6 — an episode's metrics and rendering
+    "shipgym.metrics": 6,
+    "shipgym.rendering": 6,
+    "shipgym.animation": 6,
+    # 7 — the environments, and the package itself (it registers them)
+    "shipgym.envs": 7,
+    "shipgym": 7,
 }
 
 #: What the ship models (the equations) must never depend on.
@@ -126,6 +126,12 @@ def test_models_import_nothing_above_them() -> None:
         if any(within(t, above) for above in ABOVE_MODELS)
     ]
     assert not bad, f"ship models import higher layers: {bad}"
+
+
+def test_each_layer_is_a_folder_or_a_module_at_the_top() -> None:
+    """No entry of LAYERS lies inside a folder: a folder sits on one layer as a whole."""
+    inside = [name for name in LAYERS if name.count(".") > 1]
+    assert not inside, f"a layer of its own inside a folder: {inside}"
 
 
 def test_every_shipgym_module_has_a_layer() -> None:

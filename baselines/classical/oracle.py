@@ -919,7 +919,7 @@ class PlantNMPC:
 
 
 # its look colours its name in the page's tables; the scenario figures draw its episode black
-# and dashed, the reference (shipgym_baselines.leaderboard.figures)
+# and dashed, the reference (shipgym_baselines.plots.figures)
 @register_controller("oracle", family="references", look=Style("#17becf", "-", "s"))
 class Oracle(PlantNMPC):
     """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""

@@ -6,7 +6,7 @@ Both keep a run record in ``--out`` (``run.json``, ``episodes.jsonl``: see
 controllers, ``results/evaluate/<suite>/<controllers>`` for the controllers given
 (``evaluate``'s policy, ``--controllers``: one folder per suite and set of controllers, outside
 the suite's).  The controllers given, and a suite that does not list the ``oracle``, run
-with the references they lack (:mod:`shipgym_baselines.leaderboard.comparison`), unless
+with the references they lack (:mod:`shipgym_baselines.scoring.comparison`), unless
 ``--no-references``; a suite that lists the oracle runs as it lists its controllers.
 """
 
@@ -19,8 +19,8 @@ from typing import Any
 
 from shipgym_baselines.cli.options import add_run_options, command_line, emit
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard.comparison import REFERENCES, RESULTS_ROOT, suite_folder
 from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
+from shipgym_baselines.scoring.comparison import REFERENCES, RESULTS_ROOT, suite_folder
 
 #: ``evaluate`` writes to ``EVALUATE_ROOT/<suite>/<policy>`` unless given ``--out``
 EVALUATE_ROOT = RESULTS_ROOT / "evaluate"
@@ -176,8 +176,8 @@ def named_controllers(
 def run(args: argparse.Namespace) -> int:
     """Run the suite (with ``evaluate``: only ``args.policy``); print the ranking (--json:
     the rows)."""
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.folders import check_out_dir, check_out_usable
+    from shipgym_baselines.suite import load_suite
 
     policy = getattr(args, "policy", None)
     if policy is not None:

@@ -103,7 +103,6 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.errors import RunError, check_seeds
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard.jobs import Job, suite_scenario, suite_scenarios, trials
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.leaderboard.twins import plan_twins
     from shipgym_baselines.records.locking import file_lock
     from shipgym_baselines.records.runrecord import now
@@ -113,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
         lookup,
         table_path,
     )
+    from shipgym_baselines.suite import load_suite
 
     if args.reference is None:
         chosen = [ORACLE] if args.table is not None else list(REFERENCES)

@@ -114,11 +114,11 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.jsonout import dumps
     from shipgym_baselines.leaderboard.jobs import check_controllers
     from shipgym_baselines.leaderboard.outputs import plot_results
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.episodes import EpisodeLabel
     from shipgym_baselines.records.folders import check_out_dir
     from shipgym_baselines.records.manifest import check_listed
     from shipgym_baselines.registry import applies_to, training_seeds
+    from shipgym_baselines.suite import load_suite
 
     guard = ActGuard(args.act_timeout)
     suite = load_suite(args.suite)
@@ -230,7 +230,7 @@ def _suite_file(scenario: str, suite: Any) -> str:
     is neither a catalogue scenario, a held-out one nor a path)."""
     from shipgym.config import is_path
     from shipgym.scenarios.loader import list_scenarios, load_scenario
-    from shipgym_baselines.leaderboard.suite import name_scenarios
+    from shipgym_baselines.suite import name_scenarios
 
     if is_path(scenario) or ":" in scenario or scenario in list_scenarios():
         return scenario

@@ -5,7 +5,7 @@ YAML line): one ``ok FILE`` line per good file, one ``FILE:LINE: key 'K': messag
 problem of a bad one, in line order; exit code 2 when any file is bad.  An unknown key
 close to a valid one is followed by "did you mean 'K'?".  A file whose top level has
 ``controllers``, ``scenarios``, ``heldout_scenarios`` or ``inrange_scenarios`` (or a packaged
-suite's name) is checked as a suite (:func:`shipgym_baselines.leaderboard.suite.check_suite_file`:
+suite's name) is checked as a suite (:func:`shipgym_baselines.suite.check_suite_file`:
 its schema, every scenario it lists, every controller), any other as a scenario.  With
 ``--json``: a list of ``{"file", "kind", "ok", "problems"}`` (``kind``: ``scenario`` or
 ``suite``; ``problems``: the lines without the file name).
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
 def validate(args: argparse.Namespace) -> int:
     """Check every ``--validate`` file; 0 when all are good, else :data:`EXIT_BAD_FILE`."""
     from shipgym.scenarios.loader import check_scenario_file
-    from shipgym_baselines.leaderboard.suite import check_suite_file, is_suite_file
+    from shipgym_baselines.suite import check_suite_file, is_suite_file
 
     results = []
     lines = []

@@ -84,7 +84,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def training_jobs(args: argparse.Namespace) -> list[dict[str, Any]]:
     """One job per (agent, seed) with its output directory (``train_sweep``'s input)."""
     from shipgym_baselines.learned.agent_folder import check_agent_folder
-    from shipgym_baselines.learned.agents import list_agent_configs, load_agent_config
+    from shipgym_baselines.training.agents import list_agent_configs, load_agent_config
 
     if args.timesteps is not None:
         check_count(args.timesteps, "--timesteps")
@@ -135,8 +135,8 @@ def run(args: argparse.Namespace) -> int:
     from shipgym_baselines.extras import require
 
     require("stable_baselines3", "rl", "shipgym train")
-    from shipgym_baselines.learned.announce import start_line, too_short_line
-    from shipgym_baselines.learned.train import train_sweep
+    from shipgym_baselines.training.announce import start_line, too_short_line
+    from shipgym_baselines.training.train import train_sweep
 
     jobs = training_jobs(args)
     for job in jobs:

@@ -19,7 +19,6 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S
 from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.isolation import isolated, run_isolated
-from shipgym_baselines.leaderboard.suite import scenario_names
 from shipgym_baselines.leaderboard.twins import plan_twins, twin_record
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.privileged import ORACLE, grants_truth
@@ -37,6 +36,7 @@ from shipgym_baselines.records.trials import (
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
 from shipgym_baselines.registry import applies_to, controller_kind, controller_label
 from shipgym_baselines.signals import worker_init
+from shipgym_baselines.suite import scenario_names
 
 
 def check_controllers(names: list[str]) -> list[str]:
@@ -108,9 +108,9 @@ def suite_scenario(name: str) -> Scenario:
 
 
 def suite_scenarios(entries: Iterable[str]) -> dict[str, Scenario]:
-    """A suite's scenarios (as :func:`~shipgym_baselines.leaderboard.suite.load_suite` gives them)
+    """A suite's scenarios (as :func:`~shipgym_baselines.suite.load_suite` gives them)
     by table name: a catalogue or held-out name as given, a YAML file's under its ``name:``
-    (:func:`~shipgym_baselines.leaderboard.suite.scenario_names`: a name that clashes is refused,
+    (:func:`~shipgym_baselines.suite.scenario_names`: a name that clashes is refused,
     naming both files)."""
     entries = list(entries)
     names = scenario_names(entries, suite_scenario).names
@@ -155,7 +155,7 @@ def run_job(job: tuple) -> EpisodeResult:
 def _guard(job: Job) -> evaluation.ActGuard:
     """How the job's episodes end when their controller fails: a privileged reference is
     never judged as an entrant (no time limit; a failed episode of it is recorded, and
-    never a denominator: :func:`~shipgym_baselines.leaderboard.scores.scored_episodes`)."""
+    never a denominator: :func:`~shipgym_baselines.scoring.scores.scored_episodes`)."""
     if grants_truth(job.controller):
         return evaluation.ActGuard(math.inf)
     return evaluation.ActGuard(job.act_timeout)
@@ -283,7 +283,7 @@ def suite_record(
 ) -> dict[str, Any]:
     """The resolved suite as ``run.json`` keeps it: evaluation seeds (``scenario_seeds``:
     the scenarios run on fewer,
-    :meth:`~shipgym_baselines.leaderboard.suite.SuiteConfig.scenario_seeds`),
+    :meth:`~shipgym_baselines.suite.SuiteConfig.scenario_seeds`),
     the trial randomisation, controllers (table name, how the suite names it, kind, training seeds),
     each scenario's settings (by table name), the pairs that do not apply, when the
     suite has its own scenarios ``scenario_files`` (table name → the YAML file read) and,

@@ -19,39 +19,47 @@ from shipgym.config import is_path
 from shipgym.notices import notice
 from shipgym.scenarios.loader import load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
+from shipgym_baselines.escaping import csv_cell, plain_text
 from shipgym_baselines.executor import Inline, task_pool
 from shipgym_baselines.jsonout import dumps, dumps_rows
-from shipgym_baselines.leaderboard import curve_figures, ranking_figures, scenario_figures
-from shipgym_baselines.leaderboard.change_share import (
+from shipgym_baselines.leaderboard.costs import tables_line
+from shipgym_baselines.page.markdown import (
+    generalisation_table,
+    markdown_table,
+    ranking_markdown,
+    ranking_tables,
+)
+from shipgym_baselines.page.verdict import folder_verdict, main_table, plain_name, verdict
+from shipgym_baselines.plots import curves as curve_figures
+from shipgym_baselines.plots import ranking as ranking_figures
+from shipgym_baselines.plots import scenarios as scenario_figures
+from shipgym_baselines.plots.style import FIGURE_DPI, controller_style
+from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
+from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
+from shipgym_baselines.records.runrecord import RUN_FILE, read_run
+from shipgym_baselines.records.trajectories import episode_result
+from shipgym_baselines.records.trials import shares_trials, twins_of
+from shipgym_baselines.scoring.change_share import (
     NO_SCENARIO_CELLS,
     episode_costs,
     scenario_twin_cells,
     share_controllers,
     share_grid,
 )
-from shipgym_baselines.leaderboard.comparison import (
+from shipgym_baselines.scoring.comparison import (
     comparison_note,
 )
-from shipgym_baselines.leaderboard.costs import tables_line
-from shipgym_baselines.leaderboard.escaping import csv_cell, plain_text
-from shipgym_baselines.leaderboard.headroom import headroom_table, scenario_ships
-from shipgym_baselines.leaderboard.markdown import (
-    generalisation_table,
-    markdown_table,
-    ranking_markdown,
-    ranking_tables,
-)
-from shipgym_baselines.leaderboard.ranking import (
+from shipgym_baselines.scoring.headroom import headroom_table, scenario_ships
+from shipgym_baselines.scoring.ranking import (
     PARTIAL,
     aggregate_ranking,
     no_ranking,
     resolution_lines,
 )
-from shipgym_baselines.leaderboard.ranking import scenario_scores as score_table
-from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, refused_trials, scored_episodes
-from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
-from shipgym_baselines.leaderboard.style import FIGURE_DPI, controller_style
-from shipgym_baselines.leaderboard.tables import (
+from shipgym_baselines.scoring.ranking import scenario_scores as score_table
+from shipgym_baselines.scoring.scores import REFERENCE_KIND, refused_trials, scored_episodes
+from shipgym_baselines.scoring.splits import suite_families, suite_splits
+from shipgym_baselines.scoring.tables import (
     AGGREGATE_FILE,
     SCENARIO_SCORES_FILE,
     aggregate_results,
@@ -59,12 +67,6 @@ from shipgym_baselines.leaderboard.tables import (
     generalisation,
     rankable,
 )
-from shipgym_baselines.leaderboard.verdict import folder_verdict, main_table, plain_name, verdict
-from shipgym_baselines.records.episodes import EpisodeResult, read_episodes
-from shipgym_baselines.records.outfiles import carried, write_bytes, write_text
-from shipgym_baselines.records.runrecord import RUN_FILE, read_run
-from shipgym_baselines.records.trajectories import episode_result
-from shipgym_baselines.records.trials import shares_trials, twins_of
 from shipgym_baselines.signals import worker_init
 
 
@@ -92,17 +94,17 @@ def write_results(
 
     ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
     controller × scenario cost ratios, then the rows), ``generalisation.json``,
-    ``aggregate.json`` (:func:`shipgym_baselines.leaderboard.ranking.aggregate_ranking`),
+    ``aggregate.json`` (:func:`shipgym_baselines.scoring.ranking.aggregate_ranking`),
     ``scenario_scores.json`` and the figures
-    (:mod:`shipgym_baselines.leaderboard.figures`: per scenario the small multiples of each
+    (:mod:`shipgym_baselines.plots.figures`: per scenario the small multiples of each
     controller's median-ACE episode, per split the ranking's interval estimates and performance
-    profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.leaderboard.page`: all of it on one
+    profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.page.html`: all of it on one
     page).  The ranking of each split and each figure are independent tasks, run in a
     pool of ``workers`` processes (default: the cores) when there are
     :data:`POOLED_FIGURES` scenario figures or more.  ``vector_figures``: each figure's
     vector copy too (the page shows the PNGs).
     """
-    from shipgym_baselines.leaderboard import page
+    from shipgym_baselines.page import html as page
 
     # completion order varies between runs: aggregate in a fixed order (bit-stable means)
     results = sorted(results, key=_order)
@@ -214,9 +216,9 @@ def add_twin_cells(
 ) -> None:
     """Each row of a changing scenario gets its controller's nominal ratio and change share
     there, with intervals that resample the scenario's trials
-    (:func:`~shipgym_baselines.leaderboard.change_share.scenario_twin_cells`); the other rows
+    (:func:`~shipgym_baselines.scoring.change_share.scenario_twin_cells`); the other rows
     None.  The references' rows have none.  ``scored``: the ranked episodes with their cost
-    ratios (:func:`~shipgym_baselines.leaderboard.scores.scored_episodes`)."""
+    ratios (:func:`~shipgym_baselines.scoring.scores.scored_episodes`)."""
     costs = episode_costs(scored)
     for row in rows:
         cells = dict(NO_SCENARIO_CELLS)
@@ -234,7 +236,7 @@ def share_table(
     twins: Mapping[str, str],
 ) -> dict[str, Any]:
     """The change share per ship × change family of the verdict's table's top competitors
-    and best learned agent (:func:`~shipgym_baselines.leaderboard.change_share.share_grid`):
+    and best learned agent (:func:`~shipgym_baselines.scoring.change_share.share_grid`):
     ``split``, ``controllers`` and ``rows``; empty without twins or a ranking.  ``scored``:
     as :func:`add_twin_cells` reads them; ``ships`` / ``families``: scenario → its ship /
     change family."""
@@ -300,7 +302,7 @@ def terminal_summary(folder: str | os.PathLike) -> str:
     """What ``leaderboard``, ``evaluate`` and ``report`` print: the ranking of the run
     folder's ``aggregate.json`` (or why there is none), its resolution, and the path of
     ``leaderboard.html``."""
-    from shipgym_baselines.leaderboard.page import PAGE_FILE
+    from shipgym_baselines.page.html import PAGE_FILE
 
     lead = folder_verdict(folder)
     board = json.loads((Path(folder) / AGGREGATE_FILE).read_text())
@@ -316,7 +318,7 @@ def terminal_summary(folder: str | os.PathLike) -> str:
 
 def _why_none(folder: str | os.PathLike) -> str:
     """Why the run folder has no ranking
-    (:func:`~shipgym_baselines.leaderboard.ranking.no_ranking`)."""
+    (:func:`~shipgym_baselines.scoring.ranking.no_ranking`)."""
     file = Path(folder) / SCENARIO_SCORES_FILE
     return no_ranking(json.loads(file.read_text()) if file.is_file() else [])
 

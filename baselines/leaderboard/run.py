@@ -19,12 +19,6 @@ from shipgym_baselines import evaluation
 from shipgym_baselines.errors import RunError, check_seeds
 from shipgym_baselines.evaluation import ACT_TIMEOUT_S, EVAL_SEED_OFFSET
 from shipgym_baselines.executor import check_backend
-from shipgym_baselines.leaderboard.comparison import (
-    RECORD_KEY,
-    references_record,
-    suite_folder,
-    with_references,
-)
 from shipgym_baselines.leaderboard.costs import eta_line
 from shipgym_baselines.leaderboard.jobs import (
     Job,
@@ -40,14 +34,20 @@ from shipgym_baselines.leaderboard.jobs import (
     suite_scenarios,
 )
 from shipgym_baselines.leaderboard.outputs import load_results, write_results
-from shipgym_baselines.leaderboard.scenario_figures import median_ace_episode
-from shipgym_baselines.leaderboard.suite import load_suite
+from shipgym_baselines.plots.scenarios import median_ace_episode
 from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.records.episodes import STATS_ERROR, EpisodeResult, controller_failed
 from shipgym_baselines.records.folders import check_out_dir, check_out_usable
 from shipgym_baselines.records.runlog import RunLog
 from shipgym_baselines.records.runrecord import read_run
 from shipgym_baselines.registry import controller_label, training_seeds
+from shipgym_baselines.scoring.comparison import (
+    RECORD_KEY,
+    references_record,
+    suite_folder,
+    with_references,
+)
+from shipgym_baselines.suite import load_suite
 
 
 def run_leaderboard(
@@ -79,10 +79,10 @@ def run_leaderboard(
     its shipped reference table (:mod:`shipgym_baselines.references`); ``vector_figures``:
     the figures' vector copies too (SVG / SVGZ).  ``workers``: local processes
     (default: the cores), clamped to the jobs; below 1 refused.  ``add_references``: run the
-    references (:data:`shipgym_baselines.leaderboard.comparison.REFERENCES`) too, those not among
+    references (:data:`shipgym_baselines.scoring.comparison.REFERENCES`) too, those not among
     the controllers already (``run.json`` records which; a resumed run that did not add them
     does not).  ``out_dir``: default
-    ``results/<suite>`` (:func:`~shipgym_baselines.leaderboard.comparison.suite_folder`).
+    ``results/<suite>`` (:func:`~shipgym_baselines.scoring.comparison.suite_folder`).
     ``show_progress``: a progress bar on stderr, after one line before the first episode: the
     episodes, workers and the time estimated from the recorded costs
     (:func:`shipgym_baselines.leaderboard.costs.eta_line`).  Ctrl-C raises
@@ -213,7 +213,7 @@ def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
 
 def keep_drawn(log: RunLog, rows: Mapping[tuple[str, str], set[tuple]], row: tuple) -> None:
     """Once every episode of ``row`` is recorded: keep the trajectory of the episode its
-    figure draws (:func:`shipgym_baselines.leaderboard.figures.median_ace_episode`), remove
+    figure draws (:func:`shipgym_baselines.plots.figures.median_ace_episode`), remove
     the others' (all of them on a twin that is no scenario of the run: no figure draws it)."""
     keys = rows[row]
     if not keys <= log.done:

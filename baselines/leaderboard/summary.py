@@ -25,16 +25,16 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.leaderboard.change_share import NOMINAL, SHARE
-from shipgym_baselines.leaderboard.headroom import (
+from shipgym_baselines.page.verdict import folder_verdict
+from shipgym_baselines.scoring.change_share import NOMINAL, SHARE
+from shipgym_baselines.scoring.headroom import (
     gmean_headroom,
     headroom_table,
     scenario_ships,
     trial_headroom,
 )
-from shipgym_baselines.leaderboard.ranking import is_partial
-from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
-from shipgym_baselines.leaderboard.verdict import folder_verdict
+from shipgym_baselines.scoring.ranking import is_partial
+from shipgym_baselines.scoring.splits import suite_families, suite_splits
 
 #: the summary's layout; bump when a field changes meaning
 SUMMARY_VERSION = 1

@@ -1,7 +1,7 @@
 """A trained agent's folder: what a training run writes there, the settings it started with,
 the value of its best model, and whether a fresh run may start in it.  Shared by the SB3 trainer
-(:mod:`shipgym_baselines.learned.train`) and the DAgger agent
-(:mod:`shipgym_baselines.learned.dagger_agent`).
+(:mod:`shipgym_baselines.training.train`) and the DAgger agent
+(:mod:`shipgym_baselines.training.dagger_agent`).
 
 A training run writes its folder as ``shipgym run`` writes its own (:func:`agent_run`): the
 folder locked while it trains (a second run on it refused in one line), every file it
@@ -37,7 +37,7 @@ TRAINING_OUTPUTS = (
     "tb",
     "learning_curve.json",
     "tuned_from.json",
-    "dagger",  # a dagger agent's DAgger run (shipgym_baselines.learned.dagger_agent)
+    "dagger",  # a dagger agent's DAgger run (shipgym_baselines.training.dagger_agent)
 )
 #: the chosen settings a run was started with (``--settings tuned``; null: the config's)
 TUNED_FROM_FILE = "tuned_from.json"

@@ -6,7 +6,7 @@
 
 one entry per periodic validation evaluation, env steps strictly increasing; the run may add
 ``"selection": [...]`` (the model-selection metric at each evaluation, lower is better, when
-the run selects on the relative cost, :mod:`shipgym_baselines.learned.selection`).
+the run selects on the relative cost, :mod:`shipgym_baselines.training.selection`).
 
 The plateau rule (:class:`PlateauRule`): training stops once the last ``window`` fraction of
 the env steps so far improved the best value of the metric by less than ``min_gain``

@@ -1,7 +1,7 @@
 """The ``hyperparams`` block of an ``algo: dagger`` agent config, checked: DAgger's settings
 (:class:`~shipgym_baselines.learned.dagger.DaggerSettings`) as an agent config gives them.
 The agent config reads it when it is validated; the DAgger agent
-(:mod:`shipgym_baselines.learned.dagger_agent`) trains with it."""
+(:mod:`shipgym_baselines.training.dagger_agent`) trains with it."""
 
 from __future__ import annotations
 

@@ -486,7 +486,7 @@ def bench_training(
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from shipgym_baselines.learned.agents import (
+    from shipgym_baselines.training.agents import (
         build_hyperparams,
         load_agent_config,
         make_training_env,

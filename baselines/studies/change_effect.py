@@ -35,8 +35,8 @@ from shipgym.scenarios.loader import Scenario, list_scenarios, load_scenario
 from shipgym.scenarios.trials import TrialRandomization, trial_scenario
 from shipgym.scenarios.twins import nominal_twin
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, run_episode
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import make_controller
+from shipgym_baselines.suite import load_suite
 
 #: the factor by which a change must raise the after-change cost per step
 MATTERS = 1.3

@@ -4,7 +4,7 @@
 reads a leaderboard run folder (its ``run.json`` and ``episodes.jsonl``) and prints, per
 change family of the split's changing scenarios (default: the catalogue), the competitors
 ranked by their change share over that family's trials, each with its stratified-bootstrap
-95 % interval (:func:`shipgym_baselines.leaderboard.change_share.twin_fields`), and the
+95 % interval (:func:`shipgym_baselines.scoring.change_share.twin_fields`), and the
 worked decomposition of one trial (``--trial SCENARIO:SEED CONTROLLER``): the cost ratio,
 the nominal ratio, D and the change share.
 """
@@ -18,21 +18,21 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym_baselines.leaderboard.change_share import (
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.records.episodes import read_episodes
+from shipgym_baselines.records.runrecord import read_run
+from shipgym_baselines.records.trajectories import episode_result
+from shipgym_baselines.records.trials import shares_trials, twins_of
+from shipgym_baselines.scoring.change_share import (
     NOMINAL,
     SHARE,
     episode_costs,
     trial_cells,
     twin_fields,
 )
-from shipgym_baselines.leaderboard.scores import REFERENCE_KIND, scored_episodes
-from shipgym_baselines.leaderboard.splits import suite_families, suite_splits
-from shipgym_baselines.leaderboard.tables import episode_rows, rankable
-from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
-from shipgym_baselines.records.episodes import read_episodes
-from shipgym_baselines.records.runrecord import read_run
-from shipgym_baselines.records.trajectories import episode_result
-from shipgym_baselines.records.trials import shares_trials, twins_of
+from shipgym_baselines.scoring.scores import REFERENCE_KIND, scored_episodes
+from shipgym_baselines.scoring.splits import suite_families, suite_splits
+from shipgym_baselines.scoring.tables import episode_rows, rankable
 
 
 def run_episodes(folder: str | Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:

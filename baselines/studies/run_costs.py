@@ -82,10 +82,10 @@ def profile_suite(
         suite_scenario,
         work,
     )
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.privileged import grants_truth
     from shipgym_baselines.records.trials import SHARED
     from shipgym_baselines.registry import controller_label, training_seeds
+    from shipgym_baselines.suite import load_suite
 
     torch.set_num_threads(1)
     check_seeds(seeds, "--seeds")
@@ -192,9 +192,9 @@ def record_costs(
     import platform
 
     from shipgym_baselines.leaderboard.jobs import Job, suite_scenario, work
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.runrecord import git_commit
     from shipgym_baselines.registry import controller_kind, controller_label
+    from shipgym_baselines.suite import load_suite
 
     spec = load_suite(suite)
     labels = [controller_label(c) for c in spec.controllers]

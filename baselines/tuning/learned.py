@@ -74,8 +74,8 @@ def train_and_score(
 ) -> list[float]:
     """Train the agent with ``overrides`` in parts, score each part (module doc); the last
     part's per-trial ratios."""
-    from shipgym_baselines.learned.agents import load_agent_config
-    from shipgym_baselines.learned.train import latest_checkpoint, train
+    from shipgym_baselines.training.agents import load_agent_config
+    from shipgym_baselines.training.train import latest_checkpoint, train
 
     spec = config.training
     assert spec is not None  # a learned config has one (validated)

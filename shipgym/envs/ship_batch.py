@@ -23,7 +23,7 @@ Autoreset as :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` (NEXT_STEP, p
 :meth:`reset_finished` for same-step adapters such as stable-baselines3's).  ``info``
 holds, at episode ends only, ``termination_reason`` (with its ``_`` mask): no per-step
 keys and no episode metrics (a training env).  Not registered with ``gym.make``: build it
-directly, or through ``shipgym_baselines.learned.agents`` (one per ship, combined).
+directly, or through ``shipgym_baselines.training.agents`` (one per ship, combined).
 """
 
 from __future__ import annotations

@@ -128,7 +128,7 @@ def test_the_smoke_leaderboard_opens_with_its_verdict(smoke: tuple[Path, list[di
     """leaderboard.md, the terminal summary and the page open with the run's two sentences:
     the catalogue leader of aggregate.json with its IQM, the learned agent's rank."""
     from shipgym_baselines.leaderboard.outputs import terminal_summary
-    from shipgym_baselines.leaderboard.verdict import folder_verdict, plain_name
+    from shipgym_baselines.page.verdict import folder_verdict, plain_name
 
     out, _ = smoke
     board = [
@@ -222,9 +222,9 @@ def test_default_suite_has_every_controller_and_learned_agent() -> None:
     of Liu et al.'s identifier rows, which play in the quick suite (the default run's
     time: docs/leaderboard.md, "The default run's size")."""
     from shipgym.scenarios.loader import list_scenarios
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.learned.policy import shipped_policies
     from shipgym_baselines.registry import CONTROLLERS
+    from shipgym_baselines.suite import load_suite
 
     suite, quick = load_suite("default"), load_suite("quick")
     every = set(CONTROLLERS) | set(shipped_policies())

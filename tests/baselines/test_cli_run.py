@@ -17,7 +17,7 @@ from shipgym.scenarios.trials import trial_scenario
 from shipgym_baselines.cli import main
 from shipgym_baselines.cli.run import default_out
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
-from shipgym_baselines.leaderboard.suite import load_suite
+from shipgym_baselines.suite import load_suite
 
 #: wall-clock figures differ between two runs of the same episode
 TIMING = ("compute_ms", "compute_ms_max")

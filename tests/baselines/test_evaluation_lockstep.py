@@ -13,8 +13,8 @@ from shipgym_baselines import evaluation
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate_batch, run_episode
 from shipgym_baselines.leaderboard.jobs import Job, trials
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.registry import make_controller
+from shipgym_baselines.suite import load_suite
 
 from .test_evaluation import _assert_same_episodes, _one_by_one
 

@@ -1,8 +1,9 @@
 """The import graph of ``baselines/`` (``shipgym_baselines``) follows its layers, ground up:
-ground floor → records → controllers → evaluation → tuning, reproduce → leaderboard →
-studies → cli.  A module imports only modules of its
-own layer or a lower one, save the edges of :data:`EXCEPTIONS`, and no import cycle runs
-through baselines, save through :data:`CYCLE_EXCEPTIONS`.
+ground floor → records → controllers → evaluation → scoring → tuning, training,
+reproduce → plots → page → leaderboard → studies → cli.  Each folder sits on one layer.  A
+module imports only modules of its own layer or a lower one, save the edges of
+:data:`EXCEPTIONS`, and no import cycle runs through baselines, save through
+:data:`CYCLE_EXCEPTIONS`.
 
 The graph is :mod:`tests.import_graph`'s: every import statement (top-level, inside
 functions, under ``if TYPE_CHECKING:``, in ``try`` blocks) and the modules a module imports
@@ -29,14 +30,15 @@ from tests.import_graph import (
 
 B = "shipgym_baselines"
 
-#: The layer of every baselines module, lowest first; an entry for a package covers its
-#: submodules unless they have their own.
+#: The layer of every folder of baselines and of every module at its top, lowest first.  An
+#: entry for a folder covers every module in it: no folder spans two layers.
 LAYERS: dict[str, int] = {
-    # 0 — ground floor: error types, signal handling, JSON output, optional extras, the
-    #     executor (local pool or Ray), the shipped reference data (no code)
+    # 0 — ground floor: error types, signal handling, JSON output, names written as text,
+    #     optional extras, the executor (local pool or Ray), the shipped reference data
     f"{B}.errors": 0,
     f"{B}.signals": 0,
     f"{B}.jsonout": 0,
+    f"{B}.escaping": 0,
     f"{B}.extras": 0,
     f"{B}.executor": 0,
     f"{B}.reference_data": 0,
@@ -44,7 +46,7 @@ LAYERS: dict[str, int] = {
     f"{B}.records": 1,
     # 2 — controllers: what a controller is, how it enters, its privileged channel, the
     #     references' tables, the classical controllers and the learned policies (loading
-    #     and acting; their training sits in layer 4)
+    #     and acting)
     f"{B}.policy": 2,
     f"{B}.plugins": 2,
     f"{B}.registry": 2,
@@ -52,30 +54,27 @@ LAYERS: dict[str, int] = {
     f"{B}.references": 2,
     f"{B}.classical": 2,
     f"{B}.learned": 2,
-    # 3 — the evaluation loop, and a controller's own process for it
+    # 3 — the evaluation loop, a controller's own process for it, and a suite file (its
+    #     trials are what ``evaluate(suite=...)`` draws)
     f"{B}.evaluation": 3,
     f"{B}.isolation": 3,
-    # 4 — tuning, training the learned agents (their configs, the trainers, model
-    #     selection), the papers' reproductions (with the scenario variants they use)
-    f"{B}.tuning": 4,
-    f"{B}.learned.agents": 4,
-    f"{B}.learned.train": 4,
-    f"{B}.learned.announce": 4,
-    f"{B}.learned.selection": 4,
-    f"{B}.learned.dagger_agent": 4,
-    f"{B}.learned.meta": 4,
-    f"{B}.learned.plant_id.train": 4,
-    f"{B}.reproduce": 4,
-    # 5 — the leaderboard
-    f"{B}.leaderboard": 5,
-    #   its suite file's schema and reader sit with the evaluation loop (3): they import
-    #   nothing above it, and ``evaluate(suite=...)`` draws a suite's trials from them
-    f"{B}.leaderboard.suite": 3,
-    # 6 — one-off studies beside the leaderboard
-    f"{B}.studies": 6,
-    # 7 — the command line, and the package itself (its lazy ``register_controller``)
-    f"{B}.cli": 7,
-    B: 7,
+    f"{B}.suite": 3,
+    # 4 — scoring: the cost ratio, intervals, headroom, change share, ranking, rows, splits
+    f"{B}.scoring": 4,
+    # 5 — tuning, training the learned agents, the papers' reproductions
+    f"{B}.tuning": 5,
+    f"{B}.training": 5,
+    f"{B}.reproduce": 5,
+    # 6 — the figures, then 7 — the pages and tables that embed them
+    f"{B}.plots": 6,
+    f"{B}.page": 7,
+    # 8 — running the leaderboard: jobs, the run, its outputs, reports, summaries
+    f"{B}.leaderboard": 8,
+    # 9 — one-off studies beside the leaderboard
+    f"{B}.studies": 9,
+    # 10 — the command line, and the package itself
+    f"{B}.cli": 10,
+    B: 10,
 }
 
 
@@ -145,19 +144,27 @@ def test_the_graph_sees_lazy_and_importlib_imports() -> None:
         "import importlib\n"
         'BUILTIN = ("shipgym_baselines.classical.pid",)\n'
         "def f():\n"
-        "    from shipgym_baselines.leaderboard import ranking\n"
+        "    from shipgym_baselines.scoring import ranking\n"
         "for name in BUILTIN:\n"
         "    importlib.import_module(name)\n"
     )
     tree = ast.parse(source)
-    assert f"{B}.leaderboard.ranking" in set(imported_names(tree, f"{B}.registry", False))
+    assert f"{B}.scoring.ranking" in set(imported_names(tree, f"{B}.registry", False))
     assert named_modules(tree, f"{B}.registry") == {f"{B}.classical.pid"}
     assert named_modules(ast.parse("X = 'shipgym_baselines.classical.pid'\n"), B) == set()
-    assert _upward([(f"{B}.records.episodes", f"{B}.leaderboard.ranking")])
+    assert _upward([(f"{B}.records.episodes", f"{B}.scoring.ranking")])
     assert _upward([(f"{B}.classical.pid", f"{B}.cli")])
     assert not _upward([(f"{B}.cli.run", f"{B}.records.runlog")])  # downward
     listed = [(m.replace(".*", ".any"), t.replace(".*", ".any")) for m, t in EXCEPTIONS]
     assert not _upward(listed)
+
+
+def test_each_layer_is_a_folder_or_a_module_at_the_top() -> None:
+    """No entry of LAYERS lies inside a folder: a folder sits on one layer as a whole."""
+    inside = [name for name in LAYERS if name.count(".") > 1]
+    assert not inside, f"a layer of its own inside a folder: {inside}"
+    top = {m.split(".")[1] for m in files() if within(m, B) and m != B}
+    assert {name.split(".")[1] for name in LAYERS if name != B} == top
 
 
 def test_every_baselines_module_has_a_layer() -> None:

@@ -19,7 +19,7 @@ from shipgym.limits import (
 )
 from shipgym.scenarios.loader import catalogue_dir
 from shipgym_baselines.cli import main
-from shipgym_baselines.learned.train import train_sweep
+from shipgym_baselines.training.train import train_sweep
 
 ONE_JOB = {"name": "one", "scenarios": ["nominal"], "controllers": ["zero_rudder"], "seeds": 1}
 

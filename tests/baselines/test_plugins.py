@@ -26,7 +26,6 @@ from shipgym_baselines.errors import ControllerError, RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate, run_episode
 from shipgym_baselines.leaderboard.jobs import check_controllers, run_job
 from shipgym_baselines.leaderboard.run import run_leaderboard
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerEntry, anchored, entry_point_names, parse_spec
 from shipgym_baselines.registry import (
     CONTROLLERS,
@@ -36,6 +35,7 @@ from shipgym_baselines.registry import (
     make_controller,
     unknown_controller,
 )
+from shipgym_baselines.suite import load_suite
 
 #: the docs page of plug-ins, whose example blocks run as written
 PLUGINS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "plugins.md"

@@ -46,8 +46,8 @@ def test_the_evaluate_example_gives_the_leaderboards_episodes(
     controller with the default suite's trial ranges, gives the same episodes."""
     from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
     from shipgym_baselines.leaderboard.run import run_leaderboard
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.records.episodes import read_episodes
+    from shipgym_baselines.suite import load_suite
 
     blocks = re.findall(r"```python\n(.*?)```", README, flags=re.S)
     (block,) = [b for b in blocks if "suite=" in b and "evaluate(" in b]

@@ -113,7 +113,7 @@ class NmpcLearnedId(PlantNMPC):
             if not seeds:
                 raise ControllerError(
                     "nmpc_learned_id: no shipped estimator in "
-                    f"{SHIPPED}; train one (python -m shipgym_baselines.learned.plant_id.train)"
+                    f"{SHIPPED}; train one (python -m shipgym_baselines.training.plant_id)"
                 )
             seed = seeds[0] if training_seed is None else training_seed
             if seed not in seeds:

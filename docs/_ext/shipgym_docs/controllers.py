@@ -21,9 +21,9 @@ from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical import lqr, nmpc, pid
 from shipgym_baselines.classical.adaptive.settings import L1BacksteppingSettings
 from shipgym_baselines.classical.l1_backstepping import L1Backstepping
-from shipgym_baselines.leaderboard.curve_figures import plot_learning_curves
 from shipgym_baselines.learned.curves import agent_curves
 from shipgym_baselines.learned.policy import POLICY_DIR, shipped_policies
+from shipgym_baselines.plots.curves import plot_learning_curves
 from shipgym_baselines.records.chosen import ALL_SHIPS, read_chosen
 from shipgym_baselines.registry import CONTROLLERS, ControllerRecord
 from shipgym_docs.pages import cell, rst_block, table, write_text

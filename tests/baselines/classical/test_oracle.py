@@ -39,10 +39,10 @@ from shipgym_baselines.classical.oracle import (
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import evaluate, run_episode
 from shipgym_baselines.leaderboard.jobs import Job, trials, work
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.plugins import ControllerEntry
 from shipgym_baselines.privileged import grants_truth
 from shipgym_baselines.references import ReferenceTable, entry_key, shipped_table, table_path
+from shipgym_baselines.suite import load_suite
 
 
 # ------------------------------------------------------------------ the optimiser

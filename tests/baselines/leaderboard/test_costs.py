@@ -20,9 +20,9 @@ from shipgym_baselines.leaderboard.jobs import (
     suite_record,
     suite_scenario,
 )
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.records.trials import LEARNED_TRIALS, SHARED, TWIN_PLAYERS, TWIN_SCENARIOS
 from shipgym_baselines.registry import training_seeds
+from shipgym_baselines.suite import load_suite
 
 #: the default suite's whole run, CPU seconds (docs/run_summary.json: 914 CPU s on two quiet
 #: cores, the suite as shipped with its twins)

@@ -14,10 +14,10 @@ from shipgym.config import ConfigError
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.leaderboard.jobs import Job, plan_jobs, plan_run, run_batch, run_job
 from shipgym_baselines.leaderboard.run import run_leaderboard
-from shipgym_baselines.leaderboard.tables import COLUMNS
 from shipgym_baselines.learned.policy import model_zip
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runrecord import read_run
+from shipgym_baselines.scoring.tables import COLUMNS
 from tests.baselines.records.conftest import TIMING, untimed, write_suite
 
 RANDOMIZE = {
@@ -225,7 +225,7 @@ def test_the_markdown_opens_with_the_ranking(ranked: Path) -> None:
 def test_the_markdown_the_terminal_and_the_page_open_with_the_verdict(
     randomised: Path, ranked: Path
 ) -> None:
-    """The run's sentences (shipgym_baselines.leaderboard.verdict; two without the frozen
+    """The run's sentences (shipgym_baselines.page.verdict; two without the frozen
     optimum) first; a report folder (no episodes of its own) prints those its leaderboard.md
     opens with; no ranking: none."""
     from shipgym_baselines.leaderboard.outputs import terminal_summary
@@ -525,7 +525,7 @@ def test_quick_suite_finishes(tmp_path: Path) -> None:
     """The quick suite runs to the end with every controller on its 12
     scenarios (one evaluation seed here, to keep CI short; the suite's own is 3): a row per
     controller and scenario, every applicable one with its episodes."""
-    from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.suite import load_suite
 
     quick = load_suite("quick")
     rows = run_leaderboard("quick", seeds=1, out_dir=tmp_path, workers=2, show_progress=False)
@@ -671,7 +671,7 @@ def test_a_scenario_file_named_as_a_catalogue_scenario_is_refused(tmp_path: Path
 
 def test_a_copy_of_a_catalogue_scenario_is_that_scenario(tmp_path: Path) -> None:
     from shipgym_baselines.leaderboard.jobs import suite_record, suite_scenarios
-    from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.suite import load_suite
 
     copy = tmp_path / "copy.yaml"
     copy.write_text(NOMINAL.read_text())
@@ -772,8 +772,8 @@ def test_the_in_range_split_is_ranked_in_its_own_table(tmp_path: Path) -> None:
     (``run.json``'s ``scenario_seeds``); its oracle reference is read from the shipped
     table, which holds the default suite's in-range trials."""
     from shipgym_baselines.leaderboard.jobs import trials
-    from shipgym_baselines.leaderboard.suite import load_suite
     from shipgym_baselines.references import shipped_table
+    from shipgym_baselines.suite import load_suite
 
     randomize = load_suite("default").randomize.model_dump(mode="json")
     suite = write_suite(

@@ -11,7 +11,7 @@ import pytest
 from shipgym_baselines.cli import main
 from shipgym_baselines.leaderboard.run import run_leaderboard
 from shipgym_baselines.leaderboard.summary import readme_table, run_summary
-from shipgym_baselines.leaderboard.verdict import folder_verdict
+from shipgym_baselines.page.verdict import folder_verdict
 from shipgym_baselines.records.episodes import read_episodes
 from tests.baselines.records.conftest import write_suite
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.leaderboard.jobs import plan_run, suite_record, suite_scenarios
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.leaderboard.twins import plan_twins
 from shipgym_baselines.records.trials import deal_names, dealt_owners, twins_of
+from shipgym_baselines.suite import load_suite
 
 SEEDS = [EVAL_SEED_OFFSET + i for i in range(8)]
 

@@ -10,7 +10,7 @@ import pytest
 
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.learned.curves import CURVE_FILE, PlateauRule, load_curve, write_curve
-from shipgym_baselines.learned.selection import geometric_mean_ratio, validation_trials
+from shipgym_baselines.training.selection import geometric_mean_ratio, validation_trials
 
 
 def test_curve_round_trip_and_monotone_steps(tmp_path) -> None:
@@ -86,12 +86,12 @@ def test_validation_trials_are_fixed_and_never_heldout() -> None:
 
 
 def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
-    from shipgym_baselines.leaderboard.curve_figures import (
+    from shipgym_baselines.learned.curves import agent_curves
+    from shipgym_baselines.page.figures import figure_sections
+    from shipgym_baselines.plots.curves import (
         LEARNING_CURVES_STEM,
         plot_learning_curves,
     )
-    from shipgym_baselines.leaderboard.page_figures import figure_sections
-    from shipgym_baselines.learned.curves import agent_curves
 
     root = tmp_path / "policies"
     for seed in (1, 0):
@@ -112,8 +112,8 @@ def test_shipped_curves_are_found_and_drawn_on_the_page(tmp_path) -> None:
 def test_selection_runs_on_all_32_validation_trials_by_default() -> None:
     """Model selection and stopping (eval.n_episodes), the learned studies' objective and
     the shipped agent configs: every validation trial, validation:0 … validation:31."""
-    from shipgym_baselines.learned.agents import EvalConfig, list_agent_configs, load_agent_config
-    from shipgym_baselines.learned.selection import SELECTION_TRIALS
+    from shipgym_baselines.training.agents import EvalConfig, list_agent_configs, load_agent_config
+    from shipgym_baselines.training.selection import SELECTION_TRIALS
     from shipgym_baselines.tuning.space import list_tuning, load_tuning
     from shipgym_baselines.tuning.validation import validation_trials as study_trials
 
@@ -137,7 +137,7 @@ def test_selection_never_names_the_leaderboards_test_splits() -> None:
     by an agent config's eval block."""
     from pydantic import ValidationError
 
-    from shipgym_baselines.learned.agents import EvalConfig
+    from shipgym_baselines.training.agents import EvalConfig
 
     for split in ("heldout", "inrange"):
         with pytest.raises(RunError, match="test_only"):
@@ -152,8 +152,8 @@ def test_the_run_folders_references_are_read_again_for_another_oracle_revision(
     """``eval/reference_costs.json`` records the oracle revision it was read at; a file of
     another revision (or the same trials without one) is replaced by the current oracle's
     costs (the shipped table holds every validation trial)."""
-    from shipgym_baselines.learned.selection import REFERENCE_FILE, reference_costs
     from shipgym_baselines.references import oracle_header
+    from shipgym_baselines.training.selection import REFERENCE_FILE, reference_costs
 
     trials = [("validation:0", 10_000), ("validation:1", 10_001)]
     stale = {"oracle": {"revision": -1}, "env_revision": oracle_header()["env_revision"]}
@@ -175,7 +175,7 @@ def test_curves_with_a_selection_metric_are_drawn_as_the_gap_to_the_oracle(
 ) -> None:
     """A run that selects on the validation cost ratio is drawn on it (log axis, the oracle
     at 1, each seed's best point ringed); one without it on its return."""
-    from shipgym_baselines.leaderboard import curve_figures
+    from shipgym_baselines.plots import curves as curve_figures
 
     drawn = {}
 
@@ -244,7 +244,7 @@ def test_the_shipped_agents_flagged_seeds() -> None:
 
 def test_flagged_seeds_are_marked_in_the_ranking_with_the_rule() -> None:
     from shipgym_baselines.leaderboard.outputs import add_seed_flags
-    from shipgym_baselines.leaderboard.page_sections import flag_lines, ranking_tables
+    from shipgym_baselines.page.sections import flag_lines, ranking_tables
 
     head = {"split": "catalogue", "runs": 4}
     rows = [

@@ -17,9 +17,9 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.envs import core
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate_batch
-from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
 from shipgym_baselines.learned.normalizer import NORMALIZER_FILE, ObsNormalizer
 from shipgym_baselines.learned.policy import LearnedPolicy, read_policy
+from shipgym_baselines.training.agents import AgentConfig, load_agent_config
 
 sb3 = pytest.importorskip("stable_baselines3")
 
@@ -192,7 +192,7 @@ def test_a_bad_history_steps_in_an_agent_config_is_named(bad: object) -> None:
 def test_the_training_envs_observe_the_config_s_history() -> None:
     """Every training env a config builds (one env per process, the batched env on a
     scenario, the per-ship envs on a distribution) and the validation env observe K steps."""
-    from shipgym_baselines.learned.agents import make_eval_env, make_training_env
+    from shipgym_baselines.training.agents import make_eval_env, make_training_env
 
     k = 2
     assert _config().env.history_steps == 0

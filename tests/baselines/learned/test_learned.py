@@ -23,9 +23,9 @@ from shipgym.scenarios.sampling import (
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, evaluate
 from shipgym_baselines.leaderboard.jobs import run_job
 from shipgym_baselines.leaderboard.run import run_leaderboard
-from shipgym_baselines.learned.agents import AgentConfig, load_agent_config
 from shipgym_baselines.learned.policy import LearnedPolicy
-from shipgym_baselines.learned.train import export_policy, latest_checkpoint, train
+from shipgym_baselines.training.agents import AgentConfig, load_agent_config
+from shipgym_baselines.training.train import export_policy, latest_checkpoint, train
 
 pytest.importorskip("stable_baselines3")
 
@@ -252,7 +252,7 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
     local = run_leaderboard(
         str(suite), seeds=2, out_dir=tmp_path / "a", workers=2, show_progress=False
     )
-    from shipgym_baselines.learned.train import train_sweep
+    from shipgym_baselines.training.train import train_sweep
 
     job = {"config": _tiny_config(), "seed": 3, "n_timesteps": 128, "tensorboard": False}
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
@@ -281,7 +281,7 @@ def test_ray_backend_returns_the_process_pool_table(tmp_path: Path) -> None:
 
 def test_training_sweep_gives_the_same_runs_in_a_process_pool(tmp_path: Path) -> None:
     """Two seeds trained in a local process pool equal the same runs trained in turn."""
-    from shipgym_baselines.learned.train import train_sweep
+    from shipgym_baselines.training.train import train_sweep
 
     def jobs(root: Path) -> list[dict]:
         return [

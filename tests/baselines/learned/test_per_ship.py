@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from shipgym_baselines.learned.agents import (
+from shipgym_baselines.learned.per_ship import VecNormalizePerShip, env_gammas, ship_gamma
+from shipgym_baselines.training.agents import (
     AgentConfig,
     load_agent_config,
     make_ship_envs,
     make_training_env,
     ship_env_counts,
 )
-from shipgym_baselines.learned.per_ship import VecNormalizePerShip, env_gammas, ship_gamma
 
 
 def test_ship_gamma_is_a_horizon_in_seconds() -> None:

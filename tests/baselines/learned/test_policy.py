@@ -19,7 +19,6 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET, ActGuard, evaluate, evaluate_batch
-from shipgym_baselines.learned.agents import list_agent_configs
 from shipgym_baselines.learned.policy import (
     AGENT_LOOKS,
     ALGORITHMS,
@@ -38,6 +37,7 @@ from shipgym_baselines.registry import (
     resolve_controller,
     training_seeds,
 )
+from shipgym_baselines.training.agents import list_agent_configs
 
 sb3 = pytest.importorskip("stable_baselines3")
 sb3_contrib = pytest.importorskip("sb3_contrib")

@@ -213,7 +213,7 @@ def test_finding7_trust_pickle_reads_a_zip_sb3_alone_can(tmp_path: Path, capsys)
 def test_finding7_train_writes_the_statistics_as_data(tmp_path: Path) -> None:
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-    from shipgym_baselines.learned.train import export_policy, save_obs_statistics
+    from shipgym_baselines.training.train import export_policy, save_obs_statistics
 
     wide = LearnedPolicy(_shipped_zip().parent).context_features  # the observation it reads
     env = DummyVecEnv([lambda: gym.make("ShipPathFollow-v0", context_features=wide)])

@@ -14,9 +14,9 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import evaluate
 from shipgym_baselines.learned.dagger import RolloutJob, rollout
-from shipgym_baselines.learned.dagger_agent import make_env
 from shipgym_baselines.learned.teachers import OracleTeacher, oracle_teacher
 from shipgym_baselines.privileged import teacher_truth
+from shipgym_baselines.training.dagger_agent import make_env
 
 pytest.importorskip("stable_baselines3")
 

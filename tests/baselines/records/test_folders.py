@@ -102,7 +102,7 @@ def test_finding4_report_force_deletes_only_its_listed_outputs(
 
 def test_train_refuses_a_used_agent_folder(tmp_path: Path, capsys) -> None:
     from shipgym_baselines.learned.agent_folder import TRAINING_OUTPUTS
-    from shipgym_baselines.learned.train import train
+    from shipgym_baselines.training.train import train
 
     out = tmp_path / "agent"
     out.mkdir()

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard import scenario_figures
+from shipgym_baselines.plots import scenarios as scenario_figures
 from shipgym_baselines.records.locking import LOCK_FILE
 from shipgym_baselines.records.manifest import (
     MANIFEST_FILE,

@@ -19,8 +19,8 @@ import pytest
 import shipgym_baselines.leaderboard.jobs
 from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError, RunFailed
-from shipgym_baselines.leaderboard import scenario_figures
 from shipgym_baselines.leaderboard.run import run_leaderboard
+from shipgym_baselines.plots import scenarios as scenario_figures
 from shipgym_baselines.records.episodes import read_episodes
 from shipgym_baselines.records.runlog import RunInterrupted
 from shipgym_baselines.records.runrecord import read_run

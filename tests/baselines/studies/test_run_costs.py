@@ -7,8 +7,8 @@ import pytest
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.leaderboard.costs import limit_steps
 from shipgym_baselines.leaderboard.jobs import Job, suite_scenario, work
-from shipgym_baselines.leaderboard.suite import load_suite
 from shipgym_baselines.studies.run_costs import profile_suite
+from shipgym_baselines.suite import load_suite
 
 
 @pytest.fixture(scope="module")

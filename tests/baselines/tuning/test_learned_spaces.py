@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from shipgym_baselines.learned.agents import load_agent_config
+from shipgym_baselines.training.agents import load_agent_config
 from shipgym_baselines.tuning.learned import apply_overrides
 from shipgym_baselines.tuning.space import list_tuning, load_tuning
 

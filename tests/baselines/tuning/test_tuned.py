@@ -11,7 +11,7 @@ import yaml
 from pydantic import ValidationError
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.learned.agents import load_agent_config
+from shipgym_baselines.training.agents import load_agent_config
 from shipgym_baselines.tuning.chosen import write_chosen
 from shipgym_baselines.tuning.space import FinalSpec, TuningConfig, load_tuning
 from shipgym_baselines.tuning.tuned import tuned_agent

@@ -46,7 +46,7 @@ def start(env: gym.Env) -> tuple[float, float, float]:
 
 
 def test_the_ids_draw_the_default_suites_ranges() -> None:
-    from shipgym_baselines.leaderboard.suite import load_suite
+    from shipgym_baselines.suite import load_suite
 
     assert env_randomization() == load_suite("default").randomize
     for env_id in SHIP_IDS:

@@ -21,9 +21,9 @@ from shipgym_baselines.learned.plant_id.controller import NmpcLearnedId
 from shipgym_baselines.learned.plant_id.features import Window, episode_windows, step_row
 from shipgym_baselines.learned.plant_id.labels import SLOTS, Labeller, plant_of, slot_mask
 from shipgym_baselines.learned.plant_id.network import Estimator, build
-from shipgym_baselines.learned.plant_id.train import rollout, windows
 from shipgym_baselines.records.manifest import check_listed, read_manifest
 from shipgym_baselines.registry import make_controller, resolve_controller
+from shipgym_baselines.training.plant_id import rollout, windows
 
 torch = pytest.importorskip("torch")
 
@@ -156,7 +156,7 @@ def test_training_writes_its_rounds_and_resumes_without_collecting_again(tmp_pat
     """A tiny run: per round its data and φ, the error curve and data cost in the final
     meta; a resumed run whose last φ was lost refits it from the kept data (no new
     episodes: the shards are untouched) and a finished run resumed trains nothing."""
-    from shipgym_baselines.learned.plant_id import train as trainer
+    from shipgym_baselines.training import plant_id as trainer
 
     out = tmp_path / "phi"
     kwargs = dict(
