@@ -222,10 +222,14 @@ def finite_gmean(ratios: np.ndarray) -> float:
     return float(np.exp(np.mean(np.log(a)))) if a.size else math.nan
 
 
-def geometric_mean(ratios: np.ndarray) -> float:
-    """exp(mean(log r)) over all runs and tasks (the mean of ratios on a log scale)."""
-    with np.errstate(divide="ignore"):
-        return np.exp(np.mean(np.log(np.asarray(ratios, dtype=np.float64))))
+def geometric_mean(ratios: Sequence[float] | np.ndarray) -> float:
+    """exp(mean(log r)) of positive ratios [–], over all runs and tasks (the mean of ratios
+    on a log scale): the leaderboard's, the tuner's and model selection's.  A ValueError
+    without ratios or with one that is not positive."""
+    values = np.asarray(ratios, dtype=np.float64)
+    if values.size == 0 or np.any(values <= 0):
+        raise ValueError(f"a geometric mean needs positive ratios, got {values.ravel().tolist()}")
+    return float(np.exp(np.mean(np.log(values))))
 
 
 def probability_of_improvement(scores_x: np.ndarray, scores_y: np.ndarray) -> float:

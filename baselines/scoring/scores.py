@@ -1,6 +1,10 @@
 """Each episode's score: its cost ratio C / C_oracle and whether it failed, the
 (runs, tasks) matrices rliable reads, and which scenarios a controller can be ranked on
-(the method: :mod:`.ranking`)."""
+(the method: :mod:`.ranking`).
+
+:func:`cost_ratio` is the one definition of the ratio: the leaderboard's
+(:func:`scored_episodes`), the tuner's objective and model selection's
+(:func:`objective_ratio`, which counts an episode without a ratio as :data:`FAILED_RATIO`)."""
 
 from __future__ import annotations
 
@@ -24,6 +28,28 @@ FAILED_EPISODES = (
 )
 
 
+#: the ratio an objective (a tuning study's, model selection's) counts for an episode whose
+#: cost is not finite (a diverged simulation): the leaderboard does not score that episode
+FAILED_RATIO = 1.0e6
+
+
+def cost_ratio(cost: Any, reference: Any) -> float | None:
+    """C / C_ref of one trial [–]: the episode's cost over the reference's (the oracle's)
+    on the same trial.  None where either cost is not finite or the reference's is not
+    positive: that trial has no ratio."""
+    c, c_ref = float_or_nan(cost), float_or_nan(reference)
+    if math.isfinite(c_ref) and c_ref > 0.0 and math.isfinite(c):
+        return c / c_ref
+    return None
+
+
+def objective_ratio(cost: Any, reference: Any) -> float:
+    """:func:`cost_ratio`, or :data:`FAILED_RATIO` where the trial has none: what a tuning
+    study's objective and model selection average (a geometric mean)."""
+    ratio = cost_ratio(cost, reference)
+    return FAILED_RATIO if ratio is None else ratio
+
+
 def is_failure(episode: Mapping[str, Any]) -> bool:
     """The episode ended outside the corridor, non-finite or by its controller's error or
     timeout (:data:`FAILURE_REASONS`), or its cost is not finite."""
@@ -45,15 +71,14 @@ def scored_episodes(
         if ep["controller"] == oracle:
             cost = math.nan if is_failure(ep) else float_or_nan(ep.get("cost"))
             ref[(ep["scenario"], int(ep["seed"]))] = cost
-    out = []
-    for ep in episodes:
-        c_ref = ref.get((ep["scenario"], int(ep["seed"])), math.nan)
-        cost = float_or_nan(ep.get("cost"))
-        ratio = None
-        if math.isfinite(c_ref) and c_ref > 0.0 and math.isfinite(cost):
-            ratio = 1.0 if ep["controller"] == oracle else cost / c_ref
-        out.append({**ep, "cost_ratio": ratio, "failure": float(is_failure(ep))})
-    return out
+    return [
+        {
+            **ep,
+            "cost_ratio": cost_ratio(ep.get("cost"), ref.get((ep["scenario"], int(ep["seed"])))),
+            "failure": float(is_failure(ep)),
+        }
+        for ep in episodes
+    ]
 
 
 def refused_trials(episodes: Iterable[Mapping[str, Any]], oracle: str = ORACLE) -> list[str]:

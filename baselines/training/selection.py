@@ -19,7 +19,6 @@ never a ``test_only`` split (the held-out and in-range ones the leaderboard rank
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -30,11 +29,11 @@ from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.privileged import ORACLE
 from shipgym_baselines.registry import BASELINE
+from shipgym_baselines.scoring.intervals import geometric_mean
+from shipgym_baselines.scoring.scores import objective_ratio
 
 #: the fallback reference where the oracle's table has no entry for a trial
 FALLBACK_REFERENCE = BASELINE
-#: costs below this are floored in the ratio (a perfect episode costs > 0 anyway)
-COST_FLOOR = 1e-9
 REFERENCE_FILE = "reference_costs.json"
 #: the selection's trials by default (``eval.n_episodes``): all 32 validation trials (with
 #: 8, two per ship, the selection score was mostly noise)
@@ -63,14 +62,12 @@ def validation_trials(
 
 
 def geometric_mean_ratio(costs: Sequence[float], references: Sequence[float]) -> float:
-    """exp(mean log(C / C_ref)) over trials, each cost floored at :data:`COST_FLOOR`."""
+    """exp(mean log(C / C_ref)) over trials: the geometric mean of their
+    :func:`~shipgym_baselines.scoring.scores.objective_ratio` (the leaderboard's cost ratio;
+    a cost that is not finite counts as :data:`~shipgym_baselines.scoring.scores.FAILED_RATIO`)."""
     if len(costs) != len(references) or not costs:
         raise ValueError("need one reference cost per cost, and at least one")
-    logs = [
-        math.log(max(c, COST_FLOOR)) - math.log(max(r, COST_FLOOR))
-        for c, r in zip(costs, references, strict=True)
-    ]
-    return math.exp(sum(logs) / len(logs))
+    return geometric_mean([objective_ratio(c, r) for c, r in zip(costs, references, strict=True)])
 
 
 def reference_cost(scenario_name: str, seed: int, action_mode: str = "rudder") -> dict[str, Any]:

@@ -21,7 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.tuning.objective import controller_ratios, geometric_mean
+from shipgym_baselines.scoring.intervals import geometric_mean
+from shipgym_baselines.tuning.objective import controller_ratios
 from shipgym_baselines.tuning.space import TuningConfig
 from shipgym_baselines.tuning.validation import ValidationTrial
 

@@ -1,44 +1,25 @@
 """The objective of every study: the cost ratio to the oracle on the validation trials.
 
-Per trial, the ratio C / C_oracle of the episode cost (the leaderboard's ``cost``: the
-step costs and any corridor penalty) to the oracle's cost on the same trial
+Per trial, the ratio C / C_oracle of the episode cost (the leaderboard's ``cost``: the step
+costs and any corridor penalty) to the oracle's cost on the same trial
 (:mod:`~shipgym_baselines.tuning.validation`); the objective is their geometric mean over
 the trials (1 = as good as the oracle, lower is better), as the leaderboard's
-``cost_ratio_gmean``.  An episode whose cost is not finite counts as
-:data:`FAILED_RATIO`.  :func:`chunked_ratios` scores the trials a chunk at a time and
-hands the running geometric mean to ``report`` after each chunk (the pruner's
-intermediate values).
-"""
+``cost_ratio_gmean``: the ratio and the mean are the leaderboard's own
+(:func:`~shipgym_baselines.scoring.scores.objective_ratio`,
+:func:`~shipgym_baselines.scoring.intervals.geometric_mean`). An episode whose cost is not
+finite counts as :data:`~shipgym_baselines.scoring.scores.FAILED_RATIO`.
+:func:`chunked_ratios` scores the trials a chunk at a time and hands the running geometric
+mean to ``report`` after each chunk (the pruner's intermediate values)."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-import numpy as np
-
 from shipgym_baselines.plugins import ControllerEntry
+from shipgym_baselines.scoring.intervals import geometric_mean
+from shipgym_baselines.scoring.scores import objective_ratio
 from shipgym_baselines.tuning.validation import ValidationTrial
-
-#: the ratio of an episode with a non-finite cost (a diverged simulation)
-FAILED_RATIO = 1.0e6
-
-
-def geometric_mean(ratios: Sequence[float]) -> float:
-    """exp(mean(log r)) of positive ratios [–]."""
-    values = np.asarray(ratios, dtype=float)
-    if values.size == 0 or np.any(values <= 0):
-        raise ValueError(f"a geometric mean needs positive ratios, got {list(values)}")
-    return float(np.exp(np.mean(np.log(values))))
-
-
-def cost_ratio(cost: Any, oracle_cost: float) -> float:
-    """C / C_oracle of one episode (:data:`FAILED_RATIO` when C is not finite)."""
-    value = float(cost)
-    if not math.isfinite(value):
-        return FAILED_RATIO
-    return max(value, 1e-12) / oracle_cost
 
 
 def controller_ratios(
@@ -52,7 +33,7 @@ def controller_ratios(
 
     entry = ControllerEntry(controller=controller, settings=settings)
     results = evaluate_batch(entry, [t.scenario for t in trials], [t.seed for t in trials])
-    return [cost_ratio(r.metrics.get("cost"), c) for r, c in zip(results, oracle, strict=True)]
+    return [objective_ratio(r.metrics.get("cost"), c) for r, c in zip(results, oracle, strict=True)]
 
 
 def chunked_ratios(

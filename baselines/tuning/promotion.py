@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from shipgym_baselines.tuning.objective import geometric_mean
+from shipgym_baselines.scoring.intervals import geometric_mean
 from shipgym_baselines.tuning.report import gmean_interval
 from shipgym_baselines.tuning.space import TuningConfig
 from shipgym_baselines.tuning.validation import ValidationTrial

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym_baselines.tuning.objective import geometric_mean
+from shipgym_baselines.scoring.intervals import geometric_mean
 
 #: a study's report, in its folder (and the shipped studies' under configs/tuning/reports)
 REPORT_FILE = "tuning_report.json"

@@ -56,10 +56,11 @@ from shipgym_baselines.records.locking import file_lock, out_lock
 from shipgym_baselines.records.manifest import Manifest
 from shipgym_baselines.records.outfiles import check_no_links, refuse_special, write_text
 from shipgym_baselines.records.runrecord import now
+from shipgym_baselines.scoring.intervals import geometric_mean
 from shipgym_baselines.tuning import chosen as chosen_settings
 from shipgym_baselines.tuning import promotion
 from shipgym_baselines.tuning.estimate import cpu_duration, recorded_cpu_s
-from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios, geometric_mean
+from shipgym_baselines.tuning.objective import chunked_ratios, controller_ratios
 from shipgym_baselines.tuning.report import REPORT_FILE, best_vs_default, trial_rows
 from shipgym_baselines.tuning.space import TuningConfig, load_tuning
 from shipgym_baselines.tuning.validation import ValidationTrial, oracle_costs, validation_trials

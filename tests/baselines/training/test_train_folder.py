@@ -17,8 +17,8 @@ from shipgym_baselines.learned.trust import trusting_pickle
 from shipgym_baselines.records.manifest import check_listed, read_manifest
 from shipgym_baselines.training.agents import load_agent_config
 from shipgym_baselines.training.train import checkpoint_names, export_policy, train
-from tests.baselines.learned.test_train_curves import _tiny
 from tests.baselines.records.test_locking import hold
+from tests.baselines.training.test_train_curves import _tiny
 
 pytest.importorskip("stable_baselines3")
 

@@ -19,9 +19,10 @@ from shipgym_baselines.cli import main
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.records import chosen as chosen_reader
 from shipgym_baselines.records.manifest import read_manifest
+from shipgym_baselines.scoring.intervals import geometric_mean
 from shipgym_baselines.tuning import chosen
 from shipgym_baselines.tuning import study as study_module
-from shipgym_baselines.tuning.objective import controller_ratios, geometric_mean
+from shipgym_baselines.tuning.objective import controller_ratios
 from shipgym_baselines.tuning.space import ParamSpec, TuningConfig, load_tuning
 from shipgym_baselines.tuning.study import default_storage, open_study, plan_studies, run_study
 from shipgym_baselines.tuning.validation import (
