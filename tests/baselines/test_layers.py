@@ -42,10 +42,11 @@ LAYERS: dict[str, int] = {
     f"{B}.reference_data": 0,
     # 1 — what a run leaves on disk
     f"{B}.records": 1,
-    # 2 — controllers: what a controller is, how it enters, its privileged channel, the
-    #     references' tables, the classical controllers and the learned policies (loading
-    #     and acting; their training sits in layer 4)
+    # 2 — controllers: what a controller is, the table of built-ins, how it enters, its
+    #     privileged channel, the references' tables, the classical controllers and the
+    #     learned policies (loading and acting; their training sits in layer 4)
     f"{B}.policy": 2,
+    f"{B}.controllers": 2,
     f"{B}.plugins": 2,
     f"{B}.registry": 2,
     f"{B}.privileged": 2,
@@ -101,8 +102,6 @@ EXCEPTIONS = _edge_table(
 #: Edges left out of the cycle check, with the reason (same form as :data:`EXCEPTIONS`).
 CYCLE_EXCEPTIONS = _edge_table(
     """
-    registry -> classical.*: _load_builtins, lazy, loads the built-ins, which register there
-    registry -> learned.plant_id.controller: _load_builtins, lazy, as the classical ones
     """
 )
 
@@ -153,6 +152,9 @@ def test_the_graph_sees_lazy_and_importlib_imports() -> None:
     assert f"{B}.leaderboard.ranking" in set(imported_names(tree, f"{B}.registry", False))
     assert named_modules(tree, f"{B}.registry") == {f"{B}.classical.pid"}
     assert named_modules(ast.parse("X = 'shipgym_baselines.classical.pid'\n"), B) == set()
+    # an entry point "module:Attr" (the built-in controllers', Gymnasium's) is no edge
+    entry_point = "import importlib\nX = 'shipgym_baselines.classical.pid:PIDLOS'\n"
+    assert named_modules(ast.parse(entry_point), f"{B}.registry") == set()
     assert _upward([(f"{B}.records.episodes", f"{B}.leaderboard.ranking")])
     assert _upward([(f"{B}.classical.pid", f"{B}.cli")])
     assert not _upward([(f"{B}.cli.run", f"{B}.records.runs")])  # downward
