@@ -311,7 +311,7 @@ class NMPC:
     """
 
     name: ClassVar[str] = "nmpc"
-    name: ClassVar[str]  # set by the registration
+    name: ClassVar[str]  # each subclass's own: its name in the registry
     kind: ClassVar[str] = "classical"
     identifier_type: ClassVar[type | None] = None
     #: options of the identifier (e.g. its front end)

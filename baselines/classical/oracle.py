@@ -826,7 +826,7 @@ class PlantNMPC:
     (``nmpc_ekf``).  :meth:`start` at an episode's start, :meth:`steer` at every step.
     ``settings`` None: the class's :attr:`default_settings`."""
 
-    name: ClassVar[str]  # set by the registration
+    name: ClassVar[str]  # each subclass's own: its name in the registry
     #: the settings of a construction without any (the references': the oracle's own)
     default_settings: ClassVar[OracleSettings] = OracleSettings()
 
@@ -916,8 +916,8 @@ class PlantNMPC:
         }
 
 
-# its look colours its name in the page's tables; the scenario figures draw its episode black
-# and dashed, the reference (shipgym_baselines.leaderboard.figures)
+# its look (shipgym_baselines.controllers) colours its name in the page's tables; the scenario
+# figures draw its episode black and dashed, the reference (shipgym_baselines.leaderboard.figures)
 class Oracle(PlantNMPC):
     """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
 
