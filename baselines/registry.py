@@ -72,7 +72,9 @@ KINDS = ("classical", "learned", "reference")
 class ControllerRecord:
     """One controller as a run knows it: its table name, where its factory is and its traits.
 
-    ``entry_point``: how any process finds the factory: ``"module:Attr"`` or
+    ``controller``: the string it was resolved from (a registered name, a spec, a learned
+    policy's name or path; a long form's ``controller``).  ``entry_point``: how any process
+    finds the factory: ``"module:Attr"`` or
     ``"path/to/file.py:Attr"`` (a Policy class, a factory function or a Policy instance), or
     the name a factory was registered under in this process (:func:`register_controller`;
     a worker forked from it has it too).  ``settings``: keyword arguments bound to the factory
@@ -87,6 +89,7 @@ class ControllerRecord:
     """
 
     name: str
+    controller: str
     entry_point: str
     action_mode: str = "rudder"
     applies_to: tuple[str, ...] | None = None
@@ -131,6 +134,7 @@ def _read_builtins() -> None:
     for builtin in BUILTINS:
         _RECORDS[builtin.name] = ControllerRecord(
             name=builtin.name,
+            controller=builtin.name,
             entry_point=builtin.entry_point,
             action_mode=builtin.action_mode,
             applies_to=builtin.applies_to,
@@ -257,6 +261,7 @@ def register_controller(
         )
     record = ControllerRecord(
         name=name,
+        controller=name,
         entry_point=name,
         action_mode=action_mode,
         applies_to=_ships(f"controller {name!r}", applies_to),
@@ -345,14 +350,15 @@ def resolve_controller(controller: ControllerRef) -> ControllerRecord:
     base = _record_of(entry.controller)
     name = entry.name or base.name
     record = base  # the short form: its record (its factory loaded once per process)
-    if name != base.name or entry.settings:
+    if name != base.name or entry.settings or entry.controller != base.controller:
         _check_settings(base, entry)
         record = dataclasses.replace(
             base,
             name=name,
+            controller=entry.controller,
             settings={**base.settings, **entry.settings},
             look=base.look if name == base.name else None,  # another name: not its look
-            privileged=False,  # only a built-in reference named as such reads the truth
+            privileged=base.privileged and name == base.name and not entry.settings,
         )
     if "training_seed" in entry.settings:  # a long form naming one training seed
         seed = entry.settings["training_seed"]
@@ -418,6 +424,7 @@ def _learned_record(name_or_path: str) -> ControllerRecord:
     label = policy_label(name_or_path)
     return ControllerRecord(
         name=label,
+        controller=name_or_path,
         entry_point=f"{LearnedPolicy.__module__}:{LearnedPolicy.__qualname__}",
         settings={"path": name_or_path, "name": label},
         loaded=LearnedPolicy,
@@ -457,6 +464,7 @@ def _plugin_record(obj: Any, spec: str, origin: str, default_name: str) -> Contr
     traits = _traits(obj, origin)
     return ControllerRecord(
         name=traits.name or default_name,
+        controller=spec,
         entry_point=spec,
         loaded=traits.factory,
         action_mode=traits.action_mode,
