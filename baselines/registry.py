@@ -358,7 +358,7 @@ def resolve_controller(controller: ControllerRef) -> ControllerRecord:
             controller=entry.controller,
             settings={**base.settings, **entry.settings},
             look=base.look if name == base.name else None,  # another name: not its look
-            privileged=base.privileged and name == base.name and not entry.settings,
+            privileged=False,  # only a built-in reference named as such reads the truth
         )
     if "training_seed" in entry.settings:  # a long form naming one training seed
         seed = entry.settings["training_seed"]

@@ -162,6 +162,8 @@ def test_only_the_references_named_as_such_read_the_truth(scratch_registry: None
     with_settings = ControllerEntry(controller=ORACLE, settings={"settings": None})
     assert not grants_truth(renamed) and not resolve_controller(renamed).privileged
     assert not grants_truth(with_settings) and not grants_truth("pid_los")
+    spec = resolve_controller("shipgym_baselines.classical.oracle:Oracle")  # the same class
+    assert spec.name == ORACLE and not grants_truth(spec)
 
 
 def test_a_record_is_resolved_once_and_crosses_a_process_pool(scratch_registry: None) -> None:
