@@ -165,12 +165,13 @@ def _load_factory(entry_point: str) -> Callable[..., Policy]:
         return _traits(load_spec(spec), f"controller {entry_point!r}").factory
     _read_builtins()
     record = _RECORDS.get(entry_point) or _record_of(entry_point)
+    # registered under this name, so with its factory: it never loads itself again
     assert record.loaded is not None or record.entry_point != entry_point, entry_point
     return record.factory
 
 
 class _Registered(Mapping[str, ControllerRecord]):
-    """The registrations, read-only, the built-in controllers loaded on first read."""
+    """The registrations, read-only, the table of built-in controllers read on first read."""
 
     def __getitem__(self, name: str) -> ControllerRecord:
         _read_builtins()
@@ -572,7 +573,9 @@ def _returning(policy: Policy) -> Callable[[], Policy]:
 
 def _check_settings(record: ControllerRecord, entry: ControllerEntry) -> None:
     """Raise unless the factory of ``record`` accepts ``entry.settings`` as keywords (the
-    rest may come with :func:`make_controller`)."""
+    rest may come with :func:`make_controller`); none: nothing is loaded."""
+    if not entry.settings:
+        return
     try:
         signature = inspect.signature(record.factory)
     except (TypeError, ValueError):  # a builtin or extension callable: nothing to check
