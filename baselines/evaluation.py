@@ -33,7 +33,6 @@ from shipgym.errors import ShipgymError
 from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym.scenarios.trials import seed_trials
 from shipgym_baselines.errors import ControllerError, RunError
-from shipgym_baselines.plugins import ControllerEntry, ControllerSpec
 from shipgym_baselines.policy import Policy
 from shipgym_baselines.privileged import grants_truth, reset_with_truth
 from shipgym_baselines.records.episodes import (
@@ -45,7 +44,12 @@ from shipgym_baselines.records.episodes import (
     EpisodeResult,
     stats_problem,
 )
-from shipgym_baselines.registry import make_controller, resolve_controller
+from shipgym_baselines.registry import (
+    ControllerRecord,
+    ControllerRef,
+    make_controller,
+    resolve_controller,
+)
 
 ENV_ID = "ShipPathFollow-v0"
 #: evaluation seeds start here, apart from the training seeds (0, 1, …) of learned agents
@@ -460,7 +464,7 @@ class _Unmade:
 
 
 def _make(
-    controller: ControllerSpec,
+    controller: ControllerRef,
     guard: ActGuard | None,
     label: EpisodeLabel | None = None,
     **settings: Any,
@@ -471,15 +475,15 @@ def _make(
     name that is no controller, and the benchmark's own refusals (a
     :class:`~shipgym.errors.ShipgymError`: a model that cannot be read, a pickle not
     trusted), are the caller's errors, raised in one line as without a guard."""
-    if guard is None:
-        return make_controller(controller, **settings)
     record = resolve_controller(controller)
+    if guard is None:
+        return make_controller(record, **settings)
     reason = CONTROLLER_ERROR
     try:
         with _watched(guard):
             watch = getattr(_watching, "watch", None)
             made, over = _timed_call(
-                lambda: make_controller(controller, **settings), watch, guard.setup_timeout
+                lambda: make_controller(record, **settings), watch, guard.setup_timeout
             )
         if over is None:
             return made
@@ -497,7 +501,7 @@ def _make(
 
 
 def failed_episode(
-    controller: ControllerSpec,
+    controller: ControllerRef,
     scenario: Any,
     seed: int,
     reason: str,
@@ -628,7 +632,7 @@ class BatchPolicy(Policy, Protocol):
 
 
 def evaluate_batch(
-    controller: ControllerSpec | Policy,
+    controller: ControllerRef | Policy,
     scenarios: Any,
     seeds: Sequence[int],
     training_seed: int | None = None,
@@ -670,11 +674,13 @@ def evaluate_batch(
     per_seed = list(scenarios) if isinstance(scenarios, list | tuple) else [scenarios] * len(seeds)
     if len(per_seed) != len(seeds):
         raise ValueError(f"{len(per_seed)} scenarios for {len(seeds)} seeds: give one per seed")
-    made = isinstance(controller, str | ControllerEntry)
+    made = isinstance(controller, ControllerRef)
     if training_seeds is not None:
         return _evaluate_dealt(
             controller, per_seed, seeds, training_seeds, action_mode, env_id, guard, label
         )
+    if made:  # resolved once: every episode's instance is made from the record
+        controller = resolve_controller(controller)
     if made:
         policy, mode = _make(controller, guard, label, training_seed=training_seed)
     elif training_seed is not None:
@@ -754,7 +760,7 @@ class DealtPolicy:
 
 
 def _evaluate_dealt(
-    controller: ControllerSpec | Policy,
+    controller: ControllerRef | Policy,
     scenarios: list[Any],
     seeds: list[int],
     training_seeds: Sequence[int | None],
@@ -767,14 +773,16 @@ def _evaluate_dealt(
     owners = list(training_seeds)
     if len(owners) != len(seeds):
         raise ValueError(f"{len(owners)} training seeds for {len(seeds)} seeds: give one per seed")
-    if not isinstance(controller, str | ControllerEntry):
+    if not isinstance(controller, ControllerRef):
         raise ControllerError("training_seeds: give the learned controller by name, not a Policy")
+    shown = controller.name if isinstance(controller, ControllerRecord) else controller
+    controller = resolve_controller(controller)
     made = {k: _make(controller, guard, label, training_seed=k) for k in dict.fromkeys(owners)}
     unmade = [i for i, k in enumerate(owners) if isinstance(made[k][0], _Unmade)]
     if not all(isinstance(p, BatchPolicy | _Unmade) for p, _ in made.values()):
         first = next(p for p, _ in made.values())
         if first.kind != "learned":
-            raise ControllerError(f"training_seeds: {controller!r} is not a learned agent")
+            raise ControllerError(f"training_seeds: {shown!r} is not a learned agent")
         # a learned controller that acts per episode (nmpc_learned_id): each episode its own
         # instance of its owner's training seed, all in lockstep
         policies = [made[owners[0]][0]] + [
@@ -1136,7 +1144,7 @@ def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) 
 
 
 def evaluate(
-    controller: ControllerSpec | Policy,
+    controller: ControllerRef | Policy,
     scenario: Any,
     seeds: list[int],
     *,
@@ -1161,7 +1169,8 @@ def evaluate(
     results = []
     for seed, trial in zip(seeds, trials, strict=True):
         privileged = False
-        if isinstance(controller, str | ControllerEntry):
+        if isinstance(controller, ControllerRef):
+            controller = resolve_controller(controller)  # once: a record resolves to itself
             policy, mode = _make(controller, guard, label, **settings)
             plain = all(k == "training_seed" and v is None for k, v in settings.items())
             privileged = plain and grants_truth(controller)

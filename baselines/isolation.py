@@ -47,9 +47,8 @@ from typing import Any, TypeVar
 
 from shipgym_baselines import evaluation, signals
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.plugins import ControllerSpec
 from shipgym_baselines.records.episodes import CONTROLLER_ERROR, CONTROLLER_TIMEOUT
-from shipgym_baselines.registry import resolve_controller
+from shipgym_baselines.registry import ControllerRef, resolve_controller
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -63,7 +62,7 @@ PERIOD_S = 0.05
 OWN_PACKAGES = ("shipgym", "shipgym_baselines")
 
 
-def isolated(controller: ControllerSpec) -> bool:
+def isolated(controller: ControllerRef) -> bool:
     """Whether ``controller``'s code is not the benchmark's own (its factory defined
     outside :data:`OWN_PACKAGES`): its jobs run in a process of their own."""
     factory: Any = resolve_controller(controller).factory

@@ -1,7 +1,8 @@
 """The one policy interface every controller and agent implements (docs/plugins.md), and how
 the figures draw a controller: its family (the column, :data:`FAMILIES`) and its look
-(:class:`Style`), traits of its registration
-(:func:`shipgym_baselines.registry.register_controller`; the learned agents':
+(:class:`Style`), traits of its record (the built-ins':
+:data:`shipgym_baselines.controllers.BUILTINS`; a plug-in's:
+:func:`shipgym_baselines.registry.register_controller`; the learned agents':
 :data:`shipgym_baselines.learned.policy.AGENT_LOOKS`), read by
 :func:`shipgym_baselines.plots.figures.controller_family` and
 :func:`shipgym_baselines.plots.style.controller_style`."""

@@ -2,12 +2,15 @@
 
 The evaluation loop gives every controller the observation, ``info`` and the controller
 context, nothing else.  The references ``oracle`` and ``oracle_frozen``
-(:mod:`shipgym_baselines.classical.oracle`) are the one exception: when, and only when, a
-run names one of them itself (not an instance, a spec, a renamed long form or one with
-settings), the loop hands it the env's
+(:mod:`shipgym_baselines.classical.oracle`, marked ``privileged`` in the table of built-ins
+:data:`shipgym_baselines.controllers.BUILTINS`) are the one exception: when, and only when,
+a run names one of them itself (not an instance, a spec, a renamed long form or one with
+settings: its record stays ``privileged``,
+:func:`~shipgym_baselines.registry.resolve_controller`), the loop hands it the env's
 :meth:`~shipgym.envs.path_follow.ShipPathFollowEnv.plant_truth` through
 ``reset_privileged``.  A plug-in cannot take the names (a registered name is never
-re-registered) and nothing of the truth reaches ``info`` or the context.
+re-registered), nor declare itself privileged, and nothing of the truth reaches ``info``
+or the context.
 
 At training time a teacher may read it too (:func:`teacher_truth`): the DAgger teacher
 (:class:`shipgym_baselines.learned.teachers.OracleTeacher`) labels the states a student
@@ -20,8 +23,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from shipgym_baselines.controllers import BUILTINS
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.plugins import ControllerEntry, as_entry
+from shipgym_baselines.registry import ControllerRecord, resolve_controller
 
 #: the reference of the leaderboard's cost ratio (its cost is the denominator)
 ORACLE = "oracle"
@@ -29,22 +34,21 @@ ORACLE = "oracle"
 #: optimum that never adapts); C_frozen / C_oracle is what knowing the change is worth
 ORACLE_FROZEN = "oracle_frozen"
 #: the names that receive the truth
-PRIVILEGED_NAMES = (ORACLE, ORACLE_FROZEN)
+PRIVILEGED_NAMES = tuple(builtin.name for builtin in BUILTINS if builtin.privileged)
 
 
 def grants_truth(controller: Any) -> bool:
-    """True only for a built-in reference named as such (module doc)."""
+    """True only for a built-in reference named as such (module doc): a record that is
+    ``privileged``, or a name or long form that resolves to one."""
+    if isinstance(controller, ControllerRecord):
+        return controller.privileged
     if not isinstance(controller, str | ControllerEntry):
         return False
     entry = as_entry(controller)
     name = entry.controller
     if name not in PRIVILEGED_NAMES or entry.settings or entry.name not in (None, name):
-        return False
-    from shipgym_baselines.classical.oracle import PRIVILEGED
-    from shipgym_baselines.registry import CONTROLLERS
-
-    record = CONTROLLERS.get(name)
-    return record is not None and record.factory is PRIVILEGED[name]
+        return False  # nothing else is privileged: no need to resolve it
+    return resolve_controller(controller).privileged
 
 
 def reset_with_truth(policy: Any, context: Any, env: Any, seed: int | None) -> None:

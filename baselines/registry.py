@@ -1,36 +1,38 @@
-"""Controller names -> factories (the names used by suites, the CLI and the leaderboard).
+"""Controller names -> records (the names used by suites, the CLI and the leaderboard).
 
-A controller declares itself once, where it is defined::
+A record holds a controller's name, its entry point (how any process finds its factory) and
+its traits: the action mode it drives, the ships it applies to, its kind, training seeds,
+whether it reads the true plant (``privileged``) and how the figures draw it (its family and
+look, :mod:`shipgym_baselines.policy`).  The built-in controllers are a table of entry
+points ``"package.module:Attr"`` and traits (:data:`shipgym_baselines.controllers.BUILTINS`):
+this module imports no controller, answers every trait from the table, and imports a
+controller's module only when its factory is first needed (:attr:`ControllerRecord.factory`,
+:func:`make_controller`).  A controller from outside registers at runtime::
 
-    @register_controller("pid_los", family="PID", look=Style("#1f77b4", "-", "o"))
-    class PIDLOS: ...
+    @register_controller("my_policy", family="PID", look=Style("#1f77b4", "-", "o"))
+    class MyPolicy: ...
 
-    register_controller("pid_los_fast", make_fast_pid)  # a factory function
+    register_controller("my_policy_fast", make_fast_policy)  # a factory function
 
-The registration is the single record of the controller's name, the action mode it drives,
-the ships it applies to and how the figures draw it (its family and look,
-:mod:`shipgym_baselines.policy`); the instances made by :func:`make_controller` carry that
-name and action mode (a class as class attributes, a factory function's policy as
-attributes set on it).
-The built-in controllers register when :mod:`shipgym_baselines.classical` is imported.
-This module imports that package in one place, :func:`_load_builtins`, lazily: every reader
-of the registry (:data:`CONTROLLERS`, :func:`resolve_controller` and all built on it,
-:func:`declared_traits`, :func:`register_controller`) calls it first, so
-``make_controller("pid_los")`` works in a fresh interpreter and
-``import shipgym_baselines.registry`` alone imports no controller.
+The instances made by :func:`make_controller` carry the table name and action mode (a
+registered class gets them as class attributes, a factory function's policy as attributes
+set on it).
 
 Every other controller is found by :func:`resolve_controller` (all that :func:`make_controller`
 accepts): an installed plug-in's entry point, a spec ``module.path:Attr`` or
 ``path/to/file.py:Attr`` (:mod:`shipgym_baselines.plugins`), the long form of a suite (a display
-name and settings), a learned policy or SB3 model zip (:mod:`shipgym_baselines.learned.policy`).  A
-controller only ever gets ``reset(context, seed)`` and ``act(obs, info)`` from the
-evaluation loop, whatever its origin.
+name and settings), a learned policy or SB3 model zip (:mod:`shipgym_baselines.learned.policy`).
+A run resolves each controller once and hands the record to its jobs: a record crosses a
+process pool as its entry point, settings and traits, and the process that makes the
+controller loads the factory again.  A controller only ever gets ``reset(context, seed)`` and
+``act(obs, info)`` from the evaluation loop, whatever its origin.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import importlib.util
 import inspect
 import types
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -40,6 +42,7 @@ from typing import Any, TypeVar, overload
 
 from shipgym.envs.core import ACTION_MODES
 from shipgym.models import MODELS
+from shipgym_baselines.controllers import BUILTINS
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.plugins import (
     ControllerEntry,
@@ -67,65 +70,119 @@ KINDS = ("classical", "learned", "reference")
 
 @dataclasses.dataclass(frozen=True)
 class ControllerRecord:
-    """One registered controller.
+    """One controller as a run knows it: its table name, where its factory is and its traits.
 
-    ``factory(**settings)`` makes a fresh :class:`~shipgym_baselines.policy.Policy`;
-    ``action_mode`` is the env mode it drives; ``applies_to`` the ship ids it runs on
-    (None: every ship); ``kind`` is ``"classical"`` unless the factory says otherwise;
-    ``training_seeds``: a learned policy's (the factory takes ``training_seed=k``), else
-    ``(None,)``.  ``family`` (one of :data:`~shipgym_baselines.policy.FAMILIES`) and
-    ``look``: how the figures draw it, as registered (None: not declared; the figures
-    derive them from the kind and name).
+    ``controller``: the string it was resolved from (a registered name, a spec, a learned
+    policy's name or path; a long form's ``controller``).  ``entry_point``: how any process
+    finds the factory: ``"module:Attr"`` or
+    ``"path/to/file.py:Attr"`` (a Policy class, a factory function or a Policy instance), or
+    the name a factory was registered under in this process (:func:`register_controller`;
+    a worker forked from it has it too).  ``settings``: keyword arguments bound to the factory
+    (a suite's long form).  :attr:`factory` loads it on first use.  ``action_mode`` is the
+    env mode it drives; ``applies_to`` the ship ids it runs on (None: every ship); ``kind``
+    one of :data:`KINDS`; ``training_seeds``: a learned policy's (the factory takes
+    ``training_seed=k``), else ``(None,)``; ``privileged``: a built-in reference named as
+    such, which reads the env's true plant (:mod:`shipgym_baselines.privileged`).
+    ``family`` (one of :data:`~shipgym_baselines.policy.FAMILIES`) and ``look``: how the
+    figures draw it, as declared (None: not declared; the figures derive them from the kind
+    and name).  A record pickles without its loaded factory (it crosses process pools).
     """
 
     name: str
-    factory: Callable[..., Policy]
+    controller: str
+    entry_point: str
     action_mode: str = "rudder"
     applies_to: tuple[str, ...] | None = None
     kind: str = "classical"
     training_seeds: tuple[int | None, ...] = (None,)
     family: str | None = None
     look: Style | None = None
+    privileged: bool = False
+    settings: Mapping[str, Any] = dataclasses.field(default_factory=dict, hash=False)
+    #: the factory once loaded in this process (not compared, not pickled)
+    loaded: Callable[..., Policy] | None = dataclasses.field(
+        default=None, compare=False, repr=False
+    )
 
+    @property
+    def factory(self) -> Callable[..., Policy]:
+        """``factory(**settings)`` makes a fresh Policy: the entry point's factory (loaded
+        once per process) with :attr:`settings` bound."""
+        if self.loaded is None:
+            object.__setattr__(self, "loaded", _load_factory(self.entry_point))
+        assert self.loaded is not None
+        return functools.partial(self.loaded, **self.settings) if self.settings else self.loaded
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "loaded": None}
+
+
+#: a controller as a run refers to it: a name or spec, the long form, or its resolved record
+ControllerRef = ControllerSpec | ControllerRecord
 
 _RECORDS: dict[str, ControllerRecord] = {}
-#: whether :func:`_load_builtins` has imported the built-in controllers
-_BUILTINS_LOADED = False
+#: whether :func:`_read_builtins` has read the table of built-in controllers
+_BUILTINS_READ = False
 
 
-def _load_builtins() -> None:
-    """Import the modules that register the built-in controllers, once per process:
-    :mod:`shipgym_baselines.classical` and the learned controller registered by name,
-    :mod:`shipgym_baselines.learned.plant_id.controller`.
-
-    The one import of the controllers by the registry, lazy (inside this function) because
-    they import the registry to register: a reader calls it before reading the records.
-    """
-    global _BUILTINS_LOADED
-    if _BUILTINS_LOADED:
+def _read_builtins() -> None:
+    """Register the built-in controllers of :data:`~shipgym_baselines.controllers.BUILTINS`,
+    once per process, importing none: a reader calls it before reading the records."""
+    global _BUILTINS_READ
+    if _BUILTINS_READ:
         return
-    _BUILTINS_LOADED = True  # set first: the package's modules register while it imports
-    try:
-        import shipgym_baselines.classical
-        import shipgym_baselines.learned.plant_id.controller  # noqa: F401
-    except BaseException:
-        _BUILTINS_LOADED = False
-        raise
+    for builtin in BUILTINS:
+        _RECORDS[builtin.name] = ControllerRecord(
+            name=builtin.name,
+            controller=builtin.name,
+            entry_point=builtin.entry_point,
+            action_mode=builtin.action_mode,
+            applies_to=builtin.applies_to,
+            kind=builtin.kind,
+            training_seeds=_listed_seeds(builtin.seeds),
+            family=builtin.family,
+            look=builtin.look,
+            privileged=builtin.privileged,
+        )
+    _BUILTINS_READ = True
+
+
+def _listed_seeds(lister: str | None) -> tuple[int | None, ...]:
+    """The training seeds the function at entry point ``lister`` lists (none, or no lister:
+    ``(None,)``)."""
+    if lister is None:
+        return (None,)
+    spec = parse_spec(lister)
+    assert spec is not None, lister
+    return tuple(load_spec(spec)()) or (None,)
+
+
+def _load_factory(entry_point: str) -> Callable[..., Policy]:
+    """The factory at ``entry_point`` (:class:`ControllerRecord`): a spec's object as a
+    factory, or the factory registered under a name (an installed plug-in's is loaded)."""
+    spec = parse_spec(entry_point)
+    if spec is not None:
+        return _traits(load_spec(spec), f"controller {entry_point!r}").factory
+    _read_builtins()
+    record = _RECORDS.get(entry_point) or _record_of(entry_point)
+    # registered under this name, so with its factory: it never loads itself again
+    assert record.loaded is not None or record.entry_point != entry_point, entry_point
+    return record.factory
 
 
 class _Registered(Mapping[str, ControllerRecord]):
-    """The registrations, read-only, the built-in controllers loaded on first read."""
+    """The registrations, read-only, the table of built-in controllers read on first read."""
 
     def __getitem__(self, name: str) -> ControllerRecord:
-        _load_builtins()
+        _read_builtins()
         return _RECORDS[name]
 
     def __iter__(self) -> Iterator[str]:
-        _load_builtins()
+        _read_builtins()
         return iter(_RECORDS)
 
     def __len__(self) -> int:
-        _load_builtins()
+        _read_builtins()
         return len(_RECORDS)
 
     def __repr__(self) -> str:
@@ -190,7 +247,7 @@ def register_controller(
             )
 
         return decorate
-    _load_builtins()
+    _read_builtins()
     if not (isinstance(name, str) and name):
         raise ValueError(f"a controller name must be a non-empty string, got {name!r}")
     if action_mode not in ACTION_MODES:
@@ -205,18 +262,25 @@ def register_controller(
         )
     record = ControllerRecord(
         name=name,
-        factory=factory,
+        controller=name,
+        entry_point=name,
         action_mode=action_mode,
         applies_to=_ships(f"controller {name!r}", applies_to),
         kind=getattr(factory, "kind", "classical"),
         training_seeds=tuple(getattr(factory, "training_seeds", (None,))),
         family=family,
         look=look,
+        loaded=factory,
     )
     existing = _RECORDS.get(name)
     if existing is not None and existing.factory is factory:  # again: keep what it declared
         record = dataclasses.replace(
-            record, family=family or existing.family, look=look or existing.look
+            record,
+            entry_point=existing.entry_point,
+            training_seeds=existing.training_seeds,
+            privileged=existing.privileged,
+            family=family or existing.family,
+            look=look or existing.look,
         )
     if existing is not None and existing != record:
         raise ValueError(
@@ -266,8 +330,9 @@ def _qualname(factory: Callable[..., Any]) -> str:
 _RESOLVED: dict[str, ControllerRecord] = {}
 
 
-def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
-    """The record of any controller a run accepts, its ``name`` the table name.
+def resolve_controller(controller: ControllerRef) -> ControllerRecord:
+    """The record of any controller a run accepts, its ``name`` the table name (a record
+    is its own).
 
     ``controller`` (short form, a string, or the long form :class:`ControllerEntry`) is
     looked up as, in turn: a registered controller; a shipped learned policy (``ppo``, …);
@@ -276,21 +341,26 @@ def resolve_controller(controller: ControllerSpec) -> ControllerRecord:
     ``shipgym.controllers``, loaded and registered on first use); a trained agent's folder
     or an SB3 model zip.  The long form's ``name`` renames it and its ``settings`` are
     bound to the factory (checked against its signature here, before any episode).
-    Anything else is a :class:`ControllerError` that lists the valid names.
+    Anything else is a :class:`ControllerError` that lists the valid names.  Only a
+    built-in reference named as such, without settings, stays ``privileged``.
     """
-    _load_builtins()
+    if isinstance(controller, ControllerRecord):
+        return controller
+    _read_builtins()
     entry = as_entry(controller)
     base = _record_of(entry.controller)
     name = entry.name or base.name
-    record = dataclasses.replace(
-        base,
-        name=name,
-        factory=functools.partial(base.factory, **entry.settings)
-        if entry.settings
-        else base.factory,
-        look=base.look if name == base.name else None,  # another name: not its look
-    )
-    _check_settings(base, entry)
+    record = base  # the short form: its record (its factory loaded once per process)
+    if name != base.name or entry.settings or entry.controller != base.controller:
+        _check_settings(base, entry)
+        record = dataclasses.replace(
+            base,
+            name=name,
+            controller=entry.controller,
+            settings={**base.settings, **entry.settings},
+            look=base.look if name == base.name else None,  # another name: not its look
+            privileged=False,  # only a built-in reference named as such reads the truth
+        )
     if "training_seed" in entry.settings:  # a long form naming one training seed
         seed = entry.settings["training_seed"]
         record = dataclasses.replace(record, training_seeds=(_check_seed(base, seed),))
@@ -317,7 +387,8 @@ def _record_of(text: str) -> ControllerRecord:
         return _learned_record(text)
     spec = parse_spec(text)
     if spec is not None:
-        return _plugin_record(load_spec(spec), f"controller {text!r}", spec.attr.split(".")[-1])
+        origin, default_name = f"controller {text!r}", spec.attr.split(".")[-1]
+        return _plugin_record(load_spec(spec), text, origin, default_name)
     entry_point = None if looks_like_path(text) else find_entry_point(text)
     if entry_point is not None:
         return _entry_point_record(entry_point)
@@ -354,7 +425,10 @@ def _learned_record(name_or_path: str) -> ControllerRecord:
     label = policy_label(name_or_path)
     return ControllerRecord(
         name=label,
-        factory=functools.partial(LearnedPolicy, name_or_path, name=label),
+        controller=name_or_path,
+        entry_point=f"{LearnedPolicy.__module__}:{LearnedPolicy.__qualname__}",
+        settings={"path": name_or_path, "name": label},
+        loaded=LearnedPolicy,
         action_mode=files[0].model.action_mode,
         kind=LearnedPolicy.kind,
         training_seeds=tuple(seeds),
@@ -382,20 +456,40 @@ def _entry_point_record(entry_point: EntryPoint) -> ControllerRecord:
     return _RECORDS[entry_point.name]
 
 
-def _plugin_record(obj: Any, origin: str, default_name: str) -> ControllerRecord:
-    """The record of an object a spec names: its registration if it has one, else one made
-    from its traits, named by its own ``name`` or ``default_name``."""
-    registered = next((r for r in _RECORDS.values() if _same_definition(r.factory, obj)), None)
+def _plugin_record(obj: Any, spec: str, origin: str, default_name: str) -> ControllerRecord:
+    """The record of the object ``obj`` the spec ``spec`` names: its registration if it has
+    one, else one made from its traits, named by its own ``name`` or ``default_name``."""
+    registered = next((r for r in _RECORDS.values() if _defines(r, obj)), None)
     if registered is not None:
         return registered
     traits = _traits(obj, origin)
     return ControllerRecord(
         name=traits.name or default_name,
-        factory=traits.factory,
+        controller=spec,
+        entry_point=spec,
+        loaded=traits.factory,
         action_mode=traits.action_mode,
         applies_to=traits.applies_to,
         kind=traits.kind,
     )
+
+
+def _defines(record: ControllerRecord, obj: Any) -> bool:
+    """Whether the registered ``record`` is ``obj``'s (:func:`_same_definition`); a built-in
+    not loaded yet is compared by its entry point, without importing it."""
+    if record.loaded is not None:
+        return _same_definition(record.loaded, obj)
+    module, _, attr = record.entry_point.partition(":")
+    if getattr(obj, "__qualname__", None) != attr:
+        return False
+    if getattr(obj, "__module__", None) == module:
+        return True
+    try:
+        found = importlib.util.find_spec(module)
+        where = Path(inspect.getfile(obj)).resolve()
+    except (ImportError, TypeError, OSError, ValueError):
+        return False
+    return found is not None and found.origin is not None and Path(found.origin).resolve() == where
 
 
 def _same_definition(factory: Any, obj: Any) -> bool:
@@ -479,7 +573,9 @@ def _returning(policy: Policy) -> Callable[[], Policy]:
 
 def _check_settings(record: ControllerRecord, entry: ControllerEntry) -> None:
     """Raise unless the factory of ``record`` accepts ``entry.settings`` as keywords (the
-    rest may come with :func:`make_controller`)."""
+    rest may come with :func:`make_controller`); none: nothing is loaded."""
+    if not entry.settings:
+        return
     try:
         signature = inspect.signature(record.factory)
     except (TypeError, ValueError):  # a builtin or extension callable: nothing to check
@@ -493,7 +589,7 @@ def _check_settings(record: ControllerRecord, entry: ControllerEntry) -> None:
         ) from None
 
 
-def controller_label(controller: ControllerSpec) -> str:
+def controller_label(controller: ControllerRef) -> str:
     """The table name of a controller: its registered name or its own ``name`` (a spec's
     attribute name when it has none), the long form's ``name``, a learned policy's name
     (a trained agent's folder name; for a zip the folder holding it, plus the zip's stem
@@ -501,10 +597,10 @@ def controller_label(controller: ControllerSpec) -> str:
     return resolve_controller(controller).name
 
 
-def _known(controller: ControllerSpec) -> ControllerRecord | None:
+def _known(controller: ControllerRef) -> ControllerRecord | None:
     """The record of a table name or controller resolved before, else resolved now (None
     when it is none)."""
-    _load_builtins()
+    _read_builtins()
     if isinstance(controller, str):
         record = _RECORDS.get(controller) or _RESOLVED.get(controller)
         if record is not None:
@@ -515,21 +611,21 @@ def _known(controller: ControllerSpec) -> ControllerRecord | None:
         return None
 
 
-def applies_to(controller: ControllerSpec, ship: str) -> bool:
+def applies_to(controller: ControllerRef, ship: str) -> bool:
     """Whether ``controller`` (a controller or a table name) runs on ``ship`` (learned
     agents and the rest: every ship)."""
     record = _known(controller)
     return record is None or record.applies_to is None or ship in record.applies_to
 
 
-def controller_kind(controller: ControllerSpec) -> str:
+def controller_kind(controller: ControllerRef) -> str:
     """``"classical"`` for a registered or plug-in controller (unless it says otherwise),
     ``"learned"`` for learned policies and anything unknown."""
     record = _known(controller)
     return record.kind if record is not None else "learned"
 
 
-def is_controller(name: ControllerSpec) -> bool:
+def is_controller(name: ControllerRef) -> bool:
     """Whether :func:`resolve_controller` accepts ``name``."""
     try:
         resolve_controller(name)
@@ -542,7 +638,7 @@ def unknown_controller(name: str) -> str:
     """The error message for a name :func:`is_controller` rejects: the valid names."""
     from shipgym_baselines.learned.policy import shipped_policies
 
-    _load_builtins()
+    _read_builtins()
     plugins = [n for n in entry_point_names() if n not in _RECORDS]
     installed = f", the installed plug-ins {', '.join(plugins)}" if plugins else ""
     return (
@@ -552,7 +648,7 @@ def unknown_controller(name: str) -> str:
     )
 
 
-def training_seeds(controller: ControllerSpec) -> list[int | None]:
+def training_seeds(controller: ControllerRef) -> list[int | None]:
     """The training seeds ``controller`` has: a learned policy's (a shipped name or a
     trained agent's folder with ``seed_<k>`` folders: every k, in order; one model: its
     meta's seed), ``[None]`` for the rest (classical controllers, plug-ins, a model without
@@ -576,7 +672,7 @@ def _check_seed(record: ControllerRecord, seed: Any) -> int | None:
 
 
 def make_controller(
-    name: ControllerSpec, training_seed: int | None = None, **settings: Any
+    name: ControllerRef, training_seed: int | None = None, **settings: Any
 ) -> tuple[Policy, str]:
     """A fresh controller and the action mode it needs; unknown names list the valid ones.
 
@@ -602,7 +698,7 @@ def declared_traits(name: str) -> tuple[str | None, Style | None]:
     registration, or for a learned agent by
     :data:`shipgym_baselines.learned.policy.AGENT_LOOKS` (family ``"learned"``); each None
     where nothing declares it (the figures derive it from the kind and name)."""
-    _load_builtins()
+    _read_builtins()
     record = _RECORDS.get(name)
     if record is not None:
         return record.family, record.look

@@ -74,12 +74,6 @@ ABOVE_MODELS = (
 #: into SI objects, and no other shipgym module reads it.
 CONFIG_SCHEMA = "shipgym.scenarios.schema"
 
-#: Edges that break the rules above and are being fixed.  Empty this set as
-#: they go: a listed edge that no longer exists fails ``test_known_pending_edges_exist``.
-#: (The two edges it listed, shipgym.disturbances and shipgym.envs.context reading
-#: ``shipgym.scenarios.schema``, are fixed.)
-KNOWN_PENDING: set[tuple[str, str]] = set()
-
 
 # ------------------------------------------------------------------------------- tests
 def test_the_graph_sees_lazy_relative_and_type_checking_imports() -> None:
@@ -143,7 +137,7 @@ def test_modules_import_only_their_own_or_lower_layers() -> None:
     bad = [
         f"{m} (layer {layer(m, LAYERS)}) imports {t} (layer {layer(t, LAYERS)})"
         for m, t in edges("shipgym")
-        if (layer(t, LAYERS) or 0) > (layer(m, LAYERS) or 0) and (m, t) not in KNOWN_PENDING
+        if (layer(t, LAYERS) or 0) > (layer(m, LAYERS) or 0)
     ]
     assert not bad, "layering broken:\n" + "\n".join(bad)
 
@@ -154,7 +148,7 @@ def test_only_the_scenario_layer_reads_the_config_schema() -> None:
         for m, t in edges("shipgym")
         if t == CONFIG_SCHEMA and not within(m, "shipgym.scenarios")
     ]
-    assert not [e for e in bad if e not in KNOWN_PENDING], f"schema read outside scenarios: {bad}"
+    assert not bad, f"schema read outside scenarios: {bad}"
 
 
 def test_every_project_error_is_a_shipgym_error() -> None:
@@ -172,9 +166,3 @@ def test_every_project_error_is_a_shipgym_error() -> None:
     for module, name in sorted(errors):
         cls = getattr(importlib.import_module(module), name)
         assert issubclass(cls, ShipgymError), f"{module}.{name} is not a ShipgymError"
-
-
-def test_known_pending_edges_exist() -> None:
-    """A fixed edge leaves KNOWN_PENDING (so the set only shrinks)."""
-    gone = [(m, t) for m, t in KNOWN_PENDING if t not in import_graph().get(m, ())]
-    assert not gone, f"fixed: remove from KNOWN_PENDING: {gone}"

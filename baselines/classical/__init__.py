@@ -1,14 +1,6 @@
-"""The built-in classical controllers and references.
+"""The built-in classical controllers and references, one module per family.
 
-Importing this package imports the modules that register them
-(:func:`shipgym_baselines.registry.register_controller`), in the order the registry lists
-them; :func:`shipgym_baselines.registry._load_builtins` imports it before any read of the
-registry.
+Importing this package imports none of them: the registry lists them by entry point
+(:data:`shipgym_baselines.controllers.BUILTINS`) and imports a module when its controller
+is made.
 """
-
-# the import order is the registration order (CONTROLLERS and the docs' index list it)
-# isort: off
-from shipgym_baselines.classical import pid, lqr, l1_backstepping, nmpc, reference, oracle, nmpc_ekf
-# isort: on
-
-__all__ = ["l1_backstepping", "lqr", "nmpc", "nmpc_ekf", "oracle", "pid", "reference"]

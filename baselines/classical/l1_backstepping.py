@@ -87,9 +87,8 @@ from shipgym_baselines.classical.adaptive.lowpass import SecondOrderLowPass
 from shipgym_baselines.classical.adaptive.predictor import StatePredictor
 from shipgym_baselines.classical.adaptive.settings import Gains, L1BacksteppingSettings
 from shipgym_baselines.classical.drift import course_and_drift
-from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
 
 #: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
 cubic_damping_from_zigzag = ship_cubic_damping
@@ -101,10 +100,10 @@ __all__ = [
 ]
 
 
-@register_controller("l1_backstepping", family="backstepping", look=Style("#756bb1", "-", "D"))
 class L1Backstepping:
     """L1 adaptive backstepping heading control on TVVF guidance (``l1_backstepping``)."""
 
+    name = "l1_backstepping"
     kind = "classical"
     #: C(s) of eq. (39) on the command (off: plain adaptive backstepping)
     low_pass = True
@@ -285,10 +284,8 @@ class L1Backstepping:
         return stats
 
 
-@register_controller(
-    "adaptive_backstepping", family="backstepping", look=Style("#bcbddc", "--", "D")
-)
 class AdaptiveBackstepping(L1Backstepping):
     """The same controller with C(s) off (``adaptive_backstepping``; Xu et al. 2021 §5.2)."""
 
+    name = "adaptive_backstepping"
     low_pass = False

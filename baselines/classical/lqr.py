@@ -70,9 +70,8 @@ from shipgym.envs.context import ControllerContext
 from shipgym.identification.continuous_ls import ContinuousLeastSquares
 from shipgym.identification.nominal import first_order_nomoto
 from shipgym_baselines.classical.drift import course_and_drift
-from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
 
 #: Borkowski (2018) §5: initial estimates on the Mariner (a0 [1/s], c0 [1/s²])
 PAPER_INITIAL_GUESS = {"mariner": (0.02, 0.002)}
@@ -176,7 +175,6 @@ def initial_guess(context: ControllerContext) -> tuple[float, float]:
     return 1.0 / T, K / T
 
 
-@register_controller("lqr", family="LQR", look=Style("#31a354", "-", "s"))
 class LQR:
     """Track-keeping LQR of Borkowski (2018) eq. (28)–(30) with a fixed model (a0, c0).
 
@@ -191,6 +189,7 @@ class LQR:
     the measured drift angle β (None: the chosen setting, else off, the paper's).
     """
 
+    name = "lqr"
     kind = "classical"
     adaptive = False
 
@@ -318,7 +317,6 @@ class LQR:
         return {"riccati_solves": float(self.solves)}
 
 
-@register_controller("adaptive_lqr", family="LQR", look=Style("#74c476", "--", "s"))
 class AdaptiveLQR(LQR):
     """Borkowski (2018) adaptive LQR: the gain of the continuous-LS estimates (â, ĉ).
 
@@ -326,6 +324,7 @@ class AdaptiveLQR(LQR):
     F (estimates used by the gain clipped to [x0/F, x0·F]; None: off).
     """
 
+    name = "adaptive_lqr"
     adaptive = True
 
     def __init__(

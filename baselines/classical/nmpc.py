@@ -64,9 +64,8 @@ from shipgym_baselines.classical.nmpc_ship import (
     ShipNMPCPlan,
     ship_plan,
 )
-from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
 
 
 @dataclasses.dataclass(frozen=True)
@@ -286,7 +285,6 @@ def yaw_acceleration(samples: dict[str, np.ndarray], yaw_rate: float, h: float) 
     return float(t @ (values - values.mean()) / tt)
 
 
-@register_controller("nmpc", family="NMPC", look=Style("#fd8d3c", "-", "^"))
 class NMPC:
     """``nmpc``: NMPC + LOS on the nominal model (no adaptation), Liu et al. (2019).
 
@@ -312,7 +310,8 @@ class NMPC:
     be given).
     """
 
-    name: ClassVar[str]  # set by the registration
+    name: ClassVar[str] = "nmpc"
+    name: ClassVar[str]  # each subclass's own: its name in the registry
     kind: ClassVar[str] = "classical"
     identifier_type: ClassVar[type | None] = None
     #: options of the identifier (e.g. its front end)
@@ -539,31 +538,31 @@ class NMPC:
         }
 
 
-@register_controller("nmpc_wlssvm", family="NMPC", look=Style("#e6550d", "--", "^"))
 class NMPCWeightedLSSVM(NMPC):
     """``nmpc_wlssvm``: NMPC with the model updated online by weighted LS-SVM."""
 
+    name: ClassVar[str] = "nmpc_wlssvm"
     identifier_type = WeightedLSSVMOnline
 
 
-@register_controller("nmpc_lambda_lssvm", family="NMPC", look=Style("#a63603", "-.", "^"))
 class NMPCLambdaLSSVM(NMPC):
     """``nmpc_lambda_lssvm``: NMPC with the model updated by λ-LS-SVM (Algorithm 2)."""
 
+    name: ClassVar[str] = "nmpc_lambda_lssvm"
     identifier_type = LambdaLSSVM
 
 
-@register_controller("nmpc_wlssvm_svf", family="NMPC", look=Style("#fdae6b", ":", "^"))
 class NMPCWeightedLSSVMSVF(NMPCWeightedLSSVM):
     """``nmpc_wlssvm_svf``: ``nmpc_wlssvm`` with the outlier + state-variable-filter front end
     (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019)."""
 
+    name: ClassVar[str] = "nmpc_wlssvm_svf"
     identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}
 
 
-@register_controller("nmpc_lambda_lssvm_svf", family="NMPC", look=Style("#7f2704", ":", "v"))
 class NMPCLambdaLSSVMSVF(NMPCLambdaLSSVM):
     """``nmpc_lambda_lssvm_svf``: ``nmpc_lambda_lssvm`` with the outlier + state-variable-filter
     front end (``front_end="svf"``, λ = 3 rad/s; an extension beyond Liu et al. 2019)."""
 
+    name: ClassVar[str] = "nmpc_lambda_lssvm_svf"
     identifier_options: ClassVar[dict[str, Any]] = {"front_end": "svf"}

@@ -37,9 +37,7 @@ from shipgym.identification.ekf import FilterSettings, ShipEKF
 from shipgym.identification.nominal import first_order_nomoto
 from shipgym.identification.servo import ServoFit, servo_constants
 from shipgym_baselines.classical.oracle import REAL_TIME_SETTINGS, OracleSettings, PlantNMPC
-from shipgym_baselines.policy import Style
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
 
 #: the filter settings a study may tune (keywords of the factory)
 FILTER_KEYS = tuple(f.name for f in dataclasses.fields(FilterSettings))
@@ -92,12 +90,12 @@ def servo_factors(fit: ServoFit) -> dict[str, float]:
     return factors
 
 
-@register_controller("nmpc_ekf", family="NMPC", look=Style("#e31a1c", "-", "v"))
 class NmpcEkf(PlantNMPC):
     """``nmpc_ekf`` (module doc).  ``preset``: "tuned" (default) reads the ship's chosen
     filter settings (``configs/tuning/chosen/nmpc_ekf.yaml``) under the ones given here;
     "default" reads none.  Keywords: the fields of :class:`FilterSettings`."""
 
+    name: ClassVar[str] = "nmpc_ekf"
     kind: ClassVar[str] = "classical"
     default_settings: ClassVar[OracleSettings] = REAL_TIME_SETTINGS
 

@@ -162,8 +162,6 @@ from shipgym.identification.nominal import first_order_nomoto
 from shipgym.models.base import ShipModel
 from shipgym_baselines.classical.box_qp import BoxQP, bind, sqp
 from shipgym_baselines.errors import ControllerError
-from shipgym_baselines.policy import Style
-from shipgym_baselines.registry import register_controller
 
 #: revision of the oracle's rules (horizon, grid, path model): reference data computed with
 #: the oracle is valid for one revision; bump it whenever a change moves its numbers
@@ -828,7 +826,7 @@ class PlantNMPC:
     (``nmpc_ekf``).  :meth:`start` at an episode's start, :meth:`steer` at every step.
     ``settings`` None: the class's :attr:`default_settings`."""
 
-    name: ClassVar[str]  # set by the registration
+    name: ClassVar[str]  # each subclass's own: its name in the registry
     #: the settings of a construction without any (the references': the oracle's own)
     default_settings: ClassVar[OracleSettings] = OracleSettings()
 
@@ -918,12 +916,12 @@ class PlantNMPC:
         }
 
 
-# its look colours its name in the page's tables; the scenario figures draw its episode black
-# and dashed, the reference (shipgym_baselines.plots.figures)
-@register_controller("oracle", family="references", look=Style("#17becf", "-", "s"))
+# its look (shipgym_baselines.controllers) colours its name in the page's tables; the scenario
+# figures draw its episode black and dashed, the reference (shipgym_baselines.plots.figures)
 class Oracle(PlantNMPC):
     """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
 
+    name: ClassVar[str] = "oracle"
     kind: ClassVar[str] = "reference"
     #: predict with the truth of the episode's start (``oracle_frozen``) instead of now
     frozen: ClassVar[bool] = False
@@ -969,11 +967,11 @@ class Oracle(PlantNMPC):
         return self.steer(self.predicted_plant(self._truth()))
 
 
-@register_controller("oracle_frozen", family="references", look=Style("#525252", "-.", "x"))
 class OracleFrozen(Oracle):
     """``oracle_frozen``: the oracle with its truth frozen at the episode's start (module
     doc): the optimum of a controller that never adapts."""
 
+    name: ClassVar[str] = "oracle_frozen"
     frozen: ClassVar[bool] = True
 
 

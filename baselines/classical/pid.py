@@ -76,9 +76,8 @@ from shipgym.identification.nominal import first_order_nomoto, second_order_nomo
 from shipgym.models.base import ShipModel
 from shipgym.scenarios.schema import GuidanceConfig
 from shipgym_baselines.classical.drift import course_and_drift
-from shipgym_baselines.policy import Style, check_action_mode
+from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
 
 TUNINGS = ("pole_placement", "vyshnegradsky")
 #: "tuned": the chosen settings of ``shipgym tune`` (docs/tuning.md) for the ship, where
@@ -241,33 +240,33 @@ class _GuidedPID:
         return {"pid_kp": self.gains.kp, "pid_ki": self.gains.ki, "pid_kd": self.gains.kd}
 
 
-@register_controller("pid_los", family="PID", look=Style("#1f77b4", "-", "o"))
 class PIDLOS(_GuidedPID):
     """PID on LOS guidance; pole placement by default (the leaderboard's numbers)."""
 
+    name: ClassVar[str] = "pid_los"
     law = "los"
     default_tuning = "pole_placement"
 
 
-@register_controller("pid_lookahead_los", family="PID", look=Style("#6baed6", "--", "o"))
 class PIDLookaheadLOS(_GuidedPID):
     """PID on look-ahead LOS guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
+    name: ClassVar[str] = "pid_lookahead_los"
     law = "lookahead_los"
     default_tuning = "vyshnegradsky"
 
 
-@register_controller("pid_vf", family="PID", look=Style("#08519c", "-.", "o"))
 class PIDVF(_GuidedPID):
     """PID on vector-field guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
+    name: ClassVar[str] = "pid_vf"
     law = "vf"
     default_tuning = "vyshnegradsky"
 
 
-@register_controller("pid_tvvf", family="PID", look=Style("#9ecae1", ":", "o"))
 class PIDTVVF(_GuidedPID):
     """PID on time-varying vector-field guidance; pole placement by default (Xu et al. 2021)."""
 
+    name: ClassVar[str] = "pid_tvvf"
     law = "tvvf"
     default_tuning = "pole_placement"

@@ -7,14 +7,12 @@ from typing import Any
 import numpy as np
 
 from shipgym.envs.context import ControllerContext
-from shipgym_baselines.policy import Style
-from shipgym_baselines.registry import register_controller
 
 
-@register_controller("zero_rudder", family="references", look=Style("#7f7f7f", ":", "."))
 class ZeroRudder:
     """Always commands zero (rudder mode) / the default guidance action."""
 
+    name = "zero_rudder"
     kind = "reference"  # shown on every scenario, never ranked as a competitor
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:
@@ -24,10 +22,10 @@ class ZeroRudder:
         return np.zeros(self._dim, dtype=np.float32)
 
 
-@register_controller("random", family="references", look=Style("#c7c7c7", ":", "."))
 class RandomRudder:
     """Uniform random action in [-1, 1], seeded per episode."""
 
+    name = "random"
     kind = "reference"  # shown on every scenario, never ranked as a competitor
 
     def reset(self, context: ControllerContext, seed: int | None = None) -> None:

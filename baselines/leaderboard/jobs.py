@@ -34,7 +34,12 @@ from shipgym_baselines.records.trials import (
     twin_scenarios,
 )
 from shipgym_baselines.references import ReferenceCache, announce, lookup, result_from_entry
-from shipgym_baselines.registry import applies_to, controller_kind, controller_label
+from shipgym_baselines.registry import (
+    ControllerRef,
+    applies_to,
+    controller_label,
+    resolve_controller,
+)
 from shipgym_baselines.signals import worker_init
 from shipgym_baselines.suite import scenario_names
 
@@ -56,7 +61,8 @@ def check_controllers(names: list[str]) -> list[str]:
 
 
 class Job(NamedTuple):
-    """One unit of work: a controller (trained with ``training_seed``; None: not trained)
+    """One unit of work: a controller (trained with ``training_seed``; None: not trained;
+    its record as :func:`plan_jobs` resolved it, or a name resolved where it runs)
     on the trials of scenario ``scenario`` (its table name, :func:`suite_scenarios`; or a
     catalogue name, held-out name or YAML path loaded as such) that ``seeds``
     draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
@@ -64,7 +70,7 @@ class Job(NamedTuple):
     as recorded whatever its file says now; None: resolved from ``scenario`` here.  The
     evaluation loop labels the job's episodes with :attr:`label`."""
 
-    controller: ControllerSpec
+    controller: ControllerRef
     scenario: str
     seeds: tuple[int, ...]
     training_seed: int | None = None
@@ -292,13 +298,13 @@ def suite_record(
     ships = {s: sc.model.name for s, sc in scenarios.items()}
     controllers = []
     for c in names:
-        label = controller_label(c)
+        record = resolve_controller(c)
         controllers.append(
             {
-                "name": label,
+                "name": record.name,
                 "controller": c if isinstance(c, str) else c.model_dump(),  # the long form
-                "kind": controller_kind(label),
-                "training_seeds": list(seeds_of[label]),
+                "kind": record.kind,
+                "training_seeds": list(seeds_of[record.name]),
             }
         )
     files = scenario_names(spec.all_scenarios(), suite_scenario).files
@@ -364,15 +370,16 @@ def plan_jobs(
     scenarios run on other seeds than ``seed_list``, with theirs; ``deal``: the name each
     scenario's trials are dealt by (default: its own;
     :func:`~shipgym_baselines.records.trials.deal_names`)."""
+    records = [resolve_controller(c) for c in names]  # once: each job carries its record
     jobs = []
     for scenario in scenarios:
         settings = scenarios[scenario] if isinstance(scenarios, Mapping) else None
         seeds = list((scenario_seeds or {}).get(scenario, seed_list))
-        for c in names:
-            label = controller_label(c)
+        for c in records:
+            label = c.name
             if (scenario, label) in skip:
                 continue
-            learned = controller_kind(label) == "learned"
+            learned = c.kind == "learned"
             if learned and shared:  # one job: each seed played by the training seed dealt it
                 by = (deal or {}).get(scenario, scenario)
                 dealt = tuple(dealt_owners(by, seeds, seeds_of[label]))
@@ -381,7 +388,7 @@ def plan_jobs(
             for k in seeds_of[label]:
                 if learned:
                     jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings))
-                elif not grants_truth(c):
+                elif not c.privileged:
                     jobs.append(Job(c, scenario, tuple(seeds), k, randomize, settings, references))
                 else:
                     jobs += [

@@ -1,9 +1,8 @@
 """The import graph of ``baselines/`` (``shipgym_baselines``) follows its layers, ground up:
 ground floor → records → controllers → evaluation → scoring → tuning, training,
 reproduce → plots → page → leaderboard → studies → cli.  Each folder sits on one layer.  A
-module imports only modules of its own layer or a lower one, save the edges of
-:data:`EXCEPTIONS`, and no import cycle runs through baselines, save through
-:data:`CYCLE_EXCEPTIONS`.
+module imports only modules of its own layer or a lower one, and no import cycle runs
+through baselines: there is no exception to either rule.
 
 The graph is :mod:`tests.import_graph`'s: every import statement (top-level, inside
 functions, under ``if TYPE_CHECKING:``, in ``try`` blocks) and the modules a module imports
@@ -47,7 +46,11 @@ LAYERS: dict[str, int] = {
     # 2 — controllers: what a controller is, how it enters, its privileged channel, the
     #     references' tables, the classical controllers and the learned policies (loading
     #     and acting)
+    # 2 — controllers: what a controller is, the table of built-ins, how it enters, its
+    #     privileged channel, the references' tables, the classical controllers and the
+    #     learned policies (loading and acting; their training sits in layer 4)
     f"{B}.policy": 2,
+    f"{B}.controllers": 2,
     f"{B}.plugins": 2,
     f"{B}.registry": 2,
     f"{B}.privileged": 2,
@@ -78,34 +81,6 @@ LAYERS: dict[str, int] = {
 }
 
 
-def _edge_table(text: str) -> dict[Edge, str]:
-    """One ``module -> imported: reason`` a line, names relative to shipgym_baselines, as
-    {(module, imported): reason}."""
-    table = {}
-    for line in filter(None, map(str.strip, text.splitlines())):
-        edge, reason = line.split(": ", 1)
-        module, target = (f"{B}.{name.strip()}" for name in edge.split(" -> "))
-        table[module, target] = reason
-    return table
-
-
-#: Upward edges allowed today, with the reason; a name ending in ``.*`` stands for every
-#: module inside that package.  A listed edge that no longer exists fails
-#: ``test_every_exception_is_still_an_edge``: remove it then.
-EXCEPTIONS = _edge_table(
-    """
-    """
-)
-
-#: Edges left out of the cycle check, with the reason (same form as :data:`EXCEPTIONS`).
-CYCLE_EXCEPTIONS = _edge_table(
-    """
-    registry -> classical.*: _load_builtins, lazy, loads the built-ins, which register there
-    registry -> learned.plant_id.controller: _load_builtins, lazy, as the classical ones
-    """
-)
-
-
 def _graph() -> dict[str, frozenset[str]]:
     """Baselines module -> the baselines modules it imports (statements and importlib)."""
     dynamic = dynamic_imports()
@@ -116,23 +91,12 @@ def _graph() -> dict[str, frozenset[str]]:
     }
 
 
-def _covers(pattern: str, module: str) -> bool:
-    """``module`` is ``pattern``, or lies inside the package ``pattern`` names as ``p.*``."""
-    return within(module, pattern[:-2]) if pattern.endswith(".*") else module == pattern
-
-
-def _matches(edge: Edge, allowed: Iterable[Edge]) -> bool:
-    """Whether an entry of ``allowed`` covers ``edge``."""
-    module, target = edge
-    return any(_covers(m, module) and _covers(t, target) for m, t in allowed)
-
-
 def _upward(found: Iterable[Edge], layers: Mapping[str, int] = LAYERS) -> list[str]:
-    """The edges of ``found`` that import a higher layer and are no exception."""
+    """The edges of ``found`` that import a higher layer."""
     return [
         f"{m} (layer {layer(m, layers)}) imports {t} (layer {layer(t, layers)})"
         for m, t in found
-        if (layer(t, layers) or 0) > (layer(m, layers) or 0) and not _matches((m, t), EXCEPTIONS)
+        if (layer(t, layers) or 0) > (layer(m, layers) or 0)
     ]
 
 
@@ -152,11 +116,12 @@ def test_the_graph_sees_lazy_and_importlib_imports() -> None:
     assert f"{B}.scoring.ranking" in set(imported_names(tree, f"{B}.registry", False))
     assert named_modules(tree, f"{B}.registry") == {f"{B}.classical.pid"}
     assert named_modules(ast.parse("X = 'shipgym_baselines.classical.pid'\n"), B) == set()
+    # an entry point "module:Attr" (the built-in controllers', Gymnasium's) is no edge
+    entry_point = "import importlib\nX = 'shipgym_baselines.classical.pid:PIDLOS'\n"
+    assert named_modules(ast.parse(entry_point), f"{B}.registry") == set()
     assert _upward([(f"{B}.records.episodes", f"{B}.scoring.ranking")])
     assert _upward([(f"{B}.classical.pid", f"{B}.cli")])
     assert not _upward([(f"{B}.cli.run", f"{B}.records.runlog")])  # downward
-    listed = [(m.replace(".*", ".any"), t.replace(".*", ".any")) for m, t in EXCEPTIONS]
-    assert not _upward(listed)
 
 
 def test_each_layer_is_a_folder_or_a_module_at_the_top() -> None:
@@ -178,16 +143,5 @@ def test_modules_import_only_their_own_or_lower_layers() -> None:
 
 
 def test_no_import_cycles_in_baselines() -> None:
-    graph = {
-        m: frozenset(t for t in targets if not _matches((m, t), CYCLE_EXCEPTIONS))
-        for m, targets in _graph().items()
-    }
-    cycle = find_cycle(graph)
+    cycle = find_cycle(_graph())
     assert cycle is None, "import cycle: " + " -> ".join(cycle or [])
-
-
-def test_every_exception_is_still_an_edge() -> None:
-    """A removed edge leaves EXCEPTIONS and CYCLE_EXCEPTIONS (so the lists only shrink)."""
-    found = list(edges(B, _graph()))
-    gone = [e for e in [*EXCEPTIONS, *CYCLE_EXCEPTIONS] if not any(_matches(f, [e]) for f in found)]
-    assert not gone, f"no longer imported: remove from the exceptions: {gone}"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pickle
 import subprocess
 import sys
 from typing import Any
@@ -13,12 +14,15 @@ import shipgym_baselines
 from shipgym.envs.context import ControllerContext
 from shipgym_baselines.classical.pid import PIDLOS
 from shipgym_baselines.classical.reference import ZeroRudder
+from shipgym_baselines.controllers import BUILTINS as BUILTIN_TABLE
+from shipgym_baselines.controllers import Builtin
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.evaluation import run_episode
+from shipgym_baselines.learned.plant_id.shipped import shipped_seeds
 from shipgym_baselines.learned.policy import shipped_policies
 from shipgym_baselines.plugins import ControllerEntry
 from shipgym_baselines.policy import FAMILIES, Style
-from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN, PRIVILEGED_NAMES, grants_truth
 from shipgym_baselines.registry import (
     BASELINE,
     CONTROLLERS,
@@ -28,6 +32,7 @@ from shipgym_baselines.registry import (
     make_controller,
     register_controller,
     resolve_controller,
+    training_seeds,
 )
 
 #: the contract: every built-in controller's name, action mode and ships (None: all)
@@ -109,18 +114,77 @@ def test_a_registration_carries_its_family_and_look(scratch_registry: None) -> N
     assert not {"test_bad_family", "test_bad_look"} & set(CONTROLLERS)
 
 
-def test_the_registry_loads_the_built_ins_on_first_read() -> None:
-    """Importing the registry imports no controller; its first reader imports
-    shipgym_baselines.classical, in a fresh interpreter too."""
+def test_the_traits_are_read_without_importing_a_controller() -> None:
+    """In a fresh interpreter, every built-in's traits come from the table of entry points:
+    no controller module is imported until one is made, and then only its own."""
     code = (
         "import sys\n"
-        "from shipgym_baselines.registry import make_controller\n"
-        "assert 'shipgym_baselines.classical' not in sys.modules\n"
+        "from shipgym_baselines.registry import CONTROLLERS, make_controller, training_seeds\n"
+        "from shipgym_baselines.registry import controller_kind, declared_traits, applies_to\n"
+        "from shipgym_baselines.privileged import grants_truth\n"
+        "for name, record in CONTROLLERS.items():\n"
+        "    controller_kind(name), declared_traits(name), training_seeds(name)\n"
+        "    applies_to(name, 'mariner'), grants_truth(name)\n"
+        "def controllers():\n"
+        "    return sorted(m for m in sys.modules if m.startswith(('shipgym_baselines.classical.',"
+        " 'shipgym_baselines.learned.plant_id.controller')))\n"
+        "assert controllers() == [], controllers()\n"
         "policy, mode = make_controller('pid_los')\n"
-        "print(policy.name, mode)\n"
+        "print(policy.name, mode, *controllers())\n"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert run.stdout.split() == ["pid_los", "rudder"]
+    assert run.stdout.split() == [
+        "pid_los",
+        "rudder",
+        "shipgym_baselines.classical.drift",
+        "shipgym_baselines.classical.pid",
+    ]
+
+
+@pytest.mark.parametrize("builtin", BUILTIN_TABLE, ids=lambda b: b.name)
+def test_each_entry_point_names_a_class_with_the_registered_traits(builtin: Builtin) -> None:
+    """The table's entry point is a Policy class that declares the table's name and kind
+    (its own attributes, read by the class itself)."""
+    cls = CONTROLLERS[builtin.name].factory
+    assert isinstance(cls, type) and f"{cls.__module__}:{cls.__qualname__}" == builtin.entry_point
+    assert (cls.name, cls.kind) == (builtin.name, builtin.kind)
+
+
+def test_the_learned_built_in_lists_its_shipped_seeds_without_its_module() -> None:
+    assert training_seeds("nmpc_learned_id") == list(shipped_seeds() or (None,))
+
+
+def test_only_the_references_named_as_such_read_the_truth(scratch_registry: None) -> None:
+    assert PRIVILEGED_NAMES == (ORACLE, ORACLE_FROZEN)
+    assert {name for name, r in CONTROLLERS.items() if r.privileged} == {ORACLE, ORACLE_FROZEN}
+    assert grants_truth(ORACLE) and grants_truth(resolve_controller(ORACLE_FROZEN))
+    renamed = ControllerEntry(controller=ORACLE, name="my_oracle")
+    with_settings = ControllerEntry(controller=ORACLE, settings={"settings": None})
+    assert not grants_truth(renamed) and not resolve_controller(renamed).privileged
+    assert not grants_truth(with_settings) and not grants_truth("pid_los")
+    spec = resolve_controller("shipgym_baselines.classical.oracle:Oracle")  # the same class
+    assert spec.name == ORACLE and not grants_truth(spec)
+
+
+def test_a_record_is_resolved_once_and_crosses_a_process_pool(scratch_registry: None) -> None:
+    """A resolved record is its own resolution; pickled it leaves its loaded factory behind
+    and the process that unpickles it loads the same controller, settings bound."""
+    stiff = resolve_controller(
+        ControllerEntry(controller="pid_los", name="pid_stiff", settings={"natural_frequency": 2.0})
+    )
+    assert resolve_controller(stiff) is stiff and stiff.loaded is PIDLOS
+    copy = pickle.loads(pickle.dumps(stiff))
+    assert copy == stiff and copy.loaded is None
+    policy, mode = make_controller(copy)
+    assert (type(policy), policy.name, mode, policy.natural_frequency) == (
+        PIDLOS,
+        "pid_stiff",
+        "rudder",
+        2.0,
+    )
+    register_controller("test_lambda", lambda: ZeroRudder())  # found again by its name
+    made, _ = make_controller(pickle.loads(pickle.dumps(resolve_controller("test_lambda"))))
+    assert isinstance(made, ZeroRudder) and made.name == "test_lambda"
 
 
 def test_the_registry_is_read_only() -> None:

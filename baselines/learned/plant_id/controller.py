@@ -27,7 +27,6 @@ time (:mod:`.train`), never at evaluation.  The shipped estimators are the folde
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -42,28 +41,9 @@ from shipgym_baselines.classical.oracle import REAL_TIME_SETTINGS, OracleSetting
 from shipgym_baselines.errors import ControllerError
 from shipgym_baselines.learned.plant_id.features import Window
 from shipgym_baselines.learned.plant_id.labels import SLOTS, UNLEARNED, plant_of, slot_mask
-from shipgym_baselines.learned.plant_id.network import WEIGHTS_FILE, Estimator
-from shipgym_baselines.policy import Style
+from shipgym_baselines.learned.plant_id.network import Estimator
+from shipgym_baselines.learned.plant_id.shipped import SHIPPED, shipped_seeds
 from shipgym_baselines.records.chosen import tuned_settings
-from shipgym_baselines.registry import register_controller
-
-#: the shipped estimators: ``seed_<k>`` folders
-SHIPPED = Path(__file__).parent / "seeds"
-_SEED = re.compile(r"seed_(\d+)")
-
-
-def shipped_seeds(folder: Path = SHIPPED) -> tuple[int, ...]:
-    """The training seeds of the estimators in ``folder`` (``seed_<k>`` with weights)."""
-    if not folder.is_dir():
-        return ()
-    return tuple(
-        sorted(
-            int(m.group(1))
-            for p in folder.iterdir()
-            if (m := _SEED.fullmatch(p.name)) and (p / WEIGHTS_FILE).is_file()
-        )
-    )
-
 
 #: s of the fallback before tuning: to the nominal ship (``prior_std``, ln factors and slot
 #: units) and to the servo's windowed fit (``fit_std``)
@@ -81,7 +61,6 @@ def _positive(key: str, value: Any) -> float:
     return number
 
 
-@register_controller("nmpc_learned_id", family="learned", look=Style("#9467bd", "-", "P"))
 class NmpcLearnedId(PlantNMPC):
     """``nmpc_learned_id`` (module doc).  ``training_seed``: which shipped estimator (None:
     the first); ``folder``: an estimator's folder instead of a shipped one; ``prior_std``
@@ -89,8 +68,8 @@ class NmpcLearnedId(PlantNMPC):
     and slot units; None: the ship's chosen value with ``preset="tuned"``, the default, from
     ``configs/tuning/chosen/nmpc_learned_id.yaml``, else :data:`FALLBACK_DEFAULTS`)."""
 
+    name: ClassVar[str] = "nmpc_learned_id"
     kind: ClassVar[str] = "learned"
-    training_seeds: ClassVar[tuple[int | None, ...]] = shipped_seeds() or (None,)
     default_settings: ClassVar[OracleSettings] = REAL_TIME_SETTINGS
 
     def __init__(
@@ -209,4 +188,4 @@ class NmpcLearnedId(PlantNMPC):
         return self.steer(plant)
 
 
-__all__ = ["NmpcLearnedId", "shipped_seeds"]
+__all__ = ["NmpcLearnedId"]

@@ -83,9 +83,9 @@ def test_the_twins_are_played_by_the_competitors_and_the_oracle_only() -> None:
         "esso_osaka_rudder_aging": "twin:esso_osaka_rudder_aging",  # no nominal in this run
     }
     jobs = plan_run(names, record, seeds_of)
-    on_twins = {(j.scenario, j.controller) for j in jobs if j.scenario.startswith("twin:")}
+    on_twins = {(j.scenario, j.label.controller) for j in jobs if j.scenario.startswith("twin:")}
     assert {c for _, c in on_twins} == {"pid_los", "ppo", "oracle"}
-    by_key = {(j.scenario, j.controller): j for j in jobs}
+    by_key = {(j.scenario, j.label.controller): j for j in jobs}
     for scenario, twin in record["twins"].items():
         assert by_key[(scenario, "ppo")].dealt == by_key[(twin, "ppo")].dealt
 

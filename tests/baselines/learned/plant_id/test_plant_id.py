@@ -21,6 +21,7 @@ from shipgym_baselines.learned.plant_id.controller import NmpcLearnedId
 from shipgym_baselines.learned.plant_id.features import Window, episode_windows, step_row
 from shipgym_baselines.learned.plant_id.labels import SLOTS, Labeller, plant_of, slot_mask
 from shipgym_baselines.learned.plant_id.network import Estimator, build
+from shipgym_baselines.learned.plant_id.shipped import shipped_seeds
 from shipgym_baselines.records.manifest import check_listed, read_manifest
 from shipgym_baselines.registry import make_controller, resolve_controller
 from shipgym_baselines.training.plant_id import rollout, windows
@@ -186,14 +187,14 @@ def test_training_writes_its_rounds_and_resumes_without_collecting_again(tmp_pat
     assert policy.estimator.meta["round"] == 1
 
 
-@pytest.mark.skipif(len(NmpcLearnedId.training_seeds) < 2, reason="needs two shipped seeds")
+@pytest.mark.skipif(len(shipped_seeds()) < 2, reason="needs two shipped seeds")
 def test_dealt_trials_are_each_seeds_own_episode() -> None:
     """A shared-trials row deals its trials among the shipped estimators: each dealt
     episode is the one its training seed plays alone (lockstep changes nothing), labelled
     with that seed."""
     from shipgym_baselines.evaluation import evaluate_batch
 
-    first, second = NmpcLearnedId.training_seeds[:2]
+    first, second = shipped_seeds()[:2]
     seeds = [10_000, 10_001]
     dealt = evaluate_batch("nmpc_learned_id", "rudder_aging", seeds, training_seeds=[first, second])
     alone = [
