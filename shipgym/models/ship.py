@@ -84,6 +84,13 @@ def rudder_quantity(*params: str) -> Quantity:
 DRAUGHT = Quantity("draught", (), 0.3, 1.6, draught=True)
 
 
+def hull_quantities(servo: str, rate: str, *rudder: str) -> tuple[Quantity, ...]:
+    """What an estimator adapts on a hull with a steering gear, in this order: the servo time
+    constant ``servo``, the rate limit ``rate``, the rudder effectiveness ``rudder`` and the
+    draught."""
+    return servo_quantity(servo), rate_quantity(rate), rudder_quantity(*rudder), DRAUGHT
+
+
 @dataclasses.dataclass(frozen=True)
 class Ship:
     """One ship: its model class and what the rest of the package reads per ship."""
