@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from shipgym_baselines.cli import main
+from tests.baselines.conftest import error_line
 
 #: a scenario file's text with one ``{line}`` to fill in (nomoto2, 30 s)
 SCENARIO = """\
@@ -21,15 +22,6 @@ events: [{{time: {event}, params: {{Tc: 1.0}}}}]
 time_limit: {limit}
 """
 GOOD = {"params": "Tc: 0.1", "heading": 0.0, "direction": 90.0, "event": 5.0, "limit": 30.0}
-
-
-def error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
-    """The one stderr line of a bad input (checked for its shape), without its prefix."""
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "Traceback" not in err, err
-    prefix = f"shipgym {command}: error: "
-    assert err.startswith(prefix), err
-    return err.removeprefix(prefix).rstrip("\n")
 
 
 def scenario_file(tmp_path: Path, **bad: object) -> str:
