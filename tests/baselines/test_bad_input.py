@@ -24,6 +24,18 @@ time_limit: {limit}
 GOOD = {"params": "Tc: 0.1", "heading": 0.0, "direction": 90.0, "event": 5.0, "limit": 30.0}
 
 
+def assert_refused(
+    capsys: pytest.CaptureFixture[str], argv: list[str], named: list[str], out: Path
+) -> None:
+    """``shipgym argv`` exits 2 with one error line naming each of ``named``, before it
+    makes ``out``."""
+    assert main(argv) == 2
+    message = error_line(capsys, argv[0])
+    for text in named:
+        assert text in message
+    assert not out.exists()
+
+
 def scenario_file(tmp_path: Path, **bad: object) -> str:
     file = tmp_path / "scenario.yaml"
     file.write_text(SCENARIO.format(**{**GOOD, **bad}))
@@ -65,12 +77,7 @@ def test_a_bad_scenario_number_is_named_before_the_episode(
 ) -> None:
     file = scenario_file(tmp_path, **bad)
     out = tmp_path / "out"
-    assert main(["run", file, "pid_los", "--out", str(out)]) == 2
-    message = error_line(capsys, "run")
-    assert file in message
-    for text in named:
-        assert text in message
-    assert not out.exists()
+    assert_refused(capsys, ["run", file, "pid_los", "--out", str(out)], [file, *named], out)
 
 
 def test_scenarios_validate_names_every_problem_and_exits_2(
@@ -277,12 +284,8 @@ def test_a_bad_suite_is_named_with_file_and_key(
     suite = tmp_path / "suite.yaml"
     suite.write_text(text)
     out = tmp_path / "out"
-    assert main(["leaderboard", "--suite", str(suite), "--out", str(out), "--no-progress"]) == 2
-    message = error_line(capsys, "leaderboard")
-    assert str(suite) in message
-    for part in named:
-        assert part in message
-    assert not out.exists()
+    command = ["leaderboard", "--suite", str(suite), "--out", str(out), "--no-progress"]
+    assert_refused(capsys, command, [str(suite), *named], out)
 
 
 def test_scenarios_validate_suggests_the_key_an_unknown_one_is_close_to(
