@@ -125,28 +125,28 @@ def test_bad_option_values_are_one_line_errors(
 def test_a_project_error_from_deep_inside_is_one_line(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def broken() -> list[str]:
         raise ScenarioError("configs/scenarios: unreadable")
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", broken)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", broken)
     assert main(["scenarios"]) == 2
     assert error_line(capsys, "scenarios") == "configs/scenarios: unreadable"
 
 
 def test_a_bug_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
     """Only project errors (bad input) become one line: anything else propagates."""
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def buggy() -> list[str]:
         raise TypeError("a real bug")
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", buggy)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", buggy)
     with pytest.raises(TypeError, match="a real bug"):
         main(["scenarios"])
     # a built-in KeyError that is not a ControllerError is a bug too
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", lambda: {}["missing"])
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", lambda: {}["missing"])
     with pytest.raises(KeyError):
         main(["scenarios"])
 
@@ -154,12 +154,12 @@ def test_a_bug_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_ctrl_c_is_one_line_and_exit_130(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def interrupted() -> list[str]:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", interrupted)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", interrupted)
     assert main(["scenarios"]) == 130
     assert capsys.readouterr().err == "shipgym scenarios: interrupted\n"
 
