@@ -9,7 +9,6 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
-import yaml
 from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
 from shipgym.config import (
@@ -17,13 +16,11 @@ from shipgym.config import (
     ConfigFile,
     Name,
     StrictModel,
-    compose_yaml,
     error_message,
     is_path,
     list_names,
     load_yaml_model,
     parse_yaml,
-    read_config_text,
     read_yaml,
     resolve,
 )
@@ -38,6 +35,7 @@ from shipgym.scenarios.loader import (
     Problem,
     Scenario,
     check_scenario_file,
+    composed_config,
     list_scenarios,
     load_scenario,
     yaml_line,
@@ -286,18 +284,10 @@ def check_suite_file(name_or_path: str | os.PathLike) -> list[Problem]:
     name, a held-out test scenario, a YAML file checked as ``shipgym scenarios --validate``
     checks it, its table name) and each controller (resolvable, its settings accepted by
     its factory, one table name each), whatever the schema found elsewhere."""
-    try:
-        file = resolve("suites", name_or_path, error=ConfigError)
-        text = read_config_text(file, ConfigError)
-    except ConfigError as exc:
-        return [Problem("", str(exc))]
-    try:
-        root = compose_yaml(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]
-    except yaml.YAMLError as exc:
-        return [Problem("", f"malformed YAML: {exc}")]
+    composed = composed_config("suites", name_or_path, ConfigError)
+    if isinstance(composed, Problem):
+        return [composed]
+    file, text, root = composed
     data = parse_yaml(text)
     if not isinstance(data, Mapping):
         return [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]

@@ -82,7 +82,8 @@ class StrictModel(BaseModel):
     ) -> Self:
         """A validated copy: the ``drop`` keys (dotted, e.g. ``"sensors"``) removed, so that
         their defaults apply, then ``overrides`` deep-merged (mappings merge key by key,
-        any other value replaces).  Errors name ``origin`` and the key."""
+        any other value replaces).  A field no dump holds (``exclude``) is kept unless
+        ``overrides`` sets it.  Errors name ``origin`` and the key."""
         data = self.model_dump()
         for dotted in drop:
             *parents, last = dotted.split(".")
@@ -92,6 +93,8 @@ class StrictModel(BaseModel):
             if not isinstance(node, dict) or last not in node:
                 raise error(f"{origin}: cannot drop {dotted!r}: no such key")
             del node[last]
+        fields = type(self).model_fields
+        data.update({name: getattr(self, name) for name, f in fields.items() if f.exclude})
         return validate_model(deep_merge(data, overrides or {}), type(self), origin, error)
 
 

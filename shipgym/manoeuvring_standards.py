@@ -41,22 +41,26 @@ class Criterion(TypedDict):
     passed: bool
 
 
+def _overshoot_limit(
+    l_over_v: float, short: float, long: float, offset: float, slope: float
+) -> float:
+    """An overshoot limit [deg] for L/V [s]: ``short`` below L/V = 10 s, ``long`` from 30 s,
+    ``offset`` + ``slope``·L/V between."""
+    if l_over_v < 10.0:
+        return short
+    if l_over_v >= 30.0:
+        return long
+    return offset + slope * l_over_v
+
+
 def first_overshoot_limit(l_over_v: float) -> float:
     """5.3.3.1: limit of the 10°/10° zig-zag's first overshoot [deg] for L/V [s]."""
-    if l_over_v < 10.0:
-        return 10.0
-    if l_over_v >= 30.0:
-        return 20.0
-    return 5.0 + 0.5 * l_over_v
+    return _overshoot_limit(l_over_v, 10.0, 20.0, 5.0, 0.5)
 
 
 def second_overshoot_limit(l_over_v: float) -> float:
     """5.3.3.2: limit of the 10°/10° zig-zag's second overshoot [deg] for L/V [s]."""
-    if l_over_v < 10.0:
-        return 25.0
-    if l_over_v >= 30.0:
-        return 40.0
-    return 17.5 + 0.75 * l_over_v
+    return _overshoot_limit(l_over_v, 25.0, 40.0, 17.5, 0.75)
 
 
 def _criterion(name: str, value: float | None, limit: float, unit: str) -> Criterion:

@@ -126,6 +126,17 @@ class _GuidedPID:
     default_tuning: ClassVar[str]
     default_preset: ClassVar[str] = "tuned"
 
+    def __init_subclass__(
+        cls, law: str | None = None, default_tuning: str | None = None, **kwargs: Any
+    ) -> None:
+        """A law's PID: ``law`` (a shipgym.guidance law) and its ``default_tuning``, given
+        as class keywords (a subclass of a law's PID keeps them)."""
+        super().__init_subclass__(**kwargs)
+        if law is not None:
+            cls.law = law
+        if default_tuning is not None:
+            cls.default_tuning = default_tuning
+
     def __init__(
         self,
         preset: str | None = None,
@@ -240,33 +251,25 @@ class _GuidedPID:
         return {"pid_kp": self.gains.kp, "pid_ki": self.gains.ki, "pid_kd": self.gains.kd}
 
 
-class PIDLOS(_GuidedPID):
+class PIDLOS(_GuidedPID, law="los", default_tuning="pole_placement"):
     """PID on LOS guidance; pole placement by default (the leaderboard's numbers)."""
 
     name: ClassVar[str] = "pid_los"
-    law = "los"
-    default_tuning = "pole_placement"
 
 
-class PIDLookaheadLOS(_GuidedPID):
+class PIDLookaheadLOS(_GuidedPID, law="lookahead_los", default_tuning="vyshnegradsky"):
     """PID on look-ahead LOS guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
     name: ClassVar[str] = "pid_lookahead_los"
-    law = "lookahead_los"
-    default_tuning = "vyshnegradsky"
 
 
-class PIDVF(_GuidedPID):
+class PIDVF(_GuidedPID, law="vf", default_tuning="vyshnegradsky"):
     """PID on vector-field guidance; Vyshnegradsky by default (Xu & Guedes Soares 2020)."""
 
     name: ClassVar[str] = "pid_vf"
-    law = "vf"
-    default_tuning = "vyshnegradsky"
 
 
-class PIDTVVF(_GuidedPID):
+class PIDTVVF(_GuidedPID, law="tvvf", default_tuning="pole_placement"):
     """PID on time-varying vector-field guidance; pole placement by default (Xu et al. 2021)."""
 
     name: ClassVar[str] = "pid_tvvf"
-    law = "tvvf"
-    default_tuning = "pole_placement"

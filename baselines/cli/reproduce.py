@@ -33,9 +33,9 @@ def run(args: argparse.Namespace) -> int:
     check_seeds(args.seeds, "--seeds")
     out = args.out or f"results/reproduce/{args.paper}"
     check_out_dir(out, force=True)  # usable (a writable folder); its earlier report replaced
-    module = PAPERS[args.paper]
+    paper = PAPERS[args.paper]
     bar = tqdm(desc=f"reproduce {args.paper}", file=sys.stderr, disable=args.no_progress)
-    rows = module.run(
+    rows = paper.run(
         out_dir=out,
         seeds=args.seeds,
         progress=lambda: bar.update(1),
@@ -44,5 +44,5 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         emit(args, rows, "")
     else:
-        sys.stdout.write(module.markdown(rows))
+        sys.stdout.write(paper.markdown(rows))
     return 0

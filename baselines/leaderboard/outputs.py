@@ -196,8 +196,7 @@ def write_results(
         files += [f for s in suite["scenarios"] if s in plots for f in plots[s].result()]
         files += curve_figures.plot_learning_curves(out, curves, vector_figures)
     lead = verdict(board, shown_episodes, plain_name, headroom)
-    page.write_html(
-        out,
+    content = page.PageContent(
         rows,
         board,
         scores,
@@ -208,6 +207,7 @@ def write_results(
         headroom=headroom,
         shares=shares,
     )
+    page.write_html(out, content)
     return rows
 
 

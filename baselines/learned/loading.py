@@ -21,6 +21,7 @@ through SB3's load (tests/golden/shipped_policy_actions.npz).
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import pickle
@@ -59,26 +60,35 @@ def is_pickled(value: Any) -> bool:
     return False
 
 
-def load_data_only(
-    path: Path,
-    algorithm: type,
-    action_mode: str,
-    context_features: bool = False,
-    history_steps: int = 0,
-) -> Any:
-    """The SB3 model of the zip ``path`` saved by ``algorithm`` (an SB3 / sb3-contrib
-    class), built without unpickling, on the CPU, for the env's spaces in ``action_mode``
-    (the observation with the context features and ``history_steps`` steps of history as
-    the model was trained)."""
+@dataclasses.dataclass(frozen=True)
+class SavedModel:
+    """What a model zip says about itself, read without torch: the algorithm that saved it
+    (None when the zip does not tell) and the action mode its action space drives."""
+
+    path: Path
+    algo: str | None
+    action_mode: str
+    #: it observes the controller-context features too (trained with context_features)
+    context_features: bool = False
+    #: K: it observes the last K control steps too (trained with history_steps)
+    history_steps: int = 0
+
+
+def load_data_only(saved: SavedModel, algorithm: type) -> Any:
+    """The SB3 model of the zip ``saved.path`` saved by ``algorithm`` (an SB3 / sb3-contrib
+    class), built without unpickling, on the CPU, for the env's spaces in its action mode
+    (the observation with the context features and history steps the model was trained
+    with)."""
     import torch
 
+    path = saved.path
     with zipfile.ZipFile(path) as archive:
         data = json.loads(archive.read("data").decode())
         weights = archive.read(WEIGHTS_ENTRY)
     alias = next(name for name in algorithm.policy_aliases if name.startswith("Mlp"))
     policy_class = algorithm.policy_aliases[alias]
-    saved = data.get("policy_class")
-    module = saved.get("__module__") if isinstance(saved, dict) else None
+    saved_class = data.get("policy_class")
+    module = saved_class.get("__module__") if isinstance(saved_class, dict) else None
     if module != policy_class.__module__:
         raise refuse_unpickling(
             path,
@@ -89,8 +99,8 @@ def load_data_only(
     if not isinstance(kwargs, dict) or is_pickled(kwargs):
         raise refuse_unpickling(path, "its policy_kwargs hold pickled objects")
     kwargs = {k: v for k, v in kwargs.items() if k != "device"}
-    obs_space = observation_space(context_features, history_steps)
-    act_space = action_space(action_mode)
+    obs_space = observation_space(saved.context_features, saved.history_steps)
+    act_space = action_space(saved.action_mode)
     for key, space in (("observation_space", obs_space), ("action_space", act_space)):
         _check_bounds(path, key, data.get(key), space)
     model = algorithm(alias, env=None, device="cpu", _init_setup_model=False)

@@ -61,7 +61,7 @@ from shipgym.envs.core import (
 )
 from shipgym.limits import MAX_HISTORY_STEPS
 from shipgym_baselines.errors import ControllerError, UnsafeFileError
-from shipgym_baselines.learned.loading import load_data_only
+from shipgym_baselines.learned.loading import SavedModel, load_data_only
 from shipgym_baselines.learned.normalizer import ObsNormalizer, load_normalizer, normalizer_file
 from shipgym_baselines.learned.trust import pickle_trusted
 from shipgym_baselines.policy import Style, check_action_mode
@@ -172,20 +172,6 @@ class PolicyMeta(BaseModel):
         if (self.env_steps is None) != (self.wall_time_s is None):
             raise ValueError("give both 'env_steps' and 'wall_time_s' (training cost) or neither")
         return self
-
-
-@dataclasses.dataclass(frozen=True)
-class SavedModel:
-    """What a model zip says about itself, read without torch: the algorithm that saved it
-    (None when the zip does not tell) and the action mode its action space drives."""
-
-    path: Path
-    algo: str | None
-    action_mode: str
-    #: it observes the controller-context features too (trained with context_features)
-    context_features: bool = False
-    #: K: it observes the last K control steps too (trained with history_steps)
-    history_steps: int = 0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -470,16 +456,11 @@ def _history_steps(meta: dict[str, Any], checked: PolicyMeta, meta_file: Path | 
     return checked.history_steps
 
 
-def load_model(
-    path: Path,
-    algo: str,
-    action_mode: str,
-    context_features: bool = False,
-    history_steps: int = 0,
-) -> Any:
-    """The SB3 model of a zip, on the CPU, read as data (:func:`load_data_only`); a zip
-    that only unpickling can read is refused unless the command trusts pickles, then
-    loaded by SB3; a zip that does not load is a clear error."""
+def load_model(saved: SavedModel, algo: str) -> Any:
+    """The SB3 model of ``saved``'s zip, saved by ``algo``, on the CPU, read as data
+    (:func:`load_data_only`); a zip that only unpickling can read is refused unless the
+    command trusts pickles, then loaded by SB3; a zip that does not load is a clear error."""
+    path = saved.path
     module, name = ALGORITHMS[algo]
     try:
         algorithm = getattr(importlib.import_module(module), name)
@@ -490,7 +471,7 @@ def load_model(
             f"{path}: a {name} model needs {module} ({exc}): {install_hint('rl')}"
         ) from exc
     try:
-        return load_data_only(path, algorithm, action_mode, context_features, history_steps)
+        return load_data_only(saved, algorithm)
     except UnsafeFileError:
         if not pickle_trusted():
             raise
@@ -509,20 +490,13 @@ def load_model(
 
 
 @functools.lru_cache(maxsize=32)
-def _cached_model(
-    path: Path,
-    stamp: tuple[int, int],
-    trusted: bool,
-    algo: str,
-    action_mode: str,
-    context_features: bool,
-    history_steps: int,
-) -> Any:
-    """:func:`load_model`, once per process for a file of the same ``stamp`` (its
-    modification time [ns] and size [bytes]) and the same trust in pickles: a leaderboard
-    worker plays the same agents on many scenarios.  Inference leaves a model unchanged
-    (evaluation mode, no gradient); episode state (history, LSTM) lives in the policy."""
-    return load_model(path, algo, action_mode, context_features, history_steps)
+def _cached_model(saved: SavedModel, stamp: tuple[int, int], trusted: bool, algo: str) -> Any:
+    """:func:`load_model`, once per process for a file (``saved.path``, resolved) of the
+    same ``stamp`` (its modification time [ns] and size [bytes]) and the same trust in
+    pickles: a leaderboard worker plays the same agents on many scenarios.  Inference leaves
+    a model unchanged (evaluation mode, no gradient); episode state (history, LSTM) lives in
+    the policy."""
+    return load_model(saved, algo)
 
 
 def lean_forward(policy: Any) -> Any:
@@ -641,13 +615,10 @@ class LearnedPolicy:
         self._history: ObservationHistory | None = None
         stat = Path(self.model_path).stat()
         self.model = _cached_model(
-            Path(self.model_path).resolve(),
+            dataclasses.replace(files.model, path=Path(self.model_path).resolve()),
             (stat.st_mtime_ns, stat.st_size),
             pickle_trusted(),
             self.algo,
-            self.action_mode,
-            self.context_features,
-            self.history_steps,
         )
         _eval_mode_once(self.model.policy)
         self.obs_normalizer: ObsNormalizer | None = (

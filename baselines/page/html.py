@@ -37,6 +37,7 @@ writes the page and returns its path.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -159,30 +160,40 @@ _JS = """
 """
 
 
-def page(
-    rows: Sequence[Mapping[str, Any]],
-    aggregate: Sequence[Mapping[str, Any]],
-    scores: Sequence[Mapping[str, Any]],
-    figures: Iterable[str | Path] = (),
-    title: str = "shipgym leaderboard",
-    subtitle: str | None = None,
-    verdict: str | None = None,
-    note: str = "",
-    headroom: Sequence[Mapping[str, Any]] = (),
-    shares: Mapping[str, Any] | None = None,
-    folder: str | Path | None = None,
-) -> str:
-    """The page's HTML (module doc); ``folder``: where the page is written (its scenario
-    figures are then linked as the files beside it, the other figures embedded; None:
-    every figure embedded); ``verdict``: the run's sentences
+@dataclasses.dataclass(frozen=True)
+class PageContent:
+    """What the page shows: ``rows`` as in ``leaderboard.json``, ``aggregate`` as in
+    ``aggregate.json``, ``scores`` from
+    :func:`shipgym_baselines.scoring.ranking.scenario_scores`, ``figures`` the PNG/SVG files
+    of :mod:`shipgym_baselines.plots.figures`; ``subtitle``: a line under the title (e.g. the
+    suite and seeds); ``verdict``: the run's sentences
     (:mod:`shipgym_baselines.page.verdict`), the page's first paragraph; ``note``: what the
     run is ranked against (:func:`~shipgym_baselines.scoring.comparison.comparison_note`),
     under it; ``headroom``: the headroom table's rows
     (:func:`~shipgym_baselines.scoring.ranking.headroom_table`), after the ranking;
     ``shares``: the change share per ship × change family
     (:func:`~shipgym_baselines.leaderboard.outputs.share_table`), after the headroom."""
+
+    rows: Sequence[Mapping[str, Any]]
+    aggregate: Sequence[Mapping[str, Any]]
+    scores: Sequence[Mapping[str, Any]]
+    figures: Iterable[str | Path] = ()
+    title: str = "shipgym leaderboard"
+    subtitle: str | None = None
+    verdict: str | None = None
+    note: str = ""
+    headroom: Sequence[Mapping[str, Any]] = ()
+    shares: Mapping[str, Any] | None = None
+
+
+def page(content: PageContent, folder: str | Path | None = None) -> str:
+    """The page's HTML of ``content`` (module doc); ``folder``: where the page is written
+    (its scenario figures are then linked as the files beside it, the other figures
+    embedded; None: every figure embedded)."""
+    rows, aggregate, scores = content.rows, content.aggregate, content.scores
+    title, subtitle, verdict, note = content.title, content.subtitle, content.verdict, content.note
     ranking_figs, scenario_figs, legend_names = figure_sections(
-        figures, (r["scenario"] for r in rows), folder
+        content.figures, (r["scenario"] for r in rows), folder
     )
     names = [r["controller"] for r in [*rows, *aggregate]] + legend_names
     names += [c["controller"] for s in scores for c in s["controllers"]]
@@ -199,7 +210,7 @@ def page(
         '<h2 id="ranking">Ranking</h2><p class="note">'
         f"{esc(SCORE_EXPLAINED.replace('`', ''))} Click a column header to sort.</p>"
         f"{ranking_tables(aggregate) if aggregate else _no_ranking(scores)}"
-        f"{headroom_html(headroom)}{share_html(shares or {})}"
+        f"{headroom_html(content.headroom)}{share_html(content.shares or {})}"
         '<h2 id="scores-per-scenario">Cost ratio per scenario</h2><p class="note">The '
         "geometric mean of each controller's cost ratio C / C_oracle on each scenario, 95 % "
         "interval below (green: the oracle's cost, red: 4× or more); under each scenario's "
@@ -232,44 +243,11 @@ def _no_ranking(scores: Sequence[Mapping[str, Any]]) -> str:
     return f'<p class="note">{esc(no_ranking(scores).replace("`", ""))}</p>'
 
 
-def write_html(
-    out_dir: str | Path,
-    rows: Sequence[Mapping[str, Any]],
-    aggregate: Sequence[Mapping[str, Any]],
-    scores: Sequence[Mapping[str, Any]],
-    figures: Iterable[str | Path] = (),
-    title: str = "shipgym leaderboard",
-    subtitle: str | None = None,
-    verdict: str | None = None,
-    note: str = "",
-    headroom: Sequence[Mapping[str, Any]] = (),
-    shares: Mapping[str, Any] | None = None,
-) -> Path:
-    """Write ``leaderboard.html`` into ``out_dir`` (module doc): ``rows`` as in
-    ``leaderboard.json``, ``aggregate`` as in ``aggregate.json``, ``scores`` from
-    :func:`shipgym_baselines.scoring.ranking.scenario_scores`, ``figures`` the PNG/SVG files of
-    :mod:`shipgym_baselines.plots.figures`; ``subtitle``: a line under the title (e.g. the
-    suite
-    and seeds); ``verdict``: the paragraph the page opens with; ``note``: what the run is
-    ranked against; ``headroom``: the headroom table's rows; ``shares``: the change share
-    per ship × change family.  Returns the page's path."""
+def write_html(out_dir: str | Path, content: PageContent) -> Path:
+    """Write ``leaderboard.html`` of ``content`` into ``out_dir`` (module doc); returns the
+    page's path."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / PAGE_FILE
-    write_bytes(
-        path,
-        page(
-            rows,
-            aggregate,
-            scores,
-            figures,
-            title,
-            subtitle,
-            verdict,
-            note,
-            headroom,
-            shares,
-            folder=out,
-        ).encode("utf-8"),
-    )
+    write_bytes(path, page(content, folder=out).encode("utf-8"))
     return path

@@ -8,15 +8,12 @@ the rows are :func:`shipgym_baselines.reproduce.rows.reproduction_row`'s, the ta
 
 from shipgym_baselines.reproduce import borkowski2018, liu2019, morenosalinas2013, xu2020, xu2021
 
-#: paper id -> its package: ``REPRODUCTION`` (a :class:`Reproduction`) and, what
-#: :mod:`shipgym_baselines.cli` calls, ``run(out_dir, seeds, progress) -> rows`` (writes the report)
-#: and ``markdown(rows) -> str``
+#: paper id -> its package's ``REPRODUCTION`` (a :class:`~.protocol.Reproduction`), what
+#: :mod:`shipgym_baselines.cli` calls: ``run(out_dir, seeds, progress) -> rows`` (writes the
+#: report) and ``markdown(rows) -> str``
 PAPERS = {
-    "liu2019": liu2019,
-    "morenosalinas2013": morenosalinas2013,
-    "borkowski2018": borkowski2018,
-    "xu2020": xu2020,
-    "xu2021": xu2021,
+    package.REPRODUCTION.name: package.REPRODUCTION
+    for package in (liu2019, morenosalinas2013, borkowski2018, xu2020, xu2021)
 }
 
 __all__ = [

@@ -10,8 +10,8 @@ Every paper is a package ``shipgym_baselines.reproduce.<paper>`` with the same p
 * ``figures.plots(outcome, out_dir)``: the figures, from the outcome's episodes;
 
 joined by one :class:`Reproduction` (the package's ``REPRODUCTION``), whose :meth:`run`
-writes ``<name>.json``, ``<name>.md``, the outcome's extra documents and the figures.  The
-package also exposes ``run`` and ``markdown``: what :mod:`shipgym_baselines.cli` calls through
+writes ``<name>.json``, ``<name>.md``, the outcome's extra documents and the figures;
+:mod:`shipgym_baselines.cli` calls its ``run`` and ``markdown`` through
 :data:`shipgym_baselines.reproduce.PAPERS`.
 """
 

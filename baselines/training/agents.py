@@ -317,19 +317,16 @@ def make_training_env(config: AgentEnvConfig, seed: int) -> Any:
     return VecMonitor(venv)
 
 
-def make_eval_env(
-    config: EvalConfig,
-    action_mode: str,
-    seed: int,
-    context_features: bool = False,
-    history_steps: int = 0,
-) -> Any:
+def make_eval_env(config: EvalConfig, env: AgentEnvConfig, seed: int) -> Any:
     """One env cycling through the validation scenarios in order, seeded (reproducible
-    model selection)."""
+    model selection), observing and acting as the training envs of ``env`` do."""
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     factory = _single_env_factory(
-        {"distribution": config.distribution}, action_mode, context_features, history_steps
+        {"distribution": config.distribution},
+        env.action_mode,
+        env.context_features,
+        env.history_steps,
     )
     venv = DummyVecEnv([factory])
     venv.seed(seed)

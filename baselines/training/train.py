@@ -252,13 +252,7 @@ def _return_callback(config: AgentConfig, out: Path, n_envs: int, resumed_at: in
             write_best(out, float(self.parent.best_mean_reward), int(self.num_timesteps))
             return True
 
-    eval_env = make_eval_env(
-        config.eval,
-        config.env.action_mode,
-        seed=config.seed,
-        context_features=config.env.context_features,
-        history_steps=config.env.history_steps,
-    )
+    eval_env = make_eval_env(config.eval, config.env, seed=config.seed)
     eval_env = VecNormalize(VecMonitor(eval_env), norm_obs=False, norm_reward=False, training=False)
     evaluation = _Evaluation(
         eval_env,

@@ -188,25 +188,10 @@ class _SlidingWindowNomoto:
         self.history: list[dict[str, Any]] = []
         self.t = 0.0
 
-    @property
-    def _rows1(self) -> np.ndarray:
-        """Regressors of eq. (36) in the window (n, 6)."""
-        return self._windows[0].view()
-
-    @property
-    def _y1(self) -> np.ndarray:
-        """Targets of eq. (36) in the window (n,)."""
-        return self._windows[1].view()
-
-    @property
-    def _rows2(self) -> np.ndarray:
-        """Regressors of eq. (37) in the window (n, 1)."""
-        return self._windows[2].view()
-
-    @property
-    def _y2(self) -> np.ndarray:
-        """Targets of eq. (37) in the window (n,)."""
-        return self._windows[3].view()
+    def _window_data(self) -> tuple[np.ndarray, ...]:
+        """The window's regressors (n, 6) and targets (n,) of eq. (36), then its regressors
+        (n, 1) and targets (n,) of eq. (37)."""
+        return tuple(window.view() for window in self._windows)
 
     @property
     def delay(self) -> int:
@@ -275,7 +260,8 @@ class _SlidingWindowNomoto:
 
     def _degenerate_window(self) -> str | None:
         """Why the window cannot identify the model (None when it can)."""
-        return excitation_problem(self._rows1, self._rows2)
+        x1, _, x2, _ = self._window_data()
+        return excitation_problem(x1, x2)
 
     def _trim(self, k: int) -> None:
         for window in self._windows:
@@ -333,8 +319,9 @@ class WeightedLSSVMOnline(_SlidingWindowNomoto):
     """
 
     def _identify(self) -> None:
-        s1 = self._solve(self._rows1, self._y1, None)
-        s2 = self._solve(self._rows2, self._y2, None)
+        x1, y1, x2, y2 = self._window_data()
+        s1 = self._solve(x1, y1, None)
+        s2 = self._solve(x2, y2, None)
         flags = self._accept(s1.theta, s1.bias, s2.theta, s2.bias, reject_negative=False)
         self._record(**flags)
 
@@ -388,7 +375,7 @@ class LambdaLSSVM(_SlidingWindowNomoto):
         return w
 
     def _identify(self) -> None:
-        x1, y1, x2, y2 = self._rows1, self._y1, self._rows2, self._y2
+        x1, y1, x2, y2 = self._window_data()
         if self.identified:
             lam1 = self.change_index(x1, y1, self.sub1)
             lam2 = self.change_index(x2, y2, self.sub2)

@@ -245,6 +245,10 @@ class ShipModel(ABC):
     #: parameter -> the draught factor it is multiplied by, where a loading change is a
     #: product (:meth:`loading_change`'s default)
     scaled_by: ClassVar[dict[str, str]] = {}
+    #: the parameters that hold the length [m] and the nominal speed [m/s], read by
+    #: :attr:`length` and :attr:`nominal_speed` (a model that computes a figure overrides it)
+    length_parameter: ClassVar[str] = "L"
+    speed_parameter: ClassVar[str] = "u0"
 
     @classmethod
     def loading_change(
@@ -302,14 +306,14 @@ class ShipModel(ABC):
 
     # -- declared figures ---------------------------------------------------------------
     @property
-    @abstractmethod
     def length(self) -> float:
-        """Ship length L [m]."""
+        """Ship length L [m]: the parameter :attr:`length_parameter`."""
+        return float(getattr(self.params, self.length_parameter))
 
     @property
-    @abstractmethod
     def nominal_speed(self) -> float:
-        """Nominal (service) speed [m/s]."""
+        """Nominal (service) speed [m/s]: the parameter :attr:`speed_parameter`."""
+        return float(getattr(self.params, self.speed_parameter))
 
     @property
     def n_states(self) -> int:

@@ -97,14 +97,7 @@ import numpy as np
 
 from shipgym.models.base import ParameterRecord, ShipModel
 from shipgym.models.hull import Hull
-from shipgym.models.ship import (
-    DRAUGHT,
-    EnvId,
-    Ship,
-    rate_quantity,
-    rudder_quantity,
-    servo_quantity,
-)
+from shipgym.models.ship import EnvId, Ship, hull_quantities
 
 DEG = math.pi / 180.0
 
@@ -247,6 +240,7 @@ class _Blanke3DOF(ShipModel):
     disturbance_names = ("current_x", "current_y", "yaw_disturbance")
     control_period = 0.2  # Ts [s]: IMU sampling of Moreno-Salinas et al. (2013) §4.1
     fine_step = 0.05  # h [s] (our choice)
+    speed_parameter = "U0"
 
     def __init__(self, params: ParameterRecord | None = None, variant: str | None = None) -> None:
         super().__init__(params, variant)
@@ -282,14 +276,6 @@ class _Blanke3DOF(ShipModel):
         values = dict(values)
         values.setdefault("u", self.nominal_speed)
         return self.initial_state(**values)
-
-    @property
-    def length(self) -> float:
-        return self.params.L
-
-    @property
-    def nominal_speed(self) -> float:
-        return self.params.U0
 
 
 class Blanke(_Blanke3DOF):
@@ -505,12 +491,7 @@ def regression_coefficients(
 #: the blanke ship
 SHIP = Ship(
     model=Blanke,
-    adapted=(
-        servo_quantity("T_delta"),
-        rate_quantity("delta_dot_max"),
-        rudder_quantity("dCL"),
-        DRAUGHT,
-    ),
+    adapted=hull_quantities("T_delta", "delta_dot_max", "dCL"),
     env_ids=(
         EnvId("ShipPathFollow-Blanke-v0", "blanke_current_shift", 3500),
         EnvId("ShipPathFollow-Blanke-v1", "blanke_rudder_aging", 1290),

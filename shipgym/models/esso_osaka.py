@@ -135,15 +135,7 @@ from scipy.optimize import root
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
 from shipgym.models.hull import Hull, inertia_after
-from shipgym.models.ship import (
-    DRAUGHT,
-    EnvId,
-    Published,
-    Ship,
-    rate_quantity,
-    rudder_quantity,
-    servo_quantity,
-)
+from shipgym.models.ship import EnvId, Published, Ship, hull_quantities
 
 DEG = math.pi / 180.0
 #: regularisation of the speeds divided by (U, c) at rest [m/s]; far below any used speed
@@ -571,12 +563,7 @@ FRT_WHY = "15 %: the 3 m model is another scale and loading than the seeds' 1:10
 #: the esso_osaka ship
 SHIP = Ship(
     model=EssoOsaka,
-    adapted=(
-        servo_quantity("T_servo"),
-        rate_quantity("rudder_rate"),
-        rudder_quantity("Yd", "Nd"),
-        DRAUGHT,
-    ),
+    adapted=hull_quantities("T_servo", "rudder_rate", "Yd", "Nd"),
     env_ids=(
         EnvId("ShipPathFollow-EssoOsaka-v0", "osaka_stochastic_current", 4000),
         EnvId("ShipPathFollow-EssoOsaka-v1", "esso_osaka_rudder_aging", 632),

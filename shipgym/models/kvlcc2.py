@@ -93,15 +93,7 @@ import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel, current_in_body
 from shipgym.models.hull import Hull
-from shipgym.models.ship import (
-    DRAUGHT,
-    EnvId,
-    Published,
-    Ship,
-    rate_quantity,
-    rudder_quantity,
-    servo_quantity,
-)
+from shipgym.models.ship import EnvId, Published, Ship, hull_quantities
 
 DEG = math.pi / 180.0
 #: regularisation of the speed U divided by at rest [m/s]; far below any used speed
@@ -460,12 +452,7 @@ ZZ_WHY = "25 %: the tests' port-first and starboard-first 20/20 first overshoots
 #: the kvlcc2 ship: the unseen hull (no controller is tuned or trained on it)
 SHIP = Ship(
     model=KVLCC2,
-    adapted=(
-        servo_quantity("T_servo"),
-        rate_quantity("rudder_rate"),
-        rudder_quantity("f_alpha"),
-        DRAUGHT,
-    ),
+    adapted=hull_quantities("T_servo", "rudder_rate", "f_alpha"),
     env_ids=(EnvId("ShipPathFollow-KVLCC2-v1", "kvlcc2_rudder_aging", 476),),
     published=(
         Published("advance", 3.09, MARIN.format("tc_-35"), TURN_TOL, TURN_WHY),

@@ -76,15 +76,7 @@ import numpy as np
 
 from shipgym.models.base import ParameterError, ParameterRecord, ShipModel
 from shipgym.models.hull import Hull, inertia_after
-from shipgym.models.ship import (
-    DRAUGHT,
-    EnvId,
-    Published,
-    Ship,
-    rate_quantity,
-    rudder_quantity,
-    servo_quantity,
-)
+from shipgym.models.ship import EnvId, Published, Ship, hull_quantities
 
 
 @dataclasses.dataclass(frozen=True)
@@ -227,10 +219,6 @@ class Mariner(ShipModel):
         return self.initial_state(**values)
 
     @property
-    def length(self) -> float:
-        return self.params.L
-
-    @property
     def nominal_speed(self) -> float:
         """Straight-line equilibrium speed S/f [m/s] (7.857 m/s; the paper starts at 7.7)."""
         return self.params.S / self.params.f
@@ -239,12 +227,7 @@ class Mariner(ShipModel):
 #: the mariner ship
 SHIP = Ship(
     model=Mariner,
-    adapted=(
-        servo_quantity("T_delta"),
-        rate_quantity("delta_dot_max"),
-        rudder_quantity("a3"),
-        DRAUGHT,
-    ),
+    adapted=hull_quantities("T_delta", "delta_dot_max", "a3"),
     env_ids=(
         EnvId("ShipPathFollow-Mariner-v0", "mariner_track", 2400),
         EnvId("ShipPathFollow-Mariner-v1", "mariner_rudder_aging", 894),

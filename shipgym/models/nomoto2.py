@@ -161,14 +161,6 @@ class Nomoto2(ShipModel):
         p = self.params
         return p.K, p.T1, p.T2, p.T3
 
-    @property
-    def length(self) -> float:
-        return self.params.L
-
-    @property
-    def nominal_speed(self) -> float:
-        return self.params.u0
-
 
 #: the nomoto2 ship: the manoeuvrability change moves its K (×12 in the catalogue) and T1
 SHIP = Ship(

@@ -15,7 +15,8 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-from collections.abc import Callable, Iterable, Iterator, Mapping, Set
+from abc import abstractmethod
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Set
 from typing import TypeVar
 
 from shipgym.models.base import ParameterRecord, ShipModel
@@ -82,6 +83,13 @@ def rudder_quantity(*params: str) -> Quantity:
 
 #: the draught ratio × [0.3, 1.6] (the catalogue's loading changes are ×0.4 and ×1.35)
 DRAUGHT = Quantity("draught", (), 0.3, 1.6, draught=True)
+
+
+def hull_quantities(servo: str, rate: str, *rudder: str) -> tuple[Quantity, ...]:
+    """What an estimator adapts on a hull with a steering gear, in this order: the servo time
+    constant ``servo``, the rate limit ``rate``, the rudder effectiveness ``rudder`` and the
+    draught."""
+    return servo_quantity(servo), rate_quantity(rate), rudder_quantity(*rudder), DRAUGHT
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,47 +159,45 @@ def registered(ship: Ship) -> Iterator[Ship]:
         del SHIPS[ship.name]
 
 
-class ShipTable(Mapping[str, V]):
+class _ShipView(Collection[str]):
+    """Keys read off :data:`SHIPS` at every access (:meth:`_read`: the current ones)."""
+
+    @abstractmethod
+    def _read(self) -> Collection[str]: ...
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._read())
+
+    def __len__(self) -> int:
+        return len(self._read())
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._read()!r})"
+
+
+class ShipTable(_ShipView, Mapping[str, V]):
     """A per-ship table read off :data:`SHIPS` at every access: ``entries`` gives a record's
     (key, value) pairs (none, one or several)."""
 
     def __init__(self, entries: Callable[[Ship], Iterable[tuple[str, V]]]) -> None:
         self._entries = entries
 
-    def _table(self) -> dict[str, V]:
+    def _read(self) -> dict[str, V]:
         return {key: value for ship in SHIPS.values() for key, value in self._entries(ship)}
 
     def __getitem__(self, key: str) -> V:
-        return self._table()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._table())
-
-    def __len__(self) -> int:
-        return len(self._table())
-
-    def __repr__(self) -> str:
-        return f"ShipTable({self._table()!r})"
+        return self._read()[key]
 
 
-class ShipSet(Set[str]):
+class ShipSet(_ShipView, Set[str]):
     """The names of the ships whose record satisfies ``test``, read off :data:`SHIPS` at
     every access."""
 
     def __init__(self, test: Callable[[Ship], bool]) -> None:
         self._test = test
 
-    def _names(self) -> list[str]:
+    def _read(self) -> list[str]:
         return [name for name, ship in SHIPS.items() if self._test(ship)]
 
     def __contains__(self, name: object) -> bool:
-        return name in self._names()
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._names())
-
-    def __len__(self) -> int:
-        return len(self._names())
-
-    def __repr__(self) -> str:
-        return f"ShipSet({self._names()!r})"
+        return name in self._read()

@@ -14,6 +14,7 @@ from pydantic import ValidationError
 
 from shipgym.config import (
     ConfigError,
+    ConfigFile,
     catalogue,
     compose_yaml,
     error_message,
@@ -275,18 +276,10 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     events after the time limit) and, when the schema passes, all problems of building
     the scenario (non-physical parameters, a bad path, …), then the nominal model's
     identification (:func:`nominal_nomoto`): every file it accepts makes an env."""
-    try:
-        file = resolve("scenarios", path, error=ScenarioError)
-        text = read_config_text(file, ScenarioError)
-    except ScenarioError as exc:
-        return [Problem("", str(exc))]
-    try:
-        root = compose_yaml(text)  # the node tree: where each key is written
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        return [Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)]
-    except yaml.YAMLError as exc:
-        return [Problem("", f"malformed YAML: {exc}")]
+    composed = composed_config("scenarios", path, ScenarioError)
+    if isinstance(composed, Problem):
+        return [composed]
+    file, _, root = composed
     try:
         data = read_yaml(file, ScenarioError)
     except ScenarioError as exc:
@@ -308,6 +301,27 @@ def check_scenario_file(path: str | os.PathLike | Traversable) -> list[Problem]:
     else:
         return []
     return [dataclasses.replace(p, line=yaml_line(root, p.key)) for p in found]
+
+
+def composed_config(
+    kind: str, name_or_path: str | os.PathLike | Traversable, error: type[ConfigError]
+) -> tuple[ConfigFile, str, yaml.Node | None] | Problem:
+    """The config file of ``kind`` (:func:`shipgym.config.resolve`), its text and its YAML
+    node tree (where each key is written), or the problem that stops a check there (the
+    file unreadable, ``error``'s message, or its YAML malformed)."""
+    try:
+        file = resolve(kind, name_or_path, error=error)
+        text = read_config_text(file, error)
+    except error as exc:
+        return Problem("", str(exc))
+    try:
+        root = compose_yaml(text)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        return Problem("", f"malformed YAML: {exc.problem}", mark.line + 1 if mark else None)
+    except yaml.YAMLError as exc:
+        return Problem("", f"malformed YAML: {exc}")
+    return file, text, root
 
 
 def yaml_line(root: yaml.Node | None, key: str) -> int | None:

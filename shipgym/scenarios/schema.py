@@ -12,13 +12,12 @@ that relate two keys (an event after the time limit) name the key at fault.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from typing import Annotated, Any, Literal, Self
+from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
-from shipgym.config import ConfigError, Name, StrictModel
+from shipgym.config import Name, StrictModel
 from shipgym.disturbance_config import DisturbanceConfig, SensorConfig
 from shipgym.limits import MAX_POSITION_M, MAX_WAYPOINTS
 from shipgym.models import MODELS
@@ -170,6 +169,7 @@ class ScenarioConfig(StrictModel):
     source: str = ""
     #: the change family (shipgym.scenarios.families; a file without it: "other"), left
     #: out of every dump: the recorded settings, and a trial's identity, are the plant's
+    #: (a copy with overrides keeps it: StrictModel.with_overrides)
     family: Annotated[str, AfterValidator(check_family)] = Field(OTHER, exclude=True)
     ship: ShipConfig = ShipConfig()
     initial_state: InitialState = InitialState()
@@ -183,18 +183,6 @@ class ScenarioConfig(StrictModel):
     fine_step: float | None = Field(None, gt=0)  # s; None: the ship's default
     reward: RewardConfig = RewardConfig()
     convergence_threshold: float | None = Field(None, gt=0)  # m; None: 0.05·L/0.95
-
-    def with_overrides(
-        self,
-        overrides: Mapping[str, Any] | None = None,
-        drop: Iterable[str] = (),
-        origin: str = "<overrides>",
-        error: type[Exception] = ConfigError,
-    ) -> Self:
-        """:meth:`StrictModel.with_overrides`, the family kept unless ``overrides`` sets it
-        (no dump holds it)."""
-        kept = {"family": self.family, **(overrides or {})}
-        return super().with_overrides(kept, drop, origin, error)
 
     @model_validator(mode="after")
     def _times_within_the_episode(self) -> ScenarioConfig:

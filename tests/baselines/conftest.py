@@ -72,3 +72,13 @@ def truth_calls(monkeypatch: pytest.MonkeyPatch) -> list[str]:
         ShipPathFollowEnv, "plant_truth", spy("plant_truth", ShipPathFollowEnv.plant_truth)
     )
     return calls
+
+
+def error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
+    """The one stderr line of a bad input to ``shipgym command`` (checked for its shape:
+    one line, no traceback, the command's prefix), without its prefix."""
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    prefix = f"shipgym {command}: error: "
+    assert err.startswith(prefix), err
+    return err.removeprefix(prefix).rstrip("\n")

@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from shipgym_baselines.cli import main
+from tests.baselines.conftest import error_line
 
 #: a scenario file's text with one ``{line}`` to fill in (nomoto2, 30 s)
 SCENARIO = """\
@@ -23,13 +24,16 @@ time_limit: {limit}
 GOOD = {"params": "Tc: 0.1", "heading": 0.0, "direction": 90.0, "event": 5.0, "limit": 30.0}
 
 
-def error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
-    """The one stderr line of a bad input (checked for its shape), without its prefix."""
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "Traceback" not in err, err
-    prefix = f"shipgym {command}: error: "
-    assert err.startswith(prefix), err
-    return err.removeprefix(prefix).rstrip("\n")
+def assert_refused(
+    capsys: pytest.CaptureFixture[str], argv: list[str], named: list[str], out: Path
+) -> None:
+    """``shipgym argv`` exits 2 with one error line naming each of ``named``, before it
+    makes ``out``."""
+    assert main(argv) == 2
+    message = error_line(capsys, argv[0])
+    for text in named:
+        assert text in message
+    assert not out.exists()
 
 
 def scenario_file(tmp_path: Path, **bad: object) -> str:
@@ -73,12 +77,7 @@ def test_a_bad_scenario_number_is_named_before_the_episode(
 ) -> None:
     file = scenario_file(tmp_path, **bad)
     out = tmp_path / "out"
-    assert main(["run", file, "pid_los", "--out", str(out)]) == 2
-    message = error_line(capsys, "run")
-    assert file in message
-    for text in named:
-        assert text in message
-    assert not out.exists()
+    assert_refused(capsys, ["run", file, "pid_los", "--out", str(out)], [file, *named], out)
 
 
 def test_scenarios_validate_names_every_problem_and_exits_2(
@@ -285,12 +284,8 @@ def test_a_bad_suite_is_named_with_file_and_key(
     suite = tmp_path / "suite.yaml"
     suite.write_text(text)
     out = tmp_path / "out"
-    assert main(["leaderboard", "--suite", str(suite), "--out", str(out), "--no-progress"]) == 2
-    message = error_line(capsys, "leaderboard")
-    assert str(suite) in message
-    for part in named:
-        assert part in message
-    assert not out.exists()
+    command = ["leaderboard", "--suite", str(suite), "--out", str(out), "--no-progress"]
+    assert_refused(capsys, command, [str(suite), *named], out)
 
 
 def test_scenarios_validate_suggests_the_key_an_unknown_one_is_close_to(

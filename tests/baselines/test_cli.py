@@ -15,20 +15,12 @@ import yaml
 from shipgym.scenarios.loader import ScenarioError
 from shipgym_baselines.cli import build_parser, main
 from shipgym_baselines.errors import ControllerError
+from tests.baselines.conftest import error_line
 
 
 def _subcommands() -> list[str]:
     (action,) = (a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     return list(action.choices)
-
-
-def _error_line(capsys: pytest.CaptureFixture[str], command: str) -> str:
-    """The one stderr line of a bad input, checked for its shape; returns the message."""
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "Traceback" not in err, err
-    prefix = f"shipgym {command}: error: "
-    assert err.startswith(prefix), err
-    return err.removeprefix(prefix).rstrip("\n")
 
 
 def test_every_subcommand_is_listed() -> None:
@@ -94,7 +86,7 @@ def test_cli_scenarios_json(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_unknown_controller_is_one_line_and_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["evaluate", "nope", "--suite", "smoke", "--no-progress"]) == 2
-    message = _error_line(capsys, "evaluate")
+    message = error_line(capsys, "evaluate")
     assert message.startswith("unknown controller 'nope'; valid:") and "pid_los" in message
 
 
@@ -108,12 +100,12 @@ def test_unknown_scenario_is_one_line_and_exit_2(
     out = str(tmp_path / "out")  # an --out holding the suite file would be refused first
     code = main(["leaderboard", "--suite", str(suite), "--out", out, "--no-progress"])
     assert code == 2
-    assert "no_such_scenario" in _error_line(capsys, "leaderboard")
+    assert "no_such_scenario" in error_line(capsys, "leaderboard")
 
 
 def test_cli_bad_suite_is_a_clear_error(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["leaderboard", "--suite", "nope", "--no-progress"]) == 2
-    assert "valid: default" in _error_line(capsys, "leaderboard")
+    assert "valid: default" in error_line(capsys, "leaderboard")
 
 
 def test_bad_option_values_are_one_line_errors(
@@ -121,40 +113,40 @@ def test_bad_option_values_are_one_line_errors(
 ) -> None:
     out = ["--out", str(tmp_path)]
     assert main(["reproduce", "liu2019", "--seeds", "0", "--no-progress", *out]) == 2
-    assert _error_line(capsys, "reproduce") == "--seeds must be ≥ 1, got 0"
+    assert error_line(capsys, "reproduce") == "--seeds must be ≥ 1, got 0"
     assert main(["manoeuvre", "nomoto2", "zigzag", "--rudder", "-5", *out]) == 2
-    assert "must be > 0" in _error_line(capsys, "manoeuvre")
+    assert "must be > 0" in error_line(capsys, "manoeuvre")
     assert main(["manoeuvre", "nomoto2", "zigzag", "--variant", "nope", *out]) == 2
-    assert "unknown variant" in _error_line(capsys, "manoeuvre")
+    assert "unknown variant" in error_line(capsys, "manoeuvre")
     assert main(["train", "all", "--config", "x.yaml"]) == 2
-    assert _error_line(capsys, "train") == "train all: --config applies to one agent"
+    assert error_line(capsys, "train") == "train all: --config applies to one agent"
 
 
 def test_a_project_error_from_deep_inside_is_one_line(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def broken() -> list[str]:
         raise ScenarioError("configs/scenarios: unreadable")
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", broken)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", broken)
     assert main(["scenarios"]) == 2
-    assert _error_line(capsys, "scenarios") == "configs/scenarios: unreadable"
+    assert error_line(capsys, "scenarios") == "configs/scenarios: unreadable"
 
 
 def test_a_bug_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
     """Only project errors (bad input) become one line: anything else propagates."""
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def buggy() -> list[str]:
         raise TypeError("a real bug")
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", buggy)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", buggy)
     with pytest.raises(TypeError, match="a real bug"):
         main(["scenarios"])
     # a built-in KeyError that is not a ControllerError is a bug too
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", lambda: {}["missing"])
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", lambda: {}["missing"])
     with pytest.raises(KeyError):
         main(["scenarios"])
 
@@ -162,12 +154,12 @@ def test_a_bug_keeps_its_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_ctrl_c_is_one_line_and_exit_130(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import shipgym.scenarios
+    import shipgym.scenarios.loader
 
     def interrupted() -> list[str]:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(shipgym.scenarios, "list_scenarios", interrupted)
+    monkeypatch.setattr(shipgym.scenarios.loader, "list_scenarios", interrupted)
     assert main(["scenarios"]) == 130
     assert capsys.readouterr().err == "shipgym scenarios: interrupted\n"
 
@@ -282,10 +274,10 @@ def test_finding11_a_bad_suite_is_named_before_the_state_of_out(
     for command in (["leaderboard"], ["evaluate", "pid_los"]):
         out = ["--out", "results/smoke"]
         assert main([*command, "--suite", "smok", *out, "--no-progress"]) == 2
-        message = _error_line(capsys, command[0])
+        message = error_line(capsys, command[0])
         assert "smok" in message and "valid: default" in message and "not empty" not in message
     assert main(["leaderboard", "--suite", "smoke", "--no-progress"]) == 2  # then the folder
-    message = _error_line(capsys, "leaderboard")
+    message = error_line(capsys, "leaderboard")
     assert "--out results/smoke is not empty" in message
     assert "(the leaderboard's folder for --suite smoke; give --out for another)" in message
 
@@ -456,5 +448,5 @@ def test_failure_options_that_cannot_work_are_one_line_before_any_work(
 ) -> None:
     out = tmp_path / "out"
     assert main([*command, "--suite", "smoke", "--out", str(out), *extra]) == 2
-    assert _error_line(capsys, command[0]) == message
+    assert error_line(capsys, command[0]) == message
     assert not out.exists()

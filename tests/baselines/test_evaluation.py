@@ -525,6 +525,18 @@ class SpinningConstructor(PIDLOS):
         _spin()
 
 
+def _metrics_in_every_path(name: str, *limit: float) -> list[dict[str, Any]]:
+    """The metrics of the registered controller ``name`` on rudder_aging in every path of
+    the loop (two seeds batched, one alone), each under a fresh ``ActGuard(*limit)``."""
+    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
+    results = [
+        *evaluate_batch(name, "rudder_aging", seeds, guard=ActGuard(*limit)),
+        *evaluate(name, "rudder_aging", seeds[:1], guard=ActGuard(*limit)),
+    ]
+    assert [result.controller for result in results] == [name] * 3
+    return [result.metrics for result in results]
+
+
 def test_a_constructor_that_never_returns_fails_every_episode(
     scratch_registry: None, quick_setup: None
 ) -> None:
@@ -532,17 +544,8 @@ def test_a_constructor_that_never_returns_fails_every_episode(
     fails each of its episodes at its reset as controller_timeout, in every path of the
     loop."""
     register_controller("test_spins_when_made", lambda: SpinningConstructor())
-    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
-    results = [
-        *evaluate_batch("test_spins_when_made", "rudder_aging", seeds, guard=ActGuard(0.01)),
-        *evaluate("test_spins_when_made", "rudder_aging", seeds[:1], guard=ActGuard(0.01)),
-    ]
-    for result in results:
-        m = result.metrics
-        assert (result.controller, m["termination_reason"]) == (
-            "test_spins_when_made",
-            "controller_timeout",
-        )
+    for m in _metrics_in_every_path("test_spins_when_made", 0.01):
+        assert m["termination_reason"] == "controller_timeout"
         assert re.fullmatch(
             r"the controller could not be made: the call ran 0\.3\d* s of CPU time, over the "
             r"limit of 0\.3 s",
@@ -560,23 +563,14 @@ def test_a_controller_that_cannot_be_made_fails_every_episode(scratch_registry: 
     """With a guard, a constructor that raises (even SystemExit) fails each episode at its
     reset, in every path of the loop; without one it raises."""
     register_controller("test_unbuildable", lambda: Unbuildable())
-    seeds = [EVAL_SEED_OFFSET, EVAL_SEED_OFFSET + 1]
-    results = [
-        *evaluate_batch("test_unbuildable", "rudder_aging", seeds, guard=ActGuard()),
-        *evaluate("test_unbuildable", "rudder_aging", seeds[:1], guard=ActGuard()),
-    ]
-    for result in results:
-        m = result.metrics
-        assert (result.controller, m["termination_reason"]) == (
-            "test_unbuildable",
-            "controller_error",
-        )
+    for m in _metrics_in_every_path("test_unbuildable"):
+        assert m["termination_reason"] == "controller_error"
         assert (
             m["error"] == "the controller could not be made: SystemExit: no licence for the solver"
         )
         assert m["steps"] == 1
     with pytest.raises(SystemExit):
-        evaluate("test_unbuildable", "rudder_aging", seeds[:1])
+        evaluate("test_unbuildable", "rudder_aging", [EVAL_SEED_OFFSET])
 
 
 def test_in_lockstep_only_the_failing_seeds_episode_ends(scratch_registry: None) -> None:

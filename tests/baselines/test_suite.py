@@ -20,6 +20,13 @@ def write(tmp_path: Path, text: str, name: str = "suite.yaml") -> Path:
     return file
 
 
+def assert_suite_error(tmp_path: Path, text: str, match: str) -> None:
+    """Loading a suite file of ``text`` is a ConfigError matching ``match``."""
+    file = write(tmp_path, text)
+    with pytest.raises(ConfigError, match=match):
+        load_suite(file)
+
+
 def test_packaged_suites_load() -> None:
     assert list_suites() == list_names("suites") == ["default", "paper_settings", "quick", "smoke"]
     smoke = load_suite("smoke")
@@ -116,14 +123,14 @@ def test_quick_suite_is_one_scenario_per_ship_and_family() -> None:
 
 
 def test_a_suite_by_path_equals_the_same_suite_by_name(tmp_path: Path) -> None:
-    text = (Path(__file__).resolve().parents[3] / "configs/suites/smoke.yaml").read_text()
+    text = (Path(__file__).resolve().parents[2] / "configs/suites/smoke.yaml").read_text()
     assert load_suite(write(tmp_path, text)) == load_suite("smoke")
 
 
 def test_relative_scenario_paths_are_read_against_the_suite_folder(
     tmp_path: Path, monkeypatch
 ) -> None:
-    nominal = (Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml").read_text()
+    nominal = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
     text = nominal.replace("name: nominal", "name: mine")
     scenario = write(tmp_path, text, "suites/scenarios/mine.yaml")
     suite = write(
@@ -137,22 +144,24 @@ def test_relative_scenario_paths_are_read_against_the_suite_folder(
 
 
 def test_unknown_key_is_named(tmp_path: Path) -> None:
-    file = write(tmp_path, "name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\nseed: 3\n")
-    with pytest.raises(ConfigError, match=r"suite\.yaml: key 'seed': Extra inputs"):
-        load_suite(file)
+    assert_suite_error(
+        tmp_path,
+        "name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\nseed: 3\n",
+        r"suite\.yaml: key 'seed': Extra inputs",
+    )
 
 
 @pytest.mark.parametrize("controllers", ["", "controllers: []\n"])
 def test_a_suite_without_controllers_is_an_error(tmp_path: Path, controllers: str) -> None:
-    file = write(tmp_path, f"name: s\nscenarios: [nominal]\n{controllers}")
-    with pytest.raises(ConfigError, match=r"suite\.yaml: key 'controllers'"):
-        load_suite(file)
+    assert_suite_error(
+        tmp_path, f"name: s\nscenarios: [nominal]\n{controllers}", r"suite\.yaml: key 'controllers'"
+    )
 
 
 def test_a_suite_without_scenarios_is_an_error(tmp_path: Path) -> None:
-    file = write(tmp_path, "name: s\ncontrollers: [pid_los]\n")
-    with pytest.raises(ConfigError, match="needs 'scenarios' or 'heldout_scenarios'"):
-        load_suite(file)
+    assert_suite_error(
+        tmp_path, "name: s\ncontrollers: [pid_los]\n", "needs 'scenarios' or 'heldout_scenarios'"
+    )
     only_heldout = write(tmp_path, "name: s\nheldout_scenarios: 2\ncontrollers: [pid_los]\n")
     assert load_suite(only_heldout).all_scenarios() == ["heldout:0", "heldout:1"]
     only_inrange = write(tmp_path, "name: s\ninrange_scenarios: 2\ncontrollers: [pid_los]\n")
@@ -199,15 +208,17 @@ def test_unknown_suite_lists_the_suites() -> None:
     ],
 )
 def test_counts_are_validated(tmp_path: Path, extra: str, key: str) -> None:
-    file = write(tmp_path, f"name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\n{extra}")
-    with pytest.raises(ConfigError, match=f"key '{key}'"):
-        load_suite(file)
+    assert_suite_error(
+        tmp_path, f"name: s\nscenarios: [nominal]\ncontrollers: [pid_los]\n{extra}", f"key '{key}'"
+    )
 
 
 def test_a_scenario_listed_twice_is_an_error(tmp_path: Path) -> None:
-    file = write(tmp_path, "name: s\nscenarios: [nominal, nominal]\ncontrollers: [pid_los]\n")
-    with pytest.raises(ConfigError, match="more than once"):
-        load_suite(file)
+    assert_suite_error(
+        tmp_path,
+        "name: s\nscenarios: [nominal, nominal]\ncontrollers: [pid_los]\n",
+        "more than once",
+    )
 
 
 def test_a_suite_of_ten_thousand_files_is_refused_within_a_second(tmp_path: Path) -> None:
@@ -232,7 +243,7 @@ def test_a_suite_of_ten_thousand_files_is_refused_within_a_second(tmp_path: Path
 
 # --- check_suite_file (shipgym scenarios --validate) -----------------------------------------
 
-NOMINAL = (Path(__file__).resolve().parents[3] / "configs/scenarios/nominal.yaml").read_text()
+NOMINAL = (Path(__file__).resolve().parents[2] / "configs/scenarios/nominal.yaml").read_text()
 
 
 def test_a_suite_check_lists_schema_and_later_problems_together(tmp_path: Path) -> None:

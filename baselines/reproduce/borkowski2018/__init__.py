@@ -32,10 +32,3 @@ from shipgym_baselines.reproduce.borkowski2018.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("borkowski2018", run_experiment, report, plots)
-run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
-
-__all__ = [
-    "REPRODUCTION",
-    "markdown",
-    "run",
-]

@@ -16,10 +16,3 @@ from shipgym_baselines.reproduce.liu2019.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("liu2019", run_experiment, report, plots)
-run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
-
-__all__ = [
-    "REPRODUCTION",
-    "markdown",
-    "run",
-]

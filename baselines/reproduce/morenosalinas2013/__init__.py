@@ -35,10 +35,3 @@ from shipgym_baselines.reproduce.morenosalinas2013.tables import report
 from shipgym_baselines.reproduce.protocol import Reproduction
 
 REPRODUCTION = Reproduction("morenosalinas2013", run_experiment, report, plots)
-run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
-
-__all__ = [
-    "REPRODUCTION",
-    "markdown",
-    "run",
-]

@@ -64,10 +64,3 @@ from shipgym_baselines.reproduce.xu2020.figures import plots
 from shipgym_baselines.reproduce.xu2020.tables import report
 
 REPRODUCTION = Reproduction("xu2020", run_experiment, report, plots)
-run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
-
-__all__ = [
-    "REPRODUCTION",
-    "markdown",
-    "run",
-]

@@ -85,17 +85,8 @@ log), :mod:`.tables` (the markdown), :mod:`.figures` (the plots).
 """
 
 from shipgym_baselines.reproduce.protocol import Reproduction
-from shipgym_baselines.reproduce.xu2021.claims import claims
 from shipgym_baselines.reproduce.xu2021.experiment import run_experiment
 from shipgym_baselines.reproduce.xu2021.figures import plots
 from shipgym_baselines.reproduce.xu2021.tables import report
 
 REPRODUCTION = Reproduction("xu2021", run_experiment, report, plots)
-run, markdown = REPRODUCTION.run, REPRODUCTION.markdown
-
-__all__ = [
-    "REPRODUCTION",
-    "claims",
-    "markdown",
-    "run",
-]

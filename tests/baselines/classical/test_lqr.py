@@ -216,9 +216,9 @@ def test_nomoto2_nominal_reaches_the_goal(cls: type[LQR]) -> None:
 
 # ----------------------------------------------------------------------------- reproduction
 def test_reproduction_rows_and_J_replay(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    assert PAPERS["borkowski2018"] is borkowski2018
+    assert PAPERS["borkowski2018"] is borkowski2018.REPRODUCTION
     assert build_parser().parse_args(["reproduce", "borkowski2018"]).paper == "borkowski2018"
-    rows = borkowski2018.run(
+    rows = borkowski2018.REPRODUCTION.run(
         tmp_path, seeds=1, guesses=((0.02, 0.002),), time_limit=150.0, plot=False
     )
     for row in rows:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import pytest
 
@@ -64,13 +65,17 @@ def test_it_finds_the_aged_servo_it_was_not_told_of() -> None:
             assert abs(final[name]) < 0.1, name
 
 
-def test_bad_settings_are_refused_at_construction() -> None:
-    with pytest.raises(ValueError, match="parameter_walk"):
-        NmpcEkf(parameter_walk=-1.0)
-    with pytest.raises(ValueError, match="no setting"):
-        NmpcEkf(process_noise=1.0)
-    with pytest.raises(ValueError, match="servo"):
-        NmpcEkf(servo="guess")
+@pytest.mark.parametrize(
+    ("settings", "match"),
+    [
+        ({"parameter_walk": -1.0}, "parameter_walk"),
+        ({"process_noise": 1.0}, "no setting"),
+        ({"servo": "guess"}, "servo"),
+    ],
+)
+def test_bad_settings_are_refused_at_construction(settings: dict[str, Any], match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        NmpcEkf(**settings)
 
 
 def test_the_solvers_objective_is_never_read_at_another_parameter_vector() -> None:

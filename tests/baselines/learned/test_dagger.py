@@ -263,7 +263,7 @@ def test_the_student_is_an_sb3_zip_the_data_only_loader_reads(tmp_path: Path) ->
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from shipgym.envs.core import action_space, observation_space
-    from shipgym_baselines.learned.loading import load_data_only
+    from shipgym_baselines.learned.loading import SavedModel, load_data_only
 
     settings = small()
     obs_space, act_space = observation_space(True), action_space("rudder")
@@ -275,7 +275,7 @@ def test_the_student_is_an_sb3_zip_the_data_only_loader_reads(tmp_path: Path) ->
     fit_student(student, obs, labels, settings, round_=0)
     assert not np.array_equal(policy_actions(student)(obs), before)  # it learned
     path = save_student(student, tmp_path / "student.zip")
-    loaded = load_data_only(path, PPO, "rudder", context_features=True)
+    loaded = load_data_only(SavedModel(path, "ppo", "rudder", context_features=True), PPO)
     np.testing.assert_array_equal(
         loaded.predict(obs, deterministic=True)[0], student.predict(obs, deterministic=True)[0]
     )

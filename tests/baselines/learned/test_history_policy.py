@@ -207,7 +207,8 @@ def test_the_training_envs_observe_the_config_s_history() -> None:
         obs = venv.reset()
         assert not obs[:, -k * core.HISTORY_WIDTH :].any()
         venv.close()
-    evaluation = make_eval_env(_config().eval, "rudder", 0, history_steps=k)
+    config = _config(history_steps=k)
+    evaluation = make_eval_env(config.eval, config.env, 0)
     assert evaluation.observation_space.shape == (core.observation_size(False, k),)
 
 

@@ -14,7 +14,7 @@ import pytest
 from PIL import Image
 
 from shipgym_baselines.page.cells import unpacked_body
-from shipgym_baselines.page.html import PAGE_FILE, page, write_html
+from shipgym_baselines.page.html import PAGE_FILE, PageContent, page, write_html
 from shipgym_baselines.plots.scenarios import DrawnEpisode, plot_scenario
 from shipgym_baselines.scoring.change_share import NOMINAL, SHARE
 from shipgym_baselines.scoring.headroom import GAIN
@@ -142,7 +142,7 @@ def score_rows(dom: str) -> _ScoreRows:
 
 def test_the_page_is_self_contained_and_escaped() -> None:
     rows, aggregate, scores = synthetic_tables()
-    text = page(rows, aggregate, scores)
+    text = page(PageContent(rows, aggregate, scores))
     assert "<plugin>" not in text and "my &lt;plugin&gt; &amp; co" in text
     # no address outside the page: every src / href is a data URI or an anchor
     assert not re.findall(r'(?:src|href)="(?!data:|#)', text)
@@ -151,7 +151,7 @@ def test_the_page_is_self_contained_and_escaped() -> None:
 
 def test_a_cell_shows_the_interval_and_n_a_where_a_controller_does_not_apply() -> None:
     rows, aggregate, scores = synthetic_tables()
-    text = page(rows, aggregate, scores)
+    text = page(PageContent(rows, aggregate, scores))
     (nominal,) = [s for s in scores if s["scenario"] == "nominal"]
     cell = next(c for c in nominal["controllers"] if c["controller"] == "lqr")
     lo, hi = cell["cost_ratio_gmean_ci95"]
@@ -199,7 +199,9 @@ def built_page(tmp_path_factory: pytest.TempPathFactory) -> Path:
     drawn = {"pid_los": DrawnEpisode(10000, traj), "lqr": DrawnEpisode(10000, traj)}
     figs = plot_scenario(out / "fig", "nominal", drawn, 30.0, np.array([[0, 0], [120, 0]]))
     rows, aggregate, scores = synthetic_tables()
-    return write_html(out, rows, aggregate, scores, figs, subtitle="synthetic: 18 controllers")
+    return write_html(
+        out, PageContent(rows, aggregate, scores, figs, subtitle="synthetic: 18 controllers")
+    )
 
 
 def test_the_written_page_links_its_scenario_figures_beside_it(built_page: Path) -> None:
@@ -354,7 +356,7 @@ def test_every_numeric_column_of_the_long_table_sorts_as_its_values() -> None:
         if "ace" in r:
             r["ace"] = round(r["ace"], 1) + 1e-5 * (i % 7)
     parser = _Cells()
-    parser.feed(unpacked_body(page(rows, aggregate, scores)))
+    parser.feed(unpacked_body(page(PageContent(rows, aggregate, scores))))
     kinds, body = parser.kinds["rows"], parser.rows["rows"]
     assert len(body) == len(rows)
     for col, key in enumerate(["controller", "scenario", "split", "kind", "seeds"]):
@@ -405,7 +407,7 @@ def _with_the_frozen_optimum() -> tuple[list, list, list, list]:
 
 def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
     rows, aggregate, scores, headroom = _with_the_frozen_optimum()
-    text = page(rows, aggregate, scores, headroom=headroom)
+    text = page(PageContent(rows, aggregate, scores, headroom=headroom))
     # the main ranking: the nominal ratio and the change share, nothing against C_frozen
     main = text[text.index('id="ranking-catalogue"') :]
     main = main[: main.index("</table>")]
@@ -430,7 +432,7 @@ def test_the_page_shows_the_gap_columns_and_the_headroom_table() -> None:
     assert table.index(">nomoto2<") < table.index(">mariner<")  # ships in the rows' order
     assert "maneuverability" not in table  # no column for a family without trials
     # without the frozen optimum: no gap column, no headroom table, no frozen cost
-    bare = page(*synthetic_tables())
+    bare = page(PageContent(*synthetic_tables()))
     assert "C_frozen" not in bare and 'id="headroom"' not in bare
     assert "ranking-long-" not in bare and "nominal ratio" not in bare
     assert "oracle_frozen cost" not in bare
@@ -442,6 +444,6 @@ def test_the_frozen_optimum_has_its_own_legend_swatch() -> None:
 
     html = _legend_html([("PID", [("oracle", "o"), ("oracle_frozen", "f"), ("pid_los", "p")])])
     assert '<span class="kref"></span>o' in html and '<span class="kfrozen"></span>f' in html
-    text = page(*synthetic_tables())
+    text = page(PageContent(*synthetic_tables()))
     grey = controller_style("oracle_frozen").color
     assert f".kfrozen{{border-top-style:dashed;border-top-color:{grey}}}" in text

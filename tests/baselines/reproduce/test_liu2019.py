@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from shipgym_baselines.reproduce.liu2019 import markdown
 from shipgym_baselines.reproduce.liu2019.experiment import IDENTIFIED, run_experiment
+from shipgym_baselines.reproduce.liu2019.tables import report
 
 #: the paper-literal ACE [m] (si reading, 1 seed) as recorded before the SVF front end:
 #: the extension must not move them.  Bit for bit on the recording machine; to
@@ -74,7 +74,7 @@ def test_svf_restores_the_adaptive_advantage_in_case3(rows) -> None:
 
 
 def test_report_labels_the_front_end_as_an_extension(rows) -> None:
-    text = markdown(rows)
+    text = report(rows)
     literal, _, extension = text.partition("## Extension beyond the paper")
     assert extension, "the SVF rows have their own, labelled section"
     assert "_svf" not in literal

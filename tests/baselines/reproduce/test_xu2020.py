@@ -21,12 +21,12 @@ ROW_KEYS = {"case", "controller", "metric", "ours", "paper"}
 
 
 def test_registered_and_cli_choice() -> None:
-    assert PAPERS["xu2020"] is xu2020
+    assert PAPERS["xu2020"] is xu2020.REPRODUCTION
     assert build_parser().parse_args(["reproduce", "xu2020"]).paper == "xu2020"
 
 
 def test_short_run_rows_markdown_and_files(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    rows = xu2020.run(
+    rows = xu2020.REPRODUCTION.run(
         tmp_path,
         seeds=1,
         settings=("literal_no_rate_limit",),
@@ -56,7 +56,7 @@ def test_short_run_rows_markdown_and_files(tmp_path) -> None:  # type: ignore[no
     straight = index[("straight", "pid_vf", "duration", "literal_no_rate_limit", "A=B=4")]
     assert curved["initial_speed"] == pytest.approx(0.1)
     assert straight["initial_speed"] == pytest.approx(0.41152, rel=1e-4)
-    md = xu2020.markdown(rows)
+    md = xu2020.REPRODUCTION.markdown(rows)
     assert md == (tmp_path / "xu2020.md").read_text()
     assert "| paper (§5.2, printed) | 0.1850 | 7.8569 | 0.3815 | 0.5297 |" in md
     assert "straight path (§6.1, Table 2)" in md and "curved path (§6.2, Table 3)" in md
@@ -67,7 +67,7 @@ def test_bad_names() -> None:
     with pytest.raises(ValueError, match="unknown case"):
         scenarios.build_scenario("zigzag")
     with pytest.raises(ValueError, match="settings"):
-        xu2020.run("/nonexistent", settings=("full_scale",))
+        xu2020.REPRODUCTION.run("/nonexistent", settings=("full_scale",))
 
 
 def test_literal_zigzag_fit_near_the_published_model() -> None:

@@ -26,14 +26,14 @@ ROW_KEYS = {"case", "controller", "metric", "ours", "paper"}
 def short_run(tmp_path_factory):  # type: ignore[no-untyped-def]
     """L1 (filter on the command) and adaptive backstepping over 300 s (switch at 150 s)."""
     out = tmp_path_factory.mktemp("xu2021")
-    rows = xu2021.run(
+    rows = xu2021.REPRODUCTION.run(
         out, seeds=1, controllers=(controllers.L1, controllers.AB), time_limit=300.0, plot=False
     )
     return out, rows, {(r["case"], r["controller"], r["metric"]): r for r in rows}
 
 
 def test_registered_and_cli_choice() -> None:
-    assert PAPERS["xu2021"] is xu2021
+    assert PAPERS["xu2021"] is xu2021.REPRODUCTION
     assert build_parser().parse_args(["reproduce", "xu2021"]).paper == "xu2021"
 
 
@@ -51,7 +51,7 @@ def test_short_run_rows_markdown_and_files(short_run) -> None:  # type: ignore[n
     assert index[("claims", controllers.L1, "reaches_goal")]["paper"] is True
     assert index[("claims", controllers.L1, "ace_ratio_to_adaptive_backstepping")]["paper"] == 1.0
     assert index[("linearised", controllers.L1, "stable")]["paper"] is True
-    md = xu2021.markdown(rows)
+    md = xu2021.REPRODUCTION.markdown(rows)
     assert md == (out / "xu2021.md").read_text()
     for text in (
         "**weak_current**",

@@ -24,7 +24,7 @@ from shipgym_baselines.evaluation import evaluate, evaluate_batch
 from shipgym_baselines.learned.curves import CURVE_KEYS, load_curve
 from shipgym_baselines.learned.dagger import ROUND_KEYS, load_student, student_state
 from shipgym_baselines.learned.dagger_config import settings
-from shipgym_baselines.learned.loading import load_data_only
+from shipgym_baselines.learned.loading import SavedModel, load_data_only
 from shipgym_baselines.learned.policy import LearnedPolicy, read_policy
 from shipgym_baselines.training.agents import AgentConfig, load_agent_config
 from shipgym_baselines.training.dagger_agent import RUN_DIR, finished, train_dagger
@@ -109,7 +109,7 @@ def test_the_selected_student_ships_loads_as_data_and_is_scored_without_truth(
         n for n in POLICY_FILES if (target / n).is_file()
     )
     assert {"model.zip", "meta.json", "learning_curve.json"} <= {p.name for p in target.iterdir()}
-    model = load_data_only(target / "model.zip", sb3.PPO, "rudder", True, K)
+    model = load_data_only(SavedModel(target / "model.zip", "ppo", "rudder", True, K), sb3.PPO)
     assert model.observation_space.shape == (core.observation_size(True, K),)
     best = trained["meta"]["dagger"]["best_round"]
     config = AgentConfig.model_validate({**TINY, "seed": 1})

@@ -53,6 +53,17 @@ TINY = {
     },
 }
 
+#: what the learned studies share: not per ship, one trial scored on nomoto2's first
+#: validation trial
+LEARNED = {
+    "kind": "learned",
+    "per_ship": False,
+    "ships": ["nomoto2"],
+    "budget": 1,
+    "validation": {"distribution": "validation", "per_ship": 1},
+    "startup_trials": 1,
+}
+
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -283,14 +294,9 @@ def test_a_learned_study_trains_scores_and_prunes_through_the_same_command(
     """``shipgym tune`` on a learned config: each trial trains a tiny PPO in two parts and
     reports the validation cost ratio after each (the pruner's intermediate values)."""
     config = {
+        **LEARNED,
         "name": "ppo_tiny",
         "controller": "ppo",
-        "kind": "learned",
-        "per_ship": False,
-        "ships": ["nomoto2"],
-        "budget": 1,
-        "validation": {"distribution": "validation", "per_ship": 1},
-        "startup_trials": 1,
         "training": {"agent": "ppo", "n_timesteps": 256, "evaluations": 2},
         "fixed": {"env.n_envs": 1, "hyperparams.n_steps": 64, "hyperparams.batch_size": 64},
         "default": {"env.n_envs": 1, "hyperparams.n_steps": 64, "hyperparams.batch_size": 64},
@@ -331,14 +337,9 @@ def test_a_dagger_study_trains_its_rounds_in_parts(tmp_path: Path) -> None:
     agent_file = tmp_path / "dagger_tiny.yaml"
     agent_file.write_text(yaml.safe_dump(agent))
     config = {
+        **LEARNED,
         "name": "dagger_tiny",
         "controller": "dagger",
-        "kind": "learned",
-        "per_ship": False,
-        "ships": ["nomoto2"],
-        "budget": 1,
-        "validation": {"distribution": "validation", "per_ship": 1},
-        "startup_trials": 1,
         "training": {"agent": str(agent_file), "n_timesteps": 100, "evaluations": 2},
         "params": {"env.history_steps": {"choices": [2, 4]}},
     }

@@ -331,7 +331,7 @@ def test_window_keeps_the_paper_rhythm_for_large_feeds() -> None:
     original = weighted._identify
 
     def spy() -> None:
-        sizes.append(weighted._y1.shape[0])
+        sizes.append(weighted._window_data()[1].shape[0])
         original()
 
     weighted._identify = spy
@@ -351,7 +351,7 @@ def test_dropped_sample_restarts_the_difference_chain() -> None:
     psi_nan[700] = np.nan
     dropped.update_arrays(psi_nan, delta, delta_c)
     # only the 4 rows touching sample 700 are lost; no row spans the gap
-    assert dropped._y1.max() <= clean._y1.max() * (1 + 1e-12)
+    assert dropped._window_data()[1].max() <= clean._window_data()[1].max() * (1 + 1e-12)
     assert "non-finite" in dropped.last_reason
 
 
@@ -390,4 +390,4 @@ def test_samples_without_a_key_are_refused_naming_it_and_the_keys_needed(cls) ->
     samples = {"psi": np.zeros(50), "delta": np.zeros(50)}
     with pytest.raises(IdentificationError, match=r"'delta_c'.*'psi', 'delta', 'delta_c'"):
         ident.update(samples)
-    assert ident._y1.shape[0] == 0 and ident.updates == 0
+    assert ident._window_data()[1].shape[0] == 0 and ident.updates == 0

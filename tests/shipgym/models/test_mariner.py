@@ -18,6 +18,7 @@ from shipgym.models import MODELS
 from shipgym.models.base import ParameterError
 from shipgym.models.integrator import PeriodIntegrator
 from shipgym.models.mariner import Mariner, MarinerParams
+from tests.shipgym.models.batching import assert_columns_are_ships
 
 DEG = math.pi / 180.0
 R_MAX = 0.0191  # rad/s, Borkowski (2018) §5
@@ -127,12 +128,7 @@ def test_batched_numpy_equals_per_ship() -> None:
     u = rng.uniform(-1.0, 1.0, size=(1, n))
     w = rng.normal(size=(3, n)) * 0.1
     p = np.stack([random_params(rng).to_vector() for _ in range(n)], axis=1)
-    f = model.f_numpy(x, u, w, p)
-    assert f.shape == (7, n)
-    for j in range(n):
-        np.testing.assert_allclose(
-            f[:, j], model.f_numpy(x[:, j], u[:, j], w[:, j], p[:, j]), rtol=1e-14
-        )
+    assert_columns_are_ships(model, x, u, w, p)
 
 
 # --------------------------------------------------------------------------------------------

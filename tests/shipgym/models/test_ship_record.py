@@ -75,14 +75,6 @@ class Nomoto1(ShipModel):
             ]
         )
 
-    @property
-    def length(self) -> float:
-        return self.params.L
-
-    @property
-    def nominal_speed(self) -> float:
-        return self.params.u0
-
 
 TEST_ENV_ID = "ShipPathFollow-TestNomoto1-v0"
 #: 60 s at Ts = 0.5 s; the servo ages at 20 s
