@@ -2,8 +2,8 @@
 
 The ``shipgym`` CLI prints them as one line (exit code 2); each also derives from the
 built-in it refines, so ``except KeyError`` / ``except ValueError`` keep working.  A bad
-suite or agent config raises shipgym's :class:`~shipgym.config.ConfigError` (re-exported
-here), as a bad scenario file does.
+suite or agent config raises shipgym's :class:`~shipgym.config.ConfigError`, as a bad
+scenario file does.
 """
 
 from __future__ import annotations

@@ -42,18 +42,15 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-# the page's tables, cells and figures have their own modules (html_cells, page_sections,
-# page_figures); their names stay importable from here
-from shipgym_baselines.page.cells import esc
-from shipgym_baselines.page.cells import packed_body as packed_body
-from shipgym_baselines.page.cells import swatch_css as swatch_css
-from shipgym_baselines.page.figures import figure_sections as figure_sections
-from shipgym_baselines.page.figures import reference_css
-from shipgym_baselines.page.sections import headroom_html as headroom_html
-from shipgym_baselines.page.sections import ranking_tables as ranking_tables
-from shipgym_baselines.page.sections import row_table as row_table
-from shipgym_baselines.page.sections import score_table as score_table
-from shipgym_baselines.page.sections import share_html
+from shipgym_baselines.page.cells import esc, packed_body, swatch_css
+from shipgym_baselines.page.figures import figure_sections, reference_css
+from shipgym_baselines.page.sections import (
+    headroom_html,
+    ranking_tables,
+    row_table,
+    score_table,
+    share_html,
+)
 from shipgym_baselines.privileged import ORACLE_FROZEN
 from shipgym_baselines.records.outfiles import write_bytes
 from shipgym_baselines.scoring.ranking import SCORE_EXPLAINED, no_ranking

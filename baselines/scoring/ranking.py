@@ -53,7 +53,7 @@ process and order.
 
 The statistics live in :mod:`.intervals`, each episode's score in :mod:`.scores`, what
 adaptation is worth in :mod:`.headroom`; this module assembles the ranking's rows
-(``aggregate.json``, ``scenario_scores.json``) and re-exports their names.
+(``aggregate.json``, ``scenario_scores.json``).
 """
 
 from __future__ import annotations
@@ -66,10 +66,8 @@ from typing import Any
 import numpy as np
 
 # the references: ORACLE (its cost is the cost ratio's denominator) and ORACLE_FROZEN
-from shipgym_baselines.privileged import ORACLE as ORACLE
-from shipgym_baselines.privileged import ORACLE_FROZEN as ORACLE_FROZEN
+from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
-# an episode its controller ended is told by its record, in records.episodes; these names
 # stay importable from here
 # the controller of the probability of improvement
 from shipgym_baselines.registry import BASELINE
@@ -77,27 +75,27 @@ from shipgym_baselines.scoring.change_share import TWIN_FIELDS, episode_costs, t
 
 # the statistics, the episodes' scores and what adaptation is worth have their own
 # modules (intervals, scores, headroom); their names stay importable from here
-from shipgym_baselines.scoring.headroom import GAP_FIELDS as GAP_FIELDS
-from shipgym_baselines.scoring.headroom import gap_fields as gap_fields
-from shipgym_baselines.scoring.intervals import AGGREGATE_REPS as AGGREGATE_REPS
-from shipgym_baselines.scoring.intervals import bounds
-from shipgym_baselines.scoring.intervals import geometric_mean as geometric_mean
-from shipgym_baselines.scoring.intervals import interquartile_mean as interquartile_mean
-from shipgym_baselines.scoring.intervals import interval_estimate as interval_estimate
+from shipgym_baselines.scoring.headroom import GAP_FIELDS, gap_fields
 from shipgym_baselines.scoring.intervals import (
-    probability_of_lower_ratio as probability_of_lower_ratio,
+    AGGREGATE_REPS,
+    bounds,
+    geometric_mean,
+    interquartile_mean,
+    interval_estimate,
+    probability_of_lower_ratio,
+    row_intervals,
+    seeded_global_rng,
 )
-from shipgym_baselines.scoring.intervals import row_intervals as row_intervals
-from shipgym_baselines.scoring.intervals import seeded_global_rng as seeded_global_rng
-from shipgym_baselines.scoring.scores import FAILED_EPISODES as FAILED_EPISODES
-from shipgym_baselines.scoring.scores import REFERENCE_KIND as REFERENCE_KIND
-from shipgym_baselines.scoring.scores import controller_kinds as controller_kinds
-from shipgym_baselines.scoring.scores import ranked_scenarios as ranked_scenarios
-from shipgym_baselines.scoring.scores import rated_scenarios
-from shipgym_baselines.scoring.scores import run_matrix as run_matrix
-from shipgym_baselines.scoring.scores import scored_episodes as scored_episodes
+from shipgym_baselines.scoring.scores import (
+    FAILED_EPISODES,
+    REFERENCE_KIND,
+    controller_kinds,
+    ranked_scenarios,
+    rated_scenarios,
+    run_matrix,
+    scored_episodes,
+)
 
-#: the split label's suffix of the table of controllers ranked on fewer scenarios
 PARTIAL = ":partial"
 #: an aggregate row's probability of improvement over ``pid_los`` (None: no comparison)
 PROB = f"prob_improvement_over_{BASELINE}"

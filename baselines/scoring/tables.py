@@ -16,11 +16,12 @@ from shipgym_baselines.registry import controller_kind
 from shipgym_baselines.scoring.intervals import row_intervals
 
 # the splits are defined in .splits; these names stay importable from here
-from shipgym_baselines.scoring.splits import ALWAYS_GENERALISED
-from shipgym_baselines.scoring.splits import GENERALISATION_SPLITS as GENERALISATION_SPLITS
-from shipgym_baselines.scoring.splits import scenario_split as scenario_split
+from shipgym_baselines.scoring.splits import (
+    ALWAYS_GENERALISED,
+    GENERALISATION_SPLITS,
+    scenario_split,
+)
 
-#: metric columns aggregated over a row's episodes (mean, ``*_std`` and ``*_ci95``)
 COLUMNS = (
     "ace",
     "ace_L",

@@ -61,9 +61,7 @@ import numpy as np
 from shipgym_baselines.errors import RunError
 from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.learned.agent_folder import read_record
-from shipgym_baselines.learned.dagger_config import check_config as check_config
-from shipgym_baselines.learned.dagger_config import hyperparams as hyperparams
-from shipgym_baselines.learned.dagger_config import settings as settings
+from shipgym_baselines.learned.dagger_config import check_config, hyperparams, settings
 from shipgym_baselines.records.outfiles import write_bytes
 from shipgym_baselines.training.meta import training_meta
 

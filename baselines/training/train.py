@@ -56,11 +56,11 @@ from shipgym_baselines.executor import map_jobs
 from shipgym_baselines.learned.agent_folder import (
     BEST_FILE,
     agent_run,
+    check_tuned_from,
     read_record,
+    write_best,
     write_json_file,
 )
-from shipgym_baselines.learned.agent_folder import check_tuned_from as check_tuned_from
-from shipgym_baselines.learned.agent_folder import write_best as write_best
 from shipgym_baselines.learned.trust import (
     TRUST_PICKLE_OPTION,
     pickle_trusted,

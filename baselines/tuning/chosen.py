@@ -31,9 +31,7 @@ import yaml
 
 # the reader sits below the controllers (records/chosen.py: a controller's 'tuned' preset
 # reads it); its names stay importable from here
-from shipgym_baselines.records.chosen import chosen_file as chosen_file
-from shipgym_baselines.records.chosen import packaged_chosen as packaged_chosen
-from shipgym_baselines.records.chosen import read_chosen as read_chosen
+from shipgym_baselines.records.chosen import chosen_file, packaged_chosen, read_chosen
 from shipgym_baselines.records.locking import file_lock
 from shipgym_baselines.records.outfiles import refuse_special, write_text
 from shipgym_baselines.records.runrecord import now

@@ -5,7 +5,7 @@ with an error naming the file and the key.  Values are in the units of the confi
 metres, seconds, degrees where a key says ``_deg``; ship parameters in the units of the
 model's source paper (for nomoto2: Liu et al. 2019, d0 in °/s), converted to SI by the
 model under the scenario's ``unit_reading``.  The ``disturbances`` and ``sensors`` sections
-are the models of :mod:`shipgym.disturbance_config` (re-exported here).  Every number is
+are the models of :mod:`shipgym.disturbance_config`.  Every number is
 finite (``.inf`` / ``.nan`` are rejected, :class:`shipgym.config.StrictModel`), and the checks
 that relate two keys (an event after the time limit) name the key at fault.
 """
