@@ -17,9 +17,9 @@
                      at most that last second); an episode's key is (scenario, controller,
                      seed, training_seed)
     trajectories/    the drawn episodes' trajectories: each episode's is written as it
-                     ends (``<hash of its key>.npz``, :func:`~.trajectories.trajectory_file`), and once a
-                     row (scenario, controller) is complete only the episode its figure
-                     draws is kept (:meth:`~.runlog.RunLog.drop_trajectories`)
+                     ends (``<hash of its key>.npz``,
+                     :func:`~.trajectories.trajectory_file`), and once a row (scenario,
+                     controller) is complete only the episode its figure draws is kept (:meth:`~.runlog.RunLog.drop_trajectories`)
 
 A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.records.locking`) and
 lists every path it writes in ``manifest.txt`` (:mod:`shipgym_baselines.records.manifest`),
@@ -28,13 +28,14 @@ link is refused).  A folder that is not empty is refused before any work unless 
 (run the episodes missing from ``episodes.jsonl``; the resolved suite must equal
 ``run.json``'s) or ``force`` (delete what the manifest lists first; a folder holding anything
 else is refused).  ``episodes.jsonl`` is read as a set keyed by the episode key
-(:func:`~.episodes.read_episodes`).  Tables are always aggregated from ``episodes.jsonl`` (so a resumed
-run's tables equal a clean run's, and ``shipgym report`` rebuilds them from the folder).
+(:func:`~.episodes.read_episodes`).  Tables are always aggregated from ``episodes.jsonl``
+(so a resumed run's tables equal a clean run's, and ``shipgym report`` rebuilds them from
+the folder).
 
 Strict JSON has no infinity or NaN: in ``episodes.jsonl`` a metric of ±inf (t_c = inf, "never
 converged") is the string ``"inf"`` / ``"-inf"`` and NaN is ``null`` (metrics ignore NaN), so
-a record reads back to the same numbers (:func:`~.episodes.read_episodes`).  Read back, each value is
-checked by type: a metric is a finite number, null, ``"inf"`` or ``"-inf"``; only
+a record reads back to the same numbers (:func:`~.episodes.read_episodes`).  Read back, each
+value is checked by type: a metric is a finite number, null, ``"inf"`` or ``"-inf"``; only
 :data:`~.episodes.BOOL_METRICS` are booleans and :data:`~.episodes.TEXT_METRICS` text.
 
 Each module is named for what it holds: the output folder
