@@ -19,7 +19,8 @@
     trajectories/    the drawn episodes' trajectories: each episode's is written as it
                      ends (``<hash of its key>.npz``,
                      :func:`~.trajectories.trajectory_file`), and once a row (scenario,
-                     controller) is complete only the episode its figure draws is kept (:meth:`~.runlog.RunLog.drop_trajectories`)
+                     controller) is complete only the episode its figure draws is kept
+                     (:meth:`~.runlog.RunLog.drop_trajectories`)
 
 A run holds an exclusive lock on its folder (:mod:`shipgym_baselines.records.locking`) and
 lists every path it writes in ``manifest.txt`` (:mod:`shipgym_baselines.records.manifest`),
