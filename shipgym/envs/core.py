@@ -839,16 +839,16 @@ def metric_settings(scenario: Scenario) -> MetricSettings:
     return MetricSettings(convergence_threshold=scenario.config.convergence_threshold)
 
 
-def check_action(action: Any, shape: tuple[int]) -> list[float]:
-    """One env's action as the floats of the 1-D ``shape`` (n_act,), not clipped;
-    ValueError naming what is wrong if it is not numbers of that shape or holds NaN or inf."""
+def check_action(action: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """One env's action as a float64 array of ``shape``, not clipped; ValueError naming
+    what is wrong if it is not numbers of that shape or holds NaN or inf."""
     try:
         if action is None:  # numpy reads None as NaN
             raise TypeError("None is no number")
-        values = np.asarray(action, dtype=np.float64).reshape(shape).tolist()
+        values = np.asarray(action, dtype=np.float64).reshape(shape)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"action must be an array of shape {shape}, got {action!r}") from exc
-    if not all(map(math.isfinite, values)):
+    if not all(map(math.isfinite, values.ravel().tolist())):
         raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
     return values
 

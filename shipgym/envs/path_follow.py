@@ -366,7 +366,7 @@ class ShipPathFollowEnv(gym.Env):
     # ------------------------------------------------------------------ pieces
     def _check_action(self, action: Any) -> list[float]:
         """The action as floats clipped to [-1, 1]; ValueError (state untouched) if malformed."""
-        values = core.check_action(action, self.action_space.shape)
+        values = core.check_action(action, self.action_space.shape).tolist()
         return [min(1.0, max(-1.0, v)) for v in values]
 
     def _command(self, a: list[float], s: core.EnvState, live: bool) -> tuple[float, float]:
