@@ -515,7 +515,7 @@ def transition(
     xp: Any,
     command: Callable[[Any, EnvState, Any], tuple[Any, Any]],
     plant: Callable[[EnvState, Any, Any], np.ndarray],
-    measure: Callable[[np.ndarray, EnvState, Any, Any, Any, Any], tuple[Any, Any]],
+    measure: Callable[[np.ndarray, EnvState, EnvState, Any], tuple[Any, Any]],
     tracker: Any,
 ) -> tuple[EnvState, Period]:
     """One control period of every env: the new state and what the period gave, for one
@@ -529,9 +529,9 @@ def transition(
     :func:`rudder_command`; ``plant(state, δc, live)`` sets the period's true parameters
     and disturbances and integrates the plant → the states at the substep ends, (...,
     n_sub, n_x) (one ship's may start with the period's start); ``measure(trajectory,
-    state, δc, ψ, r, advance)`` → the measured (ψ, r) of the ``advance`` rows, given their
-    true values at the period's end (the other rows': their last measurement; never
-    written into); ``tracker``
+    state, new, advance)`` → the measured (ψ, r) of the ``advance`` rows, given the new
+    state whose ``psi_m``, ``r_m`` hold their true values at the period's end (the other
+    rows': their last measurement; never written into); ``tracker``
     (``frame``, ``update(x, y, mask=None)``) follows the path.  A row whose plant state
     ends non-finite keeps its state, measurements and frame, and ends with
     :func:`diverged_reward`.  While every row steps and stays finite no masked selection
@@ -562,18 +562,18 @@ def transition(
         if not moved:
             speed = xp.where(advance, speed, state.speed)
     if moved:
-        psi, r = measure(trajectory, state, delta_c, heading, yaw_rate, advance)
+        psi, r = heading, yaw_rate
+    else:  # the rows that do not advance keep their last measurement
+        psi, r = xp.where(advance, heading, state.psi_m), xp.where(advance, yaw_rate, state.r_m)
+    new = EnvState(x, steps, t, delta_c, psi, r, speed, integral)
+    new.psi_m, new.r_m = measure(trajectory, state, new, advance)
+    if moved:
         frame = tracker.update(px, py)
     else:
-        psi = xp.where(advance, heading, state.psi_m)
-        psi, r = measure(
-            trajectory, state, delta_c, psi, xp.where(advance, yaw_rate, state.r_m), advance
-        )
         frame = tracker.update(px, py, advance) if xp.any(advance) else tracker.frame
     heading_error = wrap_angle(heading - frame.path_angle)
     reward = step_reward(frame.cross_track, heading_error, delta_c, state.delta_c, k, xp)
     reward, goal, corridor, truncated = terminate(reward, frame, steps, k, xp)
-    new = EnvState(x, steps, t, delta_c, psi, r, speed, integral)
     if moved:
         diverged = xp.logical_not(live)  # none
         return new, Period(frame, heading_error, reward, goal, corridor, diverged, truncated)

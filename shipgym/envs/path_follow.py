@@ -347,17 +347,9 @@ class ShipPathFollowEnv(gym.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._state is None:
             raise RuntimeError("call reset() before step()")
-        a = self._check_action(action)
+        a, s = self._check_action(action), self._state
         self._state, period = core.transition(
-            self._state,
-            a,
-            True,
-            self._k,
-            SCALAR,
-            self._command,
-            self._plant,
-            self._measure,
-            self._tracker,
+            s, a, True, self._k, SCALAR, self._command, self._plant, self._measure, self._tracker
         )
         if self._history is not None:
             self._history.stepped()
@@ -387,18 +379,12 @@ class ShipPathFollowEnv(gym.Env):
         return self._integrator(s.x, delta_c, self._w_block, self._p_block)
 
     def _measure(
-        self,
-        trajectory: np.ndarray,
-        s: core.EnvState,
-        delta_c: float,
-        psi: float,
-        r: float,
-        advance: bool,
+        self, trajectory: np.ndarray, s: core.EnvState, new: core.EnvState, advance: bool
     ) -> tuple[float, float]:
         """The sensors over the period's substeps (core.transition's measure), and the
         period's ``samples`` at the substep starts t0, t0+h, …, t0+Ts−h (module doc)."""
         if not advance:
-            return psi, r
+            return new.psi_m, new.r_m
         k = self._k
         start, states = trajectory[:-1], trajectory[1:]
         psi_m, r_m = self._sensor.measure(states[:, k.ipsi], states[:, k.ir], self.np_random)
@@ -407,7 +393,7 @@ class ShipPathFollowEnv(gym.Env):
             "psi": np.concatenate(([s.psi_m], psi_m[:-1])),
             "r": np.concatenate(([s.r_m], r_m[:-1])),
             "delta": start[:, k.idelta],  # a view into this step's fresh trajectory
-            "delta_c": np.full(k.substeps, delta_c),
+            "delta_c": np.full(k.substeps, new.delta_c),
             "e": self._tracker.cross_track_of(start[:, k.ix], start[:, k.iy]),
         }
         return float(psi_m[-1]), float(r_m[-1])

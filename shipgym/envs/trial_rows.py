@@ -190,16 +190,9 @@ class TrialRowsVectorEnv(VectorEnv):
         ``a`` (n_envs, n_act), checked and clipped (:func:`core.batch_actions`); the other
         rows keep their state.  Each row ends at its own time limit."""
         self._samples = {}
+        kk = self._kk  # the constants with each row's own max_steps
         self._state, period = core.transition(
-            self._state,
-            a,
-            live,
-            self._kk,  # the constants with each row's own max_steps
-            ARRAY,
-            self._command,
-            self._plant,
-            self._measure,
-            self._tracks,
+            self._state, a, live, kk, ARRAY, self._command, self._plant, self._measure, self._tracks
         )
         if self._history is not None:
             self._history.stepped(live)
@@ -251,13 +244,7 @@ class TrialRowsVectorEnv(VectorEnv):
         return self._integrator.substep_states(s.x, delta_c, self._w_block, self._p_block)
 
     def _measure(
-        self,
-        trajectory: np.ndarray,
-        s: core.EnvState,
-        delta_c: np.ndarray,
-        psi: np.ndarray,
-        r: np.ndarray,
-        advance: np.ndarray,
+        self, trajectory: np.ndarray, s: core.EnvState, new: core.EnvState, advance: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         """Noisy sensors of the ``advance`` rows, each with its trial's generator
         (core.transition's measure); with :attr:`record_samples` each such row's single env
@@ -270,6 +257,7 @@ class TrialRowsVectorEnv(VectorEnv):
             e_s = self._tracks.cross_track_of(start[:, :, k.ix], start[:, :, k.iy])
             psi_s = np.concatenate((s.psi_m[:, None], trajectory[:, :-1, k.ipsi]), axis=1)
             r_s = np.concatenate((s.r_m[:, None], trajectory[:, :-1, k.ir]), axis=1)
+        psi, r = new.psi_m, new.r_m
         noisy = (advance & self._noisy).nonzero()[0].tolist()
         if noisy:
             psi, r = psi.copy(), r.copy()
@@ -281,7 +269,7 @@ class TrialRowsVectorEnv(VectorEnv):
                 psi_s[i, 1:], r_s[i, 1:] = p_i[:-1], r_i[:-1]
         if record:
             t_s = s.t[:, None] + self._sample_offsets
-            delta_c_s = np.repeat(delta_c[:, None], k.substeps, axis=1)
+            delta_c_s = np.repeat(new.delta_c[:, None], k.substeps, axis=1)
             for i in advance.nonzero()[0].tolist():
                 self._samples[i] = {
                     "t": t_s[i],

@@ -157,15 +157,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         if np.any(resetting):
             self._reset_envs(resetting)
         self._state, period = core.transition(
-            self._state,
-            a,
-            live,
-            k,
-            ARRAY,
-            self._command,
-            self._plant,
-            self._measure,
-            self._tracker,
+            self._state, a, live, k, ARRAY, self._command, self._plant, self._measure, self._tracker
         )
         if self._history is not None:
             self._history.stepped(live)
@@ -276,20 +268,14 @@ class ShipPathFollowVectorEnv(VectorEnv):
         return self._integrator.substep_states(s.x, delta_c, self._w_block, self._p_block)
 
     def _measure(
-        self,
-        trajectory: np.ndarray,
-        s: core.EnvState,
-        delta_c: np.ndarray,
-        psi: np.ndarray,
-        r: np.ndarray,
-        advance: np.ndarray,
+        self, trajectory: np.ndarray, s: core.EnvState, new: core.EnvState, advance: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         """Noisy sensors of the ``advance`` envs, each with its generator in the single
         env's order (core.transition's measure)."""
         if self._ideal:
-            return psi, r
+            return new.psi_m, new.r_m
         k = self._k
-        psi, r = psi.copy(), r.copy()
+        psi, r = new.psi_m.copy(), new.r_m.copy()
         for i in np.flatnonzero(advance):
             p_i, r_i = self._sensors[i].measure(
                 trajectory[i, :, k.ipsi], trajectory[i, :, k.ir], self._rngs[i]
