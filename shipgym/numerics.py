@@ -10,12 +10,18 @@ implementations that differ from libm in the last bit: :data:`ARRAY` therefore m
 ``asin``, ``atan``, ``atan2`` and ``pow(2, ·)`` over the elements (≈ 60 ns each) and keeps
 numpy's ``sin`` and ``cos``, which equal libm's here (checked by
 tests/shipgym/test_numerics.py).  So the single env and the batched env agree bit for bit.
+
+Both also read state vectors alike: :data:`SCALAR`'s ``column(x, j)`` is entry j of one
+ship's vector as a float, :data:`ARRAY`'s column j of N ships' rows as a fresh array
+(``columns``: several at once); ``where_rows`` selects whole rows, ``all_finite`` checks
+each ship's vector.
 """
 
 from __future__ import annotations
 
 import bisect
 import math
+import operator
 from typing import Any
 
 import numpy as np
@@ -42,15 +48,32 @@ class ScalarOps:
     exp2 = staticmethod(_exp2)
     minimum = staticmethod(min)
     maximum = staticmethod(max)
-    logical_not = staticmethod(lambda c: not c)
+    logical_not = staticmethod(operator.not_)
+    any = staticmethod(bool)
+    all = staticmethod(bool)
 
     @staticmethod
     def where(cond: Any, a: Any, b: Any) -> Any:
         return a if cond else b
 
     @staticmethod
-    def any(cond: Any) -> bool:
-        return bool(cond)
+    def column(vector: Any, j: int) -> float:
+        """Entry j of one ship's vector (array or list) as a float."""
+        return float(vector[j])
+
+    @staticmethod
+    def columns(vector: np.ndarray, js: tuple[int, ...]) -> tuple[float, ...]:
+        """Entries ``js`` of one ship's vector as floats."""
+        return operator.itemgetter(*js)(vector.tolist())
+
+    @staticmethod
+    def where_rows(cond: Any, a: Any, b: Any) -> Any:
+        return a if cond else b
+
+    @staticmethod
+    def all_finite(vector: Any) -> bool:
+        """Whether every entry of one ship's vector is finite."""
+        return all(map(math.isfinite, vector.tolist()))
 
     @staticmethod
     def searchsorted_right(table: Any, value: float) -> int:
@@ -95,6 +118,30 @@ class ArrayOps:
     @staticmethod
     def any(cond: Any) -> Any:
         return np.asarray(cond).any()  # the array method: no dispatch of np.any
+
+    @staticmethod
+    def all(cond: Any) -> bool:
+        return bool(np.asarray(cond).all())
+
+    @staticmethod
+    def column(rows: Any, j: int) -> np.ndarray:
+        """Column j of N ships' rows (N, n) as a fresh array (never a view)."""
+        return rows[:, j].copy()
+
+    @staticmethod
+    def columns(rows: np.ndarray, js: tuple[int, ...]) -> list[np.ndarray]:
+        """Columns ``js`` of N ships' rows (N, n), each a fresh array."""
+        return [rows[:, j].copy() for j in js]
+
+    @staticmethod
+    def where_rows(cond: Any, a: Any, b: Any) -> np.ndarray:
+        """Row i of ``a`` where ``cond[i]``, else of ``b`` ((N, n) arrays, (N,) mask)."""
+        return np.where(cond[:, None], a, b)
+
+    @staticmethod
+    def all_finite(rows: Any) -> np.ndarray:
+        """Per ship: whether every entry of its row of (N, n) is finite."""
+        return np.isfinite(rows).all(axis=1)
 
     @staticmethod
     def searchsorted_right(table: Any, value: Any) -> Any:

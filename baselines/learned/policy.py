@@ -588,13 +588,11 @@ class LearnedPolicy:
         history_steps: int | None = None,
     ) -> None:
         files = read_policy(path, training_seed)
-        if history_steps is not None:
-            history_steps = check_history_steps(history_steps)
-            if history_steps != files.model.history_steps:
-                raise ControllerError(
-                    f"{files.model.path}: asked for history_steps {history_steps}, but it was "
-                    f"trained with history_steps {files.model.history_steps} (its {META_FILE})"
-                )
+        if history_steps is not None and history_steps != files.model.history_steps:
+            raise ControllerError(
+                f"{files.model.path}: asked for history_steps {history_steps}, but it was "
+                f"trained with history_steps {files.model.history_steps} (its {META_FILE})"
+            )
         self.model_path = files.model.path
         self.algo = files.algo
         self.meta: dict[str, Any] = files.meta

@@ -1,14 +1,18 @@
 """The step core of ShipPathFollow: one definition for the single and the batched env.
 
-In the spirit of Gymnasium's functional env (``gymnasium.experimental.functional``): the
-pieces of one control period that are not the plant — the action's rudder command, the
-parameters of the period, the reward, termination, the observation and ``info`` —
-are pure functions of floats (one ship, ``xp = SCALAR``) or arrays (N ships,
-``xp = ARRAY``) of :mod:`shipgym.numerics`.  :class:`~shipgym.envs.path_follow.ShipPathFollowEnv`
-calls them for one ship, :class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` for N; both
-build their parts from a scenario with :class:`EnvParts`.  Tracking is
-:class:`shipgym.tracking.PathTracker`, guidance :data:`shipgym.guidance.GUIDANCE_LAWS`, the
-autopilot :func:`shipgym.autopilot.pid_step`: the same code for one ship and N.
+In the spirit of Gymnasium's functional env (``gymnasium.experimental.functional``): one
+control period is :func:`transition`, a function of the env's state (:class:`EnvState`) and
+the action, written once over floats (one ship, ``xp = SCALAR``) or arrays (N ships,
+``xp = ARRAY``) of :mod:`shipgym.numerics`: action → rudder command → plant over the period
+→ sensors → path tracking → reward and termination (:class:`Period`); the env supplies the
+parts that draw random numbers or hold buffers (the plant's inputs, the sensors, its path
+tracker).  :class:`~shipgym.envs.path_follow.ShipPathFollowEnv` calls it for one ship,
+:class:`~shipgym.envs.vector.ShipPathFollowVectorEnv` and
+:class:`~shipgym.envs.trial_rows.TrialRowsVectorEnv` for N; they differ in how they reset
+and batch, and build their parts from a scenario with :class:`EnvParts`.  The observation
+and ``info`` are functions here too.  Tracking is :class:`shipgym.tracking.PathTracker`,
+guidance :data:`shipgym.guidance.GUIDANCE_LAWS`, the autopilot
+:func:`shipgym.autopilot.pid_step`: the same code for one ship and N.
 
 Reward per step, from the *true* state (the score, the same for everyone):
 
@@ -26,6 +30,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -167,7 +172,8 @@ class StepConstants:
 def check_history_steps(history_steps: Any) -> int:
     """``history_steps`` (K, control steps of history in the observation) checked: an int
     from 0 to :data:`~shipgym.limits.MAX_HISTORY_STEPS` (not a bool), else a ValueError
-    naming it."""
+    naming it.  Checked where K enters: :meth:`EnvParts.build` (every env's constructor);
+    the observation's functions below and :class:`ObservationHistory` take a checked K."""
     if (
         isinstance(history_steps, bool)
         or not isinstance(history_steps, numbers.Integral)
@@ -181,17 +187,17 @@ def check_history_steps(history_steps: Any) -> int:
 
 
 def history_bounds(history_steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) of the history window of K = ``history_steps`` steps: per step the
-    bounds of :data:`HISTORY_MEASUREMENTS` and of the applied command, [-1, 1]."""
-    k = check_history_steps(history_steps)
-    return np.tile(_HISTORY_LOW, k), np.tile(_HISTORY_HIGH, k)
+    """(low, high) of the history window of K = ``history_steps`` steps (checked,
+    :func:`check_history_steps`): per step the bounds of :data:`HISTORY_MEASUREMENTS` and
+    of the applied command, [-1, 1]."""
+    return np.tile(_HISTORY_LOW, history_steps), np.tile(_HISTORY_HIGH, history_steps)
 
 
 def history_names(history_steps: int) -> tuple[str, ...]:
     """The names of the history window's entries, oldest step first: ``<name>_lag<j>``
     with j the steps back (j = 1: the control step that just ended)."""
-    k = check_history_steps(history_steps)
-    return tuple(f"{name}_lag{lag}" for lag in range(k, 0, -1) for name in HISTORY_STEP_NAMES)
+    lags = range(history_steps, 0, -1)
+    return tuple(f"{name}_lag{lag}" for lag in lags for name in HISTORY_STEP_NAMES)
 
 
 def observation_bounds(
@@ -199,15 +205,14 @@ def observation_bounds(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) of the observation: :data:`OBS_NAMES`, then :data:`CONTEXT_NAMES` when
     ``context_features``, then the history window of ``history_steps`` steps."""
-    k = check_history_steps(history_steps)
-    if not context_features and k == 0:
+    if not context_features and history_steps == 0:
         return OBS_LOW, OBS_HIGH
     lows, highs = [OBS_LOW], [OBS_HIGH]
     if context_features:
         lows.append(CONTEXT_LOW)
         highs.append(CONTEXT_HIGH)
-    if k:
-        low, high = history_bounds(k)
+    if history_steps:
+        low, high = history_bounds(history_steps)
         lows.append(low)
         highs.append(high)
     return np.concatenate(lows), np.concatenate(highs)
@@ -231,7 +236,7 @@ def observation_size(context_features: bool = False, history_steps: int = 0) -> 
     return (
         len(OBS_NAMES)
         + (len(CONTEXT_NAMES) if context_features else 0)
-        + HISTORY_WIDTH * check_history_steps(history_steps)
+        + HISTORY_WIDTH * history_steps
     )
 
 
@@ -413,6 +418,177 @@ def diverged_reward(steps: Any, k: StepConstants) -> Any:
     return -(k.max_cross_track / k.ship_length) * (k.max_steps - steps + 1)
 
 
+# ---------------------------------------------------------------------------------- one period
+@dataclasses.dataclass(slots=True)
+class EnvState:
+    """What an env carries from one control period to the next, besides its path tracker,
+    its random streams and its plant's input blocks: one ship's (floats, ``x`` an (n_x,)
+    array) or N ships' (arrays over the rows).  :func:`transition` returns a new one and
+    never writes into the one it is given; a batched env's reset writes rows in place."""
+
+    x: Any  # plant state, (n_x,) or (N, n_x) [SI]
+    steps: Any  # control periods of the episode so far
+    t: Any  # time [s]
+    delta_c: Any  # rudder command of the last period [rad]
+    psi_m: Any  # measured heading [rad]
+    r_m: Any  # measured yaw rate [rad/s]
+    speed: Any  # speed over ground U [m/s]
+    integral: Any  # guidance mode: the heading PID's integral
+
+    @classmethod
+    def rows(cls, n: int, n_states: int, speed: float = 0.0) -> EnvState:
+        """N ships' state before their first reset: zeros, each speed ``speed`` [m/s]."""
+        zeros = [np.zeros(n) for _ in range(4)]
+        return cls(
+            np.zeros((n, n_states)),
+            np.zeros(n, dtype=np.int64),
+            *zeros,
+            np.full(n, speed),
+            np.zeros(n),
+        )
+
+
+@dataclasses.dataclass(slots=True)
+class Period:
+    """What one control period gave (:func:`transition`): one ship's floats and bools, or
+    arrays over N rows (a row not stepped: reward 0, no end)."""
+
+    frame: TrackFrame  # the path frame after the period
+    heading_error: Any  # true ψ − path angle [rad]
+    reward: Any
+    goal: Any
+    corridor: Any
+    diverged: Any  # the plant state went non-finite
+    truncated: Any
+
+    @property
+    def terminated(self) -> Any:
+        return self.goal | self.corridor | self.diverged
+
+    def reasons(self) -> Any:
+        """The termination reason (None where the episode goes on): one ship's str or
+        None, or an object array over the rows."""
+        if not isinstance(self.reward, np.ndarray):
+            return (
+                "goal"
+                if self.goal
+                else "corridor"
+                if self.corridor
+                else "non_finite_state"
+                if self.diverged
+                else "time_limit"
+                if self.truncated
+                else None
+            )
+        ends = (
+            ("goal", self.goal),
+            ("corridor", self.corridor),
+            ("non_finite_state", self.diverged),
+            ("time_limit", self.truncated),
+        )
+        reasons = np.full(self.reward.shape, None, dtype=object)
+        for reason, end in ends:
+            reasons[end] = reason
+        return reasons
+
+
+def rudder_command(
+    action: Any, state: EnvState, frame: TrackFrame, parts: EnvParts, xp: Any
+) -> tuple[Any, Any]:
+    """The rudder command δc [rad] of ``action`` and the heading PID's new integral: in
+    rudder mode δc = a0·δmax (the integral unchanged), in guidance mode
+    :func:`guidance_command` from the path ``frame`` at the period's start."""
+    a0 = xp.column(action, 0)
+    if parts.action_mode == "rudder":
+        return a0 * parts.constants.rudder_limit, state.integral
+    return guidance_command(
+        a0, xp.column(action, 1), frame, state.psi_m, state.r_m, state.integral, parts, xp
+    )
+
+
+def transition(
+    state: EnvState,
+    action: Any,
+    live: Any,
+    k: StepConstants,
+    xp: Any,
+    command: Callable[[Any, EnvState, Any], tuple[Any, Any]],
+    plant: Callable[[EnvState, Any, Any], np.ndarray],
+    measure: Callable[[np.ndarray, EnvState, EnvState, Any], tuple[Any, Any]],
+    tracker: Any,
+) -> tuple[EnvState, Period]:
+    """One control period of every env: the new state and what the period gave, for one
+    ship (``xp = SCALAR``, ``live = True``) or the ``live`` rows of N (``xp = ARRAY``, a
+    mask; the other rows keep their state and get reward 0).  ``action``: checked and
+    clipped, one ship's floats or (N, n_act).  ``k.max_steps`` may be an array (each row's
+    time limit).
+
+    The env supplies what draws random numbers, holds buffers or follows a path, called in
+    this order: ``command(action, state, live)`` → (δc [rad], PID integral), e.g.
+    :func:`rudder_command`; ``plant(state, δc, live)`` sets the period's true parameters
+    and disturbances and integrates the plant → the states at the substep ends, (...,
+    n_sub, n_x) (one ship's may start with the period's start); ``measure(trajectory,
+    state, new, advance)`` → the measured (ψ, r) of the ``advance`` rows, given the new
+    state whose ``psi_m``, ``r_m`` hold their true values at the period's end (the other
+    rows': their last measurement; never written into); ``tracker``
+    (``frame``, ``update(x, y, mask=None)``) follows the path.  A row whose plant state
+    ends non-finite keeps its state, measurements and frame, and ends with
+    :func:`diverged_reward`.  While every row steps and stays finite no masked selection
+    is made (a step's fixed cost is its numpy calls).
+    """
+    every = xp.all(live)
+    delta_c, integral = command(action, state, live)
+    if not every:
+        delta_c = xp.where(live, delta_c, state.delta_c)
+        integral = xp.where(live, integral, state.integral)
+    trajectory = plant(state, delta_c, live)
+    last = trajectory[..., -1, :]
+    finite = xp.all_finite(last)
+    moved = every and xp.all(finite)  # every row advances
+    advance = live if moved else live & finite
+    steps = state.steps + 1
+    if every:
+        t = steps * k.control_period
+    else:
+        steps = xp.where(live, steps, state.steps)
+        t = xp.where(live, steps * k.control_period, state.t)
+    x = last.copy() if moved else xp.where_rows(advance, last, state.x)
+    px, py, heading, yaw_rate = xp.columns(x, (k.ix, k.iy, k.ipsi, k.ir))  # true, at the end
+    speed = state.speed
+    if k.substeps > 1:  # U over the last substep
+        bx, by = xp.columns(trajectory[..., -2, :], (k.ix, k.iy))
+        speed = speed_over_ground(px - bx, py - by, k, xp)
+        if not moved:
+            speed = xp.where(advance, speed, state.speed)
+    if moved:
+        psi, r = heading, yaw_rate
+    else:  # the rows that do not advance keep their last measurement
+        psi, r = xp.where(advance, heading, state.psi_m), xp.where(advance, yaw_rate, state.r_m)
+    new = EnvState(x, steps, t, delta_c, psi, r, speed, integral)
+    new.psi_m, new.r_m = measure(trajectory, state, new, advance)
+    if moved:
+        frame = tracker.update(px, py)
+    else:
+        frame = tracker.update(px, py, advance) if xp.any(advance) else tracker.frame
+    heading_error = wrap_angle(heading - frame.path_angle)
+    reward = step_reward(frame.cross_track, heading_error, delta_c, state.delta_c, k, xp)
+    reward, goal, corridor, truncated = terminate(reward, frame, steps, k, xp)
+    if moved:
+        diverged = xp.logical_not(live)  # none
+        return new, Period(frame, heading_error, reward, goal, corridor, diverged, truncated)
+    diverged = live & xp.logical_not(finite)
+    reward = xp.where(diverged, diverged_reward(steps, k), reward)
+    return new, Period(
+        frame=frame,
+        heading_error=heading_error,
+        reward=xp.where(live, reward, 0.0),
+        goal=goal & advance,
+        corridor=corridor & advance,
+        diverged=diverged,
+        truncated=truncated & advance,
+    )
+
+
 # ---------------------------------------------------------------------------------- observation
 def observation_columns(
     frame: TrackFrame,
@@ -490,7 +666,7 @@ def batch_observation(
         frame, heading, yaw_rate, rudder_angle, rudder_command, speed, k, ARRAY
     )
     obs = np.stack(columns, axis=1).astype(np.float32)
-    np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+    obs.clip(OBS_LOW, OBS_HIGH, out=obs)
     if context is None:
         return obs
     return np.concatenate(
@@ -522,7 +698,7 @@ class ObservationHistory:
     """
 
     def __init__(self, n_rows: int, history_steps: int) -> None:
-        self.history_steps = check_history_steps(history_steps)
+        self.history_steps = history_steps
         self.window = np.zeros((n_rows, HISTORY_WIDTH * self.history_steps), dtype=np.float32)
         #: each row's observation at its last update (the start of its pending step)
         self._last = np.zeros((n_rows, len(OBS_NAMES)), dtype=np.float32)
@@ -671,7 +847,7 @@ def check_action(action: Any, shape: tuple[int, ...]) -> np.ndarray:
         values = np.asarray(action, dtype=np.float64).reshape(shape)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"action must be an array of shape {shape}, got {action!r}") from exc
-    if not np.isfinite(values).all():
+    if not all(map(math.isfinite, values.ravel().tolist())):
         raise ValueError(f"action contains NaN or inf: {action!r}; the env state is unchanged")
     return values
 

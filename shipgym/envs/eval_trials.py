@@ -80,7 +80,6 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         row_infos: str = "all",
         history_steps: int = 0,
     ) -> None:
-        history_steps = core.check_history_steps(history_steps)
         if row_infos not in ROW_INFOS:
             raise RowInfosError(f"row_infos must be one of {ROW_INFOS}, got {row_infos!r}")
         if row_infos == "end" and samples:
@@ -133,7 +132,8 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
             self._install(i, trial)
             trackers.append(trial.tracker)
         k = self._k0
-        self._tracks = RouteGroups(trackers, self._state[:, k.ix], self._state[:, k.iy])
+        x = self._state.x
+        self._tracks = RouteGroups(trackers, x[:, k.ix], x[:, k.iy])
         self.finished[:] = False
         self._started = True
         self._reached_goal = np.zeros(self.num_envs, dtype=bool)
@@ -163,14 +163,14 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
         rows = live.nonzero()[0]
         if rows.size:  # the live rows step together: one step count
-            step = int(self._steps[rows[0]])
+            step = int(self._state.steps[rows[0]])
             frame = period.frame
             self._write_columns(rows, step, frame.cross_track, period.heading_error, period.reward)
         reasons = period.reasons() if ended.any() else None
         for i in (rows if self.row_infos == "all" else ended.nonzero()[0]).tolist():
             info = self._row_info(i)
-            if i in period.samples:
-                info["samples"] = period.samples[i]
+            if i in self._samples:
+                info["samples"] = self._samples[i]
             if ended[i]:
                 self._reached_goal[i] = bool(period.goal[i])
                 info["termination_reason"] = reasons[i]
@@ -195,12 +195,12 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
             raise RuntimeError("call reset() before abandon()")
         if self.finished[i]:
             raise ValueError(f"row {i} has finished: it cannot be abandoned")
-        k = self._k0
-        self._steps[i] += 1
-        step = int(self._steps[i])
-        self._t[i] = step * k.control_period
+        k, s = self._k0, self._state
+        s.steps[i] += 1
+        step = int(s.steps[i])
+        s.t[i] = step * k.control_period
         frame = self._tracks.frame
-        heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
+        heading_error = wrap_angle(s.x[:, k.ipsi] - frame.path_angle)
         reward = np.zeros(self.num_envs)
         reward[i] = core.diverged_reward(step, self._trials[i].constants)
         self._write_columns(np.array([i]), step, frame.cross_track, heading_error, reward)
@@ -219,21 +219,21 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
         reward: np.ndarray | None,
     ) -> None:
         """Column ``step`` (0: the reset) of the ``rows``' episode columns (_COLUMNS)."""
-        k = self._k0
+        k, s = self._k0, self._state
         whole = rows.size == self.num_envs  # every row: no gathers
 
         def take(values: np.ndarray) -> np.ndarray:
             return values if whole else values[rows]
 
-        state = take(self._state)
+        state = take(s.x)
         values = [
-            take(self._t),
+            take(s.t),
             state[:, k.ix],
             state[:, k.iy],
             take(cross_track),
-            take(self._psi_m),
+            take(s.psi_m),
             state[:, k.idelta],
-            take(self._delta_c),
+            take(s.delta_c),
         ]
         if heading_error is not None:
             values += [take(heading_error), take(reward)]
@@ -242,29 +242,29 @@ class EvaluationTrialsVectorEnv(TrialRowsVectorEnv):
     def trajectory(self, i: int) -> dict[str, np.ndarray]:
         """Row i's trajectory so far: per key of ``core.TRAJECTORY_KEYS`` its values at the
         reset and each control step (the rows' ``info`` values, bit for bit)."""
-        n = int(self._steps[i]) + 1
+        n = int(self._state.steps[i]) + 1
         return {
             name: self._columns[j, i, :n].copy()
             for name, j in zip(core.TRAJECTORY_KEYS, _TRAJECTORY, strict=True)
         }
 
     def _row_info(self, i: int) -> dict[str, Any]:
-        k = self._k0
-        x, y = float(self._state[i, k.ix]), float(self._state[i, k.iy])
+        k, s = self._k0, self._state
+        x, y = float(s.x[i, k.ix]), float(s.x[i, k.iy])
         return core.info_values(
-            float(self._t[i]),
+            float(s.t[i]),
             self._tracks.row_frame(i),
-            float(self._psi_m[i]),
-            float(self._r_m[i]),
-            float(self._state[i, k.idelta]),
-            float(self._delta_c[i]),
+            float(s.psi_m[i]),
+            float(s.r_m[i]),
+            float(s.x[i, k.idelta]),
+            float(s.delta_c[i]),
             (x, y),
         )
 
     def episode_metrics(self, i: int) -> dict[str, Any]:
         """Row i's episode metrics so far (the single env's ``episode_metrics()``)."""
         sc = self.scenarios[i]
-        steps = int(self._steps[i])
+        steps = int(self._state.steps[i])
         columns = {
             name: self._columns[j, i, 1 : steps + 1].copy()
             for name, j in zip(core.LOG_FIELDS, _LOG, strict=True)

@@ -41,7 +41,7 @@ has the same length (vector envs stack infos across sub-envs).
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -245,7 +245,6 @@ class ShipPathFollowEnv(gym.Env):
         history_steps: int = 0,
         randomize: bool = False,
     ) -> None:
-        history_steps = core.check_history_steps(history_steps)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -260,14 +259,15 @@ class ShipPathFollowEnv(gym.Env):
         self._randomization = env_randomization() if randomize else None
         #: the observation ends with the controller-context features (core.CONTEXT_NAMES)
         self.context_features = context_features
-        #: K: the observation ends with the last K control steps (core.ObservationHistory)
-        self.history_steps = history_steps
-        self._history = core.ObservationHistory(1, history_steps) if history_steps else None
+        self.history_steps = history_steps  # checked by the parts' build, then read back
         self.action_mode = action_mode
         self.render_mode = render_mode
         self._compile = compile
         self._fig = None
         self.use_scenario(self.base_scenario)
+        #: K: the observation ends with the last K control steps (core.ObservationHistory)
+        self.history_steps = k = self._parts.history_steps
+        self._history = core.ObservationHistory(1, k) if k else None
         self.action_space = self._parts.action_space
         self.observation_space = self._parts.observation_space
 
@@ -298,7 +298,10 @@ class ShipPathFollowEnv(gym.Env):
         self._w_block[:] = self._disturbances.constant_row()
         self._p_block = np.zeros((k.substeps, self.model.n_params))
         self._sample_offsets = k.fine_step * np.arange(k.substeps)
-        self._state: np.ndarray | None = None
+        #: the period state (None until reset)
+        self._state: core.EnvState | None = None
+        #: the last period's ``info["samples"]`` (module doc)
+        self._samples: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ public helpers
     @property
@@ -315,11 +318,7 @@ class ShipPathFollowEnv(gym.Env):
             draws = draw_trial(self._randomization, self.np_random)
             self.use_scenario(apply_trial(self.base_scenario, draws))
         sc, k = self.scenario, self._k
-        self._state = x = sc.initial_state()
-        self._step_count = 0
-        self._t = 0.0
-        self._delta_c = 0.0
-        self._integral = 0.0  # guidance mode: the heading PID's integral
+        x = sc.initial_state()
         self._p_block[:] = sc.schedule.vector_at(0.0)
         self._p_block_dirty = False
         self._disturbances.reset(0, self.np_random)  # before the sensor's draws
@@ -327,11 +326,20 @@ class ShipPathFollowEnv(gym.Env):
         psi_m, r_m = self._sensor.measure(
             x[k.ipsi : k.ipsi + 1], x[k.ir : k.ir + 1], self.np_random
         )
-        self._psi_m, self._r_m = float(psi_m[0]), float(r_m[0])
+        self._state = core.EnvState(
+            x=x,
+            steps=0,
+            t=0.0,
+            delta_c=0.0,
+            psi_m=float(psi_m[0]),
+            r_m=float(r_m[0]),
+            speed=k.nominal_speed,
+            integral=0.0,  # guidance mode: the heading PID's integral
+        )
         frame = self._tracker.reset(float(x[k.ix]), float(x[k.iy]))
-        self._speed = k.nominal_speed
         self._track = [(float(x[k.ix]), float(x[k.iy]))]
-        self._log: dict[str, list[float]] = {name: [] for name in LOG_FIELDS}
+        #: per control step the LOG_FIELDS values (true errors, for the metrics)
+        self._log: list[tuple[float, ...]] = []
         self._w_log: list[np.ndarray] = []
         self._reached_goal = False
         if self._history is not None:
@@ -341,81 +349,13 @@ class ShipPathFollowEnv(gym.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._state is None:
             raise RuntimeError("call reset() before step()")
-        a = self._check_action(action)
-        frame = self._tracker.frame
-        sc, k = self.scenario, self._k
-        # --- action -> rudder command (rad)
-        if self.action_mode == "rudder":
-            delta_c = a[0] * k.rudder_limit
-        else:
-            delta_c, self._integral = core.guidance_command(
-                a[0], a[1], frame, self._psi_m, self._r_m, self._integral, self._parts, SCALAR
-            )
-        prev_delta_c = self._delta_c
-        # --- true parameters and disturbances of the period, then the plant
-        t0 = self._t
-        self._p_block_dirty = core.refresh_parameters(
-            sc.schedule, t0, k, self._p_block, self._p_block_dirty
+        a, s = self._check_action(action), self._state
+        self._state, period = core.transition(
+            s, a, True, self._k, SCALAR, self._command, self._plant, self._measure, self._tracker
         )
-        if self._disturbances.time_varying:
-            self._disturbances.fill_one(self._w_block, t0, self.np_random)
-            self._w_log.append(self._w_block.copy())
-        else:
-            self._w_log.append(self._w_block)  # the constant block, never written again
-        trajectory = self._integrator(self._state, delta_c, self._w_block, self._p_block)
-        self._step_count += 1
-        self._t = self._step_count * k.control_period
-        self._delta_c = delta_c
         if self._history is not None:
             self._history.stepped()
-        # NaN/inf propagate through RK4: checking the final state suffices
-        if not all(map(math.isfinite, trajectory[-1].tolist())):
-            return self._non_finite_step(frame, delta_c)
-        states = trajectory[1:]  # ends of the substeps
-        # fine samples at the substep *starts* t0, t0+h, …, t0+Ts−h (module doc)
-        start = trajectory[:-1]
-        e_samples = self._tracker.cross_track_of(start[:, k.ix], start[:, k.iy])
-        psi_m0, r_m0 = self._psi_m, self._r_m
-        self._state = x = states[-1]
-        px, py = float(x[k.ix]), float(x[k.iy])
-        self._track.append((px, py))
-        # --- sensors
-        psi_m, r_m = self._sensor.measure(states[:, k.ipsi], states[:, k.ir], self.np_random)
-        self._psi_m, self._r_m = float(psi_m[-1]), float(r_m[-1])
-        if k.substeps > 1:
-            dx = float(states[-1, k.ix]) - float(states[-2, k.ix])
-            dy = float(states[-1, k.iy]) - float(states[-2, k.iy])
-            self._speed = core.speed_over_ground(dx, dy, k, SCALAR)
-        # --- path, reward (true state), termination
-        frame = self._tracker.update(px, py)
-        heading_error = wrap_angle(float(x[k.ipsi]) - frame.path_angle)
-        reward = core.step_reward(
-            frame.cross_track, heading_error, delta_c, prev_delta_c, k, SCALAR
-        )
-        reward, goal, corridor, truncated = core.terminate(
-            reward, frame, self._step_count, k, SCALAR
-        )
-        terminated = goal or corridor
-        self._reached_goal = goal
-        self._record(frame.cross_track, heading_error, float(x[k.idelta]), delta_c, reward)
-        samples = {
-            "t": t0 + self._sample_offsets,
-            "psi": np.concatenate(([psi_m0], psi_m[:-1])),
-            "r": np.concatenate(([r_m0], r_m[:-1])),
-            "delta": start[:, k.idelta],  # a view into this step's fresh trajectory
-            "delta_c": np.full(k.substeps, delta_c),
-            "e": e_samples,
-        }
-        info = self._info(frame)
-        info["samples"] = samples
-        if terminated or truncated:
-            info["termination_reason"] = (
-                "goal" if goal else "corridor" if corridor else "time_limit"
-            )
-            info["episode_metrics"] = self.episode_metrics()
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(frame), float(reward), terminated, truncated, info
+        return self._end_step(period)
 
     # ------------------------------------------------------------------ pieces
     def _check_action(self, action: Any) -> list[float]:
@@ -423,22 +363,59 @@ class ShipPathFollowEnv(gym.Env):
         values = core.check_action(action, self.action_space.shape).tolist()
         return [min(1.0, max(-1.0, v)) for v in values]
 
-    def _observation(self, frame: Any) -> np.ndarray:
+    def _command(self, a: list[float], s: core.EnvState, live: bool) -> tuple[float, float]:
+        """The period's rudder command [rad] and PID integral (core.transition's command)."""
+        return core.rudder_command(a, s, self._tracker.frame, self._parts, SCALAR)
+
+    def _plant(self, s: core.EnvState, delta_c: float, live: bool) -> np.ndarray:
+        """The period's true parameters and disturbances, then the plant: the (n_sub + 1,
+        n_x) states at t0, t0 + h, …, t0 + Ts, a fresh array (core.transition's plant)."""
+        self._p_block_dirty = core.refresh_parameters(
+            self.scenario.schedule, s.t, self._k, self._p_block, self._p_block_dirty
+        )
+        if self._disturbances.time_varying:
+            self._disturbances.fill_one(self._w_block, s.t, self.np_random)
+            self._w_log.append(self._w_block.copy())
+        else:
+            self._w_log.append(self._w_block)  # the constant block, never written again
+        return self._integrator(s.x, delta_c, self._w_block, self._p_block)
+
+    def _measure(
+        self, trajectory: np.ndarray, s: core.EnvState, new: core.EnvState, advance: bool
+    ) -> tuple[float, float]:
+        """The sensors over the period's substeps (core.transition's measure), and the
+        period's ``samples`` at the substep starts t0, t0+h, …, t0+Ts−h (module doc)."""
+        if not advance:
+            return new.psi_m, new.r_m
         k = self._k
+        start, states = trajectory[:-1], trajectory[1:]
+        psi_m, r_m = self._sensor.measure(states[:, k.ipsi], states[:, k.ir], self.np_random)
+        self._samples = {
+            "t": s.t + self._sample_offsets,
+            "psi": np.concatenate(([s.psi_m], psi_m[:-1])),
+            "r": np.concatenate(([s.r_m], r_m[:-1])),
+            "delta": start[:, k.idelta],  # a view into this step's fresh trajectory
+            "delta_c": np.full(k.substeps, new.delta_c),
+            "e": self._tracker.cross_track_of(start[:, k.ix], start[:, k.iy]),
+        }
+        return float(psi_m[-1]), float(r_m[-1])
+
+    def _observation(self, frame: Any) -> np.ndarray:
+        s, k = self._state, self._k
         obs = np.array(
             core.observation_columns(
                 frame,
-                self._psi_m,
-                self._r_m,
-                float(self._state[k.idelta]),
-                self._delta_c,
-                self._speed,
+                s.psi_m,
+                s.r_m,
+                float(s.x[k.idelta]),
+                s.delta_c,
+                s.speed,
                 k,
                 SCALAR,
             ),
             dtype=np.float32,
         )
-        np.clip(obs, OBS_LOW, OBS_HIGH, out=obs)
+        obs.clip(OBS_LOW, OBS_HIGH, out=obs)
         if self.context_features:
             obs = np.concatenate([obs, self._parts.context_row])
         if self._history is not None:
@@ -446,32 +423,43 @@ class ShipPathFollowEnv(gym.Env):
         return obs
 
     def _info(self, frame: Any) -> dict[str, Any]:
-        x, k = self._state, self._k
+        s, k = self._state, self._k
+        x = s.x
         return core.info_values(
-            self._t,
+            s.t,
             frame,
-            self._psi_m,
-            self._r_m,
+            s.psi_m,
+            s.r_m,
             float(x[k.idelta]),
-            self._delta_c,
+            s.delta_c,
             (float(x[k.ix]), float(x[k.iy])),
         )
 
-    def _non_finite_step(self, frame: Any, delta_c: float, reason: str = "non_finite_state"):
-        """The plant produced NaN/inf: keep the last finite state and terminate with a reason.
-
-        The penalty is that of leaving the corridor; the step is logged like any other, so
-        ``episode_metrics`` count it.  ``info`` has no ``samples`` (none are valid).
-        """
-        k = self._k
-        reward = core.diverged_reward(self._step_count, k)
-        x = self._state
-        heading_error = wrap_angle(float(x[k.ipsi]) - frame.path_angle)
-        self._record(frame.cross_track, heading_error, float(x[k.idelta]), delta_c, reward)
+    def _end_step(
+        self, period: core.Period, reason: str | None = None
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """The step's log entry and return values after ``period``; ``reason``: the end of
+        an abandoned episode.  A non-finite plant state (or an abandoned episode) is
+        charged the corridor penalty from the step before and logged like any other step,
+        so ``episode_metrics`` count it; its ``info`` has no ``samples`` (none are valid)."""
+        s, k, frame = self._state, self._k, period.frame
+        x = s.x
+        reward = period.reward
+        self._record(frame.cross_track, period.heading_error, float(x[k.idelta]), s.delta_c, reward)
         info = self._info(frame)
-        info["termination_reason"] = reason
-        info["episode_metrics"] = self.episode_metrics()
-        return self._observation(frame), float(reward), True, False, info
+        moved = not period.diverged
+        if moved:
+            self._track.append((float(x[k.ix]), float(x[k.iy])))
+            self._reached_goal = period.goal
+            info["samples"] = self._samples
+        reason = reason or period.reasons()
+        if reason is not None:
+            info["termination_reason"] = reason
+            info["episode_metrics"] = self.episode_metrics()
+        if moved and self.render_mode == "human":
+            self.render()
+        obs = self._observation(frame)
+        return obs, float(reward), period.terminated, period.truncated, info
 
     def abandon(self, reason: str) -> dict[str, Any]:
         """End the episode now, for a cause outside the plant (e.g. its controller gave no
@@ -482,24 +470,27 @@ class ShipPathFollowEnv(gym.Env):
         """
         if self._state is None:
             raise RuntimeError("call reset() before abandon()")
-        self._step_count += 1
-        self._t = self._step_count * self._k.control_period
+        s, k = self._state, self._k
+        steps = s.steps + 1
+        self._state = dataclasses.replace(s, steps=steps, t=steps * k.control_period)
         if self._history is not None:
             self._history.stepped()
-        return self._non_finite_step(self._tracker.frame, self._delta_c, reason)[4]
+        frame = self._tracker.frame
+        heading_error = wrap_angle(float(s.x[k.ipsi]) - frame.path_angle)
+        reward = core.diverged_reward(steps, k)
+        period = core.Period(frame, heading_error, reward, False, False, True, False)
+        return self._end_step(period, reason)[4]
 
     def _record(
         self, e: float, heading_error: float, delta: float, delta_c: float, reward: float
     ) -> None:
-        """Append one control step to the episode log (columns in LOG_FIELDS order)."""
-        for column, value in zip(
-            self._log.values(), (self._t, e, heading_error, delta, delta_c, reward), strict=True
-        ):
-            column.append(value)
+        """Append one control step to the episode log (LOG_FIELDS order)."""
+        self._log.append((self._state.t, e, heading_error, delta, delta_c, reward))
 
     def episode_log(self) -> EpisodeLog:
         """The control-step log of the current episode (true errors, for the metrics)."""
-        columns = {name: np.array(values) for name, values in self._log.items()}
+        table = np.array(self._log, dtype=float).reshape(-1, len(LOG_FIELDS))
+        columns = {name: table[:, j].copy() for j, name in enumerate(LOG_FIELDS)}
         return core.episode_log(columns, self.scenario, self._reached_goal)
 
     def episode_metrics(self) -> dict[str, Any]:
@@ -525,17 +516,17 @@ class ShipPathFollowEnv(gym.Env):
         ``oracle`` and ``oracle_frozen`` only."""
         if self._state is None:
             raise RuntimeError("call reset() before plant_truth()")
-        sc = self.scenario
-        if self._disturbances.time_varying and self._step_count > 0:
+        sc, s = self.scenario, self._state
+        if self._disturbances.time_varying and s.steps > 0:
             now = self._w_block[-1].copy()  # the last substep's disturbances
             waves = self._disturbances.wave_row()
         else:
-            now = self._disturbances.mean_rows(np.array([self._t]))[0]
+            now = self._disturbances.mean_rows(np.array([s.t]))[0]
             waves = np.zeros_like(now)
         return PlantTruth(
-            t=self._t,
-            state=self._state.copy(),
-            params=sc.schedule.record_at(self._t),
+            t=s.t,
+            state=s.x.copy(),
+            params=sc.schedule.record_at(s.t),
             disturbance_now=now,
             wave_now=waves,
         )
@@ -543,13 +534,13 @@ class ShipPathFollowEnv(gym.Env):
     @property
     def pose(self) -> tuple[float, float, float]:
         """True position x, y [m] and heading ψ [rad] now (for rendering and analysis)."""
-        x, k = self._state, self._k
+        x, k = self._state.x, self._k
         return float(x[k.ix]), float(x[k.iy]), float(x[k.ipsi])
 
     @property
     def time(self) -> float:
         """Simulation time [s] now."""
-        return self._t
+        return self._state.t
 
     @property
     def frame(self) -> TrackFrame | None:

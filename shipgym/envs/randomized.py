@@ -18,7 +18,6 @@ from typing import Any, ClassVar
 import gymnasium as gym
 import numpy as np
 
-from shipgym.envs.core import check_history_steps
 from shipgym.envs.path_follow import ShipPathFollowEnv
 from shipgym.scenarios.loader import build_scenario
 from shipgym.scenarios.sampling import (
@@ -78,8 +77,6 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         context_features: bool = False,
         history_steps: int = 0,
     ) -> None:
-        #: K: the observation ends with the last K control steps (as the single env)
-        self.history_steps = check_history_steps(history_steps)
         self.distribution = (
             distribution
             if isinstance(distribution, ScenarioDistribution)
@@ -90,7 +87,9 @@ class ShipPathFollowRandomizedEnv(gym.Env):
         self._compile = compile
         self.context_features = context_features
         self._next_test_index = 0
-        self._env = self._make_env(self._first_config())
+        self._env = self._make_env(self._first_config(), history_steps)
+        #: K: the observation ends with the last K control steps (as the single env)
+        self.history_steps = self._env.history_steps
         self.action_space = self._env.action_space
         self.observation_space = self._env.observation_space
 
@@ -99,14 +98,14 @@ class ShipPathFollowRandomizedEnv(gym.Env):
             return self.distribution.test_scenario(0)
         return self.distribution.sample(train_rng(0))
 
-    def _make_env(self, config) -> ShipPathFollowEnv:
+    def _make_env(self, config, history_steps: int) -> ShipPathFollowEnv:
         return ShipPathFollowEnv(
             build_scenario(config, config.name),
             action_mode=self.action_mode,
             render_mode=self.render_mode,
             compile=self._compile,
             context_features=self.context_features,
-            history_steps=self.history_steps,
+            history_steps=history_steps,
         )
 
     def reset(

@@ -103,17 +103,19 @@ class RouteGroups:
     def _take(self, a: np.ndarray, rows: np.ndarray) -> np.ndarray:
         return a if self._whole else a[rows]
 
-    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
-        """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
+    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray | None = None) -> TrackFrame:
+        """Move on the ``advance`` rows (None: all) to positions (x, y) [m] (arrays over all
+        rows); returns the rows' frame."""
         for g, (rows, tracker) in enumerate(self.groups):  # PathTracker(batch) or RowTrackers
-            mask = self._take(advance, rows)
-            moving = int(mask.sum())
+            mask = None if advance is None else self._take(advance, rows)
+            moving = len(rows) if mask is None else int(mask.sum())
             if not moving:
                 continue
             if isinstance(tracker, PathTracker) and moving < MIN_BATCHED_ROWS[_kind(tracker)]:
                 tracker = self._to_scalar(g)
             tracker.update(self._take(x, rows), self._take(y, rows), mask)
         self._gather()
+        return self.frame
 
     def _to_scalar(self, g: int) -> RowTrackers:
         """Group g's batched tracker as one scalar tracker per row, in the same state."""
@@ -182,12 +184,15 @@ class RowTrackers:
         self._frames[i] = tracker.frame
         self._frame = None
 
-    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray) -> None:
-        """Move on the ``advance`` rows to positions (x, y) [m] (arrays over all rows)."""
+    def update(self, x: np.ndarray, y: np.ndarray, advance: np.ndarray | None = None) -> TrackFrame:
+        """Move on the ``advance`` rows (None: all) to positions (x, y) [m] (arrays over all
+        rows); returns the rows' frame."""
         xs, ys = x.tolist(), y.tolist()
-        for i in np.flatnonzero(advance).tolist():
+        rows = range(len(xs)) if advance is None else np.flatnonzero(advance).tolist()
+        for i in rows:
             self._frames[i] = self._trackers[i].update(xs[i], ys[i])
         self._frame = None
+        return self.frame
 
     @property
     def frame(self) -> TrackFrame:

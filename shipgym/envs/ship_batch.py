@@ -84,7 +84,6 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
     ) -> None:
         if not (isinstance(num_envs, int) and num_envs >= 1):
             raise ValueError(f"num_envs must be an int ≥ 1, got {num_envs!r}")
-        history_steps = core.check_history_steps(history_steps)
         dist = (
             distribution
             if isinstance(distribution, ScenarioDistribution)
@@ -178,5 +177,5 @@ class ShipTrialsVectorEnv(TrialRowsVectorEnv):
         for i in np.flatnonzero(mask).tolist():
             trial = self._new_trial(i)
             self._install(i, trial)
-            x, y = float(self._state[i, k.ix]), float(self._state[i, k.iy])
+            x, y = float(self._state.x[i, k.ix]), float(self._state.x[i, k.iy])
             self._tracks.install(i, trial.tracker, x, y)

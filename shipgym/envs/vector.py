@@ -34,7 +34,6 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from shipgym.angles import wrap_angle
 from shipgym.disturbances import Disturbances, SensorModel
 from shipgym.envs import core
 from shipgym.envs.core import LOG_FIELDS
@@ -66,7 +65,6 @@ class ShipPathFollowVectorEnv(VectorEnv):
         history_steps: int = 0,
         randomize: bool = False,
     ) -> None:
-        history_steps = core.check_history_steps(history_steps)
         if not isinstance(randomize, bool):
             raise ValueError(f"randomize must be True or False, got {randomize!r}")
         if num_envs < 1:
@@ -90,8 +88,8 @@ class ShipPathFollowVectorEnv(VectorEnv):
         #: the observation ends with the controller-context features (as the single env)
         self.context_features = context_features
         #: K: then the last K control steps (as the single env)
-        self.history_steps = history_steps
-        self._history = core.ObservationHistory(num_envs, history_steps) if history_steps else None
+        self.history_steps = k = parts.history_steps
+        self._history = core.ObservationHistory(num_envs, k) if k else None
         self.num_envs = num_envs
         #: the scenario as given (with ``randomize`` each env's reset draws a trial of it)
         self.scenario = sc
@@ -130,15 +128,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         self._sensors = [SensorModel(sc.config.sensors) for _ in range(num_envs)]
         self._ideal = self._sensors[0].ideal
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
-        # state
-        self._state = np.zeros((num_envs, sc.model.n_states))
-        self._steps = np.zeros(num_envs, dtype=np.int64)
-        self._t = np.zeros(num_envs)
-        self._delta_c = np.zeros(num_envs)
-        self._psi_m = np.zeros(num_envs)
-        self._r_m = np.zeros(num_envs)
-        self._speed = np.zeros(num_envs)
-        self._integral = np.zeros(num_envs)  # guidance mode: the heading PIDs' integrals
+        self._state = core.EnvState.rows(num_envs, sc.model.n_states)
         self._autoreset = np.zeros(num_envs, dtype=bool)
         self._log = np.zeros(
             (len(LOG_FIELDS), num_envs, min(k.max_steps, self.max_episode_steps) + 1)
@@ -162,105 +152,38 @@ class ShipPathFollowVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before step()")
         a = core.batch_actions(actions, self.action_space.shape)
         k = self._k
-        n = self.num_envs
-        reasons = np.full(n, None, dtype=object)
         resetting = self._autoreset.copy()
-        live = ~resetting
+        live = ~resetting  # envs being autoreset ignore their action
         if np.any(resetting):
             self._reset_envs(resetting)
-        # --- action -> rudder command; envs being autoreset ignore their action
-        if self.action_mode == "rudder":
-            delta_c = a[:, 0] * k.rudder_limit
-        else:
-            delta_c, integral = core.guidance_command(
-                a[:, 0],
-                a[:, 1],
-                self._tracker.frame,
-                self._psi_m,
-                self._r_m,
-                self._integral,
-                self._parts,
-                ARRAY,
-            )
-            self._integral = np.where(live, integral, self._integral)
-        delta_c = np.where(live, delta_c, self._delta_c)
-        prev_delta_c = self._delta_c.copy()
-        # --- true parameters of the period (per env: times differ after resets)
-        t0 = self._t.copy()
-        self._refresh_parameters(t0, live)
-        # --- disturbances of the period: noise per env (its generator, the single env's
-        # order), the processes over all advancing ships at once
-        if self._disturbances.time_varying and np.any(live):
-            rows = np.flatnonzero(live)
-            if self._row_disturbances is not None:  # each env's trial has its own current
-                for i in rows.tolist():
-                    self._row_disturbances[i].fill_one(
-                        self._w_block[i], float(t0[i]), self._rngs[i]
-                    )
-            else:
-                dist = self._disturbances
-                noise = [dist.draw(self._rngs[i]) for i in rows] if dist.n_noise else None
-                dist.fill(self._w_block, t0[rows], None if noise is None else np.stack(noise), rows)
-        # --- plant: one call for all ships
-        # states at t0 + h … t0 + Ts (the integrator's buffer, valid until the next step)
-        traj = self._integrator.substep_states(self._state, delta_c, self._w_block, self._p_block)
-        steps = np.where(live, self._steps + 1, self._steps)
+        self._state, period = core.transition(
+            self._state, a, live, k, ARRAY, self._command, self._plant, self._measure, self._tracker
+        )
         if self._history is not None:
             self._history.stepped(live)
-        finite = np.all(np.isfinite(traj[:, -1]), axis=1)
-        advance = live & finite
-        self._steps = steps
-        self._t = np.where(live, steps * k.control_period, self._t)
-        self._delta_c = np.where(live, delta_c, self._delta_c)
-        self._state = np.where(advance[:, None], traj[:, -1], self._state)
-        # --- sensors
-        if self._ideal:
-            psi_m, r_m = traj[:, -1, k.ipsi], traj[:, -1, k.ir]
-        else:
-            psi_m, r_m = self._psi_m.copy(), self._r_m.copy()
-            for i in np.flatnonzero(advance):
-                p_i, r_i = self._sensors[i].measure(
-                    traj[i, :, k.ipsi], traj[i, :, k.ir], self._rngs[i]
-                )
-                psi_m[i], r_m[i] = p_i[-1], r_i[-1]
-        self._psi_m = np.where(advance, psi_m, self._psi_m)
-        self._r_m = np.where(advance, r_m, self._r_m)
-        if k.substeps > 1:
-            dx = traj[:, -1, k.ix] - traj[:, -2, k.ix]
-            dy = traj[:, -1, k.iy] - traj[:, -2, k.iy]
-            self._speed = np.where(advance, core.speed_over_ground(dx, dy, k, ARRAY), self._speed)
-        # --- path, reward (true state), termination
-        frame = self._tracker.update(self._state[:, k.ix], self._state[:, k.iy], advance)
-        heading_error = wrap_angle(self._state[:, k.ipsi] - frame.path_angle)
-        reward = core.step_reward(frame.cross_track, heading_error, delta_c, prev_delta_c, k, ARRAY)
-        reward, goal, corridor, truncated = core.terminate(reward, frame, steps, k, ARRAY)
-        truncated = truncated | ~(goal | corridor) & (steps >= self.max_episode_steps)
-        goal, corridor, truncated = goal & advance, corridor & advance, truncated & advance
-        diverged = live & ~finite
-        reward = np.where(diverged, core.diverged_reward(steps, k), reward)
-        terminated = goal | corridor | diverged
-        rewards = np.where(live, reward, 0.0)
-        reasons[goal] = "goal"
-        reasons[corridor] = "corridor"
-        reasons[diverged] = "non_finite_state"
-        reasons[truncated] = "time_limit"
+        s = self._state
+        if self.max_episode_steps < k.max_steps:  # as a TimeLimit wrapper of single envs
+            time_up = live & ~period.terminated & (s.steps >= self.max_episode_steps)
+            period.truncated = period.truncated | time_up
         # --- episode log (true values), one column per control step
         rows = np.flatnonzero(live)
-        col = steps[rows] - 1
+        col = s.steps[rows] - 1
+        e, heading_error = period.frame.cross_track, period.heading_error
         for j, values in enumerate(
-            (self._t, frame.cross_track, heading_error, self._state[:, k.idelta], delta_c, rewards)
+            (s.t, e, heading_error, s.x[:, k.idelta], s.delta_c, period.reward)
         ):
             self._log[j, rows, col] = values[rows]
+        terminated, truncated = period.terminated, period.truncated
         done = terminated | truncated
         info = self._info()
         if np.any(done):
-            info["termination_reason"] = reasons
+            info["termination_reason"] = period.reasons()
             info["_termination_reason"] = done
             if self.episode_metrics:
-                info["episode_metrics"] = self._stacked_metrics(done, goal)
+                info["episode_metrics"] = self._stacked_metrics(done, period.goal)
                 info["_episode_metrics"] = done
         self._autoreset = done
-        return self._observation(), rewards, terminated, truncated, info
+        return self._observation(), period.reward, terminated, truncated, info
 
     def reset_finished(self) -> tuple[np.ndarray, np.ndarray]:
         """Reset now the envs whose episode ended at the last step (instead of at the next
@@ -274,19 +197,19 @@ class ShipPathFollowVectorEnv(VectorEnv):
 
     # ------------------------------------------------------------------ pieces
     def _reset_envs(self, mask: np.ndarray) -> None:
-        sc, k = self.scenario, self._k
+        sc, k, s = self.scenario, self._k, self._state
         if self._randomization is None:
-            self._state[mask] = sc.initial_state()
+            s.x[mask] = sc.initial_state()
             self._p_block[mask] = sc.schedule.vector_at(0.0)
         else:
             for i in np.flatnonzero(mask).tolist():
                 self._install_trial(i)
-        self._steps[mask] = 0
-        self._t[mask] = 0.0
-        self._delta_c[mask] = 0.0
-        self._integral[mask] = 0.0
+        s.steps[mask] = 0
+        s.t[mask] = 0.0
+        s.delta_c[mask] = 0.0
+        s.integral[mask] = 0.0
         self._p_dirty[mask] = False
-        self._speed[mask] = k.nominal_speed
+        s.speed[mask] = k.nominal_speed
         self._log[:, mask] = 0.0
         if self._history is not None:
             self._history.restart(mask)
@@ -297,13 +220,13 @@ class ShipPathFollowVectorEnv(VectorEnv):
             else:
                 self._row_disturbances[i].reset(0, self._rngs[i])
             sensor.reset()
-            x = self._state[i]
+            x = s.x[i]
             if self._ideal:
-                self._psi_m[i], self._r_m[i] = x[k.ipsi], x[k.ir]
+                s.psi_m[i], s.r_m[i] = x[k.ipsi], x[k.ir]
             else:
                 p_i, r_i = sensor.measure(x[k.ipsi : k.ipsi + 1], x[k.ir : k.ir + 1], self._rngs[i])
-                self._psi_m[i], self._r_m[i] = p_i[0], r_i[0]
-        self._tracker.reset(self._state[:, k.ix], self._state[:, k.iy], mask)
+                s.psi_m[i], s.r_m[i] = p_i[0], r_i[0]
+        self._tracker.reset(s.x[:, k.ix], s.x[:, k.iy], mask)
 
     def _install_trial(self, i: int) -> None:
         """Env i's next trial, drawn from its generator (the single env's reset): its
@@ -311,12 +234,54 @@ class ShipPathFollowVectorEnv(VectorEnv):
         rng = self._rngs[i]
         trial = apply_trial(self.scenario, draw_trial(self._randomization, rng))
         self.trials[i] = trial
-        self._state[i] = trial.initial_state()
+        self._state.x[i] = trial.initial_state()
         self._p_block[i] = trial.schedule.vector_at(0.0)
         start, end = _event_bounds([trial])
         self._event_start[i], self._event_end[i] = start[0], end[0]
         dist = self._row_disturbances[i] = core.scenario_disturbances(trial)
         self._w_block[i] = dist.constant_row()
+
+    def _command(
+        self, a: np.ndarray, s: core.EnvState, live: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The period's rudder commands [rad] and PID integrals (core.transition's command)."""
+        return core.rudder_command(a, s, self._tracker.frame, self._parts, ARRAY)
+
+    def _plant(self, s: core.EnvState, delta_c: np.ndarray, live: np.ndarray) -> np.ndarray:
+        """The period's true parameters and disturbances of the ``live`` envs, then the
+        plant of all: the integrator's (N, n_sub, n_x) buffer (core.transition's plant)."""
+        t0 = s.t
+        self._refresh_parameters(t0, live)
+        # disturbances: noise per env (its generator, the single env's order), the
+        # processes over all advancing ships at once
+        if self._disturbances.time_varying and np.any(live):
+            rows = np.flatnonzero(live)
+            if self._row_disturbances is not None:  # each env's trial has its own current
+                for i in rows.tolist():
+                    self._row_disturbances[i].fill_one(
+                        self._w_block[i], float(t0[i]), self._rngs[i]
+                    )
+            else:
+                dist = self._disturbances
+                noise = [dist.draw(self._rngs[i]) for i in rows] if dist.n_noise else None
+                dist.fill(self._w_block, t0[rows], None if noise is None else np.stack(noise), rows)
+        return self._integrator.substep_states(s.x, delta_c, self._w_block, self._p_block)
+
+    def _measure(
+        self, trajectory: np.ndarray, s: core.EnvState, new: core.EnvState, advance: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Noisy sensors of the ``advance`` envs, each with its generator in the single
+        env's order (core.transition's measure)."""
+        if self._ideal:
+            return new.psi_m, new.r_m
+        k = self._k
+        psi, r = new.psi_m.copy(), new.r_m.copy()
+        for i in np.flatnonzero(advance):
+            p_i, r_i = self._sensors[i].measure(
+                trajectory[i, :, k.ipsi], trajectory[i, :, k.ir], self._rngs[i]
+            )
+            psi[i], r[i] = p_i[-1], r_i[-1]
+        return psi, r
 
     def _refresh_parameters(self, t0: np.ndarray, live: np.ndarray) -> None:
         """Parameter rows of the period [t0, t0 + Ts] per env (core.refresh_parameters);
@@ -340,29 +305,29 @@ class ShipPathFollowVectorEnv(VectorEnv):
             )
 
     def _observation(self) -> np.ndarray:
-        k = self._k
+        k, s = self._k, self._state
         obs = core.batch_observation(
             self._tracker.frame,
-            self._psi_m,
-            self._r_m,
-            self._state[:, k.idelta],
-            self._delta_c,
-            self._speed,
+            s.psi_m,
+            s.r_m,
+            s.x[:, k.idelta],
+            s.delta_c,
+            s.speed,
             k,
             self._parts.context_row if self.context_features else None,
         )
         return obs if self._history is None else self._history.append(obs)
 
     def _info(self) -> dict[str, Any]:
-        k = self._k
+        k, s = self._k, self._state
         values = core.info_values(
-            self._t,
+            s.t,
             self._tracker.frame,
-            self._psi_m,
-            self._r_m,
-            self._state[:, k.idelta],
-            self._delta_c,
-            self._state[:, [k.ix, k.iy]],
+            s.psi_m,
+            s.r_m,
+            s.x[:, k.idelta],
+            s.delta_c,
+            s.x[:, [k.ix, k.iy]],
         )
         info: dict[str, Any] = {}
         every = np.ones(self.num_envs, dtype=bool)
@@ -380,7 +345,7 @@ class ShipPathFollowVectorEnv(VectorEnv):
         return stacked
 
     def _episode_metrics(self, i: int, reached: bool) -> dict[str, Any]:
-        n = int(self._steps[i])
+        n = int(self._state.steps[i])
         columns = {name: self._log[j, i, :n].copy() for j, name in enumerate(LOG_FIELDS)}
         log = core.episode_log(columns, self.trials[i], reached)
         return compute_metrics(log, self._parts.metric_settings)

@@ -54,6 +54,26 @@ def test_where_any_and_index_helpers_agree() -> None:
     np.testing.assert_array_equal(got, want)
 
 
+def test_state_column_helpers_agree() -> None:
+    rows = RNG.normal(0.0, 1.0, (40, 5))
+    rows[3, 2] = np.nan
+    cond = X[:40] > 0
+    for j in range(5):
+        column = ARRAY.column(rows, j)
+        assert not np.shares_memory(column, rows)
+        np.testing.assert_array_equal(column, [SCALAR.column(row, j) for row in rows])
+    got = ARRAY.columns(rows, (4, 0))
+    np.testing.assert_array_equal(
+        got, [[SCALAR.columns(r, (4, 0))[i] for r in rows] for i in (0, 1)]
+    )
+    np.testing.assert_array_equal(
+        ARRAY.where_rows(cond, rows, -rows),
+        [SCALAR.where_rows(bool(c), r, -r) for c, r in zip(cond, rows, strict=True)],
+    )
+    assert ARRAY.all_finite(rows).tolist() == [SCALAR.all_finite(r) for r in rows]
+    assert ARRAY.all(cond) == SCALAR.all(bool(cond.all()))
+
+
 def test_wrap_angle_is_the_identity_on_its_range_and_agrees_for_floats_and_arrays() -> None:
     inside = RNG.uniform(-math.pi, math.pi, 1000)
     np.testing.assert_array_equal(wrap_angle(inside), inside)

@@ -24,14 +24,14 @@ def test_open_loop_prediction_equals_the_simulator() -> None:
     env = gym.make("ShipPathFollow-v0", scenario="nominal")
     env.reset(seed=0)
     inner = env.unwrapped
-    x0 = inner._state.copy()
+    x0 = inner._state.x.copy()
     fractions = np.array([0.25, -0.125, 0.75, 0.0, -1.0, 0.5, 0.125, -0.375], dtype=np.float32)
     plan = fractions.astype(float) * 30 * DEG  # exactly what the float32 action becomes
     p = solver.parameters(x0, (1.0, 1.0), 0.0, 2.85, params.to_vector())
     predicted = solver.predict(plan, p)
     for i in range(settings.horizon):
         env.step(fractions[min(i, 7)][None])
-        np.testing.assert_allclose(predicted[i], inner._state, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(predicted[i], inner._state.x, rtol=0, atol=1e-9)
 
 
 def test_default_prediction_is_close_to_the_simulator() -> None:

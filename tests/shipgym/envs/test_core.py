@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from shipgym.envs import core
+from shipgym.envs.path_follow import ShipPathFollowEnv
+from shipgym.envs.vector import ShipPathFollowVectorEnv
 from shipgym.numerics import ARRAY, SCALAR
 from shipgym.scenarios.loader import load_scenario
 from shipgym.tracking import TrackFrame
@@ -72,3 +75,30 @@ def test_observation_columns_are_the_documented_scalings() -> None:
     assert (obs[4], obs[5]) == (0.1 / K.rudder_limit, -0.2 / K.rudder_limit)
     assert obs[6] == 1.1 / K.nominal_speed
     assert obs[7] == 0.5 and obs[8] == pytest.approx(0.5)
+
+
+def test_transition_returns_a_new_state_and_never_writes_the_one_it_is_given() -> None:
+    """One control period is a function of the state: the envs' old states stay as they
+    were (noisy sensors, whose measurements are written per row, included)."""
+    single = ShipPathFollowEnv("maneuverability_change")
+    batched = ShipPathFollowVectorEnv(3, "maneuverability_change")
+    single.reset(seed=0)
+    batched.reset(seed=0)
+    for env, action in ((single, np.full(1, 0.5)), (batched, np.full((3, 1), 0.5))):
+        before = env._state
+        kept = {f.name: np.copy(getattr(before, f.name)) for f in dataclasses.fields(before)}
+        for _ in range(5):
+            env.step(action.astype(np.float32))
+        assert env._state is not before
+        for name, value in kept.items():
+            np.testing.assert_array_equal(getattr(before, name), value, err_msg=name)
+
+
+def test_period_reasons_of_one_ship_and_of_rows_agree() -> None:
+    ends = [(True, False, False, False), (False, True, False, False), (False, False, True, False)]
+    ends += [(False, False, False, True), (False, False, False, False)]
+    flags = np.array(ends).T
+    rows = core.Period(frame(), np.zeros(5), np.zeros(5), *flags)
+    singles = [core.Period(frame(), 0.0, 0.0, *end).reasons() for end in ends]
+    want = ["goal", "corridor", "non_finite_state", "time_limit", None]
+    assert rows.reasons().tolist() == singles == want

@@ -28,9 +28,9 @@ def test_the_truth_carries_the_parameters_acting_now_never_the_schedule() -> Non
     after = env.unwrapped.plant_truth()
     assert after.params == sc.schedule.record_at(after.t)
     assert after.params != sc.nominal_params
-    assert np.array_equal(after.state, env.unwrapped._state)
+    assert np.array_equal(after.state, env.unwrapped._state.x)
     after.state[0] += 1.0  # a copy: the oracle cannot move the plant
-    assert not np.array_equal(after.state, env.unwrapped._state)
+    assert not np.array_equal(after.state, env.unwrapped._state.x)
 
 
 def test_the_truth_is_causal_it_holds_the_current_now_never_the_switch_ahead() -> None:

@@ -105,10 +105,10 @@ def test_reset_mask_and_step_before_reset() -> None:
     env.reset(seed=0)
     for _ in range(5):
         env.step(np.full((3, 1), 0.5, dtype=np.float32))
-    moved = env._state.copy()
+    moved = env._state.x.copy()
     env.reset(options={"reset_mask": np.array([False, True, False])})
-    np.testing.assert_array_equal(env._state[[0, 2]], moved[[0, 2]])
-    np.testing.assert_array_equal(env._state[1], env.scenario.initial_state())
+    np.testing.assert_array_equal(env._state.x[[0, 2]], moved[[0, 2]])
+    np.testing.assert_array_equal(env._state.x[1], env.scenario.initial_state())
 
 
 def test_make_vec_uses_the_batched_env_and_rejects_bad_actions() -> None:
@@ -116,12 +116,12 @@ def test_make_vec_uses_the_batched_env_and_rejects_bad_actions() -> None:
     assert isinstance(env.unwrapped, ShipPathFollowVectorEnv)
     obs, _ = env.reset(seed=0)
     assert obs.shape == (3, 9) and obs.dtype == np.float32
-    before = env.unwrapped._state.copy()
+    before = env.unwrapped._state.x.copy()
     bad = np.zeros((3, 1), dtype=np.float32)
     bad[1, 0] = np.nan
     with pytest.raises(ValueError, match=r"envs \[1\]"):
         env.step(bad)
-    np.testing.assert_array_equal(env.unwrapped._state, before)
+    np.testing.assert_array_equal(env.unwrapped._state.x, before)
 
 
 def test_sb3_adapter_trains_ppo_and_autoresets_same_step() -> None:

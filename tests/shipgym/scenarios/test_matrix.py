@@ -100,7 +100,7 @@ def test_jumps_reach_the_true_parameters_at_their_time(name: str) -> None:
     nominal = sc.nominal_params.to_vector()
     base = env.unwrapped
     while True:
-        t0 = base._t
+        t0 = base.time
         env.step(np.zeros(1, dtype=np.float32))
         block = base._p_block
         if t0 + sc.control_period <= event.time:
