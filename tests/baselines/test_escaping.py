@@ -12,7 +12,7 @@ import yaml
 from shipgym_baselines.cli import main
 from shipgym_baselines.escaping import csv_cell, md_cell, plain_text
 
-ROOT = Path(__file__).resolve().parents[3]
+ROOT = Path(__file__).resolve().parents[2]
 MATHTEXT = r"$\undefinedmacro{x}$"
 FORMULA = "=HYPERLINK(1)|x"
 

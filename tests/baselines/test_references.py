@@ -16,7 +16,13 @@ import pytest
 from shipgym.scenarios.loader import Scenario, load_scenario
 from shipgym_baselines import evaluation, references
 from shipgym_baselines.errors import RunError
-from shipgym_baselines.leaderboard.jobs import Job, announce_references, reference_work, trials
+from shipgym_baselines.leaderboard.jobs import (
+    Job,
+    announce_references,
+    reference_work,
+    trials,
+    work,
+)
 from shipgym_baselines.records.episodes import EpisodeLabel, EpisodeResult
 from shipgym_baselines.references import (
     ORACLE_CPU_S_PER_STEP,
@@ -246,7 +252,7 @@ def test_recomputed_references_are_all_announced(
     (line,) = capsys.readouterr().err.splitlines()
     assert line.startswith("shipgym: computing 2 oracle references (≈ ")
     assert "--recompute-references" in line
-    (result,) = jobs.work(jobs[0])  # run, neither read from nor stored in the cache
+    (result,) = work(jobs[0])  # run, neither read from nor stored in the cache
     assert result.metrics["cost"] == 1 + 5 / 1e5 and len(oracle.runs) == 1
     assert not user_cache_path().exists()
 

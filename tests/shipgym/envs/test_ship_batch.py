@@ -43,7 +43,7 @@ def test_per_reset_draws_equal_the_distribution_draws(ship: str) -> None:
     count = np.zeros(N, dtype=int)
     for mask in ([True, False, True], [False, True, True], None):
         for i in range(N):
-            assert env.trial_configs[i].model_dump() == want[i][count[i]][0]
+            assert env.trial_scenarios[i].config.model_dump() == want[i][count[i]][0]
         if mask is not None:  # the masked envs draw their next trial, the others keep theirs
             env.reset(options={"reset_mask": np.array(mask)})
             count += np.array(mask)
@@ -60,7 +60,7 @@ def test_each_env_runs_the_single_env_episode_of_its_trial() -> None:
         obs, _ = env.reset(seed=5)
         for i in range(N):
             single = ShipPathFollowEnv(
-                env.trial_configs[i], action_mode=mode, context_features=True
+                env.trial_scenarios[i], action_mode=mode, context_features=True
             )
             o, _ = single.reset(seed=draws[i][1])
             np.testing.assert_array_equal(obs[i], o)
