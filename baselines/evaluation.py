@@ -1123,9 +1123,9 @@ def _traj_row(info: dict[str, Any]) -> tuple[float, ...]:
 
 
 def suite_trials(scenario: Any, seeds: Sequence[int], suite: str | os.PathLike) -> list[Any]:
-    """The trial of ``scenario`` (a name, YAML path, :class:`~shipgym.scenarios.Scenario`
+    """The trial of ``scenario`` (a name, YAML path, :class:`~shipgym.scenarios.loader.Scenario`
     or settings dict) that each seed draws with ``suite``'s ``randomize`` ranges: the
-    leaderboard's own drawing (:func:`shipgym_baselines.leaderboard.trials`), so seed
+    leaderboard's own drawing (:func:`shipgym_baselines.leaderboard.jobs.trials`), so seed
     10000 + i is the leaderboard's trial i of the scenario."""
     # the suite file's reader sits beside this loop (the leaderboard's suite module imports
     # nothing above it); the drawing is the leaderboard job's: the scenario loaded by name,

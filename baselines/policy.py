@@ -4,7 +4,7 @@ the figures draw a controller: its family (the column, :data:`FAMILIES`) and its
 :data:`shipgym_baselines.controllers.BUILTINS`; a plug-in's:
 :func:`shipgym_baselines.registry.register_controller`; the learned agents':
 :data:`shipgym_baselines.learned.policy.AGENT_LOOKS`), read by
-:func:`shipgym_baselines.plots.figures.controller_family` and
+:func:`shipgym_baselines.plots.panels.controller_family` and
 :func:`shipgym_baselines.plots.style.controller_style`."""
 
 from __future__ import annotations

@@ -41,7 +41,13 @@ def grants_truth(controller: Any) -> bool:
     """True only for a built-in reference named as such (module doc): a record that is
     ``privileged``, or a name or long form that resolves to one."""
     if isinstance(controller, ControllerRecord):
-        return controller.privileged
+        # only the registry's own record of a reference: a record built by hand that says
+        # ``privileged`` (under another name, with settings, another entry point) is not
+        return (
+            controller.privileged
+            and controller.name in PRIVILEGED_NAMES
+            and controller == resolve_controller(controller.name)
+        )
     if not isinstance(controller, str | ControllerEntry):
         return False
     entry = as_entry(controller)

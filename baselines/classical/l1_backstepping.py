@@ -58,7 +58,9 @@ Behaviour (seed 0, tests/baselines/classical/test_l1_backstepping.py).  Linearis
 design model, the printed design is stable without C(s) and *unstable* with C(s) on the
 whole command on every ship, the paper's own included (Esso Osaka: K2 = 15 makes the
 yaw-rate loop cross over near 0.45 rad/s, above ω, with a phase margin of −26°; pole at
-+0.070 1/s, :func:`linearised_closed_loop_poles`).  ``l1_backstepping`` therefore settles
++0.070 1/s,
+:func:`~shipgym_baselines.classical.adaptive.loop_analysis.linearised_closed_loop_poles`).
+``l1_backstepping`` therefore settles
 into an oscillation bounded by the rudder limit (Esso Osaka, calm water: rudder ±30°,
 heading ±15°, period ≈ 33 s) instead of the smooth rudder the paper describes;
 ``adaptive_backstepping`` is stable, its saturated high-gain law switching at the control
@@ -79,7 +81,6 @@ import numpy as np
 from shipgym.angles import wrap_angle
 from shipgym.envs.context import ControllerContext
 from shipgym.guidance import tvvf_heading, tvvf_heading_derivatives
-from shipgym.identification.cubic_damping import ship_cubic_damping
 from shipgym.metrics import high_frequency_power
 from shipgym_baselines.classical.adaptive.backstepping import backstepping_rudder
 from shipgym_baselines.classical.adaptive.design_model import nominal_design_model
@@ -90,13 +91,9 @@ from shipgym_baselines.classical.drift import course_and_drift
 from shipgym_baselines.policy import check_action_mode
 from shipgym_baselines.records.chosen import tuned_settings
 
-#: the former name of :func:`shipgym.identification.cubic_damping.ship_cubic_damping`
-cubic_damping_from_zigzag = ship_cubic_damping
-
 __all__ = [
     "AdaptiveBackstepping",
     "L1Backstepping",
-    "cubic_damping_from_zigzag",
 ]
 
 

@@ -18,7 +18,8 @@ along-track rule eq. (27), |P_iP_{i+1}| − x_r < R, R = 500 m).
 
 ``lqr`` keeps the gain of the initial guess (a0, c0).  ``adaptive_lqr`` feeds the fine-step
 samples of the yaw rate and the (actual) rudder angle to the continuous least squares of
-eq. (12)–(15), (32)–(34) (:class:`shipgym.identification.ContinuousLeastSquares`, started at
+eq. (12)–(15), (32)–(34) (:class:`shipgym.identification.continuous_ls.ContinuousLeastSquares`,
+started at
 (a0, c0)) and re-solves the Riccati equation with the current estimates (certainty
 equivalence, Fig. 1).  The sliding-mode term of eq. (24) is not used: the paper's own
 experiments (§5) run the plain LQR (4) with the identified model, and eq. (24) needs bounds

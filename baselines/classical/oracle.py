@@ -917,7 +917,7 @@ class PlantNMPC:
 
 
 # its look (shipgym_baselines.controllers) colours its name in the page's tables; the scenario
-# figures draw its episode black and dashed, the reference (shipgym_baselines.plots.figures)
+# figures draw its episode black and dashed, the reference (shipgym_baselines.plots)
 class Oracle(PlantNMPC):
     """``oracle``: NMPC on the true plant now, through the privileged channel (module doc)."""
 

@@ -65,7 +65,8 @@ class Job(NamedTuple):
     its record as :func:`plan_jobs` resolved it, or a name resolved where it runs)
     on the trials of scenario ``scenario`` (its table name, :func:`suite_scenarios`; or a
     catalogue name, held-out name or YAML path loaded as such) that ``seeds``
-    draw with ``randomize`` (a :class:`TrialRandomization` as a dict; None: no trials).
+    draw with ``randomize`` (a :class:`~shipgym.scenarios.trials.TrialRandomization` as a dict;
+    None: no trials).
     ``settings``: the scenario as the run resolved it at its start (``run.json``'s), run
     as recorded whatever its file says now; None: resolved from ``scenario`` here.  The
     evaluation loop labels the job's episodes with :attr:`label`."""
@@ -269,7 +270,8 @@ def failed_episodes(job: Job, reason: str, error: str) -> list[EpisodeResult]:
 
 
 def iter_results(jobs: list[Job], backend: str, workers: int) -> Iterator[list[EpisodeResult]]:
-    """The results of ``jobs`` on ``backend`` (:data:`BACKENDS`), job by job in completion
+    """The results of ``jobs`` on ``backend`` (:data:`~shipgym_baselines.executor.BACKENDS`), job
+    by job in completion
     order (in turn, or in a pool of ``workers`` processes started with
     :func:`shipgym_baselines.signals.worker_init`; :mod:`shipgym_baselines.executor`)."""
     return map_jobs(work, jobs, backend, workers, initializer=worker_init)

@@ -89,14 +89,15 @@ def write_results(
     announce: bool = True,
 ) -> list[dict[str, Any]]:
     """Tables, ranking and figures into ``out`` from episode results and a suite as
-    ``run.json`` keeps it (:func:`suite_record`); returns the rows.  ``announce``: say so
+    ``run.json`` keeps it (:func:`~shipgym_baselines.leaderboard.jobs.suite_record`); returns the
+    rows.  ``announce``: say so
     first in one line on stderr, with the time it takes (:func:`tables_line`).
 
     ``leaderboard.{json,csv}`` (the rows), ``leaderboard.md`` (the ranking, the
     controller × scenario cost ratios, then the rows), ``generalisation.json``,
     ``aggregate.json`` (:func:`shipgym_baselines.scoring.ranking.aggregate_ranking`),
     ``scenario_scores.json`` and the figures
-    (:mod:`shipgym_baselines.plots.figures`: per scenario the small multiples of each
+    (:mod:`shipgym_baselines.plots`: per scenario the small multiples of each
     controller's median-ACE episode, per split the ranking's interval estimates and performance
     profiles) and ``leaderboard.html`` (:mod:`shipgym_baselines.page.html`: all of it on one
     page).  The ranking of each split and each figure are independent tasks, run in a

@@ -213,7 +213,7 @@ def row_keys(jobs: Iterable[Job]) -> dict[tuple[str, str], set[tuple]]:
 
 def keep_drawn(log: RunLog, rows: Mapping[tuple[str, str], set[tuple]], row: tuple) -> None:
     """Once every episode of ``row`` is recorded: keep the trajectory of the episode its
-    figure draws (:func:`shipgym_baselines.plots.figures.median_ace_episode`), remove
+    figure draws (:func:`shipgym_baselines.plots.scenarios.median_ace_episode`), remove
     the others' (all of them on a twin that is no scenario of the run: no figure draws it)."""
     keys = rows[row]
     if not keys <= log.done:

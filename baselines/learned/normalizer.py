@@ -121,7 +121,8 @@ def read_normalizer(file: Path) -> ObsNormalizer:
 
 
 def unpickle_normalizer(file: Path) -> ObsNormalizer:
-    """The statistics of a ``vecnormalize.pkl``: refused (:class:`UnsafeFileError`) unless
+    """The statistics of a ``vecnormalize.pkl``: refused
+    (:class:`~shipgym_baselines.errors.UnsafeFileError`) unless
     the command trusts pickles; an unreadable or foreign pickle is a clear error."""
     if not pickle_trusted():
         raise refuse_unpickling(

@@ -1,5 +1,6 @@
 """The page's sortable tables: escaped text, cells with their intervals and sort keys,
-the controllers' swatches, the table's HTML and its packed body (:mod:`.page`)."""
+the controllers' swatches, the table's HTML and its packed body
+(:mod:`~shipgym_baselines.page.html`)."""
 
 from __future__ import annotations
 

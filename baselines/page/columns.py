@@ -4,7 +4,8 @@ and when the column is there at all.
 
 :data:`RANKING_COLUMNS` holds them in the page's order; :data:`MARKDOWN_ORDER` names them
 in ``leaderboard.md``'s.  Each output formats a cell by its :attr:`RankingColumn.cell`
-(:mod:`.markdown`: value and interval on one line; :mod:`.page`: the interval below).
+(:mod:`.markdown`: value and interval on one line; :mod:`~shipgym_baselines.page.html`: the
+interval below).
 """
 
 from __future__ import annotations

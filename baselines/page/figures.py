@@ -1,7 +1,7 @@
 """The page's figures: the ranking figures embedded as data URIs (a light WebP or PNG, else
 the SVG), the scenario figures linked as the files beside the page (:data:`LINKED_KINDS`),
 a scenario figure's legends as text below it, the ranking and the scenario figures'
-sections (:mod:`.page`)."""
+sections (:mod:`~shipgym_baselines.page.html`)."""
 
 from __future__ import annotations
 
@@ -23,14 +23,14 @@ from shipgym_baselines.privileged import ORACLE, ORACLE_FROZEN
 
 def anchor(name: str) -> str:
     """The id of a scenario's figure (the stem
-    :func:`shipgym_baselines.plots.figures.plot_scenario` gives
+    :func:`shipgym_baselines.plots.scenarios.plot_scenario` gives
     its files)."""
     return "scenario_" + figure_stem(name)
 
 
 class PageImage(NamedTuple):
     """A figure as the page embeds it: MIME type, bytes, and the legends it carries as text
-    (a scenario figure's :data:`~shipgym_baselines.plots.figures.LEGEND_KEY`; None: in the
+    (a scenario figure's :data:`~shipgym_baselines.plots.files.LEGEND_KEY`; None: in the
     image)."""
 
     mime: str
@@ -56,7 +56,7 @@ def page_image(png: Path) -> PageImage:
     (a palette figure: ≈ 20 % smaller; every current browser shows WebP; effort 4 of 6:
     0.1 s a figure, 2 % larger than 6 at 60 times its CPU), else the PNG as it is.  A
     scenario figure whose PNG says where its legends start
-    (:data:`~shipgym_baselines.plots.figures.LEGEND_TOP_KEY`) is cut above them and its
+    (:data:`~shipgym_baselines.plots.files.LEGEND_TOP_KEY`) is cut above them and its
     legends returned as text (the page writes them under the image)."""
     data = png.read_bytes()
     from PIL import Image, features
@@ -115,7 +115,7 @@ def embedded_figures(
     figures: Iterable[str | Path], folder: str | Path | None = None
 ) -> dict[str, _Embedded]:
     """stem → (data URI, file name, legends) of each figure, the PNG where a stem has one (a
-    page-sized palette PNG, :func:`shipgym_baselines.plots.figures.write_page_png`, embedded
+    page-sized palette PNG, :func:`shipgym_baselines.plots.files.write_page_png`, embedded
     as :func:`page_image` gives it: the page stays light), else the SVG; in the
     order of ``figures``.  ``folder``: the page's; a scenario figure's PNG is then linked
     by its path from there (:func:`_linked`) instead of embedded."""

@@ -12,9 +12,9 @@ holds, in order:
    rate, the nominal ratio and the change share, 95 % intervals; a split's partial table
    below it; every ``aggregate.json`` field in a collapsed long table), the resolution of
    each split, the headroom per ship × change family (what knowing the change is worth:
-   C_frozen / C_oracle, :func:`shipgym_baselines.scoring.ranking.headroom_table`), the
+   C_frozen / C_oracle, :func:`shipgym_baselines.scoring.headroom.headroom_table`), the
    change share per ship × change family of the top competitors and the figures
-   (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.plots.figures`);
+   (``ranking_*`` / ``profile_*`` of :mod:`shipgym_baselines.plots`);
 2. the **controller × scenario table**: the oracle's mean cost, then each controller's
    geometric-mean cost ratio with its interval (``scenario_scores.json``,
    :func:`shipgym_baselines.scoring.ranking.scenario_scores`), shaded from 1 (the oracle, green)
@@ -162,12 +162,12 @@ class PageContent:
     """What the page shows: ``rows`` as in ``leaderboard.json``, ``aggregate`` as in
     ``aggregate.json``, ``scores`` from
     :func:`shipgym_baselines.scoring.ranking.scenario_scores`, ``figures`` the PNG/SVG files
-    of :mod:`shipgym_baselines.plots.figures`; ``subtitle``: a line under the title (e.g. the
+    of :mod:`shipgym_baselines.plots`; ``subtitle``: a line under the title (e.g. the
     suite and seeds); ``verdict``: the run's sentences
     (:mod:`shipgym_baselines.page.verdict`), the page's first paragraph; ``note``: what the
     run is ranked against (:func:`~shipgym_baselines.scoring.comparison.comparison_note`),
     under it; ``headroom``: the headroom table's rows
-    (:func:`~shipgym_baselines.scoring.ranking.headroom_table`), after the ranking;
+    (:func:`~shipgym_baselines.scoring.headroom.headroom_table`), after the ranking;
     ``shares``: the change share per ship × change family
     (:func:`~shipgym_baselines.leaderboard.outputs.share_table`), after the headroom."""
 

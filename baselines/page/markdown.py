@@ -20,7 +20,6 @@ from shipgym_baselines.privileged import ORACLE
 from shipgym_baselines.scoring.change_share import (
     CHANGE_SHARE_EXPLAINED,
     NOMINAL,
-    SHARE,
     SHARE_GRID_EXPLAINED,
 )
 from shipgym_baselines.scoring.headroom import HEADROOM_EXPLAINED, headroom_grid
@@ -81,10 +80,6 @@ def ranking_tables(board: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
-#: the ranking tables' columns against the changing trials' twins
-TWIN_HEADERS = tuple(str(c.markdown) for c in markdown_columns() if c.key in (NOMINAL, SHARE))
-
-
 def _ranking_cell(column: RankingColumn, row: Mapping[str, Any], rank: int) -> str:
     """A ranking row's cell in ``column``: the value and its interval on one line (the
     count of trials after it where the column has one), "–" where there is none."""
@@ -115,7 +110,7 @@ def ranking_markdown(
     controller × scenario table of cost ratios; ``episodes``: the ranked ones (to name the
     scenarios without the oracle's); ``note``: what the run is ranked against
     (:func:`~shipgym_baselines.scoring.comparison.comparison_note`), under the score's
-    sentences; ``headroom``: :func:`~shipgym_baselines.scoring.ranking.headroom_table`'s
+    sentences; ``headroom``: :func:`~shipgym_baselines.scoring.headroom.headroom_table`'s
     rows; ``shares``: the change share per ship × change family
     (:func:`~shipgym_baselines.leaderboard.outputs.share_table`)."""
     lead = verdict(board, episodes, headroom=headroom)
@@ -143,7 +138,7 @@ def ranking_markdown(
 
 
 def headroom_markdown(headroom: Sequence[Mapping[str, Any]]) -> list[str]:
-    """The headroom table (:func:`~shipgym_baselines.scoring.ranking.headroom_table` rows): a
+    """The headroom table (:func:`~shipgym_baselines.scoring.headroom.headroom_table` rows): a
     row per ship, a column per change family, each cell the geometric mean of C_frozen / C_oracle
     and its trials; no lines without rows."""
     if not headroom:

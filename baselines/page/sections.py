@@ -1,5 +1,6 @@
 """The page's tables: the ranking per split, the controller × scenario cost ratios, the
-headroom per ship × change family and the long per-row table (:mod:`.page`)."""
+headroom per ship × change family and the long per-row table
+(:mod:`~shipgym_baselines.page.html`)."""
 
 from __future__ import annotations
 
@@ -92,7 +93,8 @@ def _ranking_table(
 
 
 def _sort_kind(column: RankingColumn) -> str:
-    """How the page sorts a ranking column (:func:`_head`): text, or numbers (``lower``:
+    """How the page sorts a ranking column (:func:`~shipgym_baselines.page.cells._head`): text, or
+    numbers (``lower``:
     ascending on the first click)."""
     if column.cell in ("name", "text"):
         return "text"
@@ -196,7 +198,7 @@ def _oracle_cost(entry: Mapping[str, Any] | None) -> str:
 
 
 def headroom_html(headroom: Sequence[Mapping[str, Any]]) -> str:
-    """The headroom table (:func:`shipgym_baselines.scoring.ranking.headroom_table` rows): one
+    """The headroom table (:func:`shipgym_baselines.scoring.headroom.headroom_table` rows): one
     row per ship, one column per change family, each cell the geometric mean of C_frozen / C_oracle
     over its trials (how many beside it); empty without rows."""
     if not headroom:

@@ -18,7 +18,8 @@ truth frozen at the episode's start):
 3. **What knowing the change is worth**: the geometric mean of C_frozen / C_oracle over the
    table's trials, and its range over ship × change family.
 4. **Who copes with the change**: the change share of the leader and of the best learned
-   agent (:mod:`.change_share`; their gap closed when the run has no twins).
+   agent (:mod:`~shipgym_baselines.scoring.change_share`; their gap closed when the run has no
+   twins).
 
 No ranking (no ``aggregate.json`` rows): no verdict.
 """
@@ -164,7 +165,8 @@ def failure_clause(
     episodes: Sequence[Mapping[str, Any]],
     code: Callable[[str], str],
 ) -> str:
-    """The median failure rate of ``table``'s rows (:data:`FAILED_EPISODES`) and the
+    """The median failure rate of ``table``'s rows
+    (:data:`~shipgym_baselines.scoring.scores.FAILED_EPISODES`) and the
     scenario of the table with most of their failed episodes (from ``episodes``)."""
     rates = [r["failure_rate"] for r in table]
     median = statistics.median(rates)
@@ -306,7 +308,7 @@ def folder_verdict(folder: str | os.PathLike, code: Callable[[str], str] = md_co
 
 def recorded_verdict(markdown: Path) -> str | None:
     """The paragraph after ``leaderboard.md``'s title when it is not a heading (the verdict
-    :func:`shipgym_baselines.scoring.ranking_markdown` writes there); None without one."""
+    :func:`shipgym_baselines.page.markdown.ranking_markdown` writes there); None without one."""
     if not markdown.is_file():
         return None
     blocks = markdown.read_text(encoding="utf-8").split("\n\n")

@@ -350,7 +350,7 @@ def _scenario_title(
 
 def scenario_geometry(scenario: Any, points: int = 400) -> dict[str, Any]:
     """``change_time`` [s], ``path_xy`` (``points`` × 2) [m] and ``ship_length`` [m] of a
-    :class:`~shipgym.scenarios.Scenario`: the keyword arguments of :func:`plot_scenario`."""
+    :class:`~shipgym.scenarios.loader.Scenario`: the keyword arguments of :func:`plot_scenario`."""
     path = scenario.path
     return {
         "change_time": scenario.change_time,
@@ -369,7 +369,7 @@ def plot_scenarios(
 ) -> list[Path]:
     """:func:`plot_scenario` for every scenario of ``drawn`` ((scenario, controller) →
     episode), in sorted order; ``scenarios``: name → what
-    :func:`shipgym.scenarios.load_scenario` takes (``run.json``'s settings; default: the
+    :func:`shipgym.scenarios.loader.load_scenario` takes (``run.json``'s settings; default: the
     name).  Returns every written file."""
     from shipgym.scenarios.loader import load_scenario
 

@@ -36,7 +36,7 @@ from shipgym_baselines.records.episodes import (
 #: the folder of a run's kept trajectories
 TRAJECTORY_DIR = "trajectories"
 
-#: the arrays a scenario figure draws (:func:`shipgym_baselines.plots.figures.plot_scenario`),
+#: the arrays a scenario figure draws (:func:`shipgym_baselines.plots.scenarios.plot_scenario`),
 #: the only ones a run folder keeps of a trajectory: time [s], position [m], cross-track error
 #: [m], rudder angle [rad]
 DRAWN_KEYS = ("t", "x", "y", "cross_track_error", "rudder_angle")

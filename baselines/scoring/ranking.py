@@ -14,7 +14,7 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   (evaluation seed): C / C_oracle, 1 = as good as the oracle, lower is better
   (:func:`scored_episodes`).  An episode *fails* when it ends outside the corridor, with a
   non-finite state or by its controller's error or timeout (``termination_reason``,
-  :data:`FAILURE_REASONS`), or its cost is not finite.
+  :data:`~shipgym_baselines.scoring.scores.FAILURE_REASONS`), or its cost is not finite.
 * **Aggregate ranking** per controller and split (catalogue / held-out / in-range / yours),
   over the scenarios of the split that have the oracle's episodes: the interquartile mean
   (IQM) and the geometric mean of the cost ratios, the probability of improvement over ``pid_los``
@@ -30,17 +30,19 @@ After Agarwal et al. (2021), "Deep RL at the edge of the statistical precipice" 
   runs with ratio > τ) comes from ``rliable`` too (:func:`performance_profiles`).
 * **What adaptation is worth**: the second reference ``oracle_frozen`` is the same NMPC
   with its truth frozen at the episode's start (the optimum that never adapts).  Per trial,
-  ``headroom`` = C_frozen / C_oracle (:func:`trial_headroom`): what knowing the change is
+  ``headroom`` = C_frozen / C_oracle (:func:`~shipgym_baselines.scoring.headroom.trial_headroom`):
+  what knowing the change is
   worth.  Per controller and split (:func:`ranking_row`, the same bootstrap as the rest):
   the geometric mean of C_frozen / C (``cost_vs_frozen_gmean``: > 1, better than never
   adapting), P(C < C_frozen) + ½ P(C = C_frozen) over the trials
   (``prob_beats_frozen``) and the IQM of the gap closed, log(C_frozen / C) /
   log(C_frozen / C_oracle), over the trials whose headroom is at least
-  :data:`GAP_HEADROOM` (``gap_closed_iqm``: 0 = no better than never adapting, 1 = the
+  :data:`~shipgym_baselines.scoring.headroom.GAP_HEADROOM` (``gap_closed_iqm``: 0 = no better than
+  never adapting, 1 = the
   oracle; ``gap_trials`` of them).  The gap's run matrix holds NaN on the trials that do
   not qualify and its IQM is over the finite entries, so each bootstrap sample redraws
   the qualifying trials with the rest (the interval is None if one sample draws none).
-  :func:`headroom_table`: the headroom per ship × change family.
+  :func:`~shipgym_baselines.scoring.headroom.headroom_table`: the headroom per ship × change family.
 * **Steering and adapting, apart** (:mod:`.change_share`): with each changing trial's
   no-change twin, the nominal ratio C(twin) / C_oracle(twin) (``nominal_cost_ratio_gmean``)
   and the change share (``change_share_iqm``) of each row, same bootstrap.

@@ -1,7 +1,7 @@
 """Where a leaderboard run's CPU time goes: per controller, per ship and per control step.
 
 :func:`profile_suite` runs a suite's jobs as the leaderboard does
-(:func:`shipgym_baselines.leaderboard.work`, one process, a few evaluation seeds, a learned
+(:func:`shipgym_baselines.leaderboard.jobs.work`, one process, a few evaluation seeds, a learned
 agent's first training seed only) and measures each job's CPU seconds
 (:func:`time.process_time`: not inflated by other work on the machine) and, inside them,
 the CPU seconds of the controller's ``act`` calls (:func:`shipgym_baselines.evaluation.act_clock`);

@@ -171,7 +171,7 @@ def hyperparameter_names(algo: str) -> list[str] | None:
     """The keyword arguments of the algorithm's SB3 constructor that ``hyperparams`` may set
     (its signature, less :data:`TRAINER_ARGUMENTS` and private ones), sorted; None when the
     algorithm is unknown or stable-baselines3 is not installed; for ``dagger`` the DAgger
-    settings (:class:`~shipgym_baselines.training.dagger_agent.DaggerHyperparams`)."""
+    settings (:class:`~shipgym_baselines.learned.dagger_config.DaggerHyperparams`)."""
     if algo == "dagger":
         from shipgym_baselines.learned.dagger_config import hyperparameter_names as dagger_names
 

@@ -12,7 +12,8 @@ The config's blocks (``configs/agents/dagger.yaml``):
 =================  ==========================================================================
 block              for ``algo: dagger``
 =================  ==========================================================================
-``hyperparams``    the DAgger settings (:class:`DaggerHyperparams`): ``rounds``,
+``hyperparams``    the DAgger settings
+(:class:`~shipgym_baselines.learned.dagger_config.DaggerHyperparams`): ``rounds``,
                    ``episodes_per_round``, ``beta_schedule``, ``beta_decay``, ``epochs``,
                    ``batch_size``, ``learning_rate``, ``warm_start``, and ``workers`` (label
                    processes; the data do not depend on it)
@@ -27,7 +28,8 @@ block              for ``algo: dagger``
 
 The env's ``n_envs``, ``vec_env``, ``normalize_reward`` do not apply: every rollout is one
 single env in the rollout's own process.  Training seed k draws its rollouts' env seeds
-from ``k ×`` :data:`ENV_SEED_STRIDE` on (disjoint between seeds while a run has fewer
+from ``k ×`` :data:`~shipgym_baselines.learned.dagger_config.ENV_SEED_STRIDE` on (disjoint between
+seeds while a run has fewer
 rollouts than that).
 
 Agent folder (``results/agents/<name>``; what every agent writes, plus ``dagger/``)::

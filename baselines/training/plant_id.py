@@ -3,14 +3,17 @@
 ``python -m shipgym_baselines.training.plant_id --seed K --out DIR [--resume]``
 
 1. **Data**: episodes on the training distribution (``configs/distributions/train.yaml``,
-   every trained ship), each step's features (:mod:`.features`) with its label read from
+   every trained ship), each step's features (:mod:`shipgym_baselines.learned.plant_id.features`)
+   with its label read from
    the truth through the training-time teacher channel
-   (:func:`shipgym_baselines.privileged.teacher_truth`; :mod:`.labels`).  Round 0 is
+   (:func:`shipgym_baselines.privileged.teacher_truth`;
+   :mod:`shipgym_baselines.learned.plant_id.labels`).  Round 0 is
    steered by the behaviour controller ``pid_los``; every later round by
    ``nmpc_learned_id`` itself with the previous round's φ (DAgger on the estimate, Ross,
    Gordon & Bagnell 2011: the estimator learns on the states its own closed loop visits).
    The labels cost nothing but simulation.
-2. **Fit**: φ on every round's data so far (the Gaussian NLL of :mod:`.network`), warm
+2. **Fit**: φ on every round's data so far (the Gaussian NLL of
+:mod:`shipgym_baselines.learned.plant_id.network`), warm
    started from the previous round, Adam, one thread.
 3. **Error curve**: after each round, φ's RMSE per slot on the validation trials' windows
    (``validation:0`` … ``:31``, steered by ``pid_los``; never the held-out split or the
@@ -125,7 +128,7 @@ def round_jobs(seed: int, round_: int, episodes: int, folder: str | None) -> lis
 
 def windows(data: dict[str, np.ndarray], index: np.ndarray) -> np.ndarray:
     """(B, WINDOW·F + C) the windows ending at rows ``index`` (zeros before each episode's
-    start, as :class:`~.features.Window` holds them)."""
+    start, as :class:`~shipgym_baselines.learned.plant_id.features.Window` holds them)."""
     step_of = np.searchsorted(data["starts"], index, side="right") - 1
     first = data["starts"][step_of]
     rows = index[:, None] - (WINDOW - 1) + np.arange(WINDOW)[None, :]
@@ -218,7 +221,7 @@ def train(
 ) -> dict[str, Any]:
     """The rounds of module doc, in the run folder ``out`` (module doc); returns the meta
     written to ``out/estimator/meta.json``.  A folder that is not empty is refused unless
-    ``resume`` (:class:`RunError`, one line)."""
+    ``resume`` (:class:`~shipgym_baselines.errors.RunError`, one line)."""
     check_out_usable(out, resume=resume)
     with out_lock(out, now()):
         check_no_links(out)

@@ -19,6 +19,7 @@ never a ``test_only`` split (the held-out and in-range ones the leaderboard rank
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,7 @@ from shipgym_baselines.evaluation import EVAL_SEED_OFFSET
 from shipgym_baselines.privileged import ORACLE
 from shipgym_baselines.registry import BASELINE
 from shipgym_baselines.scoring.intervals import geometric_mean
-from shipgym_baselines.scoring.scores import objective_ratio
+from shipgym_baselines.scoring.scores import cost_ratio
 
 #: the fallback reference where the oracle's table has no entry for a trial
 FALLBACK_REFERENCE = BASELINE
@@ -62,12 +63,15 @@ def validation_trials(
 
 
 def geometric_mean_ratio(costs: Sequence[float], references: Sequence[float]) -> float:
-    """exp(mean log(C / C_ref)) over trials: the geometric mean of their
-    :func:`~shipgym_baselines.scoring.scores.objective_ratio` (the leaderboard's cost ratio;
-    a cost that is not finite counts as :data:`~shipgym_baselines.scoring.scores.FAILED_RATIO`)."""
+    """exp(mean log(C / C_ref)) over trials: the geometric mean of the leaderboard's cost
+    ratios (:func:`~shipgym_baselines.scoring.scores.cost_ratio`); inf where a trial has no
+    ratio (a diverged episode), so that a checkpoint with one is never selected."""
     if len(costs) != len(references) or not costs:
         raise ValueError("need one reference cost per cost, and at least one")
-    return geometric_mean([objective_ratio(c, r) for c, r in zip(costs, references, strict=True)])
+    ratios = [cost_ratio(c, r) for c, r in zip(costs, references, strict=True)]
+    if any(r is None for r in ratios):
+        return math.inf
+    return geometric_mean(ratios)
 
 
 def reference_cost(scenario_name: str, seed: int, action_mode: str = "rudder") -> dict[str, Any]:

@@ -417,7 +417,7 @@ def _run_locked(
     force: bool,
 ) -> dict[str, Any]:
     """:func:`run_study` once the study's folder is locked; its start-up line
-    (:func:`~shipgym_baselines.tuning.estimate.start_line`) once the study opened."""
+    (:func:`~shipgym_baselines.tuning.study.start_line`) once the study opened."""
     study = open_study(plan, resume)
     say(progress, start_line(plan, total))
     scorer = Scorer(plan, progress)

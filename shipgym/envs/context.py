@@ -48,7 +48,7 @@ class ControllerContext:
     def of(cls, scenario: Scenario, action_mode: str) -> ControllerContext:
         """The context of ``scenario`` (its nominal model, path and timing).  A nominal ship
         that gives no first-order Nomoto model (what model-based controllers design on) is
-        a :class:`~shipgym.scenarios.ScenarioError` naming the key, as validation reports
+        a :class:`~shipgym.scenarios.loader.ScenarioError` naming the key, as validation reports
         it (:func:`~shipgym.scenarios.loader.nominal_nomoto`; cached per ship)."""
         sc = scenario
         nominal_nomoto(sc)

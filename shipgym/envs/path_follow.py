@@ -199,7 +199,7 @@ class ShipPathFollowEnv(gym.Env):
     randomize=True)``
 
     * ``scenario``: a catalogue name (``shipgym scenarios``), a held-out test scenario
-      (``"heldout:3"``), a path to a YAML file or a :class:`shipgym.scenarios.Scenario`;
+      (``"heldout:3"``), a path to a YAML file or a :class:`shipgym.scenarios.loader.Scenario`;
       default: the id's scenario.
     * ``action_mode``: ``"rudder"`` or ``"guidance"``.
     * ``render_mode``: None, ``"rgb_array"`` or ``"human"``.

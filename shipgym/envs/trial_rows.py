@@ -1,6 +1,6 @@
 """The row machinery of the batched trial envs: N single-env episodes as the rows of arrays.
 
-Each row runs one trial (its own :class:`~shipgym.scenarios.Scenario`, route, parameter
+Each row runs one trial (its own :class:`~shipgym.scenarios.loader.Scenario`, route, parameter
 schedule, disturbance processes, sensors and episode generator); the plant of all rows is
 one call of the ship's compiled period function (the true parameters and disturbances are
 per-row inputs), reward, observation and termination are the step core's functions

@@ -352,7 +352,7 @@ class ShipModel(ABC):
         """The 2nd-order Nomoto model (K [1/s], T1, T2, T3 [s]) in closed form, or None.
 
         None (the default): the model has none, and
-        :func:`shipgym.identification.second_order_nomoto` identifies it from the ship's
+        :func:`shipgym.identification.nominal.second_order_nomoto` identifies it from the ship's
         20/20 zig-zag instead.
         """
         return None

@@ -3,7 +3,8 @@ builds it.
 
 Guidance mode's heading autopilot and every model-based controller design on the first-order
 Nomoto model (K, T) of the scenario's *nominal* ship: a closed form (nomoto2), or the fit to
-the ship's own 20/20 zig-zag (:func:`shipgym.identification.first_order_nomoto`).  A ship the
+the ship's own 20/20 zig-zag (:func:`shipgym.identification.nominal.first_order_nomoto`).  A ship
+the
 schema accepts can still fail there — a rudder limit below the zig-zag's 20°, a simulated
 zig-zag that diverges, T = T1 + T2 − T3 ≤ 0, K ≤ 0 — so this check is what both
 ``shipgym scenarios --validate`` and the env's construction call

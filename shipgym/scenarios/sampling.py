@@ -145,7 +145,8 @@ class CurrentSampling(StrictModel):
 
 
 class WaveSampling(StrictModel):
-    """Wind-wave yaw disturbance (Pierson–Moskowitz wave filter, :class:`WaveConfig`) with
+    """Wind-wave yaw disturbance (Pierson–Moskowitz wave filter,
+    :class:`~shipgym.disturbance_config.WaveConfig`) with
     ``probability``; ``wind_speed`` [m/s] uniform in its range, ``gain`` in the model's
     yaw_disturbance unit per metre of filter output."""
 

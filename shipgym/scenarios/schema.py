@@ -53,7 +53,7 @@ class ShipConfig(StrictModel):
     @model_validator(mode="after")
     def _a_real_ship(self) -> ShipConfig:
         """A known model, variant and unit reading, and parameters a real plant can have
-        (:meth:`shipgym.models.ParameterRecord.plant`: every bad one named)."""
+        (:meth:`shipgym.models.base.ParameterRecord.plant`: every bad one named)."""
         model_cls = MODELS.get(self.model)
         if model_cls is None:
             message = f"unknown model {self.model!r}; valid: {sorted(MODELS)}"

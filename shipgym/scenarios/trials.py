@@ -122,7 +122,7 @@ def seed_trials(
 
 
 def trial_scenario(scenario: Any, randomization: TrialRandomization | None, seed: int) -> Any:
-    """The trial of ``scenario`` (a :class:`shipgym.scenarios.Scenario`) that ``seed``
+    """The trial of ``scenario`` (a :class:`shipgym.scenarios.loader.Scenario`) that ``seed``
     draws; the scenario itself without randomisation.  The name is kept (a leaderboard row
     is a scenario over its trials)."""
     if randomization is None:

@@ -43,12 +43,9 @@ LAYERS: dict[str, int] = {
     f"{B}.reference_data": 0,
     # 1 — what a run leaves on disk
     f"{B}.records": 1,
-    # 2 — controllers: what a controller is, how it enters, its privileged channel, the
-    #     references' tables, the classical controllers and the learned policies (loading
-    #     and acting)
     # 2 — controllers: what a controller is, the table of built-ins, how it enters, its
     #     privileged channel, the references' tables, the classical controllers and the
-    #     learned policies (loading and acting; their training sits in layer 4)
+    #     learned policies (loading and acting; their training sits in layer 5)
     f"{B}.policy": 2,
     f"{B}.controllers": 2,
     f"{B}.plugins": 2,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import pickle
 import subprocess
 import sys
@@ -164,6 +165,15 @@ def test_only_the_references_named_as_such_read_the_truth(scratch_registry: None
     assert not grants_truth(with_settings) and not grants_truth("pid_los")
     spec = resolve_controller("shipgym_baselines.classical.oracle:Oracle")  # the same class
     assert spec.name == ORACLE and not grants_truth(spec)
+    # a record built by hand that says privileged is not the reference's own record
+    own = resolve_controller(ORACLE)
+    for forged in (
+        dataclasses.replace(resolve_controller("pid_los"), privileged=True),
+        dataclasses.replace(own, name="my_oracle"),
+        dataclasses.replace(own, settings={"horizon": 3}),
+        dataclasses.replace(own, entry_point="shipgym_baselines.classical.pid:PIDLOS"),
+    ):
+        assert not grants_truth(forged), forged
 
 
 def test_a_record_is_resolved_once_and_crosses_a_process_pool(scratch_registry: None) -> None:

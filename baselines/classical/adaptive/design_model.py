@@ -5,7 +5,8 @@
 by η: T·ṙ + σ_η·H(r)·r = ρ_η·K·δ + b*_η.  The nominal K, T, a2 of a ship (the paper gives
 them for its ship only):
 
-* K and T from the identification pipeline, :func:`shipgym.identification.first_order_nomoto`
+* K and T from the identification pipeline,
+:func:`shipgym.identification.nominal.first_order_nomoto`
   (closed form T = T1 + T2 − T3 for nomoto2, else Nomoto's reduction of the 2nd-order model
   fitted to the ship's 20/20 zig-zag, :func:`shipgym.identification.zigzag.ship_nomoto`);
 * a2: for nomoto2 the model's own cubic-damping coefficient β (β·r³ = a2·r³ in the reduced

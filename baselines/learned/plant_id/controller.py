@@ -21,7 +21,8 @@ the adapted quantities, the current and the yaw bias (:mod:`.labels`).  At every
    ones (position, heading, yaw rate, rudder angle) from ``info``.
 
 It reads ``info`` and the controller context only: φ learned from the truth at training
-time (:mod:`.train`), never at evaluation.  The shipped estimators are the folders
+time (:mod:`~shipgym_baselines.training.plant_id`), never at evaluation.  The shipped estimators
+are the folders
 ``seeds/seed_<k>`` beside this module (``estimator.pt``, weights only, and ``meta.json``).
 """
 

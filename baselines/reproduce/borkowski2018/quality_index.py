@@ -12,7 +12,8 @@ from shipgym.tracking import PathTracker
 
 
 def cumulative_J(scenario: Any, trajectory: dict[str, np.ndarray], dt: float) -> np.ndarray:
-    """J(t) of eq. (29) along a trajectory, as :func:`compute_metrics` sums it (per step).
+    """J(t) of eq. (29) along a trajectory, as :func:`~shipgym.metrics.compute_metrics` sums it
+    (per step).
 
     Replays the env's path tracker on the logged positions; the heading is the logged
     (measured) one, equal to the true heading in this noise-free scenario.

@@ -22,7 +22,7 @@ each under ``pid_lookahead_los`` (eq. (6), Δ = 2L) and ``pid_vf`` (Algorithm 1,
 The paper's Figure 8 (the waypoints) is lost: both cases use ``osaka_curved``'s assumed
 route (20, 0), (120, 40), (220, 10), (320, 50) m and its constant current (0.03 m/s towards
 90°), the straight case the same config with ``path.type: waypoints`` (built with
-:func:`shipgym.scenarios.scenario_from_dict`, not a catalogue entry).
+:func:`shipgym.scenarios.loader.scenario_from_dict`, not a catalogue entry).
 
 Plant settings (the ``setting`` column; every row carries one):
 

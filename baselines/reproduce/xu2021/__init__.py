@@ -36,7 +36,8 @@ them.  Rows (``case, controller, metric, ours, paper``, ``seeds``, ``ours_std``)
   comparison holds when ours is at least ``CLAIM_MARGIN`` = 10 % lower (the ``ratio`` is in
   the row); "cross-track errors nearly same" is the ACE ratio against the paper's 1.0;
 * ``linearised``: the law (35) with exact estimates on its design model, linearised at
-  r = 0 (:func:`~shipgym_baselines.classical.l1_backstepping.linearised_closed_loop_poles`): the
+  r = 0 (:func:`~shipgym_baselines.classical.adaptive.loop_analysis.linearised_closed_loop_poles`):
+  the
   largest closed-loop pole real part and the loop's crossover and phase margin, against
   the paper's UGAS claim (§3–4) as "stable: True".  Continuous time: the 0.5-s sampling
   (≈ 27° more lag at 1.9 rad/s) and the rudder servo are left out.

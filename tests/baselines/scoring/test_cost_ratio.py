@@ -72,3 +72,8 @@ def test_the_tuner_and_model_selection_score_the_leaderboards_ratios(tmp_path: P
     costs = [e["cost"] for e in episodes if e["controller"] == "pid_los"]
     assert geometric_mean(tuner) == geometric_mean(board)
     assert geometric_mean_ratio(costs, oracle) == geometric_mean(board)
+
+
+def test_model_selection_never_picks_a_checkpoint_with_a_diverged_episode() -> None:
+    assert geometric_mean_ratio([2.0, 2000.0], [1.0, 1000.0]) == pytest.approx(2.0)
+    assert geometric_mean_ratio([1.0, math.inf], [1.0, 1.0]) == math.inf
